@@ -1,0 +1,21 @@
+#pragma once
+// Each subcommand lives in its own file and registers itself on the app.
+// `exitCode` is written by the subcommand's callback.
+
+#include <CLI/CLI.hpp>
+
+namespace stepwise::cli {
+
+/// Process exit codes (README "Exit codes").
+enum ExitCode : int {
+    kExitOk = 0,
+    kExitFailure = 1,    ///< an unexpected internal failure
+    kExitBadInput = 2,   ///< bad file, bad argument, unwritable output
+    kExitDiverged = 3,   ///< the simulation produced a non-finite value
+};
+
+void addValidateCommand(CLI::App& app, int& exitCode);
+void addRunCommand(CLI::App& app, int& exitCode);
+void addSchemaCommand(CLI::App& app, int& exitCode);
+
+} // namespace stepwise::cli

@@ -1,0 +1,92 @@
+#pragma once
+/// \file component_table.hpp
+/// The one table of components. Each entry names a component, lists its
+/// fields (JSON key, kind, valid range, unit) and carries type-erased
+/// registry operations. The loader, the saver, the validator, the JSON
+/// schema generator and the editor's inspector all read this table; there is
+/// no if/else chain over component names anywhere.
+
+#include "stepwise/entity.hpp"
+#include "stepwise/registry.hpp"
+
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace stepwise {
+
+/// What a field holds; decides how it is read, written, checked and edited.
+enum class FieldKind {
+    Number,          ///< double
+    OptionalNumber,  ///< std::optional<double>; absent in JSON = nullopt
+    Vector,          ///< Vec2, JSON {"x","y"}
+    OptionalVector,  ///< std::optional<Vec2>
+    Color,           ///< Rgb, JSON {"x","y","z"}, channels in 0..1
+    Bool,            ///< bool
+    String,          ///< std::string, free text
+    EntityName,      ///< std::string naming another entity; empty = absent
+};
+
+/// Inclusive/exclusive bounds for Number fields. Every number must also be
+/// finite.
+struct NumberRange {
+    double min = -std::numeric_limits<double>::infinity();
+    double max = std::numeric_limits<double>::infinity();
+    bool minExclusive = false;
+
+    bool contains(double v) const {
+        return (minExclusive ? v > min : v >= min) && v <= max;
+    }
+    /// "a number > 0", "a number in [0, 1]", "a number >= 0", "a number".
+    std::string describe() const;
+};
+
+struct FieldInfo {
+    std::string_view key;          ///< JSON key; empty for an inline component
+    FieldKind kind;
+    NumberRange range;             ///< Number and OptionalNumber only
+    std::string_view unit;         ///< "m", "kg", "m/s", "" ...
+    std::string_view description;  ///< one line, for tooltips and the schema
+    void* (*address)(void* component); ///< points at the member inside the struct
+};
+
+/// One row of the table.
+struct ComponentInfo {
+    std::string_view name;         ///< JSON key on the entity object
+    std::string_view description;
+    /// True when the component's JSON is its single field's value
+    /// (`"mass": 2`), false when it is an object of fields (`"box": {...}`).
+    bool inlineValue = false;
+    /// Other components this one is meaningless without (e.g. "position").
+    std::vector<std::string_view> requires_;
+    std::vector<FieldInfo> fields;
+
+    bool (*has)(const Registry&, Entity) = nullptr;
+    void* (*get)(Registry&, Entity) = nullptr; ///< nullptr when absent
+    const void* (*getConst)(const Registry&, Entity) = nullptr;
+    /// Adds the component with its default value (replacing any present).
+    void* (*emplaceDefault)(Registry&, Entity) = nullptr;
+    bool (*remove)(Registry&, Entity) = nullptr;
+    /// Cross-field check and normalisation after the fields are read.
+    /// Returns "" when fine, else "FIELD: message" (FIELD may be empty).
+    std::string (*finish)(void* component) = nullptr;
+};
+
+/// The table, in the order components are written to files.
+std::span<const ComponentInfo> componentTable();
+
+/// Row for `name`, or nullptr.
+const ComponentInfo* findComponent(std::string_view name);
+
+/// The known name closest to `name` by edit distance, if close enough to be
+/// a plausible typo ("did you mean").
+std::optional<std::string_view> closestName(std::string_view name,
+                                            std::span<const std::string_view> candidates);
+
+/// Every component name, in table order.
+std::vector<std::string_view> componentNames();
+
+} // namespace stepwise

@@ -1,0 +1,91 @@
+#pragma once
+/// \file components.hpp
+/// Every component a scene entity can carry. Plain structs, no behaviour:
+/// systems (forces, integrators, collision) are functions over the entities
+/// that have what they need. Names, JSON keys, defaults and validation rules
+/// live in one place, the component table (component_table.hpp).
+///
+/// A component that is absent means "not modelled": no `drag` means no drag
+/// pass over that body, no `radius`/`box`/`plane` means the body never enters
+/// the collision stages.
+
+#include "stepwise/vec2.hpp"
+
+#include <optional>
+#include <string>
+
+namespace stepwise {
+
+/// Unique label; springs name their ends by it.
+struct Name { std::string value; };
+/// Free label (the course notes' "Water Animal").
+struct Type { std::string value; };
+/// Centre of the body, metres.
+struct Position { Vec2 value; };
+/// Linear velocity, m/s.
+struct Velocity { Vec2 value; };
+/// Mass, kg (> 0). A dynamic body without it has 1 kg.
+struct Mass { double value = 1.0; };
+/// Immovable when `value` is true: infinite mass, never integrated.
+struct Static { bool value = true; };
+/// Circle shape of this radius, metres (> 0).
+struct Radius { double value = 0.5; };
+/// Box shape, full width and height in metres (> 0), rotated by `Angle`.
+struct Box { double width = 1.0; double height = 1.0; };
+/// Orientation, radians, counter-clockwise.
+struct Angle { double value = 0.0; };
+/// Angular velocity, rad/s, counter-clockwise.
+struct AngularVelocity { double value = 0.0; };
+/// Display colour.
+struct Color { Rgb value; };
+/// Coefficient of restitution in [0, 1]; a pair uses the larger value.
+/// Absent: 0 (no bounce).
+struct Restitution { double value = 0.0; };
+/// Coulomb friction coefficient (>= 0); a pair uses sqrt(f1*f2).
+/// Absent: 0.2 (Box2D's default, so stacks stand without tuning).
+struct Friction { double value = 0.2; };
+/// Viscous damping coefficient b, kg/s: force -b*v.
+struct Drag { double value = 0.0; };
+
+/// Infinite wall: bodies stay where dot(normal, p) >= offset (+ radius).
+/// `normal` is unit length after loading.
+struct Plane {
+    Vec2 normal{0.0, 1.0};
+    double offset = 0.0; ///< metres along the normal
+};
+
+/// Newtonian attractor: every other dynamic body i feels
+/// G*m_i*m_a*r/(|r|^2+eps^2)^(3/2) towards it.
+struct Attractor {
+    double softening = 0.0; ///< eps, metres; removes the singularity at r = 0
+};
+
+/// Spring-damper between entities `a` and `b` (by name), or between `a` and
+/// the fixed world point `anchor` when `b` is empty. Force on a:
+/// -(k*(len-rest_length) + damping*(closing speed)) along the unit axis.
+/// A spring entity has no body of its own.
+struct Spring {
+    std::string a;
+    std::string b;                 ///< empty when anchored
+    std::optional<Vec2> anchor;    ///< world point, metres
+    double k = 100.0;              ///< stiffness, N/m (>= 0)
+    double damping = 0.0;          ///< N*s/m along the axis (>= 0)
+    /// Natural length, metres (>= 0). Absent in a file: the distance between
+    /// the ends when the level is loaded.
+    std::optional<double> restLength;
+};
+
+/// Flocking behaviour (Reynolds 1987) as proxy forces. All weights are
+/// accelerations in m/s^2 per unit of steering; radii are metres.
+struct Boid {
+    double neighborRadius = 2.0;    ///< who counts as a neighbour
+    double separationRadius = 0.8;  ///< closer than this: push apart
+    double separation = 4.0;        ///< weight of pushing apart
+    double alignment = 1.0;         ///< weight of matching neighbours' velocity
+    double cohesion = 1.0;          ///< weight of moving to neighbours' centre
+    std::optional<Vec2> goal;       ///< seek this point when set
+    double goalWeight = 1.0;        ///< weight of seeking the goal
+    double maxSpeed = 4.0;          ///< m/s; steering never exceeds it
+};
+
+} // namespace stepwise

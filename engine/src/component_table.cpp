@@ -1,0 +1,245 @@
+// The component table: the single source of truth for component names,
+// fields, defaults and validation rules. See component_table.hpp.
+
+#include "stepwise/component_table.hpp"
+
+#include "stepwise/components.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <type_traits>
+
+namespace stepwise {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr NumberRange kAny{};
+constexpr NumberRange kPositive{0.0, kInf, true};
+constexpr NumberRange kNonNegative{0.0, kInf, false};
+constexpr NumberRange kUnit{0.0, 1.0, false};
+
+template <class>
+struct MemberTraits;
+template <class C, class M>
+struct MemberTraits<M C::*> {
+    using Class = C;
+    using Type = M;
+};
+
+template <auto Member>
+void* addressOf(void* component) {
+    using C = typename MemberTraits<decltype(Member)>::Class;
+    return &(static_cast<C*>(component)->*Member);
+}
+
+/// Field kind follows from the member's C++ type, so the table cannot say
+/// "Number" for a Vec2.
+template <class M>
+constexpr FieldKind kindOf() {
+    if constexpr (std::is_same_v<M, double>) return FieldKind::Number;
+    else if constexpr (std::is_same_v<M, std::optional<double>>) return FieldKind::OptionalNumber;
+    else if constexpr (std::is_same_v<M, Vec2>) return FieldKind::Vector;
+    else if constexpr (std::is_same_v<M, std::optional<Vec2>>) return FieldKind::OptionalVector;
+    else if constexpr (std::is_same_v<M, Rgb>) return FieldKind::Color;
+    else if constexpr (std::is_same_v<M, bool>) return FieldKind::Bool;
+    else {
+        static_assert(std::is_same_v<M, std::string>, "unsupported field type");
+        return FieldKind::String;
+    }
+}
+
+template <auto Member>
+FieldInfo field(std::string_view key, NumberRange range, std::string_view unit,
+                std::string_view description) {
+    using M = typename MemberTraits<decltype(Member)>::Type;
+    return FieldInfo{key, kindOf<M>(), range, unit, description, &addressOf<Member>};
+}
+
+template <auto Member>
+FieldInfo entityNameField(std::string_view key, std::string_view description) {
+    FieldInfo f = field<Member>(key, kAny, "", description);
+    f.kind = FieldKind::EntityName;
+    return f;
+}
+
+/// Fills the type-erased registry operations for component struct T.
+template <class T>
+ComponentInfo row(std::string_view name, std::string_view description, bool inlineValue,
+                  std::vector<std::string_view> requires_, std::vector<FieldInfo> fields,
+                  std::string (*finish)(void*) = nullptr) {
+    ComponentInfo info;
+    info.name = name;
+    info.description = description;
+    info.inlineValue = inlineValue;
+    info.requires_ = std::move(requires_);
+    info.fields = std::move(fields);
+    info.has = [](const Registry& r, Entity e) { return r.has<T>(e); };
+    info.get = [](Registry& r, Entity e) -> void* { return r.tryGet<T>(e); };
+    info.getConst = [](const Registry& r, Entity e) -> const void* { return r.tryGet<T>(e); };
+    info.emplaceDefault = [](Registry& r, Entity e) -> void* { return &r.emplace<T>(e, T{}); };
+    info.remove = [](Registry& r, Entity e) { return r.remove<T>(e); };
+    info.finish = finish;
+    return info;
+}
+
+std::string finishPlane(void* component) {
+    auto& plane = *static_cast<Plane*>(component);
+    const double len = length(plane.normal);
+    if (!(len > 1e-12)) return "normal: expected a non-zero vector, got {\"x\": 0, \"y\": 0}";
+    // The offset is measured along the normal as written (n.p >= d); keep the
+    // same half-plane after normalising n by scaling d with it.
+    plane.normal = plane.normal / len;
+    plane.offset = plane.offset / len;
+    return {};
+}
+
+std::string finishSpring(void* component) {
+    auto& spring = *static_cast<Spring*>(component);
+    if (spring.a.empty()) return "a: expected the name of an entity, got nothing";
+    if (spring.b.empty() == !spring.anchor.has_value()) {
+        return spring.b.empty() ? ": expected either \"b\" (an entity name) or \"anchor\" (a point), got neither"
+                                : ": expected either \"b\" or \"anchor\", got both";
+    }
+    if (!spring.b.empty() && spring.a == spring.b)
+        return "b: a spring cannot join \"" + spring.a + "\" to itself";
+    return {};
+}
+
+std::string finishBoid(void* component) {
+    auto& boid = *static_cast<Boid*>(component);
+    if (boid.separationRadius > boid.neighborRadius)
+        return "separation_radius: expected at most neighbor_radius (" +
+               std::to_string(boid.neighborRadius) + "), got " + std::to_string(boid.separationRadius);
+    return {};
+}
+
+std::vector<ComponentInfo> buildTable() {
+    const std::vector<std::string_view> needsPosition{"position"};
+    std::vector<ComponentInfo> t;
+    t.push_back(row<Name>("name", "unique label; springs refer to entities by it", true, {},
+                          {field<&Name::value>("", kAny, "", "unique label")}));
+    t.push_back(row<Type>("type", "free label, e.g. \"Water Animal\"", true, {},
+                          {field<&Type::value>("", kAny, "", "free label")}));
+    t.push_back(row<Position>("position", "centre of the body", true, {},
+                              {field<&Position::value>("", kAny, "m", "centre of the body")}));
+    t.push_back(row<Velocity>("velocity", "linear velocity", true, needsPosition,
+                              {field<&Velocity::value>("", kAny, "m/s", "linear velocity")}));
+    t.push_back(row<Mass>("mass", "mass of a dynamic body", true, needsPosition,
+                          {field<&Mass::value>("", kPositive, "kg", "mass of a dynamic body")}));
+    t.push_back(row<Static>("static", "immovable: infinite mass, never integrated", true, needsPosition,
+                            {field<&Static::value>("", kAny, "", "immovable when true")}));
+    t.push_back(row<Radius>("radius", "circle shape; the body collides", true, needsPosition,
+                            {field<&Radius::value>("", kPositive, "m", "circle radius")}));
+    t.push_back(row<Box>("box", "box shape, rotated by angle; the body collides", false, needsPosition,
+                         {field<&Box::width>("width", kPositive, "m", "full width"),
+                          field<&Box::height>("height", kPositive, "m", "full height")}));
+    t.push_back(row<Angle>("angle", "orientation, counter-clockwise", true, needsPosition,
+                           {field<&Angle::value>("", kAny, "rad", "orientation")}));
+    t.push_back(row<AngularVelocity>("angular_velocity", "spin, counter-clockwise", true, needsPosition,
+                                     {field<&AngularVelocity::value>("", kAny, "rad/s", "spin")}));
+    t.push_back(row<Color>("color", "display colour", true, {},
+                           {field<&Color::value>("", kUnit, "", "display colour, channels in 0..1")}));
+    t.push_back(row<Restitution>("restitution", "bounciness; a pair uses the larger value", true, needsPosition,
+                                 {field<&Restitution::value>("", kUnit, "", "coefficient of restitution")}));
+    t.push_back(row<Friction>("friction", "Coulomb coefficient; a pair uses sqrt(f1*f2)", true, needsPosition,
+                              {field<&Friction::value>("", kNonNegative, "", "Coulomb friction coefficient")}));
+    t.push_back(row<Drag>("drag", "viscous damping b: force -b*v", true, needsPosition,
+                          {field<&Drag::value>("", kNonNegative, "kg/s", "viscous damping coefficient")}));
+    t.push_back(row<Plane>("plane", "infinite wall: bodies stay where normal.p >= offset", false, {},
+                           {field<&Plane::normal>("normal", kAny, "", "outward normal; normalised on load"),
+                            field<&Plane::offset>("offset", kAny, "m", "distance of the wall along the normal")},
+                           &finishPlane));
+    t.push_back(row<Attractor>("attractor", "Newtonian gravity towards this body (uses world G)", false,
+                               needsPosition,
+                               {field<&Attractor::softening>("softening", kNonNegative, "m",
+                                                             "softening length eps")}));
+    t.push_back(row<Spring>(
+        "spring", "spring-damper between entities a and b, or a and a fixed anchor", false, {},
+        {entityNameField<&Spring::a>("a", "name of the first entity"),
+         entityNameField<&Spring::b>("b", "name of the second entity (or use anchor)"),
+         field<&Spring::anchor>("anchor", kAny, "m", "fixed world point instead of b"),
+         field<&Spring::k>("k", kNonNegative, "N/m", "stiffness"),
+         field<&Spring::damping>("damping", kNonNegative, "N*s/m", "damping along the axis"),
+         field<&Spring::restLength>("rest_length", kNonNegative, "m",
+                                    "natural length; absent: the distance at load")},
+        &finishSpring));
+    t.push_back(row<Boid>(
+        "boid", "flocking proxy forces: separation, alignment, cohesion, goal", false, needsPosition,
+        {field<&Boid::neighborRadius>("neighbor_radius", kPositive, "m", "neighbours are closer than this"),
+         field<&Boid::separationRadius>("separation_radius", kNonNegative, "m", "push apart when closer"),
+         field<&Boid::separation>("separation", kNonNegative, "m/s^2", "weight of separation"),
+         field<&Boid::alignment>("alignment", kNonNegative, "m/s^2", "weight of alignment"),
+         field<&Boid::cohesion>("cohesion", kNonNegative, "m/s^2", "weight of cohesion"),
+         field<&Boid::goal>("goal", kAny, "m", "point to seek"),
+         field<&Boid::goalWeight>("goal_weight", kNonNegative, "m/s^2", "weight of seeking the goal"),
+         field<&Boid::maxSpeed>("max_speed", kPositive, "m/s", "speed limit of steering")},
+        &finishBoid));
+    return t;
+}
+
+std::size_t editDistance(std::string_view a, std::string_view b) {
+    std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        cur[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t sub = prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+            cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, sub});
+        }
+        std::swap(prev, cur);
+    }
+    return prev[b.size()];
+}
+
+} // namespace
+
+std::string NumberRange::describe() const {
+    std::ostringstream out;
+    auto num = [](double v) {
+        std::ostringstream s;
+        s << v;
+        return s.str();
+    };
+    const bool hasMin = std::isfinite(min), hasMax = std::isfinite(max);
+    if (hasMin && hasMax && !minExclusive) out << "a number in [" << num(min) << ", " << num(max) << "]";
+    else if (hasMin && hasMax) out << "a number in (" << num(min) << ", " << num(max) << "]";
+    else if (hasMin) out << "a number " << (minExclusive ? "> " : ">= ") << num(min);
+    else if (hasMax) out << "a number <= " << num(max);
+    else out << "a finite number";
+    return out.str();
+}
+
+std::span<const ComponentInfo> componentTable() {
+    static const std::vector<ComponentInfo> table = buildTable();
+    return table;
+}
+
+const ComponentInfo* findComponent(std::string_view name) {
+    for (const ComponentInfo& info : componentTable())
+        if (info.name == name) return &info;
+    return nullptr;
+}
+
+std::vector<std::string_view> componentNames() {
+    std::vector<std::string_view> names;
+    for (const ComponentInfo& info : componentTable()) names.push_back(info.name);
+    return names;
+}
+
+std::optional<std::string_view> closestName(std::string_view name,
+                                            std::span<const std::string_view> candidates) {
+    std::optional<std::string_view> best;
+    std::size_t bestDistance = std::max<std::size_t>(2, name.size() / 3) + 1;
+    for (std::string_view c : candidates) {
+        const std::size_t d = editDistance(name, c);
+        if (d < bestDistance) {
+            bestDistance = d;
+            best = c;
+        }
+    }
+    return best;
+}
+
+} // namespace stepwise

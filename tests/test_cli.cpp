@@ -1,0 +1,221 @@
+// The `stepwise` command line as a user meets it: exit codes, messages on
+// stderr, outputs written or not written, same bytes for the same input.
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Outcome {
+    int exitCode = -1;
+    std::string out;
+    std::string err;
+};
+
+std::string readFile(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+class Cli : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() /
+               ("stepwise_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    /// Runs build/stepwise with `args` (shell words), capturing both streams.
+    Outcome stepwise(const std::string& args) {
+        const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+        const std::string command = std::string(STEPWISE_BINARY) + " " + args + " >" + out.string() + " 2>" +
+                                    err.string() + " </dev/null";
+        const int status = std::system(command.c_str());
+        Outcome o;
+        o.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        o.out = readFile(out);
+        o.err = readFile(err);
+        fs::remove(out);
+        fs::remove(err);
+        return o;
+    }
+    fs::path write(const std::string& name, const std::string& text) {
+        const fs::path p = dir_ / name;
+        std::ofstream(p, std::ios::binary) << text;
+        return p;
+    }
+    std::string level(const std::string& name) const {
+        return (fs::path(STEPWISE_SOURCE_DIR) / "levels" / name).string();
+    }
+
+    fs::path dir_;
+};
+
+// A shape-free scene with every force kind the engine has: gravity, drag,
+// springs (body-body and anchored) and an attractor.
+const char* kForces = R"({
+  "world": {"gravity": {"x": 0, "y": -9.81}, "integrator": "rk4", "dt": 0.01},
+  "entities": [
+    {"name": "sun", "position": {"x": 0, "y": 0}, "mass": 50, "static": true, "attractor": {"softening": 0.1}},
+    {"name": "p", "position": {"x": 3, "y": 0}, "velocity": {"x": 0, "y": 4}, "drag": 0.05},
+    {"name": "q", "position": {"x": 3.5, "y": 0.5}, "mass": 0.5},
+    {"name": "pq", "spring": {"a": "p", "b": "q", "k": 40, "damping": 0.2}},
+    {"name": "hang", "spring": {"a": "q", "anchor": {"x": 4, "y": 2}, "k": 10, "rest_length": 1}}
+  ]
+})";
+
+} // namespace
+
+TEST_F(Cli, ValidatePrintsASummaryOfAGoodLevel) {
+    const fs::path file = write("forces.json", kForces);
+    Outcome o = stepwise("validate " + file.string());
+    EXPECT_EQ(o.exitCode, 0) << o.err;
+    EXPECT_EQ(o.out.rfind(file.string() + ": ok: 5 entities; components: name x5, position x3, velocity x1, mass x2, "
+                                          "static x1, drag x1, attractor x1, spring x2; systems: ",
+                          0),
+              0u)
+        << o.out;
+    for (const char* system : {"gravity", "drag", "springs", "attractors"})
+        EXPECT_NE(o.out.find(system), std::string::npos) << system << " missing from: " << o.out;
+    EXPECT_EQ(o.out.find("boids"), std::string::npos) << "a scene without boids must not run the boid system";
+}
+
+TEST_F(Cli, ValidateRefusesABadFileWithExitTwoAndTheLoaderMessage) {
+    const fs::path file = write("bad.json", R"({"entities": [{"name": "ball", "position": {"x": 0, "y": 0}, "mass": -1}]})");
+    Outcome o = stepwise("validate " + file.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, file.string() + ": error: /entities/0/mass: expected a number > 0, got -1\n");
+    EXPECT_EQ(o.out, "");
+}
+
+TEST_F(Cli, ValidateMissingFile) {
+    Outcome o = stepwise("validate " + (dir_ / "nope.json").string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, (dir_ / "nope.json").string() + ": error: no such file\n");
+}
+
+TEST_F(Cli, BadArgumentsExitTwoNamingTheArgument) {
+    const fs::path file = write("forces.json", kForces);
+    Outcome o = stepwise("run " + file.string() + " --steps -5");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_NE(o.err.find("--steps"), std::string::npos) << o.err;
+    o = stepwise("run " + file.string() + " --steps 10 --integrator rk5");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_NE(o.err.find("--integrator: rk5 not in {explicit_euler,semi_implicit_euler,"), std::string::npos) << o.err;
+    o = stepwise("run " + file.string() + " --steps 10 --dt 0");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_NE(o.err.find("--dt"), std::string::npos) << o.err;
+    o = stepwise("run " + file.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_NE(o.err.find("--steps is required"), std::string::npos) << o.err;
+    o = stepwise("frobnicate");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_NE(o.err.find("frobnicate"), std::string::npos) << o.err;
+}
+
+TEST_F(Cli, RunWritesTheSceneWithTimeAdvanced) {
+    const fs::path file = write("forces.json", kForces), out = dir_ / "out.json";
+    Outcome o = stepwise("run " + file.string() + " --steps 100 --out " + out.string());
+    ASSERT_EQ(o.exitCode, 0) << o.err;
+    const std::string saved = readFile(out);
+    EXPECT_NE(saved.find("\"time\": 1.0000000000000007,"), std::string::npos)
+        << "100 additions of 0.01 give this double exactly:\n" << saved.substr(0, 300);
+    EXPECT_NE(saved.find("\"integrator\": \"rk4\""), std::string::npos);
+}
+
+TEST_F(Cli, SameInputGivesTheSameBytes) {
+    const fs::path file = write("forces.json", kForces);
+    const fs::path a = dir_ / "a.json", b = dir_ / "b.json", ta = dir_ / "a.csv", tb = dir_ / "b.csv";
+    ASSERT_EQ(stepwise("run " + file.string() + " --steps 150 --out " + a.string() + " --trace " + ta.string()).exitCode, 0);
+    ASSERT_EQ(stepwise("run " + file.string() + " --steps 150 --out " + b.string() + " --trace " + tb.string()).exitCode, 0);
+    EXPECT_EQ(readFile(a), readFile(b));
+    EXPECT_EQ(readFile(ta), readFile(tb));
+}
+
+TEST_F(Cli, TwoHundredStepsEqualHundredSavedLoadedAndHundredMore) {
+    for (const char* integrator : {"semi_implicit_euler", "rk4", "velocity_verlet", "implicit_euler"}) {
+        const fs::path file = write("forces.json", kForces);
+        const fs::path whole = dir_ / "whole.json", half = dir_ / "half.json", resumed = dir_ / "resumed.json";
+        const std::string common = std::string(" --integrator ") + integrator;
+        ASSERT_EQ(stepwise("run " + file.string() + " --steps 200 --out " + whole.string() + common).exitCode, 0);
+        ASSERT_EQ(stepwise("run " + file.string() + " --steps 100 --out " + half.string() + common).exitCode, 0);
+        ASSERT_EQ(stepwise("run " + half.string() + " --steps 100 --out " + resumed.string() + common).exitCode, 0);
+        EXPECT_EQ(readFile(whole), readFile(resumed)) << integrator;
+    }
+}
+
+TEST_F(Cli, TraceHasARowPerStepPlusTheInitialState) {
+    const fs::path file = write("forces.json", kForces), trace = dir_ / "t.csv";
+    ASSERT_EQ(stepwise("run " + file.string() + " --steps 25 --trace " + trace.string()).exitCode, 0);
+    std::istringstream lines(readFile(trace));
+    std::string header, line;
+    std::getline(lines, header);
+    EXPECT_EQ(header, "step,time,kinetic,potential_gravity,potential_springs,potential_attractors,potential,total,"
+                      "momentum_x,momentum_y,contacts");
+    int rows = 0;
+    while (std::getline(lines, line)) {
+        EXPECT_EQ(line.rfind(std::to_string(rows) + ",", 0), 0u) << line;
+        ++rows;
+    }
+    EXPECT_EQ(rows, 26);
+}
+
+TEST_F(Cli, DivergenceExitsThreeNamesTheStepAndWritesNoScene) {
+    // h*omega = 0.1*sqrt(1e6) = 100: explicit Euler multiplies the energy by
+    // 1 + (h omega)^2 every step, so it overflows within a few hundred steps.
+    const fs::path file = write("stiff.json", R"({"world": {"gravity": {"x": 0, "y": 0}, "dt": 0.1, "integrator": "explicit_euler"},
+      "entities": [{"name": "bob", "position": {"x": 1.5, "y": 0}},
+                   {"name": "s", "spring": {"a": "bob", "anchor": {"x": 0, "y": 0}, "k": 1e6, "rest_length": 1}}]})");
+    const fs::path out = dir_ / "out.json";
+    Outcome o = stepwise("run " + file.string() + " --steps 10000 --out " + out.string());
+    EXPECT_EQ(o.exitCode, 3) << o.err;
+    EXPECT_NE(o.err.find("simulation diverged at step "), std::string::npos) << o.err;
+    EXPECT_NE(o.err.find("entity 0 (\"bob\")"), std::string::npos) << o.err;
+    EXPECT_NE(o.err.find("--out not written"), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Cli, UnwritableOutputIsAClearErrorAndLeavesNothing) {
+    const fs::path file = write("forces.json", kForces);
+    Outcome o = stepwise("run " + file.string() + " --steps 3 --out " + (dir_ / "missing" / "o.json").string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, (dir_ / "missing" / "o.json").string() + ": error: cannot write: No such file or directory\n");
+}
+
+TEST_F(Cli, RunRefusesWhatTheEngineCannotSimulate) {
+    const fs::path out = dir_ / "out.json";
+    Outcome o = stepwise("run " + level("course_notes.json") + " --steps 10 --out " + out.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_NE(o.err.find("cannot simulate"), std::string::npos) << o.err;
+    EXPECT_NE(o.err.find("radius"), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Cli, SchemaCommandMatchesTheCommittedSchema) {
+    Outcome o = stepwise("schema");
+    ASSERT_EQ(o.exitCode, 0);
+    EXPECT_EQ(o.out, readFile(level("scene.schema.json")))
+        << "levels/scene.schema.json is stale: regenerate it with `build/stepwise schema --out levels/scene.schema.json`";
+}
+
+TEST_F(Cli, EverySubcommandHasHelp) {
+    for (const char* sub : {"validate", "run", "schema"}) {
+        Outcome o = stepwise(std::string(sub) + " --help");
+        EXPECT_EQ(o.exitCode, 0) << sub;
+        EXPECT_NE(o.out.find("Usage:"), std::string::npos) << sub << ": " << o.out;
+    }
+}
