@@ -5,6 +5,7 @@
 
 #include <exception>
 #include <iostream>
+#include <string>
 
 int main(int argc, char** argv) {
     using namespace stepwise::cli;
@@ -14,7 +15,24 @@ int main(int argc, char** argv) {
     int exitCode = kExitOk;
     addValidateCommand(app, exitCode);
     addRunCommand(app, exitCode);
+    addBenchCommand(app, exitCode);
+    addRenderCommand(app, exitCode);
     addSchemaCommand(app, exitCode);
+    // CLI11 reports an unknown first word only as "A subcommand is
+    // required"; name the word and the choices instead.
+    if (argc > 1 && argv[1][0] != '-') {
+        std::string known;
+        bool found = false;
+        for (const CLI::App* sub : app.get_subcommands({})) {
+            found = found || sub->get_name() == argv[1];
+            known += (known.empty() ? "" : ", ") + sub->get_name();
+        }
+        if (!found) {
+            std::cerr << "stepwise: error: unknown subcommand \"" << argv[1] << "\"; expected one of: " << known
+                      << " (see stepwise --help)\n";
+            return kExitBadInput;
+        }
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

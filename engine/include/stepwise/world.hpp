@@ -34,6 +34,11 @@ struct StepStats {
     std::uint64_t step = 0;            ///< steps taken since build
     std::vector<StageTime> stages;     ///< in pipeline order
     std::size_t contactCount = 0;
+    /// Time of each active force system inside "forces" (addition): their
+    /// sum is the "forces" stage. With gravity and drag only, semi-implicit
+    /// Euler fuses them into its update and their time is in "integrate".
+    std::vector<StageTime> systems;
+    int forceEvaluations = 0;          ///< force evaluations in the last step (addition)
 };
 
 /// Energy and momentum of the dynamic bodies, joules and kg*m/s.
@@ -65,6 +70,7 @@ struct StiffnessHint {
     double hOmega = 0.0;      ///< dt*sqrt(k/m_reduced) per substep
     double limit = 0.0;       ///< the integrator's stable h*omega
     double largestStableDt = 0.0;  ///< seconds per step (whole step, substeps included)
+    std::string integrator;   ///< the integrator whose limit it is (addition)
     std::string message() const;
 };
 
@@ -119,6 +125,10 @@ public:
     Vec2 bodyVelocity(std::size_t body) const;
     /// Net force on each dynamic body at the current state, newtons.
     std::vector<Vec2> bodyForces() const;
+
+    /// Per-stage timing on (default) or off. Off, a step reads no clock at
+    /// all; the benchmarks use this to time the integrators alone. (Addition.)
+    void setProfiling(bool on);
 
     WorldImpl& impl() { return *impl_; }
     const WorldImpl& impl() const { return *impl_; }

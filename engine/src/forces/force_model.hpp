@@ -91,6 +91,7 @@ private:
     mutable std::vector<std::uint32_t> bucketStart_;  ///< mask_+2 entries
     mutable std::vector<std::uint32_t> sorted_;       ///< boid indices by bucket
     mutable std::vector<std::uint32_t> bucketOfBoid_;
+    mutable std::vector<std::uint32_t> gather_;       ///< candidates of one boid
 };
 
 /// Receives the 2x2 blocks of the force Jacobians (implicit integrators).
@@ -126,7 +127,7 @@ public:
 
     /// Seconds spent in each system since the last resetTimers(); filled
     /// only while `profiling` is true (two clock reads per system call).
-    bool profiling = true;
+    mutable bool profiling = true;
     mutable std::array<double, std::size_t(ForceSystem::Count)> systemSeconds{};
 
     bool springsOn() const { return !springs.empty(); }

@@ -1,0 +1,36 @@
+#pragma once
+// The speed-against-error report (`stepwise bench accuracy`): every
+// integrator, and Boost.Odeint's matching steppers as the peer, on a set of
+// problems with analytic or converged reference answers, at several dt.
+// Writes accuracy.csv, accuracy.md and a work-precision plot accuracy.png
+// (SciML style: error against CPU time per step, log-log, one panel per
+// problem, one line per method).
+
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace stepwise::bench {
+
+struct AccuracyOptions {
+    bool quick = false;              ///< fewer dt and timing repeats: under a minute
+    std::filesystem::path out;       ///< directory, created if missing
+};
+
+struct AccuracyRow {
+    std::string problem;
+    std::string method;              ///< integrator name or odeint_<stepper>
+    double dt = 0.0;                 ///< s
+    long steps = 0;
+    double error = 0.0;              ///< max position error over bodies at the end, m (inf: diverged)
+    double secondsPerStep = 0.0;     ///< CPU (wall, single thread) seconds per step; -1: World::step stopped on divergence
+    std::string reference;           ///< "analytic" or "rk4 dt=..."
+};
+
+/// Runs the report. Progress goes to `log`. Returns "" or an error message
+/// (unwritable directory, gnuplot failure).
+std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
+                              std::vector<AccuracyRow>* rowsOut = nullptr);
+
+} // namespace stepwise::bench

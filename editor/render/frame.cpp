@@ -1,0 +1,872 @@
+// Frame building: scene + overlays + camera -> instance batches (no GL).
+//
+// Coordinates: every instance is emitted in pixels (origin bottom-left, y
+// up). The world -> pixel transform is done here in double precision, so a
+// level far from the origin draws as crisply as one near it (float world
+// coordinates in the shaders would lose sub-pixel precision past ~1e4 m).
+
+#include "render/frame.hpp"
+
+#include "stepwise/components.hpp"
+#include "stepwise/world.hpp"
+
+#define STB_EASY_FONT_IMPLEMENTATION
+#include <stb/stb_easy_font.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace stepwise::render {
+
+namespace {
+
+// ---- Palette (dark theme; linear 0..1 RGB, alpha last) ---------------------
+struct Rgba {
+    float r, g, b, a;
+};
+constexpr Rgba rgb(int hex, float a = 1.0f) {
+    return {float((hex >> 16) & 255) / 255.0f, float((hex >> 8) & 255) / 255.0f, float(hex & 255) / 255.0f, a};
+}
+constexpr Rgba kGridMinor = rgb(0x171c25);
+constexpr Rgba kGridMajor = rgb(0x212835);
+constexpr Rgba kGridAxis = rgb(0x2f3a4c);
+constexpr Rgba kDefaultBody = rgb(0x9fb3c8);
+constexpr Rgba kSpringColor = rgb(0xcbd5e0);
+constexpr Rgba kAnchorColor = rgb(0x718096);
+constexpr Rgba kVelocity = rgb(0x4fd1c5);
+constexpr Rgba kVelocityField = rgb(0x38b2ac, 0.8f);
+constexpr Rgba kForce = rgb(0xf6ad55);
+constexpr Rgba kForceField = rgb(0xa78bfa, 0.5f);
+constexpr Rgba kContactPoint = rgb(0xff6b6b);
+constexpr Rgba kContactNormal = rgb(0xffa8a8);
+constexpr Rgba kAabb = rgb(0x68d391, 0.75f);
+constexpr Rgba kAabbCell = rgb(0x68d391, 0.06f);
+constexpr Rgba kText = rgb(0xd5dde8);
+constexpr Rgba kTextDim = rgb(0x8190a5);
+constexpr Rgba kPanel = rgb(0x0a0d12, 0.82f);
+constexpr Rgba kPanelBorder = rgb(0x2d3748);
+
+// Instance flags shared with disc.frag / box.frag.
+constexpr float kSelected = 1, kStatic = 2, kTick = 4, kGlow = 8, kFlat = 16;
+constexpr float kOutline = 4;  // box.frag
+
+Rgba colourOf(const Scene& scene, Entity e, Rgba fallback) {
+    if (const Color* c = scene.registry.tryGet<Color>(e))
+        return {float(c->value.r), float(c->value.g), float(c->value.b), 1.0f};
+    return fallback;
+}
+
+Rgba withAlpha(Rgba c, float a) { return {c.r, c.g, c.b, a}; }
+
+/// Smallest 1-2-5 x 10^k number >= x (x > 0).
+double niceCeil(double x) {
+    const double decade = std::pow(10.0, std::floor(std::log10(x)));
+    for (double m : {1.0, 2.0, 5.0, 10.0})
+        if (m * decade >= x * (1.0 - 1e-12)) return m * decade;
+    return 10.0 * decade;
+}
+
+/// Largest 1-2-5 x 10^k number <= x (x > 0).
+double niceFloor(double x) {
+    const double decade = std::pow(10.0, std::floor(std::log10(x)));
+    for (double m : {5.0, 2.0, 1.0})
+        if (m * decade <= x * (1.0 + 1e-12)) return m * decade;
+    return decade;
+}
+
+/// Reference magnitude for a set of arrows: the median non-zero magnitude
+/// rounded up to a 1-2-5 number, so a typical arrow is about the reference
+/// length and the legend reads as a round number.
+double autoReference(std::vector<double> magnitudes) {
+    std::erase_if(magnitudes, [](double m) { return !(m > 0.0) || !std::isfinite(m); });
+    if (magnitudes.empty()) return 1.0;
+    auto mid = magnitudes.begin() + std::ptrdiff_t(magnitudes.size() / 2);
+    std::nth_element(magnitudes.begin(), mid, magnitudes.end());
+    return niceCeil(*mid);
+}
+
+std::string formatNumber(double v) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%g", v);
+    return buffer;
+}
+
+std::string formatLength(double metres) {
+    if (metres < 0.01) return formatNumber(metres * 1000.0) + " mm";
+    if (metres < 1.0) return formatNumber(metres * 100.0) + " cm";
+    if (metres >= 1000.0) return formatNumber(metres / 1000.0) + " km";
+    return formatNumber(metres) + " m";
+}
+
+struct Bounds {
+    Vec2 lo{1e300, 1e300};
+    Vec2 hi{-1e300, -1e300};
+    bool empty() const { return lo.x > hi.x; }
+    void add(Vec2 p, double r = 0.0) {
+        lo = {std::min(lo.x, p.x - r), std::min(lo.y, p.y - r)};
+        hi = {std::max(hi.x, p.x + r), std::max(hi.y, p.y + r)};
+    }
+};
+
+/// Half extents of the axis-aligned box around a shape, metres.
+std::optional<Vec2> shapeHalfExtents(const Scene& scene, Entity e) {
+    if (const Radius* r = scene.registry.tryGet<Radius>(e)) return Vec2{r->value, r->value};
+    if (const Box* b = scene.registry.tryGet<Box>(e)) {
+        const Angle* a = scene.registry.tryGet<Angle>(e);
+        const double c = std::abs(std::cos(a ? a->value : 0.0)), s = std::abs(std::sin(a ? a->value : 0.0));
+        return Vec2{0.5 * (c * b->width + s * b->height), 0.5 * (s * b->width + c * b->height)};
+    }
+    return std::nullopt;
+}
+
+bool isStatic(const Scene& scene, Entity e) {
+    const Static* s = scene.registry.tryGet<Static>(e);
+    return s && s->value;
+}
+
+class Builder {
+public:
+    Builder(DrawData& out, const FrameInput& input, int w, int h)
+        : out_(out), in_(input), scene_(*input.scene), w_(w), h_(h),
+          ppm_(input.camera.pixelsPerMetre(h)),
+          textScale_(h / 700 + 1),
+          arrowRef_(0.06 * h) {
+        for (Entity e : input.selection) selected_.insert(e);
+        // Level of detail: with thousands of bodies, per-body lines get
+        // thinner and trails coarser. Legibility is unchanged (the arrows
+        // would overlap anyway) and llvmpipe shades a third of the pixels.
+        dense_ = scene_.registry.count<Position>() > 2000;
+        for (Entity e : scene_.registry.entities())
+            if (const Name* n = scene_.registry.tryGet<Name>(e)) byName_.emplace(n->value, e);
+    }
+
+    void build();
+
+private:
+    // ---- coordinates ---------------------------------------------------
+    Vec2 toPx(Vec2 p) const {
+        return {(p.x - in_.camera.center.x) * ppm_ + 0.5 * w_, (p.y - in_.camera.center.y) * ppm_ + 0.5 * h_};
+    }
+    Vec2 toWorld(Vec2 px) const {
+        return {(px.x - 0.5 * w_) / ppm_ + in_.camera.center.x, (px.y - 0.5 * h_) / ppm_ + in_.camera.center.y};
+    }
+    /// True when a circle of radius r (pixels) around p touches the image.
+    bool visible(Vec2 p, double r) const {
+        return p.x + r >= 0 && p.y + r >= 0 && p.x - r <= w_ && p.y - r <= h_;
+    }
+    bool segmentVisible(Vec2 a, Vec2 b, double pad) const {
+        return std::max(a.x, b.x) + pad >= 0 && std::max(a.y, b.y) + pad >= 0 && std::min(a.x, b.x) - pad <= w_ &&
+               std::min(a.y, b.y) - pad <= h_;
+    }
+
+    // ---- batches -------------------------------------------------------
+    std::vector<float>& batch(BatchKind kind) {
+        if (out_.batches.empty() || out_.batches.back().kind != kind) out_.batches.push_back({kind, {}});
+        return out_.batches.back().data;
+    }
+    static void push(std::vector<float>& d, std::initializer_list<double> values) {
+        for (double v : values) d.push_back(float(v));
+    }
+    void disc(Vec2 c, double r, double angle, Rgba col, float flags) {
+        if (!visible(c, r + 8)) return;
+        push(batch(BatchKind::Disc), {c.x, c.y, r, angle, col.r, col.g, col.b, col.a, flags});
+    }
+    void box(Vec2 c, Vec2 half, double angle, Rgba col, float flags, double rounding = 0.0) {
+        if (!visible(c, std::hypot(half.x, half.y) + 8)) return;
+        push(batch(BatchKind::Box), {c.x, c.y, half.x, half.y, angle, col.r, col.g, col.b, col.a, flags, rounding});
+    }
+    void segment(Vec2 a, Vec2 b, double width, Rgba col) {
+        if (!segmentVisible(a, b, width + 2)) return;
+        push(batch(BatchKind::Segment), {a.x, a.y, b.x, b.y, width, col.r, col.g, col.b, col.a});
+    }
+    void arrow(Vec2 a, Vec2 b, double width, Rgba col) {
+        if (!segmentVisible(a, b, 12)) return;
+        push(batch(BatchKind::Arrow), {a.x, a.y, b.x, b.y, width, col.r, col.g, col.b, col.a});
+    }
+    void rect(double x0, double y0, double x1, double y1, Rgba col) {
+        auto& d = batch(BatchKind::Solid);
+        const double v[6][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y0}, {x1, y1}, {x0, y1}};
+        for (const auto& p : v) push(d, {p[0], p[1], col.r, col.g, col.b, col.a});
+    }
+    /// Text with its top-left corner at pixel (x, yTop); y measured up from
+    /// the bottom like everything else. Returns the width in pixels.
+    double text(double x, double yTop, const std::string& s, Rgba col);
+    double textWidth(const std::string& s) const {
+        std::string copy = s;
+        return double(stb_easy_font_width(copy.data()) * textScale_);
+    }
+    double textHeight() const { return 7.0 * textScale_; }
+
+    /// Arrow length in pixels for magnitude m against reference `ref` drawn
+    /// `refPx` long: log2(1 + m/ref) keeps both tiny and huge values visible.
+    static double arrowLength(double m, double ref, double refPx, double maxPx) {
+        return std::min(refPx * std::log2(1.0 + m / ref), maxPx);
+    }
+
+    // ---- layers --------------------------------------------------------
+    void grid();
+    void planes();
+    void aabbCells();
+    void attractorGlows();
+    void fields();
+    void trails();
+    void springs();
+    void bodies();
+    void aabbOutlines();
+    void bodyArrows();
+    void contacts();
+    void hud();
+
+    DrawData& out_;
+    const FrameInput& in_;
+    const Scene& scene_;
+    int w_, h_;
+    double ppm_;        ///< pixels per metre at this image height
+    int textScale_;     ///< integer pixel scale of the bitmap font
+    double arrowRef_;   ///< pixels drawn for a reference-magnitude arrow
+    bool dense_ = false;  ///< thousands of bodies: thinner per-body lines
+    std::unordered_set<Entity> selected_;
+    std::unordered_map<std::string, Entity> byName_;
+    struct LegendRow {
+        std::string label;
+        Rgba colour;
+        double reference;  ///< magnitude drawn arrowRef_ long
+        std::string unit;
+    };
+    std::vector<LegendRow> legend_;
+};
+
+double Builder::text(double x, double yTop, const std::string& s, Rgba col) {
+    std::string copy = s;
+    // stb_easy_font: 4 vertices (x, y, z, rgba8) = 16 bytes per quad, ~270
+    // bytes per character worst case.
+    std::vector<char> buffer(copy.size() * 300 + 64);
+    unsigned char c8[4] = {255, 255, 255, 255};
+    const int quads = stb_easy_font_print(0.0f, 0.0f, copy.data(), c8, buffer.data(), int(buffer.size()));
+    auto& d = batch(BatchKind::Solid);
+    const double s8 = textScale_;
+    for (int q = 0; q < quads; ++q) {
+        const float* v = reinterpret_cast<const float*>(buffer.data() + q * 64);
+        // Vertices 0 and 2 are opposite corners (x, y, z at +0, +1, +2; stride 4 floats).
+        const double x0 = x + v[0] * s8, x1 = x + v[8] * s8;
+        const double y0 = yTop - v[1] * s8, y1 = yTop - v[9] * s8;
+        const double p[6][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y0}, {x1, y1}, {x0, y1}};
+        for (const auto& pt : p) push(d, {pt[0], pt[1], col.r, col.g, col.b, col.a});
+    }
+    return double(stb_easy_font_width(copy.data())) * s8;
+}
+
+void Builder::build() {
+    grid();
+    planes();
+    if (in_.overlays.has(Overlay::Aabb)) aabbCells();
+    attractorGlows();
+    fields();
+    if (in_.overlays.has(Overlay::Trails)) trails();
+    springs();
+    bodies();
+    if (in_.overlays.has(Overlay::Aabb)) aabbOutlines();
+    bodyArrows();
+    if (in_.overlays.has(Overlay::Contacts)) contacts();
+    if (in_.hud) hud();
+}
+
+void Builder::grid() {
+    // Minor lines every 1-2-5 metres, at least 24 px apart; majors every 5
+    // minor; the world axes brighter. Each line is one pixel wide and
+    // pixel-aligned (two Solid triangles), so it is crisp and costs llvmpipe
+    // almost nothing compared with a full-screen shader.
+    const double minorM = niceCeil(24.0 / ppm_);
+    out_.gridSpacing = minorM;
+    const Vec2 lo = toWorld({0, 0}), hi = toWorld({double(w_), double(h_)});
+    auto lines = [&](double from, double to, bool vertical) {
+        const long long k0 = (long long)std::ceil(from / minorM), k1 = (long long)std::floor(to / minorM);
+        if (k1 - k0 > 2000) return;  // never at >= 24 px spacing; guards absurd cameras
+        for (long long k = k0; k <= k1; ++k) {
+            const Rgba c = k == 0 ? kGridAxis : (k % 5 == 0 ? kGridMajor : kGridMinor);
+            const Vec2 p = toPx(vertical ? Vec2{double(k) * minorM, 0.0} : Vec2{0.0, double(k) * minorM});
+            const double x = std::floor(vertical ? p.x : p.y);
+            if (vertical) rect(x, 0, x + 1, h_, c);
+            else rect(0, x, w_, x + 1, c);
+        }
+    };
+    lines(lo.x, hi.x, true);
+    lines(lo.y, hi.y, false);
+}
+
+void Builder::planes() {
+    scene_.registry.each<Plane>([&](Entity e, const Plane& p) {
+        // Surface point on the plane, then its pixel-space offset; the
+        // normal is unchanged by a uniform scale and translation.
+        const Vec2 px = toPx(p.normal * p.offset);
+        const double offset = dot(p.normal, px) ;
+        const Rgba c = colourOf(scene_, e, rgb(0x8a9bb0));
+        // Bounding box of the solid side (dot(n, p) <= offset + 2 px for
+        // the edge line) clipped to the image: clip the image rectangle by
+        // the half-plane (Sutherland-Hodgman, one edge) and take its box.
+        const Vec2 corners[4] = {{0, 0}, {double(w_), 0}, {double(w_), double(h_)}, {0, double(h_)}};
+        const double limit = offset + 2.0;
+        Bounds box;
+        for (int k = 0; k < 4; ++k) {
+            const Vec2 a = corners[k], b = corners[(k + 1) % 4];
+            const double da = dot(p.normal, a) - limit, db = dot(p.normal, b) - limit;
+            if (da <= 0) box.add(a);
+            if ((da < 0) != (db < 0)) box.add(a + (b - a) * (da / (da - db)));
+        }
+        if (box.empty()) return;
+        push(batch(BatchKind::Plane), {p.normal.x, p.normal.y, offset, c.r, c.g, c.b, c.a,
+                                       selected_.count(e) ? kSelected : 0.0f, box.lo.x, box.lo.y, box.hi.x, box.hi.y});
+    });
+}
+
+void Builder::aabbCells() {
+    // The broad phase's uniform grid as the renderer pictures it: cells of
+    // the 1-2-5 size just above twice the median shape extent, shaded where
+    // a bounding box overlaps them. (The engine will expose its own cells
+    // when collisions land; until then this shows the bounding-box density.)
+    std::vector<std::pair<Vec2, Vec2>> boxes;  // centre, half extents (metres)
+    std::vector<double> extents;
+    for (Entity e : scene_.registry.entities()) {
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        auto half = shapeHalfExtents(scene_, e);
+        if (!p || !half) continue;
+        boxes.emplace_back(p->value, *half);
+        extents.push_back(2.0 * std::max(half->x, half->y));
+    }
+    if (boxes.empty()) return;
+    const double cell = niceCeil(2.0 * autoReference(extents));
+    std::vector<std::pair<long long, long long>> cells;
+    for (const auto& [c, half] : boxes) {
+        const long long x0 = (long long)std::floor((c.x - half.x) / cell), x1 = (long long)std::floor((c.x + half.x) / cell);
+        const long long y0 = (long long)std::floor((c.y - half.y) / cell), y1 = (long long)std::floor((c.y + half.y) / cell);
+        if ((x1 - x0 + 1) * (y1 - y0 + 1) > 64) continue;  // huge shape: its box says enough
+        for (long long x = x0; x <= x1; ++x)
+            for (long long y = y0; y <= y1; ++y) cells.emplace_back(x, y);
+    }
+    std::sort(cells.begin(), cells.end());
+    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    const double halfPx = 0.5 * cell * ppm_;
+    for (const auto& [x, y] : cells) {
+        const Vec2 c = toPx({(double(x) + 0.5) * cell, (double(y) + 0.5) * cell});
+        box(c, {halfPx - 1.0, halfPx - 1.0}, 0.0, kAabbCell, kFlat);
+    }
+}
+
+void Builder::attractorGlows() {
+    const double g = length(scene_.world.gravity);
+    scene_.registry.each<Attractor, Position>([&](Entity e, const Attractor&, const Position& p) {
+        const Mass* m = scene_.registry.tryGet<Mass>(e);
+        const double mass = m ? m->value : 1.0;
+        const Radius* r = scene_.registry.tryGet<Radius>(e);
+        const double bodyPx = (r ? r->value : 0.15) * ppm_;
+        // Ring radius: where the attractor's pull G*m/r^2 equals gravity's,
+        // the edge of its sphere of dominance. With no gravity: 4 radii.
+        double ringM = g > 0.0 ? std::sqrt(scene_.world.G * mass / g) : 4.0 * (r ? r->value : 0.5);
+        const double ringPx = std::clamp(ringM * ppm_, bodyPx * 2.0 + 10.0, 0.6 * h_);
+        const double glowPx = std::max(3.0 * bodyPx, 18.0);
+        const Vec2 c = toPx(p.value);
+        const Rgba col = colourOf(scene_, e, rgb(0xf6e05e));
+        disc(c, glowPx, 0.0, col, kGlow);
+        // Dashed ring as 48 short chords: a full-size quad shaded per pixel
+        // would cost llvmpipe tens of milliseconds for a large ring.
+        if (!visible(c, ringPx + 4)) return;
+        const int dashes = 48;
+        for (int k = 0; k < dashes; ++k) {
+            const double a0 = 2.0 * std::numbers::pi * k / dashes;
+            const double a1 = a0 + std::numbers::pi / dashes;
+            segment(c + Vec2{std::cos(a0), std::sin(a0)} * ringPx, c + Vec2{std::cos(a1), std::sin(a1)} * ringPx, 1.2,
+                    withAlpha(col, 0.45f));
+        }
+    });
+}
+
+void Builder::fields() {
+    const bool vField = in_.overlays.has(Overlay::VelocityField);
+    const bool fField = in_.overlays.has(Overlay::ForceField);
+    if (!vField && !fField) return;
+    // Samples sit at the centres of a world-aligned grid about 1/20 of the
+    // image height apart, so panning does not make the field shimmer.
+    const double spacingPx = std::max(24.0, std::round(h_ / 20.0));
+    const double s = spacingPx / ppm_;  // metres
+    const Vec2 lo = toWorld({0, 0}), hi = toWorld({double(w_), double(h_)});
+    const long long i0 = (long long)std::floor(lo.x / s), i1 = (long long)std::floor(hi.x / s);
+    const long long j0 = (long long)std::floor(lo.y / s), j1 = (long long)std::floor(hi.y / s);
+    std::vector<Vec2> points;
+    for (long long j = j0; j <= j1; ++j)
+        for (long long i = i0; i <= i1; ++i) points.push_back({(double(i) + 0.5) * s, (double(j) + 0.5) * s});
+    const double maxPx = 0.95 * spacingPx, refPx = 0.42 * spacingPx;
+
+    if (fField) {
+        if (!in_.world) {
+            out_.notes.push_back("force-field: needs a World (not built)");
+        } else {
+            std::vector<Vec2> forces;
+            std::vector<double> mags;
+            forces.reserve(points.size());
+            for (Vec2 p : points) {
+                forces.push_back(in_.world->probeForce(p));
+                mags.push_back(length(forces.back()));
+            }
+            const double ref = in_.scales.forceField > 0 ? in_.scales.forceField : autoReference(mags);
+            out_.scales.forceField = ref;
+            for (std::size_t k = 0; k < points.size(); ++k) {
+                const double m = mags[k];
+                if (!(m > 0.0) || !std::isfinite(m)) continue;
+                const double len = arrowLength(m, ref, refPx, maxPx);
+                const Vec2 dir = forces[k] / m, c = toPx(points[k]);
+                arrow(c - dir * (0.5 * len), c + dir * (0.5 * len), 1.3, kForceField);
+            }
+            legend_.push_back({"force field", kForceField, ref, "N/kg"});
+        }
+    }
+    if (vField) {
+        // Gaussian kernel of width h = grid spacing, cut at 2h; bodies are
+        // binned into cells of size s so each sample visits 5x5 cells.
+        struct Sample { Vec2 p, v; };
+        std::unordered_map<long long, std::vector<Sample>> cells;
+        auto key = [](long long x, long long y) { return (x << 32) ^ (y & 0xffffffffLL); };
+        scene_.registry.each<Position, Velocity>([&](Entity e, const Position& p, const Velocity& v) {
+            if (isStatic(scene_, e)) return;
+            cells[key((long long)std::floor(p.value.x / s), (long long)std::floor(p.value.y / s))].push_back({p.value, v.value});
+        });
+        std::vector<std::pair<Vec2, double>> fieldValues;  // mean velocity, confidence
+        std::vector<double> mags;
+        for (Vec2 p : points) {
+            const long long ci = (long long)std::floor(p.x / s), cj = (long long)std::floor(p.y / s);
+            Vec2 sum;
+            double wsum = 0.0;
+            for (long long dj = -2; dj <= 2; ++dj)
+                for (long long di = -2; di <= 2; ++di) {
+                    auto it = cells.find(key(ci + di, cj + dj));
+                    if (it == cells.end()) continue;
+                    for (const Sample& b : it->second) {
+                        const double r2 = lengthSquared(b.p - p) / (s * s);
+                        if (r2 > 4.0) continue;
+                        const double w = std::exp(-0.5 * r2);
+                        sum += w * b.v;
+                        wsum += w;
+                    }
+                }
+            if (wsum < 0.02) {
+                fieldValues.push_back({{}, 0.0});
+                continue;
+            }
+            const Vec2 v = sum / wsum;
+            fieldValues.push_back({v, std::min(1.0, wsum / 0.6)});
+            mags.push_back(length(v));
+        }
+        const double ref = in_.scales.velocityField > 0 ? in_.scales.velocityField : autoReference(mags);
+        out_.scales.velocityField = ref;
+        for (std::size_t k = 0; k < points.size(); ++k) {
+            const auto& [v, confidence] = fieldValues[k];
+            const double m = length(v);
+            if (confidence <= 0.0 || !(m > 0.0) || !std::isfinite(m)) continue;
+            const double len = arrowLength(m, ref, refPx, maxPx);
+            const Vec2 dir = v / m, c = toPx(points[k]);
+            arrow(c - dir * (0.5 * len), c + dir * (0.5 * len), 1.3,
+                  withAlpha(kVelocityField, float(0.25 + 0.6 * confidence)));
+        }
+        legend_.push_back({"velocity field", kVelocityField, ref, "m/s"});
+    }
+}
+
+void Builder::trails() {
+    if (!in_.trails) {
+        out_.notes.push_back("trails: nothing recorded (use --steps)");
+        return;
+    }
+    for (const TrailRecorder::Trail& t : in_.trails->trails()) {
+        if (t.points.size() < 2 || !scene_.registry.alive(t.entity)) continue;
+        const Rgba c = colourOf(scene_, t.entity, kDefaultBody);
+        const std::size_t n = t.points.size();
+        Vec2 prev = toPx(t.points[0]);
+        for (std::size_t k = 1; k < n; ++k) {
+            const Vec2 cur = toPx(t.points[k]);
+            // Merge steps into segments at least 3 px long (the newest one
+            // excepted): a 10,000-body scene draws ~8 segments per trail
+            // instead of 47, and the curve looks the same.
+            if (lengthSquared(cur - prev) < (dense_ ? 64.0 : 9.0) && k + 1 < n) continue;
+            // Older segments fade out: alpha rises linearly to 0.7 at the body.
+            const float a = float(0.7 * double(k) / double(n - 1));
+            if (lengthSquared(cur - prev) > 0.01) segment(prev, cur, dense_ ? 1.0 : 1.6, withAlpha(c, a));
+            prev = cur;
+        }
+    }
+}
+
+void Builder::springs() {
+    scene_.registry.each<Spring>([&](Entity e, const Spring& sp) {
+        auto endOf = [&](const std::string& name) -> std::optional<Vec2> {
+            auto it = byName_.find(name);
+            if (it == byName_.end()) return std::nullopt;
+            const Position* p = scene_.registry.tryGet<Position>(it->second);
+            return p ? std::optional<Vec2>(p->value) : std::nullopt;
+        };
+        std::optional<Vec2> a = endOf(sp.a);
+        std::optional<Vec2> b = sp.b.empty() ? sp.anchor : endOf(sp.b);
+        if (!a || !b) return;
+        const Vec2 pa = toPx(*a), pb = toPx(*b);
+        const bool sel = selected_.count(e) != 0;
+        const Rgba c = sel ? rgb(0xffd166) : colourOf(scene_, e, kSpringColor);
+        const double width = sel ? 2.2 : 1.5;
+        if (sp.b.empty()) {
+            // Anchor: a small hatched pin.
+            disc(pb, 4.5, 0.0, kAnchorColor, kStatic);
+        }
+        const Vec2 d = pb - pa;
+        const double len = length(d);
+        if (len < 6.0) {
+            segment(pa, pb, width, c);
+            return;
+        }
+        // Zigzag: straight leads at each end, then 12 half-coils of a
+        // fixed pixel amplitude, so compression shows as tighter coils.
+        const Vec2 axis = d / len, side{-axis.y, axis.x};
+        const double lead = std::min(0.18 * len, 14.0);
+        const int kinks = 12;
+        const double amplitude = std::clamp(0.09 * len, 3.0, 6.0);
+        Vec2 prev = pa;
+        Vec2 start = pa + axis * lead;
+        segment(prev, start, width, c);
+        prev = start;
+        const double body = len - 2.0 * lead;
+        for (int k = 0; k < kinks; ++k) {
+            const double t = (double(k) + 0.5) / kinks;
+            const Vec2 p = pa + axis * (lead + t * body) + side * (k % 2 == 0 ? amplitude : -amplitude);
+            segment(prev, p, width, c);
+            prev = p;
+        }
+        const Vec2 end = pb - axis * lead;
+        segment(prev, end, width, c);
+        segment(end, pb, width, c);
+    });
+}
+
+void Builder::bodies() {
+    // Boxes first, then discs: each kind is one instanced batch.
+    for (Entity e : scene_.registry.entities()) {
+        const Box* b = scene_.registry.tryGet<Box>(e);
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!b || !p) continue;
+        const Angle* a = scene_.registry.tryGet<Angle>(e);
+        float flags = 0;
+        if (selected_.count(e)) flags += kSelected;
+        if (isStatic(scene_, e)) flags += kStatic;
+        // Corner rounding of half a pixel's worth keeps rotated corners clean.
+        box(toPx(p->value), {0.5 * b->width * ppm_, 0.5 * b->height * ppm_}, a ? a->value : 0.0,
+            colourOf(scene_, e, kDefaultBody), flags, 1.0);
+    }
+    for (Entity e : scene_.registry.entities()) {
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!p || scene_.registry.has<Box>(e) || scene_.registry.has<Spring>(e)) continue;
+        const Radius* r = scene_.registry.tryGet<Radius>(e);
+        const Angle* a = scene_.registry.tryGet<Angle>(e);
+        float flags = 0;
+        if (selected_.count(e)) flags += kSelected;
+        if (isStatic(scene_, e)) flags += kStatic;
+        const Rgba c = colourOf(scene_, e, kDefaultBody);
+        if (r) {
+            disc(toPx(p->value), r->value * ppm_, a ? a->value : 0.0, c, flags + kTick);
+        } else {
+            // A point mass: a fixed-size dot, larger for an attractor.
+            const double dot = scene_.registry.has<Attractor>(e) ? 6.0 : 4.0;
+            disc(toPx(p->value), dot, 0.0, c, flags);
+        }
+    }
+}
+
+void Builder::aabbOutlines() {
+    for (Entity e : scene_.registry.entities()) {
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        auto half = shapeHalfExtents(scene_, e);
+        if (!p || !half) continue;
+        box(toPx(p->value), *half * ppm_, 0.0, kAabb, kOutline);
+    }
+}
+
+void Builder::bodyArrows() {
+    const double maxPx = 3.2 * arrowRef_;
+    if (in_.overlays.has(Overlay::Force)) {
+        if (!in_.world) {
+            out_.notes.push_back("force: needs a World (not built)");
+        } else {
+            const std::vector<Vec2> forces = in_.world->bodyForces();
+            std::vector<double> mags;
+            for (Vec2 f : forces) mags.push_back(length(f));
+            const double ref = in_.scales.force > 0 ? in_.scales.force : autoReference(mags);
+            out_.scales.force = ref;
+            for (std::size_t i = 0; i < forces.size(); ++i) {
+                if (!(mags[i] > 0.0) || !std::isfinite(mags[i])) continue;
+                const Vec2 from = toPx(in_.world->bodyPosition(i));
+                const double len = arrowLength(mags[i], ref, arrowRef_, maxPx);
+                arrow(from, from + forces[i] / mags[i] * len, dense_ ? 1.0 : 2.0, kForce);
+            }
+            legend_.push_back({"force", kForce, ref, "N"});
+        }
+    }
+    if (in_.overlays.has(Overlay::Velocity)) {
+        std::vector<std::pair<Vec2, Vec2>> arrows;  // position, velocity
+        std::vector<double> mags;
+        for (Entity e : scene_.registry.entities()) {
+            const Position* p = scene_.registry.tryGet<Position>(e);
+            const Velocity* v = scene_.registry.tryGet<Velocity>(e);
+            if (!p || !v || isStatic(scene_, e)) continue;
+            arrows.emplace_back(p->value, v->value);
+            mags.push_back(length(v->value));
+        }
+        const double ref = in_.scales.velocity > 0 ? in_.scales.velocity : autoReference(mags);
+        out_.scales.velocity = ref;
+        for (std::size_t i = 0; i < arrows.size(); ++i) {
+            if (!(mags[i] > 0.0) || !std::isfinite(mags[i])) continue;
+            const Vec2 from = toPx(arrows[i].first);
+            const double len = arrowLength(mags[i], ref, arrowRef_, maxPx);
+            arrow(from, from + arrows[i].second / mags[i] * len, dense_ ? 1.0 : 2.0, kVelocity);
+        }
+        legend_.push_back({"velocity", kVelocity, ref, "m/s"});
+    }
+}
+
+void Builder::contacts() {
+    if (!in_.world) {
+        out_.notes.push_back("contacts: needs a World (not built)");
+        return;
+    }
+    const auto records = in_.world->contacts();
+    std::vector<double> mags;
+    for (const ContactRecord& c : records) mags.push_back(std::abs(c.normalImpulse));
+    const double ref = in_.scales.impulse > 0 ? in_.scales.impulse : autoReference(mags);
+    out_.scales.impulse = ref;
+    for (const ContactRecord& c : records) {
+        const Vec2 p = toPx(c.point);
+        // Normal arrow: length from the normal impulse (a short stub when
+        // the contact carried none, so the normal still shows).
+        const double m = std::abs(c.normalImpulse);
+        const double len = m > 0.0 ? std::max(8.0, arrowLength(m, ref, arrowRef_, 3.2 * arrowRef_)) : 10.0;
+        arrow(p, p + c.normal * len, 1.5, kContactNormal);
+        disc(p, 3.0, 0.0, kContactPoint, kFlat);
+    }
+    legend_.push_back({"contact impulse", kContactNormal, ref, "N s"});
+}
+
+void Builder::hud() {
+    const double s = textScale_;
+    const double margin = 14.0 * s;
+    // ---- caption, top-left -------------------------------------------
+    if (!in_.caption.empty()) {
+        const double th = textHeight();
+        const double width = textWidth(in_.caption);
+        box({margin + 0.5 * width, h_ - margin - 0.5 * th}, {0.5 * width + 7 * s, 0.5 * th + 5 * s}, 0.0, kPanel,
+            kFlat, 4.0 * s);
+        text(margin, h_ - margin, in_.caption, kText);
+    }
+    // ---- scale bar, bottom-left --------------------------------------
+    {
+        // The largest 1-2-5 length that fits in about 110 px per font scale.
+        const double metres = niceFloor(110.0 * s / ppm_);
+        const double px = metres * ppm_;
+        const std::string label = formatLength(metres);
+        const double th = textHeight();
+        const double panelW = std::max(px, textWidth(label)) + 16 * s;
+        const double panelH = th + 20 * s;
+        box({margin + 0.5 * panelW, margin + 0.5 * panelH}, {0.5 * panelW, 0.5 * panelH}, 0.0, kPanel, kFlat, 4.0 * s);
+        const double x0 = std::floor(margin + 8 * s) + 0.5, y = std::floor(margin + 7 * s) + 0.5;
+        segment({x0, y}, {x0 + px, y}, 2.0, kText);
+        segment({x0, y - 3 * s}, {x0, y + 4 * s}, 1.5, kText);
+        segment({x0 + px, y - 3 * s}, {x0 + px, y + 4 * s}, 1.5, kText);
+        text(x0 + 0.5 * px - 0.5 * textWidth(label), y + 6 * s + th, label, kText);
+    }
+    // ---- legend, bottom-right -----------------------------------------
+    if (legend_.empty() && out_.notes.empty() && !in_.overlays.has(Overlay::Aabb) && !in_.overlays.has(Overlay::Trails))
+        return;
+    struct Row {
+        std::string label, value;
+        Rgba colour;
+        int kind;  // 0 arrow, 1 swatch box, 2 line, 3 note
+    };
+    std::vector<Row> rows;
+    for (const LegendRow& r : legend_)
+        rows.push_back({r.label, "= " + formatNumber(r.reference) + " " + r.unit, r.colour, 0});
+    if (in_.overlays.has(Overlay::Aabb)) rows.push_back({"bounding boxes", "", kAabb, 1});
+    if (in_.overlays.has(Overlay::Trails) && in_.trails)
+        rows.push_back({"trails", std::to_string(in_.trails->capacity()) + " steps", rgb(0x9fb3c8, 0.8f), 2});
+    for (const std::string& n : out_.notes) rows.push_back({n, "", kTextDim, 3});
+    if (!legend_.empty()) rows.push_back({"arrow length ~ log2(1 + |x| / ref)", "", kTextDim, 3});
+
+    const double rowH = 14.0 * s;
+    const double sampleW = arrowRef_;
+    double labelW = 0, valueW = 0, noteW = 0;
+    for (const Row& r : rows) {
+        if (r.kind == 3) {
+            noteW = std::max(noteW, textWidth(r.label));
+        } else {
+            labelW = std::max(labelW, textWidth(r.label));
+            valueW = std::max(valueW, textWidth(r.value));
+        }
+    }
+    const double pad = 9.0 * s;
+    const double innerW = std::max(sampleW + 8 * s + labelW + 10 * s + valueW, noteW);
+    const double panelW = innerW + 2 * pad, panelH = double(rows.size()) * rowH + 2 * pad - 4 * s;
+    const double x0 = w_ - margin - panelW, y0 = margin;
+    box({x0 + 0.5 * panelW, y0 + 0.5 * panelH}, {0.5 * panelW, 0.5 * panelH}, 0.0, kPanel, kFlat, 4.0 * s);
+    box({x0 + 0.5 * panelW, y0 + 0.5 * panelH}, {0.5 * panelW, 0.5 * panelH}, 0.0, kPanelBorder, kOutline, 4.0 * s);
+    double yTop = y0 + panelH - pad;
+    for (const Row& r : rows) {
+        const double mid = std::floor(yTop - 0.5 * textHeight()) + 0.5;
+        double x = x0 + pad;
+        if (r.kind == 3) {
+            text(x, yTop, r.label, kTextDim);
+        } else {
+            if (r.kind == 0) arrow({x, mid}, {x + sampleW, mid}, 2.0, withAlpha(r.colour, 1.0f));
+            if (r.kind == 1) box({x + 0.5 * sampleW, mid}, {0.5 * sampleW, 4.0 * s}, 0.0, r.colour, kOutline);
+            if (r.kind == 2) segment({x, mid}, {x + sampleW, mid}, 1.6, r.colour);
+            x += sampleW + 8 * s;
+            text(x, yTop, r.label, kText);
+            text(x + labelW + 10 * s, yTop, r.value, kTextDim);
+        }
+        yTop -= rowH;
+    }
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------
+
+const std::vector<std::pair<std::string_view, Overlay>>& overlayNames() {
+    static const std::vector<std::pair<std::string_view, Overlay>> names = {
+        {"velocity", Overlay::Velocity}, {"velocity-field", Overlay::VelocityField},
+        {"force-field", Overlay::ForceField}, {"force", Overlay::Force},
+        {"contacts", Overlay::Contacts}, {"aabb", Overlay::Aabb},
+        {"trails", Overlay::Trails},
+    };
+    return names;
+}
+
+Result<OverlaySet> parseOverlayList(std::string_view list) {
+    OverlaySet set;
+    std::size_t start = 0;
+    while (start <= list.size()) {
+        std::size_t comma = list.find(',', start);
+        if (comma == std::string_view::npos) comma = list.size();
+        std::string_view item = list.substr(start, comma - start);
+        while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+        while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
+        if (item == "all") {
+            for (const auto& [name, o] : overlayNames()) set.add(o);
+        } else if (item == "none" || (item.empty() && list.find_first_not_of(' ') == std::string_view::npos)) {
+        } else {
+            bool found = false;
+            for (const auto& [name, o] : overlayNames())
+                if (name == item) { set.add(o); found = true; }
+            if (!found) {
+                std::string known;
+                for (const auto& [name, o] : overlayNames()) known += std::string(known.empty() ? "" : ", ") + std::string(name);
+                return Error{"unknown overlay \"" + std::string(item) + "\"; known overlays: " + known + ", all, none"};
+            }
+        }
+        start = comma + 1;
+    }
+    return set;
+}
+
+Camera fitCamera(const Scene& scene, int widthPx, int heightPx) {
+    Bounds b;
+    const Registry& reg = scene.registry;
+    for (Entity e : reg.entities()) {
+        if (const Position* p = reg.tryGet<Position>(e)) {
+            if (reg.has<Spring>(e)) continue;
+            if (auto half = shapeHalfExtents(scene, e)) {
+                b.add(p->value - *half);
+                b.add(p->value + *half);
+            } else {
+                b.add(p->value, 0.25);
+            }
+        }
+        if (const Spring* s = reg.tryGet<Spring>(e); s && s->anchor) b.add(*s->anchor, 0.25);
+    }
+    // Planes are infinite: show the part nearest the rest of the scene, and
+    // a metre of the solid side so the hatching reads.
+    const Vec2 middle = b.empty() ? Vec2{} : 0.5 * (b.lo + b.hi);
+    reg.each<Plane>([&](Entity, const Plane& p) {
+        const Vec2 q = middle - (dot(p.normal, middle) - p.offset) * p.normal;
+        b.add(q - p.normal * 1.0);
+        b.add(q);
+    });
+    Camera cam;
+    if (b.empty()) return cam;
+    const Vec2 size{std::max(b.hi.x - b.lo.x, 2.0), std::max(b.hi.y - b.lo.y, 2.0)};
+    cam.center = 0.5 * (b.lo + b.hi);
+    // 12% margin each side.
+    const double ppm = std::min(double(widthPx) / (size.x * 1.24), double(heightPx) / (size.y * 1.24));
+    cam.zoom = ppm * 720.0 / double(heightPx);
+    return cam;
+}
+
+Camera sceneCamera(const Scene& scene, int widthPx, int heightPx) {
+    if (scene.view) return Camera{scene.view->center, scene.view->zoom};
+    return fitCamera(scene, widthPx, heightPx);
+}
+
+TrailRecorder::Trail& TrailRecorder::trailFor(Entity e) {
+    if (e.index >= slotOfIndex_.size()) slotOfIndex_.resize(std::size_t(e.index) + 1, 0);
+    std::uint32_t& slot = slotOfIndex_[e.index];
+    if (slot == 0 || trails_[slot - 1].entity != e) {
+        trails_.push_back({e, {}});
+        slot = std::uint32_t(trails_.size());
+    }
+    return trails_[slot - 1];
+}
+
+void TrailRecorder::record(const World& world) {
+    for (std::size_t i = 0; i < world.bodyCount(); ++i) {
+        Trail& t = trailFor(world.bodyEntity(i));
+        t.points.push_back(world.bodyPosition(i));
+        if (t.points.size() > capacity_) t.points.pop_front();
+    }
+}
+
+void TrailRecorder::record(const Scene& scene) {
+    for (Entity e : scene.registry.entities()) {
+        const Position* p = scene.registry.tryGet<Position>(e);
+        if (!p || isStatic(scene, e) || scene.registry.has<Spring>(e)) continue;
+        Trail& t = trailFor(e);
+        t.points.push_back(p->value);
+        if (t.points.size() > capacity_) t.points.pop_front();
+    }
+}
+
+std::size_t floatsPerInstance(BatchKind kind) {
+    switch (kind) {
+    case BatchKind::Plane: return 12;
+    case BatchKind::Disc: return 9;
+    case BatchKind::Box: return 11;
+    case BatchKind::Segment: return 9;
+    case BatchKind::Arrow: return 9;
+    case BatchKind::Solid: return 6;
+    }
+    return 1;
+}
+
+std::size_t Batch::count() const { return data.size() / floatsPerInstance(kind); }
+
+std::size_t DrawData::instanceCount() const {
+    std::size_t n = 0;
+    for (const Batch& b : batches) n += b.count();
+    return n;
+}
+
+DrawData buildDrawData(const FrameInput& input, int widthPx, int heightPx) {
+    DrawData out;
+    out.width = widthPx;
+    out.height = heightPx;
+    out.scales = input.scales;
+    if (!input.scene || widthPx <= 0 || heightPx <= 0) return out;
+    Builder(out, input, widthPx, heightPx).build();
+    return out;
+}
+
+} // namespace stepwise::render

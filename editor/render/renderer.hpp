@@ -1,0 +1,53 @@
+#pragma once
+/// \file renderer.hpp
+/// Submits DrawData to the current OpenGL 3.3 core context: one draw call
+/// per batch (instanced quads), so 10,000 bodies cost one call, not 10,000.
+/// The caller owns the context (OsmesaContext headless, SDL2 in the editor)
+/// and makes it current before create(), draw() and readPixels().
+
+#include "render/frame.hpp"
+#include "render/gl_api.hpp"
+#include "render/image.hpp"
+
+#include "stepwise/result.hpp"
+
+#include <memory>
+
+namespace stepwise::render {
+
+class Renderer {
+public:
+    /// Loads GL entry points through `getProc` and compiles the shaders.
+    /// Fails with the missing entry point or the compiler's log.
+    static Result<std::unique_ptr<Renderer>> create(GetProcAddress getProc);
+    ~Renderer();
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+
+    /// Draws into the currently bound framebuffer, viewport (0,0,w,h) with
+    /// w, h from `data`.
+    void draw(const DrawData& data);
+
+    /// buildDrawData + draw.
+    DrawData render(const FrameInput& input, int widthPx, int heightPx);
+
+    /// Waits until the GPU (llvmpipe: the rasteriser threads) has finished.
+    void finish();
+
+    /// Reads the bound framebuffer back as top-down RGB8 (waits for the GPU).
+    Image readPixels(int widthPx, int heightPx);
+
+    /// "OpenGL 4.5 (Core Profile) Mesa 22.3.6, llvmpipe (LLVM 15.0.6, 256 bits)".
+    std::string describeContext() const;
+
+    /// Number of draw calls issued by the last draw().
+    int lastDrawCalls() const { return drawCalls_; }
+
+private:
+    Renderer() = default;
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    int drawCalls_ = 0;
+};
+
+} // namespace stepwise::render

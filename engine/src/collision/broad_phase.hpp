@@ -1,0 +1,47 @@
+#pragma once
+// Broad phase: candidate pairs whose (fattened) AABBs overlap. Two
+// strategies, chosen by measurement (bench/collision_bench.cpp): sweep and
+// prune on x, and a uniform grid. Both return the same pairs in the same
+// order (sorted by (a, b)), so the solver's result does not depend on which
+// one ran.
+
+#include "collision/collision_types.hpp"
+
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+namespace stepwise::collision {
+
+/// A candidate pair of proxy indices, a < b.
+struct ProxyPair {
+    std::uint32_t a;
+    std::uint32_t b;
+    friend bool operator<(ProxyPair l, ProxyPair r) { return l.a != r.a ? l.a < r.a : l.b < r.b; }
+    friend bool operator==(ProxyPair, ProxyPair) = default;
+};
+
+enum class BroadPhaseKind { SweepAndPrune, UniformGrid, BruteForce };
+
+/// Appends every pair (a < b) whose boxes overlap and where at least one of
+/// the two is movable (`movable[i]`), sorted by (a, b). Scratch buffers live
+/// in the object so steady-state steps allocate nothing.
+class BroadPhase {
+public:
+    explicit BroadPhase(BroadPhaseKind kind = BroadPhaseKind::SweepAndPrune) : kind_(kind) {}
+    void setKind(BroadPhaseKind kind) { kind_ = kind; }
+    BroadPhaseKind kind() const { return kind_; }
+
+    void findPairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
+
+private:
+    void sweepAndPrune(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
+    void uniformGrid(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
+
+    BroadPhaseKind kind_;
+    std::vector<std::uint32_t> order_;  // SAP: proxies sorted by lower.x (kept between steps: nearly sorted)
+    std::vector<std::uint64_t> cellKeys_;  // grid: (cell, proxy) entries
+};
+
+} // namespace stepwise::collision

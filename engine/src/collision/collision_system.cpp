@@ -1,0 +1,234 @@
+#include "collision/collision_system.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace stepwise::collision {
+
+namespace {
+/// Contacts within this distance count as touching; also the base of the
+/// speculative margin. Metres (Box2D's b2_linearSlop).
+constexpr double kLinearSlop = 0.005;
+constexpr double kSpeculativeBase = 4.0 * kLinearSlop;
+
+double msSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+} // namespace
+
+double momentOfInertia(const Shape& shape, double mass) {
+    switch (shape.kind) {
+    case ShapeKind::Circle: return 0.5 * mass * shape.radius * shape.radius;
+    case ShapeKind::Box: {
+        const double w = 2.0 * shape.halfExtents.x, h = 2.0 * shape.halfExtents.y;
+        return mass * (w * w + h * h) / 12.0;
+    }
+    case ShapeKind::Plane: return 0.0;
+    }
+    return 0.0;
+}
+
+void CollisionSystem::add(const Collider& c, double angle, double angularVelocity) {
+    const std::uint32_t index = std::uint32_t(colliders_.size());
+    colliders_.push_back(c);
+    const bool dynamic = c.body >= 0 && c.mass > 0.0;
+    angles_.push_back(angle);
+    angularVelocities_.push_back(dynamic ? angularVelocity : 0.0);
+    invMass_.push_back(dynamic ? 1.0 / c.mass : 0.0);
+    const double inertia = dynamic ? momentOfInertia(c.shape, c.mass) : 0.0;
+    invInertia_.push_back(inertia > 0.0 ? 1.0 / inertia : 0.0);
+    maxExtent_.push_back(c.shape.kind == ShapeKind::Circle ? c.shape.radius : length(c.shape.halfExtents));
+    if (c.shape.kind == ShapeKind::Plane) planes_.push_back(index);
+    else finite_.push_back(index);
+    // SolverBody 0 is the shared static body.
+    if (bodies_.empty()) bodies_.push_back(SolverBody{});
+    if (dynamic) {
+        solverIndex_.push_back(std::uint32_t(bodies_.size()));
+        SolverBody b;
+        b.invMass = invMass_.back();
+        b.invInertia = invInertia_.back();
+        bodies_.push_back(b);
+    } else {
+        solverIndex_.push_back(0);
+    }
+}
+
+void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m,
+                                  std::span<const Vec2> centres) {
+    if (m.pointCount == 0) return;
+    ContactConstraint c;
+    c.colliderA = a;
+    c.colliderB = b;
+    c.bodyA = solverIndex_[a];
+    c.bodyB = solverIndex_[b];
+    c.touchesStatic = c.bodyA == 0 || c.bodyB == 0;
+    c.normal = m.normal;
+    c.friction = std::sqrt(colliders_[a].friction * colliders_[b].friction);
+    c.restitution = std::max(colliders_[a].restitution, colliders_[b].restitution);
+    c.pointCount = m.pointCount;
+    for (int i = 0; i < m.pointCount; ++i) {
+        ContactPoint& p = c.points[i];
+        p.point = m.points[i].point;
+        p.separation = m.points[i].separation;
+        p.id = m.points[i].id;
+        // Planes have no centre: their anchor is the point itself, which is
+        // fine because a plane never moves or turns.
+        p.anchorA = colliders_[a].shape.kind == ShapeKind::Plane ? Vec2{} : p.point - centres[a];
+        p.anchorB = colliders_[b].shape.kind == ShapeKind::Plane ? Vec2{} : p.point - centres[b];
+        if (settings_.warmStart) {
+            const std::uint64_t key = (std::uint64_t(a) << 40) | (std::uint64_t(b) << 16) | (p.id & 0xFFFF);
+            const auto it = std::lower_bound(cache_.begin(), cache_.end(), CachedImpulse{key, 0, 0});
+            if (it != cache_.end() && it->key == key) {
+                p.normalImpulse = it->normal;
+                p.tangentImpulse = it->tangent;
+            }
+        }
+    }
+    constraints_.push_back(c);
+}
+
+void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v, double dt, int substeps) {
+    dt_ = dt;
+    substeps_ = substeps;
+    const auto start = std::chrono::steady_clock::now();
+    const std::size_t n = colliders_.size();
+    centres_.resize(n);
+    margins_.resize(n);
+    stepStart_.resize(n);
+    stepStartAngle_.assign(angles_.begin(), angles_.end());
+    for (std::size_t i = 0; i < n; ++i) {
+        const Collider& c = colliders_[i];
+        centres_[i] = c.body >= 0 ? x[std::size_t(c.body)] : c.staticPosition;
+        stepStart_[i] = centres_[i];
+        // Speculative margin: how far any point of the shape can travel this
+        // step, so a contact exists before a fast body reaches a surface.
+        const double speed = c.body >= 0 ? length(v[std::size_t(c.body)]) : 0.0;
+        margins_[i] = kSpeculativeBase + dt * (speed + std::abs(angularVelocities_[i]) * maxExtent_[i]);
+    }
+
+    boxes_.resize(finite_.size());
+    movable_.resize(finite_.size());
+    for (std::size_t k = 0; k < finite_.size(); ++k) {
+        const std::uint32_t i = finite_[k];
+        Aabb box = computeAabb(colliders_[i].shape, centres_[i], Rot::fromAngle(angles_[i]));
+        const Vec2 fat{margins_[i], margins_[i]};
+        box.lower -= fat;
+        box.upper += fat;
+        boxes_[k] = box;
+        movable_[k] = colliders_[i].body >= 0 ? 1 : 0;
+    }
+    broadPhase_.findPairs(boxes_, movable_, pairs_);
+    timings_.broadPhaseMs = msSince(start);
+
+    const auto narrowStart = std::chrono::steady_clock::now();
+    constraints_.clear();
+    std::vector<Rot>& rots = rotScratch_;
+    rots.resize(n);
+    for (std::size_t i = 0; i < n; ++i) rots[i] = Rot::fromAngle(angles_[i]);
+    for (const ProxyPair& pair : pairs_) {
+        const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
+        const Manifold m = collide(colliders_[a].shape, centres_[a], rots[a], colliders_[b].shape, centres_[b],
+                                   rots[b], margins_[a] + margins_[b]);
+        addManifold(a, b, m, centres_);
+    }
+    // Planes against every movable finite shape: planes are few and infinite,
+    // so they stay out of the broad phase.
+    for (const std::uint32_t p : planes_) {
+        for (const std::uint32_t b : finite_) {
+            if (colliders_[b].body < 0) continue;
+            const Manifold m = collide(colliders_[p].shape, {}, {}, colliders_[b].shape, centres_[b], rots[b],
+                                       margins_[b]);
+            addManifold(p, b, m, centres_);
+        }
+    }
+
+    // Gather velocities into the solver bodies.
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t s = solverIndex_[i];
+        if (s == 0) continue;
+        bodies_[s].v = v[std::size_t(colliders_[i].body)];
+        bodies_[s].w = angularVelocities_[i];
+        bodies_[s].dp = {};
+        bodies_[s].dq = {};
+    }
+    prepareContacts(constraints_, bodies_);
+    timings_.narrowPhaseMs = msSince(narrowStart);
+    timings_.solveMs = 0.0;
+}
+
+void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double h) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::size_t n = colliders_.size();
+    unconstrainedV_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t s = solverIndex_[i];
+        if (s == 0) continue;
+        const std::size_t body = std::size_t(colliders_[i].body);
+        bodies_[s].v = v[body];
+        bodies_[s].w = angularVelocities_[i];
+        unconstrainedV_[i] = v[body];
+    }
+    // Contact stiffness may not exceed a quarter of the substep rate, or the
+    // soft constraint itself becomes unstable (Box2D v3's rule).
+    const double hertz = std::min(settings_.contactHertz, 0.25 / h);
+    const Softness soft = Softness::make(hertz, settings_.dampingRatio, h);
+    const Softness staticSoft = Softness::make(2.0 * hertz, settings_.dampingRatio, h);
+
+    // A row of n touching bodies needs up to n passes; 64 bounds the cost.
+    propagateImpacts(constraints_, bodies_, h, settings_.restitutionThreshold, 64);
+    if (settings_.warmStart) warmStart(constraints_, bodies_);
+    for (int it = 0; it < settings_.iterations; ++it)
+        solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true);
+
+    // Positions: the integrator moved x with the unconstrained velocity; add
+    // the contact velocity change over the substep. Angles integrate here
+    // (only contacts make torque).
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t s = solverIndex_[i];
+        if (s == 0) continue;
+        SolverBody& b = bodies_[s];
+        const std::size_t body = std::size_t(colliders_[i].body);
+        x[body] += h * (b.v - unconstrainedV_[i]);
+        angles_[i] += h * b.w;
+        b.dp = x[body] - stepStart_[i];
+        b.dq = Rot::fromAngle(angles_[i] - stepStartAngle_[i]);
+    }
+    for (int it = 0; it < settings_.relaxIterations; ++it)
+        solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false);
+
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t s = solverIndex_[i];
+        if (s == 0) continue;
+        v[std::size_t(colliders_[i].body)] = bodies_[s].v;
+        angularVelocities_[i] = bodies_[s].w;
+    }
+    timings_.solveMs += msSince(start);
+}
+
+void CollisionSystem::endStep() {
+    cache_.clear();
+    records_.clear();
+    for (const ContactConstraint& c : constraints_) {
+        for (int i = 0; i < c.pointCount; ++i) {
+            const ContactPoint& p = c.points[i];
+            const std::uint64_t key =
+                (std::uint64_t(c.colliderA) << 40) | (std::uint64_t(c.colliderB) << 16) | (p.id & 0xFFFF);
+            cache_.push_back({key, p.normalImpulse, p.tangentImpulse});
+            // Speculative points that never carried load are not contacts.
+            if (p.separation > kLinearSlop && p.normalImpulse == 0.0 && p.restitutionImpulse == 0.0) continue;
+            ContactRecord r;
+            r.a = colliders_[c.colliderA].entity;
+            r.b = colliders_[c.colliderB].entity;
+            r.point = p.point;
+            r.normal = c.normal;
+            r.depth = -p.separation;
+            r.normalImpulse = p.normalImpulse + p.restitutionImpulse;
+            r.tangentImpulse = p.tangentImpulse;
+            records_.push_back(r);
+        }
+    }
+    std::sort(cache_.begin(), cache_.end());
+}
+
+} // namespace stepwise::collision

@@ -1,0 +1,59 @@
+#pragma once
+// Collision data shared by the broad phase, the narrow phase and the contact
+// solver. Internal to the engine.
+
+#include "stepwise/vec2.hpp"
+
+#include <cmath>
+#include <cstdint>
+
+namespace stepwise::collision {
+
+enum class ShapeKind : std::uint8_t { Circle, Box, Plane };
+
+/// Rotation as cosine/sine, so rotating a vector is 4 multiplies.
+struct Rot {
+    double c = 1.0;
+    double s = 0.0;
+    static Rot fromAngle(double angle) { return {std::cos(angle), std::sin(angle)}; }
+};
+inline Vec2 rotate(Rot q, Vec2 v) { return {q.c * v.x - q.s * v.y, q.s * v.x + q.c * v.y}; }
+inline Vec2 invRotate(Rot q, Vec2 v) { return {q.c * v.x + q.s * v.y, -q.s * v.x + q.c * v.y}; }
+/// Perpendicular (counter-clockwise) and the 2D cross products used by
+/// impulse maths: w x r = (-w r.y, w r.x).
+inline Vec2 perp(Vec2 v) { return {-v.y, v.x}; }
+inline Vec2 crossSV(double w, Vec2 r) { return {-w * r.y, w * r.x}; }
+
+/// Geometry of one collider in its body's frame.
+struct Shape {
+    ShapeKind kind = ShapeKind::Circle;
+    double radius = 0.0;      ///< circles, metres
+    Vec2 halfExtents;         ///< boxes, metres
+    Vec2 normal{0.0, 1.0};    ///< planes: unit normal, world frame
+    double offset = 0.0;      ///< planes: dot(normal, p) >= offset is outside
+};
+
+/// One contact point of a manifold.
+struct ManifoldPoint {
+    Vec2 point;               ///< world point midway between the surfaces, metres
+    double separation = 0.0;  ///< signed gap along the normal, metres (< 0: overlap)
+    std::uint32_t id = 0;     ///< feature key for matching across steps (warm start)
+};
+
+/// Contact manifold between shapes A and B; the normal points from A to B.
+struct Manifold {
+    Vec2 normal;
+    ManifoldPoint points[2];
+    int pointCount = 0;
+};
+
+/// Axis-aligned bounding box, metres.
+struct Aabb {
+    Vec2 lower;
+    Vec2 upper;
+};
+inline bool overlaps(const Aabb& a, const Aabb& b) {
+    return a.lower.x <= b.upper.x && b.lower.x <= a.upper.x && a.lower.y <= b.upper.y && b.lower.y <= a.upper.y;
+}
+
+} // namespace stepwise::collision

@@ -1,0 +1,85 @@
+#pragma once
+// Soft-step contact solver (the scheme of Box2D v3's "soft step" and Erin
+// Catto's Solver2D notes): per substep, warm start, solve with a soft
+// position bias, integrate positions, relax without bias. Restitution is
+// applied from the approach speed measured before the solve, as impact
+// propagation, so a Newton's cradle passes one ball's momentum down the row.
+
+#include "collision/collision_types.hpp"
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace stepwise::collision {
+
+/// Velocity state of one collider during the solve. Static colliders share
+/// entry 0, which has zero inverse mass and never moves.
+struct SolverBody {
+    Vec2 v;              ///< m/s
+    double w = 0.0;      ///< rad/s
+    double invMass = 0.0;    ///< 1/kg
+    double invInertia = 0.0; ///< 1/(kg m^2)
+    Vec2 dp;             ///< displacement since the step began, metres
+    Rot dq;              ///< rotation since the step began
+};
+
+/// Soft constraint coefficients for a stiffness (Hz) and damping ratio at a
+/// time step h (Box2D v3's b2MakeSoft).
+struct Softness {
+    double biasRate = 0.0;    ///< 1/s
+    double massScale = 1.0;
+    double impulseScale = 0.0;
+    static Softness make(double hertz, double dampingRatio, double h);
+};
+
+struct ContactPoint {
+    Vec2 anchorA, anchorB;        ///< world-frame offsets from the centres at step start, metres
+    Vec2 point;                   ///< world point at step start
+    double separation = 0.0;      ///< at step start, metres
+    double adjustedSeparation = 0.0;
+    double normalMass = 0.0, tangentMass = 0.0;
+    double normalImpulse = 0.0, tangentImpulse = 0.0;  ///< accumulated, N*s
+    double restitutionImpulse = 0.0;                    ///< from impact propagation, N*s
+    double relativeVelocity = 0.0;  ///< normal approach speed before the solve, m/s
+    std::uint32_t id = 0;
+};
+
+struct ContactConstraint {
+    std::uint32_t colliderA = 0, colliderB = 0;  ///< collider indices (for records and warm starting)
+    std::uint32_t bodyA = 0, bodyB = 0;          ///< SolverBody indices (0 = static)
+    Vec2 normal;                                 ///< from A to B
+    double friction = 0.0, restitution = 0.0;
+    bool touchesStatic = false;
+    int pointCount = 0;
+    ContactPoint points[2];
+};
+
+struct SolverSettings {
+    double contactHertz = 30.0;        ///< contact stiffness, Hz (capped at a quarter of the substep rate)
+    double dampingRatio = 10.0;        ///< heavily over-damped: pushes out without bounce
+    double pushMaxVelocity = 3.0;      ///< m/s; caps the speed of overlap recovery
+    double restitutionThreshold = 1.0; ///< m/s; slower impacts do not bounce (resting contact stays put)
+    int iterations = 1;                ///< biased solve iterations per substep
+    int relaxIterations = 1;           ///< unbiased iterations per substep
+    bool warmStart = true;
+};
+
+/// Prepares masses and anchors (once per step, after the narrow phase).
+void prepareContacts(std::span<ContactConstraint> contacts, std::span<const SolverBody> bodies);
+
+/// Impact propagation, run at the start of each substep on the
+/// unconstrained velocities: repeatedly applies a pairwise impact
+/// impulse at every manifold that approaches faster than `threshold` (m/s)
+/// and touches within the substep `h`, until none does (or `maxPasses`).
+/// Exact for two-body impacts; passes a cradle's impulse down the row, which
+/// accumulated-impulse restitution cannot do.
+void propagateImpacts(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h,
+                      double threshold, int maxPasses);
+
+void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies);
+/// One Gauss-Seidel pass: normal (soft when useBias) then friction.
+void solveContacts(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h,
+                   const Softness& soft, const Softness& staticSoft, double pushMaxVelocity, bool useBias);
+
+} // namespace stepwise::collision

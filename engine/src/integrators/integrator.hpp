@@ -1,0 +1,63 @@
+#pragma once
+// Time integrators: interchangeable strategies over one state vector, the
+// course notes' takeStep(ParticleSystem*, h). The state is the positions
+// x and velocities v of the dynamic bodies (2n doubles each, interleaved
+// per body, see forces/force_model.hpp). A step reads (x0, v0) and writes
+// (x1, v1) into other buffers, so the world can drop a step that diverged
+// without a copy.
+
+#include "forces/force_model.hpp"
+
+#include <memory>
+#include <optional>
+#include <string_view>
+
+namespace stepwise::detail {
+
+enum class IntegratorKind {
+    ExplicitEuler,      ///< x1 = x0 + h v0, v1 = v0 + h a(x0, v0)            order 1
+    SemiImplicitEuler,  ///< v1 = v0 + h a(x0, v0), x1 = x0 + h v1 (symplectic) order 1
+    Midpoint,           ///< RK2 through the half step (notes' Midpoint Method) order 2
+    Trapezoid,          ///< Heun: average of Euler and Euler-from-Euler       order 2
+    Rk4,                ///< classical Runge-Kutta                             order 4
+    VelocityVerlet,     ///< kick-drift-kick (symplectic)                      order 2
+    ImplicitEuler,      ///< backward Euler, Newton on v1 (L-stable)           order 1
+    ImplicitMidpoint,   ///< implicit midpoint rule (symplectic, A-stable)     order 2
+};
+
+std::optional<IntegratorKind> integratorKind(std::string_view name);
+std::string_view integratorName(IntegratorKind kind);
+bool isImplicit(IntegratorKind kind);
+
+class Integrator {
+public:
+    virtual ~Integrator() = default;
+    /// One step of h seconds from (x0, v0) into (x1, v1). Inputs are not
+    /// changed; outputs never alias inputs. No heap allocation (scratch is
+    /// sized at construction), except inside Eigen's sparse factorisation
+    /// for the implicit methods.
+    virtual void step(const ForceModel& model, const double* x0, const double* v0, double* x1, double* v1,
+                      double h) = 0;
+    /// Force evaluations in the last step (implicit: Newton iterations + 1).
+    virtual int lastEvaluations() const = 0;
+};
+
+/// A strategy for `model`'s body count and structure.
+std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind, const ForceModel& model);
+
+/// Largest h*omega at which `kind` is stable on the damped oscillator
+/// x'' = -omega^2 x - 2 zeta omega x' (spectral radius of the one-step
+/// amplification matrix <= 1), found numerically from the method's own
+/// update formulas. Undamped: explicit Euler, midpoint and trapezoid 0
+/// (they spiral out at any dt), semi-implicit Euler and Verlet 2, RK4
+/// 2*sqrt(2). Implicit methods: +infinity (A-stable).
+double stabilityLimit(IntegratorKind kind, double zeta);
+
+/// Newton tolerance of the implicit solvers: stop when the update is below
+/// this fraction of the velocity scale.
+inline constexpr double kNewtonRelativeTolerance = 1e-13;
+inline constexpr int kNewtonMaxIterations = 30;
+
+std::unique_ptr<Integrator> makeImplicitIntegrator(bool midpointRule, const ForceModel& model);
+
+} // namespace stepwise::detail

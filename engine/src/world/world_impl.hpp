@@ -1,0 +1,56 @@
+#pragma once
+// Internals of World (world.hpp). Tests and benchmarks reach them through
+// the stepwise_engine_internal include path.
+
+#include "forces/force_model.hpp"
+#include "integrators/integrator.hpp"
+#include "stepwise/world.hpp"
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace stepwise {
+
+class WorldImpl {
+public:
+    WorldSettings settings;
+    detail::IntegratorKind kind = detail::IntegratorKind::SemiImplicitEuler;
+    std::unique_ptr<detail::Integrator> integrator;
+    detail::ForceModel model;
+
+    // Double-buffered state: buffers[current] is the state; a step writes
+    // the other one and flips `current` only if it stayed finite.
+    std::vector<double> x[2], v[2];
+    int current = 0;
+    // Start-of-step copy, only needed with substeps > 1 (the intermediate
+    // substeps overwrite both buffers).
+    std::vector<double> backupX, backupV;
+
+    // Bodies with angle and angular_velocity (angle += h * omega).
+    std::vector<std::uint32_t> spinBody;  ///< dynamic body index
+    std::vector<double> angle, angularVelocity, angleBackup;
+
+    std::vector<Entity> bodyEntity;
+    std::vector<std::uint32_t> bodySceneIndex;  ///< place in the scene order (messages, "entity N")
+    std::vector<std::string> bodyName;
+    std::vector<std::string> springName;         ///< per model spring: name or "entity N"
+
+    std::vector<std::string_view> active;
+    StepStats stats;
+    std::vector<ContactRecord> contacts;  ///< empty: collisions are another issue
+    bool profiling = true;
+
+    const double* xs() const { return x[current].data(); }
+    const double* vs() const { return v[current].data(); }
+    double* xs() { return x[current].data(); }
+    double* vs() { return v[current].data(); }
+
+    /// "step 42: entity 3 (\"ball\"): velocity.x became inf", or "" if the
+    /// state is finite.
+    std::string findNonFinite(std::uint64_t stepNumber) const;
+    void setIntegratorKind(detail::IntegratorKind k);
+};
+
+} // namespace stepwise

@@ -1,0 +1,44 @@
+// Instanced line segments with round caps (springs, trails, scale bar) and
+// arrows (same layout; the fragment shader adds the head). One quad (4
+// vertices) per segment, two per arrow (a thin quad around the shaft and
+// one around the head), so thousands of arrows shade little more than the
+// pixels they cover.
+uniform bool uArrow;
+layout(location = 0) in vec2 aFrom;     // pixels
+layout(location = 1) in vec2 aTo;       // pixels
+layout(location = 2) in float aWidth;   // pixels
+layout(location = 3) in vec4 aColor;
+out vec2 vLocal;                        // x along the segment from aFrom, y across, pixels
+flat out float vLength;
+flat out float vWidth;
+flat out vec4 vColor;
+void main() {
+    vec2 delta = aTo - aFrom;
+    float len = length(delta);
+    vec2 axis = len > 1e-6 ? delta / len : vec2(1.0, 0.0);
+    vec2 side = vec2(-axis.y, axis.x);
+    vec2 c = quadCorner();
+    float halfW = aWidth * 0.5 + 1.0;  // half the line plus a pixel of anti-aliasing
+    float u;
+    float v;
+    if (!uArrow) {
+        u = c.x < 0.0 ? -halfW : len + halfW;
+        v = c.y * halfW;
+    } else {
+        // Same head size as arrow.frag.
+        float headLen = min(4.5 + 3.0 * aWidth, 0.6 * len);
+        float shaftEnd = len - headLen;
+        if ((gl_VertexID & 4) == 0) {  // vertices 0-3 of the record: the shaft
+            u = c.x < 0.0 ? -halfW : shaftEnd + 1.0;
+            v = c.y * halfW;
+        } else {
+            u = c.x < 0.0 ? shaftEnd - 1.0 : len + 1.5;
+            v = c.y * (0.55 * headLen + 1.5);
+        }
+    }
+    vLocal = vec2(u, v);
+    vLength = len;
+    vWidth = aWidth;
+    vColor = aColor;
+    gl_Position = pixelToClip(aFrom + axis * u + side * v);
+}

@@ -1,0 +1,311 @@
+// Collision detection and response against analytic answers. These tests
+// drive the collision stages directly with a minimal semi-implicit Euler
+// loop, so a failure points at the collision code, not the integrators.
+
+#include "collision/collision_system.hpp"
+#include "collision/narrow_phase.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+using namespace stepwise;
+using namespace stepwise::collision;
+
+namespace {
+
+Shape circle(double r) { return Shape{ShapeKind::Circle, r, {}, {}, 0.0}; }
+Shape box(double w, double h) { return Shape{ShapeKind::Box, 0.0, {w / 2, h / 2}, {}, 0.0}; }
+Shape plane(Vec2 n, double offset) { return Shape{ShapeKind::Plane, 0.0, {}, n / length(n), offset / length(n)}; }
+
+/// The smallest world that exercises the collision pipeline the way World
+/// does: detect once per step, then per substep integrate (gravity,
+/// semi-implicit Euler) and solve contacts.
+struct MiniWorld {
+    CollisionSystem collision;
+    std::vector<Vec2> x, v;
+    std::vector<double> mass;
+    Vec2 gravity{0.0, 0.0};
+    int substeps = 4;
+
+    int dynamic(const Shape& s, Vec2 p, Vec2 vel, double m, double e = 0.0, double f = 0.2, double angle = 0.0) {
+        const int body = int(x.size());
+        x.push_back(p);
+        v.push_back(vel);
+        mass.push_back(m);
+        Collider c;
+        c.shape = s;
+        c.body = body;
+        c.mass = m;
+        c.restitution = e;
+        c.friction = f;
+        c.entity = Entity{std::uint32_t(collision.colliderCount()), 0};
+        collision.add(c, angle, 0.0);
+        return body;
+    }
+    void fixed(const Shape& s, Vec2 p, double e = 0.0, double f = 0.2, double angle = 0.0) {
+        Collider c;
+        c.shape = s;
+        c.staticPosition = p;
+        c.restitution = e;
+        c.friction = f;
+        c.entity = Entity{std::uint32_t(collision.colliderCount()), 0};
+        collision.add(c, angle, 0.0);
+    }
+    void step(double dt) {
+        collision.beginStep(x, v, dt, substeps);
+        const double h = dt / substeps;
+        for (int s = 0; s < substeps; ++s) {
+            for (std::size_t i = 0; i < x.size(); ++i) {
+                v[i] += h * gravity;
+                x[i] += h * v[i];
+            }
+            collision.solveSubstep(x, v, h);
+        }
+        collision.endStep();
+    }
+    double kinetic() const {
+        double k = 0.0;
+        for (std::size_t i = 0; i < x.size(); ++i) k += 0.5 * mass[i] * lengthSquared(v[i]);
+        for (std::size_t c = 0; c < collision.colliderCount(); ++c) {
+            const Collider& col = collision.collider(c);
+            if (col.body < 0) continue;
+            const double w = collision.angularVelocity(c);
+            k += 0.5 * momentOfInertia(col.shape, col.mass) * w * w;
+        }
+        return k;
+    }
+    Vec2 momentum() const {
+        Vec2 p;
+        for (std::size_t i = 0; i < x.size(); ++i) p += mass[i] * v[i];
+        return p;
+    }
+};
+
+} // namespace
+
+// ---------------------------------------------------------------- narrow phase
+
+TEST(NarrowPhase, CirclesOverlapAlongTheLineOfCentres) {
+    const Manifold m = collideCircles(1.0, {0, 0}, 0.5, {1.2, 0.9}, 0.0);  // distance 1.5
+    ASSERT_EQ(m.pointCount, 1);
+    EXPECT_NEAR(m.normal.x, 0.8, 1e-15);
+    EXPECT_NEAR(m.normal.y, 0.6, 1e-15);
+    EXPECT_NEAR(m.points[0].separation, 0.0, 1e-15);
+    EXPECT_EQ(collideCircles(1.0, {0, 0}, 0.5, {3.0, 0.0}, 0.0).pointCount, 0);
+    EXPECT_EQ(collideCircles(1.0, {0, 0}, 0.5, {3.0, 0.0}, 1.6).pointCount, 1) << "speculative margin";
+}
+
+TEST(NarrowPhase, BoxRestingOnBoxGivesTwoPointsWithTheOverlap) {
+    // 1x1 box whose bottom is 0.01 m into a 4x1 ground box.
+    const Manifold m = collideBoxes({2.0, 0.5}, {0, 0}, Rot{}, {0.5, 0.5}, {0.3, 0.99}, Rot{}, 0.0);
+    ASSERT_EQ(m.pointCount, 2);
+    EXPECT_NEAR(m.normal.x, 0.0, 1e-15);
+    EXPECT_NEAR(m.normal.y, 1.0, 1e-15);
+    for (int i = 0; i < 2; ++i) EXPECT_NEAR(m.points[i].separation, -0.01, 1e-12);
+    EXPECT_NEAR(std::abs(m.points[0].point.x - m.points[1].point.x), 1.0, 1e-12);
+}
+
+TEST(NarrowPhase, RotatedBoxCornerOnPlane) {
+    // A unit box turned 45 degrees: its lowest corner is sqrt(2)/2 below the centre.
+    const double halfDiagonal = std::sqrt(0.5);
+    const Manifold m = collidePlaneBox({0, 1}, 0.0, {0.5, 0.5}, {0.0, halfDiagonal - 0.02},
+                                       Rot::fromAngle(std::numbers::pi / 4), 0.0);
+    ASSERT_EQ(m.pointCount, 1);
+    EXPECT_NEAR(m.points[0].separation, -0.02, 1e-12);
+    EXPECT_NEAR(m.points[0].point.x, 0.0, 1e-12);
+}
+
+TEST(NarrowPhase, CircleAgainstBoxFaceAndCorner) {
+    Manifold face = collideBoxCircle({1.0, 0.5}, {0, 0}, Rot{}, 0.25, {0.2, 0.7}, 0.0);
+    ASSERT_EQ(face.pointCount, 1);
+    EXPECT_NEAR(face.normal.y, 1.0, 1e-15);
+    EXPECT_NEAR(face.points[0].separation, -0.05, 1e-12);
+    Manifold corner = collideBoxCircle({1.0, 0.5}, {0, 0}, Rot{}, 0.5, {1.3, 0.9}, 0.0);  // 0.5 from the corner
+    ASSERT_EQ(corner.pointCount, 1);
+    EXPECT_NEAR(corner.normal.x, 0.6, 1e-12);
+    EXPECT_NEAR(corner.normal.y, 0.8, 1e-12);
+    EXPECT_NEAR(corner.points[0].separation, 0.0, 1e-12);
+}
+
+TEST(BroadPhase, StrategiesAgreeWithBruteForce) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> pos(-20, 20), size(0.1, 2.0);
+    std::vector<Aabb> boxes;
+    std::vector<std::uint8_t> movable;
+    for (int i = 0; i < 500; ++i) {
+        const Vec2 p{pos(rng), pos(rng)};
+        const Vec2 h{size(rng), size(rng)};
+        boxes.push_back({p - h, p + h});
+        movable.push_back(i % 5 != 0);
+    }
+    boxes.push_back({{-30, -25}, {30, -21}});  // a long wall
+    movable.push_back(0);
+    std::vector<ProxyPair> brute, sap, grid;
+    BroadPhase(BroadPhaseKind::BruteForce).findPairs(boxes, movable, brute);
+    BroadPhase(BroadPhaseKind::SweepAndPrune).findPairs(boxes, movable, sap);
+    BroadPhase(BroadPhaseKind::UniformGrid).findPairs(boxes, movable, grid);
+    EXPECT_GT(brute.size(), 100u);
+    EXPECT_EQ(sap, brute);
+    EXPECT_EQ(grid, brute);
+}
+
+// ---------------------------------------------------------------- response
+
+TEST(Collision, HeadOnElasticUnequalMassesMatchTheCourseNotesFormula) {
+    MiniWorld w;
+    const double m1 = 1.0, m2 = 3.0, v1 = 2.0, v2 = -1.0;
+    w.dynamic(circle(0.5), {-2.0, 0.0}, {v1, 0.0}, m1, 1.0, 0.0);
+    w.dynamic(circle(0.5), {1.0, 0.0}, {v2, 0.0}, m2, 1.0, 0.0);
+    for (int i = 0; i < 120; ++i) w.step(1.0 / 60.0);
+    // v1+ = v1 - 2 m2/(m1+m2) (v1-v2), v2+ = v2 + 2 m1/(m1+m2) (v1-v2)
+    EXPECT_NEAR(w.v[0].x, v1 - 2 * m2 / (m1 + m2) * (v1 - v2), 1e-9);
+    EXPECT_NEAR(w.v[1].x, v2 + 2 * m1 / (m1 + m2) * (v1 - v2), 1e-9);
+    EXPECT_NEAR(w.v[0].y, 0.0, 1e-12);
+}
+
+TEST(Collision, ObliqueEqualMassesLeaveAtRightAnglesKeepingMomentumAndEnergy) {
+    MiniWorld w;
+    w.dynamic(circle(0.5), {-3.0, 0.37}, {2.0, 0.0}, 1.0, 1.0, 0.0);
+    w.dynamic(circle(0.5), {0.0, 0.0}, {0.0, 0.0}, 1.0, 1.0, 0.0);
+    const Vec2 p0 = w.momentum();
+    const double e0 = w.kinetic();
+    for (int i = 0; i < 120; ++i) w.step(1.0 / 60.0);
+    ASSERT_GT(length(w.v[1]), 0.1) << "the balls must have collided";
+    EXPECT_NEAR(dot(w.v[0], w.v[1]) / (length(w.v[0]) * length(w.v[1])), 0.0, 1e-9);
+    EXPECT_NEAR(length(w.momentum() - p0) / length(p0), 0.0, 1e-9);
+    EXPECT_NEAR((w.kinetic() - e0) / e0, 0.0, 1e-9);
+}
+
+TEST(Collision, PerfectlyInelasticMovesOnTogether) {
+    MiniWorld w;
+    w.dynamic(circle(0.5), {-2.0, 0.0}, {3.0, 0.0}, 2.0, 0.0, 0.0);
+    w.dynamic(circle(0.5), {1.0, 0.0}, {0.0, 0.0}, 1.0, 0.0, 0.0);
+    for (int i = 0; i < 90; ++i) w.step(1.0 / 60.0);
+    const double common = (2.0 * 3.0) / 3.0;
+    EXPECT_NEAR(w.v[0].x, common, 1e-6);
+    EXPECT_NEAR(w.v[1].x, common, 1e-6);
+    EXPECT_NEAR(w.momentum().x, 6.0, 1e-12);
+}
+
+TEST(Collision, BounceApexScalesWithRestitutionSquared) {
+    for (double e : {0.5, 0.8}) {
+        MiniWorld w;
+        w.gravity = {0.0, -9.81};
+        w.fixed(plane({0, 1}, 0.0), {}, e);
+        const double drop = 2.0;
+        w.dynamic(circle(0.25), {0.0, 0.25 + drop}, {0.0, 0.0}, 1.0, e, 0.0);
+        double apex = 0.0;
+        bool bounced = false;
+        for (int i = 0; i < 600; ++i) {
+            w.step(1.0 / 240.0);
+            if (w.v[0].y > 0.0) bounced = true;
+            if (bounced && w.v[0].y <= 0.0) {
+                apex = w.x[0].y - 0.25;
+                break;
+            }
+        }
+        ASSERT_TRUE(bounced);
+        // Discrete time: the apex is found to within one step of travel.
+        EXPECT_NEAR(apex / drop, e * e, 0.02) << "e = " << e;
+    }
+}
+
+TEST(Collision, NoTunnellingThroughPlanesOrThinBoxesAt600MetresPerSecond) {
+    MiniWorld w;
+    w.substeps = 1;
+    w.fixed(plane({-1, 0}, -10.0), {});          // wall at x = 10, facing -x
+    w.fixed(box(0.05, 4.0), {0.0, -10.0});        // 5 cm thick static wall at x = 0
+    w.dynamic(circle(0.1), {-30.0, 0.0}, {600.0, 0.0}, 1.0);
+    w.dynamic(circle(0.1), {-30.0, -10.0}, {600.0, 0.0}, 1.0);
+    w.dynamic(box(0.2, 0.2), {-30.0, -9.0}, {600.0, 0.0}, 1.0);
+    double maxX0 = -1e9, maxX1 = -1e9, maxX2 = -1e9;
+    for (int i = 0; i < 30; ++i) {
+        w.step(1.0 / 60.0);
+        maxX0 = std::max(maxX0, w.x[0].x);
+        maxX1 = std::max(maxX1, w.x[1].x);
+        maxX2 = std::max(maxX2, w.x[2].x);
+    }
+    EXPECT_LE(maxX0, 10.0 - 0.1 + 0.01) << "through the plane";
+    EXPECT_LE(maxX1, -0.025 - 0.1 + 0.01) << "through the thin box";
+    EXPECT_LE(maxX2, -0.025 - 0.1 + 0.01) << "box through the thin box";
+}
+
+TEST(Collision, NewtonsCradleOneBallInOneBallOut) {
+    MiniWorld w;
+    const int n = 5;
+    w.dynamic(circle(0.5), {-3.0, 0.0}, {2.0, 0.0}, 1.0, 1.0, 0.0);
+    for (int i = 1; i < n; ++i) w.dynamic(circle(0.5), {double(i - 1), 0.0}, {0.0, 0.0}, 1.0, 1.0, 0.0);
+    for (int i = 0; i < 120; ++i) w.step(1.0 / 60.0);
+    for (int i = 0; i < n - 1; ++i) EXPECT_NEAR(length(w.v[i]), 0.0, 1e-9) << "ball " << i << " should be still";
+    EXPECT_NEAR(w.v[n - 1].x, 2.0, 1e-9);
+}
+
+namespace {
+/// Box pyramid on static ground; returns the world and sets `top`.
+MiniWorld pyramid(int rows, int& top) {
+    MiniWorld w;
+    w.gravity = {0.0, -10.0};
+    w.fixed(box(100.0, 1.0), {0.0, -0.5}, 0.0, 0.6);
+    const double size = 1.0;
+    for (int row = 0; row < rows; ++row) {
+        for (int i = 0; i < rows - row; ++i) {
+            const double x = (i - (rows - row - 1) * 0.5) * size * 1.05;
+            top = w.dynamic(box(size, size), {x, 0.5 * size + row * size}, {}, 1.0, 0.0, 0.6);
+        }
+    }
+    return w;
+}
+} // namespace
+
+TEST(Collision, TwentyRowPyramidStandsStillForTenSeconds) {
+    int top = 0;
+    MiniWorld w = pyramid(20, top);
+    const Vec2 start = w.x[std::size_t(top)];
+    double deepest = 0.0;
+    for (int i = 0; i < 600; ++i) {
+        w.step(1.0 / 60.0);
+        for (const ContactRecord& c : w.collision.contacts()) deepest = std::max(deepest, c.depth);
+    }
+    const double drift = length(w.x[std::size_t(top)] - start);
+    EXPECT_LT(drift, 0.02) << "top box drifted";
+    EXPECT_LT(w.kinetic(), 1e-3);
+    EXPECT_LT(deepest, 0.02);
+}
+
+TEST(Collision, HeavyBoxRestsOnLightBoxes) {
+    MiniWorld w;
+    w.gravity = {0.0, -10.0};
+    w.fixed(plane({0, 1}, 0.0), {}, 0.0, 0.6);
+    w.dynamic(box(0.5, 0.5), {-1.0, 0.25}, {}, 1.0, 0.0, 0.6);
+    w.dynamic(box(0.5, 0.5), {1.0, 0.25}, {}, 1.0, 0.0, 0.6);
+    const int heavy = w.dynamic(box(3.0, 0.5), {0.0, 0.75}, {}, 100.0, 0.0, 0.6);
+    for (int i = 0; i < 600; ++i) w.step(1.0 / 60.0);
+    EXPECT_NEAR(w.x[std::size_t(heavy)].y, 0.75, 0.02) << "sank into the small boxes";
+    EXPECT_NEAR(w.x[std::size_t(heavy)].x, 0.0, 0.01);
+    EXPECT_LT(w.kinetic(), 1e-3);
+}
+
+TEST(Collision, PileOfCirclesSettlesWithoutEscapes) {
+    MiniWorld w;
+    w.gravity = {0.0, -10.0};
+    w.fixed(plane({0, 1}, 0.0), {});
+    w.fixed(plane({1, 0}, -5.0), {});
+    w.fixed(plane({-1, 0}, -5.0), {});
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+    for (int i = 0; i < 400; ++i)
+        w.dynamic(circle(0.2 + 0.05 * (i % 3)), {-4.5 + 0.6 * (i % 16) + jitter(rng), 0.5 + 0.6 * (i / 16)}, {}, 1.0, 0.1, 0.4);
+    for (int i = 0; i < 900; ++i) w.step(1.0 / 60.0);
+    double deepest = 0.0;
+    for (const ContactRecord& c : w.collision.contacts()) deepest = std::max(deepest, c.depth);
+    for (std::size_t i = 0; i < w.x.size(); ++i) {
+        ASSERT_GE(w.x[i].x, -5.0) << i;
+        ASSERT_LE(w.x[i].x, 5.0) << i;
+        ASSERT_GE(w.x[i].y, 0.0) << i;
+    }
+    EXPECT_LT(deepest, 0.01);
+    EXPECT_LT(w.kinetic() / 400.0, 1e-4) << "mean kinetic energy per body at rest, J";
+}

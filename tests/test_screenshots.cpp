@@ -1,0 +1,260 @@
+// Screenshot regression tests (ctest label `screenshot`).
+//
+// Every level in levels/ is rendered with the fixed recipe in
+// editor/render/screenshot.hpp and compared with screenshots/<level>.png.
+// Regenerate the goldens (after a deliberate visual change, and look at
+// them) with:
+//     cmake --build build --target update-goldens
+// which runs this binary with STEPWISE_UPDATE_GOLDENS=1.
+
+#include "render/screenshot.hpp"
+
+#include "stepwise/components.hpp"
+#include "stepwise/scene_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using namespace stepwise;
+using namespace stepwise::render;
+
+namespace {
+
+const fs::path kSource = STEPWISE_SOURCE_DIR;
+const fs::path kFailures = fs::path(STEPWISE_BUILD_DIR) / "screenshot-failures";
+
+OffscreenRenderer& headless() {
+    const ScreenshotSettings settings;
+    static std::unique_ptr<OffscreenRenderer> renderer = [&] {
+        auto created = OffscreenRenderer::create(settings.width, settings.height);
+        if (!created) {
+            std::fprintf(stderr, "cannot create the headless renderer: %s\n", created.error().c_str());
+            std::abort();
+        }
+        return std::move(*created);
+    }();
+    return *renderer;
+}
+
+bool updating() {
+    const char* v = std::getenv("STEPWISE_UPDATE_GOLDENS");
+    return v && std::string(v) == "1";
+}
+
+std::string readFile(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+/// Compares against the golden; on failure writes actual + diff images and
+/// returns a message with their paths, the count and the bounding box.
+::testing::AssertionResult matchesGolden(const Image& actual, const fs::path& golden, const std::string& stem) {
+    const ScreenshotSettings settings;
+    Result<Image> expected = readPng(golden.string());
+    if (!expected)
+        return ::testing::AssertionFailure()
+               << expected.error() << "\n  (no golden? regenerate: cmake --build build --target update-goldens)";
+    const ImageDiff diff = compareImages(*expected, actual, settings.channelTolerance);
+    const bool ok = diff.sameSize && diff.fraction() <= settings.maxDifferingFraction;
+    if (ok) return ::testing::AssertionSuccess();
+    fs::create_directories(kFailures);
+    const fs::path actualPath = kFailures / (stem + "-actual.png");
+    const fs::path diffPath = kFailures / (stem + "-diff.png");
+    (void)writeFileAtomically(actualPath, encodePng(actual));
+    if (diff.sameSize) (void)writeFileAtomically(diffPath, encodePng(diff.visual));
+    auto failure = ::testing::AssertionFailure();
+    if (!diff.sameSize) {
+        failure << "size differs: golden " << expected->width << "x" << expected->height << ", actual "
+                << actual.width << "x" << actual.height;
+    } else {
+        failure << diff.differing << " of " << diff.total << " pixels differ by more than "
+                << settings.channelTolerance << "/255 (" << 100.0 * diff.fraction() << "%, allowed "
+                << 100.0 * settings.maxDifferingFraction << "%), within x " << diff.x0 << ".." << diff.x1
+                << ", y " << diff.y0 << ".." << diff.y1 << " (top-left origin); largest delta " << diff.maxDelta;
+    }
+    failure << "\n  golden: " << golden.string() << "\n  actual: " << actualPath.string();
+    if (diff.sameSize) failure << "\n  diff:   " << diffPath.string() << " (differing pixels in magenta)";
+    return failure;
+}
+
+std::vector<std::string> levelStems() {
+    std::vector<std::string> stems;
+    for (const fs::path& p : listLevels(kSource / "levels")) stems.push_back(p.stem().string());
+    return stems;
+}
+
+class LevelScreenshot : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(LevelScreenshot, MatchesGolden) {
+    const std::string stem = GetParam();
+    const fs::path level = kSource / "levels" / (stem + ".json");
+    const fs::path golden = kSource / "screenshots" / (stem + ".png");
+    Result<Screenshot> shot = renderLevelScreenshot(headless(), level);
+    ASSERT_TRUE(shot.ok()) << shot.error();
+    if (!shot->note.empty()) std::printf("%s: drawn at step 0: %s\n", stem.c_str(), shot->note.c_str());
+    if (updating()) {
+        Result<void> written = writeFileAtomically(golden, encodePng(shot->image));
+        ASSERT_TRUE(written.ok()) << written.error();
+        std::printf("updated %s\n", golden.string().c_str());
+        return;
+    }
+    EXPECT_TRUE(matchesGolden(shot->image, golden, stem));
+}
+
+INSTANTIATE_TEST_SUITE_P(Levels, LevelScreenshot, ::testing::ValuesIn(levelStems()),
+                         [](const ::testing::TestParamInfo<std::string>& param) {
+                             std::string name = param.param;
+                             for (char& c : name)
+                                 if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                             return name;
+                         });
+
+// Levels added after this binary was built are not in the list above; this
+// test reads levels/ at run time so a level without a golden still fails.
+TEST(Screenshots, EveryLevelHasAGolden) {
+    for (const fs::path& level : listLevels(kSource / "levels")) {
+        const fs::path golden = kSource / "screenshots" / (level.stem().string() + ".png");
+        EXPECT_TRUE(fs::exists(golden)) << level.string() << " has no golden " << golden.string()
+                                        << "; run: cmake --build build --target update-goldens";
+    }
+}
+
+// ---- the tolerance catches what matters and forgives what does not -------
+
+Scene showcase() {
+    Result<Scene> scene = loadSceneFile(kSource / "levels" / "render_showcase.json");
+    if (!scene) ADD_FAILURE() << scene.error();
+    return scene ? std::move(*scene) : Scene{};
+}
+
+Entity entityNamed(const Scene& scene, const std::string& name) {
+    for (Entity e : scene.registry.entities())
+        if (const Name* n = scene.registry.tryGet<Name>(e); n && n->value == name) return e;
+    return {};
+}
+
+TEST(Screenshots, MovedBodyFailsTheComparison) {
+    Scene scene = showcase();
+    // Pin the camera: a fitted camera would follow the moved body's bounds.
+    const ScreenshotSettings fixed;
+    const Camera cam = fitCamera(scene, fixed.width, fixed.height);
+    scene.view = View{cam.center, cam.zoom};
+    Result<Screenshot> before = renderSceneScreenshot(headless(), scene, "showcase");
+    ASSERT_TRUE(before.ok()) << before.error();
+    // Move the ball 0.3 m (about a third of its diameter) to the right.
+    Entity ball = entityNamed(scene, "ball");
+    ASSERT_FALSE(ball.isNull());
+    scene.registry.tryGet<Position>(ball)->value.x += 0.3;
+    Result<Screenshot> after = renderSceneScreenshot(headless(), scene, "showcase");
+    ASSERT_TRUE(after.ok()) << after.error();
+    const ScreenshotSettings settings;
+    const ImageDiff diff = compareImages(before->image, after->image, settings.channelTolerance);
+    EXPECT_GT(diff.fraction(), settings.maxDifferingFraction)
+        << "a moved body must fail the screenshot comparison; only " << diff.differing << " pixels differ";
+    // ... and the difference is where the ball is, not all over the image.
+    EXPECT_LT(diff.x1 - diff.x0, settings.width / 4);
+    EXPECT_LT(diff.y1 - diff.y0, settings.height / 4);
+}
+
+TEST(Screenshots, RecolouredBodyFailsTheComparison) {
+    Scene scene = showcase();
+    Result<Screenshot> before = renderSceneScreenshot(headless(), scene, "showcase");
+    ASSERT_TRUE(before.ok());
+    scene.registry.tryGet<Color>(entityNamed(scene, "crate"))->value = Rgb{0.2, 0.4, 0.9};
+    Result<Screenshot> after = renderSceneScreenshot(headless(), scene, "showcase");
+    ASSERT_TRUE(after.ok());
+    const ScreenshotSettings settings;
+    EXPECT_GT(compareImages(before->image, after->image, settings.channelTolerance).fraction(),
+              settings.maxDifferingFraction);
+}
+
+TEST(Screenshots, SmallRasterNoisePassesTheComparison) {
+    // What a Mesa update typically does: every channel a few levels off,
+    // plus a scatter of edge pixels that flip completely.
+    Result<Screenshot> shot = renderLevelScreenshot(headless(), kSource / "levels" / "render_showcase.json");
+    ASSERT_TRUE(shot.ok());
+    Image noisy = shot->image;
+    unsigned state = 12345;
+    std::size_t flipped = 0;
+    for (std::size_t i = 0; i < noisy.rgb.size(); ++i) {
+        state = state * 1103515245u + 12345u;
+        const int delta = int((state >> 16) % 17) - 8;  // -8..8
+        noisy.rgb[i] = std::uint8_t(std::clamp(int(noisy.rgb[i]) + delta, 0, 255));
+    }
+    for (std::size_t p = 0; p < noisy.rgb.size() / 3; p += 5003, ++flipped)
+        noisy.rgb[p * 3] = std::uint8_t(255 - noisy.rgb[p * 3]);
+    const ScreenshotSettings settings;
+    const ImageDiff diff = compareImages(shot->image, noisy, settings.channelTolerance);
+    EXPECT_LE(diff.fraction(), settings.maxDifferingFraction) << diff.differing << " pixels differ";
+    EXPECT_GT(diff.differing, 0u);  // the flipped pixels do count, just not enough to fail
+}
+
+TEST(Screenshots, FailureWritesActualAndDiffImages) {
+    Result<Screenshot> shot = renderLevelScreenshot(headless(), kSource / "levels" / "render_showcase.json");
+    ASSERT_TRUE(shot.ok());
+    Image broken = shot->image;
+    // A white block in the dark top-right corner: 60 x 40 pixels.
+    for (int y = 60; y < 100; ++y)
+        for (int x = 880; x < 940; ++x) {
+            std::uint8_t* p = broken.pixel(x, y);
+            p[0] = p[1] = p[2] = 255;
+        }
+    fs::path golden = fs::path(STEPWISE_BUILD_DIR) / "golden-under-test.png";
+    ASSERT_TRUE(writeFileAtomically(golden, encodePng(shot->image)).ok());
+    const ::testing::AssertionResult r = matchesGolden(broken, golden, "self_test");
+    ASSERT_FALSE(r);
+    const std::string message = r.message();
+    EXPECT_NE(message.find("2400 of 518400 pixels differ"), std::string::npos) << message;
+    EXPECT_NE(message.find("x 880..939, y 60..99"), std::string::npos) << message;
+    EXPECT_TRUE(fs::exists(kFailures / "self_test-actual.png"));
+    EXPECT_TRUE(fs::exists(kFailures / "self_test-diff.png"));
+    Result<Image> diffImage = readPng((kFailures / "self_test-diff.png").string());
+    ASSERT_TRUE(diffImage.ok());
+    const std::uint8_t* magenta = diffImage->pixel(900, 70);
+    EXPECT_EQ(magenta[0], 255);
+    EXPECT_EQ(magenta[1], 0);
+    EXPECT_EQ(magenta[2], 255);
+    fs::remove(golden);
+}
+
+// ---- determinism ---------------------------------------------------------
+
+TEST(Screenshots, SameBuildRendersIdenticalBytesTwiceInProcess) {
+    for (const std::string level : {"render_showcase", "orbit"}) {
+        const fs::path path = kSource / "levels" / (level + ".json");
+        if (!fs::exists(path)) continue;
+        Result<Screenshot> a = renderLevelScreenshot(headless(), path);
+        Result<Screenshot> b = renderLevelScreenshot(headless(), path);
+        ASSERT_TRUE(a.ok() && b.ok());
+        EXPECT_EQ(encodePng(a->image), encodePng(b->image)) << level;
+    }
+}
+
+int runCli(const std::string& args) {
+    const int status = std::system((std::string(STEPWISE_BINARY) + " " + args).c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(Screenshots, SameBuildRendersIdenticalBytesTwiceAcrossProcesses) {
+    const fs::path dir = fs::path(STEPWISE_BUILD_DIR) / "screenshot-determinism";
+    fs::create_directories(dir);
+    const std::string level = (kSource / "levels" / "render_showcase.json").string();
+    const std::string common = "render " + level + " --width 640 --height 360 --overlay velocity,aabb,trails --select ball";
+    ASSERT_EQ(runCli(common + " --out " + (dir / "a.png").string() + " > /dev/null"), 0);
+    ASSERT_EQ(runCli(common + " --out " + (dir / "b.png").string() + " > /dev/null"), 0);
+    const std::string a = readFile(dir / "a.png"), b = readFile(dir / "b.png");
+    EXPECT_GT(a.size(), 1000u);
+    EXPECT_EQ(a, b);
+}
+
+} // namespace

@@ -1,0 +1,251 @@
+// World: building, refusal of what this build cannot simulate, divergence
+// reports, determinism across save/load, stiffness hints, the stiff chain
+// and the CLI's exit code 3.
+
+#include "physics_scenes.hpp"
+
+#include "stepwise/scene_io.hpp"
+#include "world/world_impl.hpp"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <sys/wait.h>
+
+using namespace stepwise;
+using namespace stepwise::testing;
+
+namespace {
+
+Scene mixedScene(const std::string& integrator) {
+    // Springs, drag, an attractor pair, boids and spin: every system.
+    Scene s = emptyScene(integrator, 1.0 / 60.0, {0.0, -9.81});
+    s.world.substeps = 2;
+    addStatic(s, "post", {0.0, 5.0});
+    for (int i = 0; i < 6; ++i) {
+        Entity e = addBody(s, "bead" + std::to_string(i), {0.4 * (i + 1), 5.0}, {0.0, 0.1 * i}, 0.2 + 0.05 * i);
+        s.registry.emplace<Drag>(e, {0.05});
+        addSpring(s, "link" + std::to_string(i), i == 0 ? "post" : "bead" + std::to_string(i - 1),
+                  "bead" + std::to_string(i), 50.0, 0.2, 0.4);
+    }
+    Entity star = addBody(s, "star", {-3.0, 0.0}, {0.0, 0.3}, 5.0);
+    s.registry.emplace<Attractor>(star, {0.2});
+    s.registry.emplace<Angle>(star, {0.1});
+    s.registry.emplace<AngularVelocity>(star, {1.5});
+    for (int i = 0; i < 12; ++i) {
+        Entity b = addBody(s, "boid" + std::to_string(i), {-6.0 + 0.5 * (i % 4), -2.0 + 0.5 * (i / 4)},
+                           {0.3 * (i % 3), -0.2 * (i % 2)});
+        Boid boid;
+        boid.goal = Vec2{4.0, 4.0};
+        s.registry.emplace<Boid>(b, boid);
+    }
+    return s;
+}
+
+TEST(World, ActiveSystemsAreWhatTheSceneContains) {
+    {
+        Scene s = emptyScene("rk4", 0.01);
+        addBody(s, "a", {0, 0}, {1, 0});
+        World w = buildOrDie(s);
+        EXPECT_TRUE(w.activeSystems().empty());  // zero gravity, nothing else
+    }
+    {
+        Oscillator osc;
+        World w = buildOrDie(osc.scene("rk4", 0.01));
+        EXPECT_EQ(w.activeSystems(), (std::vector<std::string_view>{"springs"}));
+        ASSERT_TRUE(w.step().ok());
+        std::vector<std::string_view> stages, systems;
+        for (const StageTime& st : w.lastStats().stages) stages.push_back(st.name);
+        for (const StageTime& st : w.lastStats().systems) systems.push_back(st.name);
+        EXPECT_EQ(stages, (std::vector<std::string_view>{"forces", "integrate", "check"}));
+        EXPECT_EQ(systems, (std::vector<std::string_view>{"springs"}));
+        EXPECT_EQ(w.lastStats().forceEvaluations, 4);  // RK4
+    }
+    World w = buildOrDie(mixedScene("midpoint"));
+    EXPECT_EQ(w.activeSystems(),
+              (std::vector<std::string_view>{"gravity", "drag", "springs", "attractors", "boids", "rotation"}));
+    EXPECT_EQ(w.bodyCount(), 6u + 1u + 12u);
+}
+
+TEST(World, RefusesShapesUntilCollisionsExist) {
+    Scene s = emptyScene("rk4", 0.01);
+    addStatic(s, "wall", {0, 0});
+    addBody(s, "x", {0, 0}, {0, 0});
+    Entity ball = addBody(s, "ball", {0, 1}, {0, 0});
+    s.registry.emplace<Radius>(ball, {0.5});
+    Result<World> w = World::build(s);
+    ASSERT_FALSE(w.ok());
+    EXPECT_EQ(w.error(), "entity 2 (\"ball\"): component \"radius\" needs collisions, which this build does not "
+                         "simulate yet");
+    s.registry.remove<Radius>(ball);
+    s.registry.emplace<Friction>(ball, {0.3});
+    Result<World> w2 = World::build(s);
+    ASSERT_FALSE(w2.ok());
+    EXPECT_EQ(w2.error(), "entity 2 (\"ball\"): component \"friction\" needs collisions, which this build does not "
+                          "simulate yet");
+    EXPECT_TRUE(w2.error().find("friction") != std::string::npos);
+    s.registry.remove<Friction>(ball);
+    Result<World> ok = World::build(s);
+    ASSERT_TRUE(ok.ok());
+    EXPECT_TRUE(ok->contacts().empty());
+}
+
+TEST(World, DivergenceNamesStepEntityAndQuantityAndKeepsState) {
+    // x grows by 0.5e308 per step: step 4 pushes it past DBL_MAX.
+    Scene s = emptyScene("semi_implicit_euler", 0.5);
+    addStatic(s, "floor", {0, 0});
+    addBody(s, "ball", {0, 0}, {1e308, 0});
+    World w = buildOrDie(s);
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(w.step().ok());
+    const Vec2 before = w.bodyPosition(0);
+    const double timeBefore = w.time();
+    Result<void> r = w.step();
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error(), "step 4: entity 1 (\"ball\"): position.x became inf");
+    EXPECT_EQ(w.bodyPosition(0), before);
+    EXPECT_EQ(w.time(), timeBefore);
+    EXPECT_EQ(w.lastStats().step, 3u);
+
+    // With substeps, the state before the whole step comes back. Velocity
+    // is reported before position (cause before effect).
+    Scene s2 = emptyScene("explicit_euler", 1.0, {0.0, -1e308});
+    s2.world.substeps = 3;
+    Entity e = s2.registry.create();
+    s2.registry.emplace<Position>(e, {{0.0, 0.0}});
+    s2.registry.emplace<Velocity>(e, {{0.0, -1.5e308}});
+    World w2 = buildOrDie(s2);
+    Result<void> r2 = w2.step();
+    ASSERT_FALSE(r2.ok());
+    EXPECT_EQ(r2.error(), "step 1: entity 0: velocity.y became -inf");
+    EXPECT_EQ(w2.bodyVelocity(0), (Vec2{0.0, -1.5e308}));
+    EXPECT_EQ(w2.bodyPosition(0), (Vec2{0.0, 0.0}));
+}
+
+std::string stepAndSave(Scene scene, int steps, int times) {
+    // `times` rounds of: build, step `steps`, write back, save, load.
+    for (int round = 0; round < times; ++round) {
+        World w = buildOrDie(scene);
+        for (int i = 0; i < steps; ++i) {
+            Result<void> r = w.step();
+            if (!r) throw std::runtime_error(r.error());
+        }
+        w.writeBack(scene);
+        const std::string text = sceneToJsonText(scene);
+        Result<Scene> loaded = parseScene(text, "roundtrip");
+        if (!loaded) throw std::runtime_error(loaded.error());
+        scene = std::move(loaded.value());
+    }
+    return sceneToJsonText(scene);
+}
+
+TEST(World, DeterministicAcrossSaveAndLoad) {
+    for (const char* integrator : {"explicit_euler", "semi_implicit_euler", "midpoint", "trapezoid", "rk4",
+                                   "velocity_verlet", "implicit_euler", "implicit_midpoint"}) {
+        const Scene scene = mixedScene(integrator);
+        const std::string straight = stepAndSave(scene, 200, 1);
+        const std::string split = stepAndSave(scene, 100, 2);
+        EXPECT_EQ(straight, split) << integrator << ": 200 steps differ from 100 + save/load + 100";
+        // And the run did something: the text differs from the start.
+        EXPECT_NE(straight, stepAndSave(scene, 0, 1)) << integrator;
+    }
+}
+
+TEST(World, SetIntegratorAndEnergyAndMomentum) {
+    Scene s = emptyScene("rk4", 0.01, {0.0, -10.0});
+    addBody(s, "a", {1.0, 2.0}, {3.0, 0.0}, 2.0);
+    World w = buildOrDie(s);
+    const EnergyReport e = w.energy();
+    EXPECT_DOUBLE_EQ(e.kinetic, 9.0);
+    EXPECT_DOUBLE_EQ(e.gravity, 40.0);  // -m g.p = -2 * (-10) * 2
+    EXPECT_DOUBLE_EQ(e.momentum.x, 6.0);
+    EXPECT_FALSE(w.setIntegrator("leapfrog").ok());
+    ASSERT_TRUE(w.setIntegrator("implicit_midpoint").ok());
+    EXPECT_EQ(w.settings().integrator, "implicit_midpoint");
+    for (int i = 0; i < 100; ++i) ASSERT_TRUE(w.step().ok());
+    // Free fall conserves kinetic + gravity energy exactly under a
+    // second-order method (the trajectory is exact).
+    EXPECT_NEAR(w.energy().total(), e.total(), 1e-9);
+}
+
+TEST(World, StiffnessHintsNameSpringAndLargestStableDt) {
+    Result<Scene> loaded = loadSceneFile(std::string(STEPWISE_SOURCE_DIR) + "/levels/stiff_spring.json");
+    ASSERT_TRUE(loaded.ok()) << loaded.error();
+    Scene scene = loaded.value();
+    EXPECT_TRUE(buildOrDie(scene).stiffnessHints().empty()) << "implicit_euler: no hints";
+    scene.world.integrator = "semi_implicit_euler";
+    World w = buildOrDie(scene);
+    const std::vector<StiffnessHint> hints = w.stiffnessHints();
+    ASSERT_EQ(hints.size(), 10u);
+    // The anchored spring: m_reduced = 0.01 kg, omega = sqrt(1e5/0.01).
+    const double omega = std::sqrt(1e5 / 0.01);
+    EXPECT_EQ(hints[0].springName, "stiff0");
+    EXPECT_NEAR(hints[0].hOmega, omega / 60.0, 1e-9);
+    EXPECT_NEAR(hints[0].limit, 2.0, 1e-9);
+    EXPECT_NEAR(hints[0].largestStableDt, 2.0 / omega, 1e-12);
+    // Bead to bead: m_reduced = 0.005 kg.
+    EXPECT_NEAR(hints[1].largestStableDt, 2.0 / std::sqrt(1e5 / 0.005), 1e-12);
+    EXPECT_NE(hints[0].message().find("stiff0"), std::string::npos);
+    EXPECT_NE(hints[0].message().find("semi_implicit_euler"), std::string::npos);
+    // With enough substeps the hint goes away.
+    scene.world.substeps = 40;  // h w = 52.7/40 = 1.3 < 2 (bead pairs: 74.5/40 = 1.9)
+    EXPECT_TRUE(buildOrDie(scene).stiffnessHints().empty());
+}
+
+TEST(World, StiffChainStaysBoundedUnderImplicitEuler) {
+    // k = 1e5 N/m, m = 0.01 kg, dt = 1/60: h w = 53 per spring.
+    Result<Scene> loaded = loadSceneFile(std::string(STEPWISE_SOURCE_DIR) + "/levels/stiff_spring.json");
+    ASSERT_TRUE(loaded.ok()) << loaded.error();
+    const Scene& scene = loaded.value();
+    ASSERT_EQ(scene.world.integrator, "implicit_euler");
+    ASSERT_DOUBLE_EQ(scene.world.dt, 1.0 / 60.0);
+    World w = buildOrDie(scene);
+    const double e0 = w.energy().total();
+    for (int i = 0; i < 600; ++i) {
+        Result<void> r = w.step();
+        ASSERT_TRUE(r.ok()) << r.error();
+        for (std::size_t b = 0; b < w.bodyCount(); ++b)
+            ASSERT_LT(length(w.bodyPosition(b)), 3.0 * 1.001) << "bead " << b << " at step " << i;
+    }
+    // Backward Euler never adds energy to a conservative system.
+    EXPECT_LT(w.energy().total(), e0);
+    // The chain hangs: links keep their rest length to within 1e-3 (g m / k
+    // stretches them by micrometres).
+    for (std::size_t b = 1; b < w.bodyCount(); ++b)
+        EXPECT_NEAR(length(w.bodyPosition(b) - w.bodyPosition(b - 1)), 0.3, 1e-3);
+}
+
+struct CliRun {
+    int exitCode = -1;
+    std::string output;
+};
+CliRun runCli(const std::string& args) {
+    CliRun r;
+    const std::string command = std::string(STEPWISE_BINARY) + " " + args + " 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return r;
+    std::array<char, 4096> buffer;
+    std::size_t got;
+    while ((got = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.output.append(buffer.data(), got);
+    const int status = pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+TEST(WorldCli, ExplicitBlowUpOnStiffChainExitsThree) {
+    const std::string level = std::string(STEPWISE_SOURCE_DIR) + "/levels/stiff_spring.json";
+    const CliRun bad = runCli("run " + level + " --steps 600 --integrator semi_implicit_euler");
+    EXPECT_EQ(bad.exitCode, 3) << bad.output;
+    EXPECT_NE(bad.output.find("diverged at step "), std::string::npos) << bad.output;
+    EXPECT_NE(bad.output.find("(\"bead"), std::string::npos) << bad.output;
+    EXPECT_NE(bad.output.find(" became "), std::string::npos) << bad.output;
+    const CliRun good = runCli("run " + level + " --steps 600");
+    EXPECT_EQ(good.exitCode, 0) << good.output;
+    const CliRun hint = runCli("validate " + level.substr(0, level.size() - 5) + ".json");
+    EXPECT_EQ(hint.exitCode, 0) << hint.output;
+}
+
+} // namespace
