@@ -263,16 +263,21 @@ MiniWorld pyramid(int rows, int& top) {
 TEST(Collision, TwentyRowPyramidStandsStillForTenSeconds) {
     int top = 0;
     MiniWorld w = pyramid(20, top);
+    w.collision.settings().iterations = 3;  // levels/pyramid.json's solver_iterations
     const Vec2 start = w.x[std::size_t(top)];
+    Vec2 settled;
     double deepest = 0.0;
     for (int i = 0; i < 600; ++i) {
         w.step(1.0 / 60.0);
+        if (i == 119) settled = w.x[std::size_t(top)];
         for (const ContactRecord& c : w.collision.contacts()) deepest = std::max(deepest, c.depth);
     }
-    const double drift = length(w.x[std::size_t(top)] - start);
-    EXPECT_LT(drift, 0.02) << "top box drifted";
+    // The soft contacts take up their load in the first second (210 boxes,
+    // 20 layers); after that nothing may move.
+    EXPECT_LT(length(w.x[std::size_t(top)] - start), 0.02) << "top box drifted from where it was placed";
+    EXPECT_LT(length(w.x[std::size_t(top)] - settled), 0.001) << "top box crept between t = 2 s and t = 10 s";
     EXPECT_LT(w.kinetic(), 1e-3);
-    EXPECT_LT(deepest, 0.02);
+    EXPECT_LT(deepest, 0.005);
 }
 
 TEST(Collision, HeavyBoxRestsOnLightBoxes) {
@@ -306,6 +311,9 @@ TEST(Collision, PileOfCirclesSettlesWithoutEscapes) {
         ASSERT_LE(w.x[i].x, 5.0) << i;
         ASSERT_GE(w.x[i].y, 0.0) << i;
     }
-    EXPECT_LT(deepest, 0.01);
-    EXPECT_LT(w.kinetic() / 400.0, 1e-4) << "mean kinetic energy per body at rest, J";
+    // Box2D 2.4.1 (8 velocity + 3 position iterations) leaves this same pile
+    // with a deepest overlap of 12.5 mm and 1.1e-7 J per body (measured on
+    // this machine, bench/collision); Stepwise must do at least as well.
+    EXPECT_LT(deepest, 0.0125);
+    EXPECT_LT(w.kinetic() / 400.0, 1.1e-7) << "mean kinetic energy per body at rest, J";
 }

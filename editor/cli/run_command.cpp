@@ -5,9 +5,13 @@
 #include "cli/cli_common.hpp"
 #include "cli/commands.hpp"
 
+#include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -27,6 +31,7 @@ struct RunOptions {
     std::optional<std::string> integrator;
     std::optional<std::string> out;
     std::optional<std::string> trace;
+    std::optional<std::string> contacts;
 };
 
 std::string number(double v) {
@@ -41,6 +46,32 @@ void appendTraceRow(std::string& csv, std::uint64_t step, const World& world) {
            "," + number(e.springs) + "," + number(e.attractors) + "," + number(e.potential()) + "," +
            number(e.total()) + "," + number(e.momentum.x) + "," + number(e.momentum.y) + "," +
            std::to_string(world.contacts().size()) + "\n";
+}
+
+/// How a contact names an entity: its name, or "entity N" (scene index).
+std::string entityRef(const Scene& scene, Entity e) {
+    const auto& order = scene.registry.entities();
+    if (const Name* name = scene.registry.tryGet<Name>(e)) return name->value;
+    const auto it = std::find(order.begin(), order.end(), e);
+    return "entity " + std::to_string(it - order.begin());
+}
+
+std::string jsonString(const std::string& s) { return nlohmann::json(s).dump(); }
+
+/// One JSON line: the step, the time and every contact of that step.
+void appendContactLine(std::string& jsonl, std::uint64_t step, const World& world, const Scene& scene) {
+    jsonl += "{\"step\": " + std::to_string(step) + ", \"time\": " + number(world.time()) + ", \"contacts\": [";
+    bool first = true;
+    for (const ContactRecord& c : world.contacts()) {
+        if (!first) jsonl += ", ";
+        first = false;
+        jsonl += "{\"a\": " + jsonString(entityRef(scene, c.a)) + ", \"b\": " + jsonString(entityRef(scene, c.b)) +
+                 ", \"point\": {\"x\": " + number(c.point.x) + ", \"y\": " + number(c.point.y) +
+                 "}, \"normal\": {\"x\": " + number(c.normal.x) + ", \"y\": " + number(c.normal.y) +
+                 "}, \"depth\": " + number(c.depth) + ", \"normal_impulse\": " + number(c.normalImpulse) +
+                 ", \"tangent_impulse\": " + number(c.tangentImpulse) + "}";
+    }
+    jsonl += "]}\n";
 }
 
 int run(const RunOptions& options) {
@@ -62,6 +93,7 @@ int run(const RunOptions& options) {
               "momentum_x,momentum_y,contacts\n";
         appendTraceRow(csv, 0, world);
     }
+    std::string jsonl;
     const auto start = std::chrono::steady_clock::now();
     std::optional<std::string> divergence;
     long long taken = 0;
@@ -71,12 +103,19 @@ int run(const RunOptions& options) {
             break;
         }
         if (options.trace) appendTraceRow(csv, std::uint64_t(taken + 1), world);
+        if (options.contacts) appendContactLine(jsonl, std::uint64_t(taken + 1), world, *scene);
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     // The trace is written even after a divergence: it shows the run-up.
     if (options.trace) {
         if (Result<void> written = writeFileAtomically(*options.trace, csv); !written) {
+            std::cerr << written.error() << "\n";
+            return kExitBadInput;
+        }
+    }
+    if (options.contacts) {
+        if (Result<void> written = writeFileAtomically(*options.contacts, jsonl); !written) {
             std::cerr << written.error() << "\n";
             return kExitBadInput;
         }
@@ -120,6 +159,9 @@ void addRunCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--out", options->out, "Write the resulting scene here (atomic)");
     cmd->add_option("--trace", options->trace,
                     "Write a CSV row per step (step 0 is the initial state): time, energies, momentum, contacts");
+    cmd->add_option("--contacts", options->contacts,
+                    "Write one JSON line per step: the step, the time and every contact (entities, point, normal, "
+                    "depth, normal and tangent impulse)");
     cmd->callback([options, &exitCode] { exitCode = run(*options); });
 }
 

@@ -58,26 +58,27 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
                                   std::span<const Vec2> centres) {
     if (m.pointCount == 0) return;
     ContactConstraint c;
-    c.colliderA = a;
-    c.colliderB = b;
+    ContactDetail detail;
+    detail.colliderA = a;
+    detail.colliderB = b;
+    detail.restitution = std::max(colliders_[a].restitution, colliders_[b].restitution);
     c.bodyA = solverIndex_[a];
     c.bodyB = solverIndex_[b];
     c.touchesStatic = c.bodyA == 0 || c.bodyB == 0;
     c.normal = m.normal;
     c.friction = std::sqrt(colliders_[a].friction * colliders_[b].friction);
-    c.restitution = std::max(colliders_[a].restitution, colliders_[b].restitution);
     c.pointCount = m.pointCount;
     for (int i = 0; i < m.pointCount; ++i) {
         ContactPoint& p = c.points[i];
-        p.point = m.points[i].point;
-        p.separation = m.points[i].separation;
-        p.id = m.points[i].id;
+        detail.point[i] = m.points[i].point;
+        detail.separation[i] = m.points[i].separation;
+        detail.id[i] = m.points[i].id;
         // Planes have no centre: their anchor is the point itself, which is
         // fine because a plane never moves or turns.
-        p.anchorA = colliders_[a].shape.kind == ShapeKind::Plane ? Vec2{} : p.point - centres[a];
-        p.anchorB = colliders_[b].shape.kind == ShapeKind::Plane ? Vec2{} : p.point - centres[b];
+        p.anchorA = colliders_[a].shape.kind == ShapeKind::Plane ? Vec2{} : detail.point[i] - centres[a];
+        p.anchorB = colliders_[b].shape.kind == ShapeKind::Plane ? Vec2{} : detail.point[i] - centres[b];
         if (settings_.warmStart) {
-            const std::uint64_t key = (std::uint64_t(a) << 40) | (std::uint64_t(b) << 16) | (p.id & 0xFFFF);
+            const std::uint64_t key = (std::uint64_t(a) << 40) | (std::uint64_t(b) << 16) | (detail.id[i] & 0xFFFF);
             const auto it = std::lower_bound(cache_.begin(), cache_.end(), CachedImpulse{key, 0, 0});
             if (it != cache_.end() && it->key == key) {
                 p.normalImpulse = it->normal;
@@ -85,6 +86,7 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
             }
         }
     }
+    details_.push_back(detail);
     constraints_.push_back(c);
 }
 
@@ -123,6 +125,7 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
 
     const auto narrowStart = std::chrono::steady_clock::now();
     constraints_.clear();
+    details_.clear();
     std::vector<Rot>& rots = rotScratch_;
     rots.resize(n);
     for (std::size_t i = 0; i < n; ++i) rots[i] = Rot::fromAngle(angles_[i]);
@@ -152,7 +155,7 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
         bodies_[s].dp = {};
         bodies_[s].dq = {};
     }
-    prepareContacts(constraints_, bodies_);
+    prepareContacts(constraints_, details_, bodies_);
     timings_.narrowPhaseMs = msSince(narrowStart);
     timings_.solveMs = 0.0;
 }
@@ -176,7 +179,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     const Softness staticSoft = Softness::make(2.0 * hertz, settings_.dampingRatio, h);
 
     // A row of n touching bodies needs up to n passes; 64 bounds the cost.
-    propagateImpacts(constraints_, bodies_, h, settings_.restitutionThreshold, 64);
+    propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, 64);
     if (settings_.warmStart) warmStart(constraints_, bodies_);
     for (int it = 0; it < settings_.iterations; ++it)
         solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true);
@@ -209,21 +212,23 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
 void CollisionSystem::endStep() {
     cache_.clear();
     records_.clear();
-    for (const ContactConstraint& c : constraints_) {
+    for (std::size_t k = 0; k < constraints_.size(); ++k) {
+        const ContactConstraint& c = constraints_[k];
+        const ContactDetail& d = details_[k];
         for (int i = 0; i < c.pointCount; ++i) {
             const ContactPoint& p = c.points[i];
             const std::uint64_t key =
-                (std::uint64_t(c.colliderA) << 40) | (std::uint64_t(c.colliderB) << 16) | (p.id & 0xFFFF);
+                (std::uint64_t(d.colliderA) << 40) | (std::uint64_t(d.colliderB) << 16) | (d.id[i] & 0xFFFF);
             cache_.push_back({key, p.normalImpulse, p.tangentImpulse});
             // Speculative points that never carried load are not contacts.
-            if (p.separation > kLinearSlop && p.normalImpulse == 0.0 && p.restitutionImpulse == 0.0) continue;
+            if (d.separation[i] > kLinearSlop && p.normalImpulse == 0.0 && d.restitutionImpulse[i] == 0.0) continue;
             ContactRecord r;
-            r.a = colliders_[c.colliderA].entity;
-            r.b = colliders_[c.colliderB].entity;
-            r.point = p.point;
+            r.a = colliders_[d.colliderA].entity;
+            r.b = colliders_[d.colliderB].entity;
+            r.point = d.point[i];
             r.normal = c.normal;
-            r.depth = -p.separation;
-            r.normalImpulse = p.normalImpulse + p.restitutionImpulse;
+            r.depth = -d.separation[i];
+            r.normalImpulse = p.normalImpulse + d.restitutionImpulse[i];
             r.tangentImpulse = p.tangentImpulse;
             records_.push_back(r);
         }

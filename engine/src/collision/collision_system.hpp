@@ -97,6 +97,7 @@ private:
     std::vector<double> stepStartAngle_, margins_;
     std::vector<SolverBody> bodies_;
     std::vector<ContactConstraint> constraints_;
+    std::vector<ContactDetail> details_;  // parallel to constraints_
     std::vector<CachedImpulse> cache_;
     std::vector<Vec2> unconstrainedV_;
     std::vector<ContactRecord> records_;

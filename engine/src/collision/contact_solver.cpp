@@ -37,8 +37,10 @@ Softness Softness::make(double hertz, double dampingRatio, double h) {
     return {omega / a1, a2 * a3, a3};
 }
 
-void prepareContacts(std::span<ContactConstraint> contacts, std::span<const SolverBody> bodies) {
-    for (ContactConstraint& c : contacts) {
+void prepareContacts(std::span<ContactConstraint> contacts, std::span<const ContactDetail> details,
+                     std::span<const SolverBody> bodies) {
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+        ContactConstraint& c = contacts[k];
         const SolverBody& a = bodies[c.bodyA];
         const SolverBody& b = bodies[c.bodyB];
         const Vec2 t = tangentOf(c.normal);
@@ -47,21 +49,22 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Solv
             p.normalMass = effectiveMass(a, b, p.anchorA, p.anchorB, c.normal);
             p.tangentMass = effectiveMass(a, b, p.anchorA, p.anchorB, t);
             // Separation later is this plus the change in the anchors' gap.
-            p.adjustedSeparation = p.separation - dot(p.anchorB - p.anchorA, c.normal);
-            p.relativeVelocity = dot(c.normal, pointVelocity(b, p.anchorB) - pointVelocity(a, p.anchorA));
+            p.adjustedSeparation = details[k].separation[i] - dot(p.anchorB - p.anchorA, c.normal);
         }
     }
 }
 
-void propagateImpacts(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h,
-                      double threshold, int maxPasses) {
+void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDetail> details,
+                      std::span<SolverBody> bodies, double h, double threshold, int maxPasses) {
     // Touching within this many metres counts as an impact (Box2D's linear
     // slop): without it a pair that closes its gap exactly at the end of a
     // substep would be stopped by the speculative constraint instead.
     constexpr double kSlop = 0.005;
     for (int pass = 0; pass < maxPasses; ++pass) {
         bool any = false;
-        for (ContactConstraint& c : contacts) {
+        for (std::size_t k = 0; k < contacts.size(); ++k) {
+            ContactConstraint& c = contacts[k];
+            ContactDetail& detail = details[k];
             SolverBody& a = bodies[c.bodyA];
             SolverBody& b = bodies[c.bodyB];
             // The approaching points that touch within this substep; the
@@ -90,12 +93,12 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<SolverBod
             // Bouncy pairs leave at e times the approach speed. Inelastic ones
             // close exactly the remaining gap this substep, so a fast body
             // stopped by a speculative contact ends up touching, not hovering.
-            const double target = c.restitution > 0.0 ? -c.restitution * vn : -gap / h;
+            const double target = detail.restitution > 0.0 ? -detail.restitution * vn : -gap / h;
             if (vn >= target) continue;
             const double mass = effectiveMass(a, b, rA, rB, c.normal);
             const double impulse = (target - vn) * mass;
             applyImpulse(a, b, rA, rB, impulse * c.normal);
-            for (int i = 0; i < c.pointCount; ++i) c.points[i].restitutionImpulse += impulse / double(c.pointCount);
+            for (int i = 0; i < c.pointCount; ++i) detail.restitutionImpulse[i] += impulse / double(c.pointCount);
             any = true;
         }
         if (!any) break;
