@@ -196,13 +196,37 @@ TEST_F(Cli, UnwritableOutputIsAClearErrorAndLeavesNothing) {
     EXPECT_EQ(o.err, (dir_ / "missing" / "o.json").string() + ": error: cannot write: No such file or directory\n");
 }
 
-TEST_F(Cli, RunRefusesWhatTheEngineCannotSimulate) {
+TEST_F(Cli, RunsTheCourseNotesLevel) {
     const fs::path out = dir_ / "out.json";
-    Outcome o = stepwise("run " + level("course_notes.json") + " --steps 10 --out " + out.string());
-    EXPECT_EQ(o.exitCode, 2);
-    EXPECT_NE(o.err.find("cannot simulate"), std::string::npos) << o.err;
-    EXPECT_NE(o.err.find("radius"), std::string::npos) << o.err;
-    EXPECT_FALSE(fs::exists(out));
+    Outcome o = stepwise("run " + level("course_notes.json") + " --steps 60 --out " + out.string());
+    EXPECT_EQ(o.exitCode, 0) << o.err;
+    // 60 additions of 1/60 in doubles give this value exactly.
+    EXPECT_NE(readFile(out).find("\"time\": 1.0000000000000013,"), std::string::npos) << readFile(out);
+}
+
+TEST_F(Cli, ContactsFileHasOneLinePerStepWithEveryContact) {
+    // A ball dropped from 0.1 m onto a plane: airborne for 0.14 s (8 steps),
+    // then resting on it with one contact.
+    const fs::path file = write("drop.json", R"({"world": {"gravity": {"x": 0, "y": -10}},
+      "entities": [{"name": "floor", "plane": {"normal": {"x": 0, "y": 1}, "offset": 0}},
+                   {"name": "ball", "position": {"x": 0, "y": 0.6}, "radius": 0.5}]})");
+    const fs::path contacts = dir_ / "contacts.jsonl";
+    Outcome o = stepwise("run " + file.string() + " --steps 30 --contacts " + contacts.string());
+    ASSERT_EQ(o.exitCode, 0) << o.err;
+    std::istringstream lines(readFile(contacts));
+    std::string line, last;
+    int count = 0, touching = 0;
+    while (std::getline(lines, line)) {
+        last = line;
+        ++count;
+        EXPECT_EQ(line.rfind("{\"step\": " + std::to_string(count) + ", \"time\": ", 0), 0u) << line;
+        if (line.find("\"a\": \"ball\", \"b\": \"floor\"") != std::string::npos) ++touching;
+    }
+    EXPECT_EQ(count, 30);
+    EXPECT_GE(touching, 20) << "the ball rests on the floor for the last 20 steps at least";
+    // The static side is b and the normal points from a to b (+ 0.0 keeps
+    // a -0 out of the file).
+    EXPECT_NE(last.find("\"normal\": {\"x\": 0, \"y\": -1}"), std::string::npos) << last;
 }
 
 TEST_F(Cli, SchemaCommandMatchesTheCommittedSchema) {

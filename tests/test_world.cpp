@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <array>
 #include <cstdio>
 #include <cstring>
@@ -71,27 +73,41 @@ TEST(World, ActiveSystemsAreWhatTheSceneContains) {
     EXPECT_EQ(w.bodyCount(), 6u + 1u + 12u);
 }
 
-TEST(World, RefusesShapesUntilCollisionsExist) {
-    Scene s = emptyScene("rk4", 0.01);
-    addStatic(s, "wall", {0, 0});
-    addBody(s, "x", {0, 0}, {0, 0});
-    Entity ball = addBody(s, "ball", {0, 1}, {0, 0});
+TEST(World, CollisionStagesRunOnlyWhenTheSceneHasShapes) {
+    Scene s = emptyScene("semi_implicit_euler", 1.0 / 60.0);
+    s.world.gravity = {0.0, -10.0};
+    addBody(s, "free", {5, 0}, {0, 0});
+    Entity ball = addBody(s, "ball", {0, 0.5}, {0, 0});
+    {
+        Result<World> shapeless = World::build(s);
+        ASSERT_TRUE(shapeless.ok()) << shapeless.error();
+        const auto systems = shapeless->activeSystems();
+        EXPECT_EQ(std::count(systems.begin(), systems.end(), "collisions"), 0);
+        ASSERT_TRUE(shapeless->step().ok());
+        for (const StageTime& stage : shapeless->lastStats().stages)
+            EXPECT_NE(stage.name, "broad_phase") << "a scene without shapes must not pay for collisions";
+        EXPECT_TRUE(shapeless->contacts().empty());
+    }
+    // A ball resting on a static box: collisions join the pipeline, the ball
+    // stays on the box and the contact carries its weight.
     s.registry.emplace<Radius>(ball, {0.5});
+    Entity floor = addStatic(s, "floor", {0, -0.5});
+    s.registry.emplace<Box>(floor, {10.0, 1.0});
     Result<World> w = World::build(s);
-    ASSERT_FALSE(w.ok());
-    EXPECT_EQ(w.error(), "entity 2 (\"ball\"): component \"radius\" needs collisions, which this build does not "
-                         "simulate yet");
-    s.registry.remove<Radius>(ball);
-    s.registry.emplace<Friction>(ball, {0.3});
-    Result<World> w2 = World::build(s);
-    ASSERT_FALSE(w2.ok());
-    EXPECT_EQ(w2.error(), "entity 2 (\"ball\"): component \"friction\" needs collisions, which this build does not "
-                          "simulate yet");
-    EXPECT_TRUE(w2.error().find("friction") != std::string::npos);
-    s.registry.remove<Friction>(ball);
-    Result<World> ok = World::build(s);
-    ASSERT_TRUE(ok.ok());
-    EXPECT_TRUE(ok->contacts().empty());
+    ASSERT_TRUE(w.ok()) << w.error();
+    const auto systems = w->activeSystems();
+    EXPECT_EQ(std::count(systems.begin(), systems.end(), "collisions"), 1);
+    for (int i = 0; i < 120; ++i) ASSERT_TRUE(w->step().ok());
+    ASSERT_EQ(w->contacts().size(), 1u);
+    const ContactRecord& c = w->contacts()[0];
+    EXPECT_EQ(c.b, floor) << "the static side is b";
+    EXPECT_EQ(c.normal, (Vec2{0.0, -1.0})) << "from a (the ball) to b (the floor)";
+    // One substep's impulse equals the weight times the substep: m g h.
+    EXPECT_NEAR(c.normalImpulse, 1.0 * 10.0 / 60.0, 1e-6);
+    Scene after = s;
+    w->writeBack(after);
+    EXPECT_NEAR(after.registry.tryGet<Position>(ball)->value.y, 0.5, 0.01);
+    EXPECT_NEAR(after.registry.tryGet<Position>(ball)->value.x, 0.0, 1e-12);
 }
 
 TEST(World, DivergenceNamesStepEntityAndQuantityAndKeepsState) {

@@ -157,8 +157,10 @@ Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex) {
         def.position.Set(float(p.x), float(p.y));
         if (const Velocity* v = r.tryGet<Velocity>(e)) def.linearVelocity.Set(float(v->value.x), float(v->value.y));
         if (const Angle* a = r.tryGet<Angle>(e)) def.angle = float(a->value);
-        b2Body* body = world.CreateBody(&def);
         const double mass = r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
+        // Box2D's linear damping c is drag per unit mass: dv/dt = -c v.
+        if (const Drag* d = r.tryGet<Drag>(e)) def.linearDamping = float(d->value / mass);
+        b2Body* body = world.CreateBody(&def);
         b2FixtureDef fd;
         fd.friction = float(r.has<Friction>(e) ? r.tryGet<Friction>(e)->value : 0.2);
         fd.restitution = float(r.has<Restitution>(e) ? r.tryGet<Restitution>(e)->value : 0.0);

@@ -67,7 +67,7 @@ void appendContactLine(std::string& jsonl, std::uint64_t step, const World& worl
         first = false;
         jsonl += "{\"a\": " + jsonString(entityRef(scene, c.a)) + ", \"b\": " + jsonString(entityRef(scene, c.b)) +
                  ", \"point\": {\"x\": " + number(c.point.x) + ", \"y\": " + number(c.point.y) +
-                 "}, \"normal\": {\"x\": " + number(c.normal.x) + ", \"y\": " + number(c.normal.y) +
+                 "}, \"normal\": {\"x\": " + number(c.normal.x + 0.0) + ", \"y\": " + number(c.normal.y + 0.0) +
                  "}, \"depth\": " + number(c.depth) + ", \"normal_impulse\": " + number(c.normalImpulse) +
                  ", \"tangent_impulse\": " + number(c.tangentImpulse) + "}";
     }

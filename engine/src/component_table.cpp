@@ -141,9 +141,10 @@ std::vector<ComponentInfo> buildTable() {
                                      {field<&AngularVelocity::value>("", kAny, "rad/s", "spin")}));
     t.push_back(row<Color>("color", "display colour", true, {},
                            {field<&Color::value>("", kUnit, "", "display colour, channels in 0..1")}));
-    t.push_back(row<Restitution>("restitution", "bounciness; a pair uses the larger value", true, needsPosition,
+    // Material properties: planes have them too, so they need no position.
+    t.push_back(row<Restitution>("restitution", "bounciness; a pair uses the larger value", true, {},
                                  {field<&Restitution::value>("", kUnit, "", "coefficient of restitution")}));
-    t.push_back(row<Friction>("friction", "Coulomb coefficient; a pair uses sqrt(f1*f2)", true, needsPosition,
+    t.push_back(row<Friction>("friction", "Coulomb coefficient; a pair uses sqrt(f1*f2)", true, {},
                               {field<&Friction::value>("", kNonNegative, "", "Coulomb friction coefficient")}));
     t.push_back(row<Drag>("drag", "viscous damping b: force -b*v", true, needsPosition,
                           {field<&Drag::value>("", kNonNegative, "kg/s", "viscous damping coefficient")}));

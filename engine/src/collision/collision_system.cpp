@@ -75,8 +75,12 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
         detail.id[i] = m.points[i].id;
         // Planes have no centre: their anchor is the point itself, which is
         // fine because a plane never moves or turns.
-        p.anchorA = colliders_[a].shape.kind == ShapeKind::Plane ? Vec2{} : detail.point[i] - centres[a];
-        p.anchorB = colliders_[b].shape.kind == ShapeKind::Plane ? Vec2{} : detail.point[i] - centres[b];
+        const Vec2 anchorA = colliders_[a].shape.kind == ShapeKind::Plane ? Vec2{} : detail.point[i] - centres[a];
+        const Vec2 anchorB = colliders_[b].shape.kind == ShapeKind::Plane ? Vec2{} : detail.point[i] - centres[b];
+        p.rnA = cross(anchorA, m.normal);
+        p.rnB = cross(anchorB, m.normal);
+        p.dnA = dot(anchorA, m.normal);
+        p.dnB = dot(anchorB, m.normal);
         if (settings_.warmStart) {
             const std::uint64_t key = (std::uint64_t(a) << 40) | (std::uint64_t(b) << 16) | (detail.id[i] & 0xFFFF);
             const auto it = std::lower_bound(cache_.begin(), cache_.end(), CachedImpulse{key, 0, 0});
@@ -109,11 +113,16 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
         margins_[i] = kSpeculativeBase + dt * (speed + std::abs(angularVelocities_[i]) * maxExtent_[i]);
     }
 
+    // One sincos per collider per step, shared by the boxes and the narrow phase.
+    std::vector<Rot>& rots = rotScratch_;
+    rots.resize(n);
+    for (std::size_t i = 0; i < n; ++i) rots[i] = Rot::fromAngle(angles_[i]);
+
     boxes_.resize(finite_.size());
     movable_.resize(finite_.size());
     for (std::size_t k = 0; k < finite_.size(); ++k) {
         const std::uint32_t i = finite_[k];
-        Aabb box = computeAabb(colliders_[i].shape, centres_[i], Rot::fromAngle(angles_[i]));
+        Aabb box = computeAabb(colliders_[i].shape, centres_[i], rots[i]);
         const Vec2 fat{margins_[i], margins_[i]};
         box.lower -= fat;
         box.upper += fat;
@@ -126,9 +135,6 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
     const auto narrowStart = std::chrono::steady_clock::now();
     constraints_.clear();
     details_.clear();
-    std::vector<Rot>& rots = rotScratch_;
-    rots.resize(n);
-    for (std::size_t i = 0; i < n; ++i) rots[i] = Rot::fromAngle(angles_[i]);
     for (const ProxyPair& pair : pairs_) {
         const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
         const Manifold m = collide(colliders_[a].shape, centres_[a], rots[a], colliders_[b].shape, centres_[b],
@@ -173,16 +179,19 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         unconstrainedV_[i] = v[body];
     }
     // Contact stiffness may not exceed a quarter of the substep rate, or the
-    // soft constraint itself becomes unstable (Box2D v3's rule).
+    // soft constraint itself becomes unstable (Box2D v3's rule). Contacts
+    // with static bodies may be twice as stiff, but under the same cap:
+    // above it a heavy box on light boxes never comes to rest (measured).
     const double hertz = std::min(settings_.contactHertz, 0.25 / h);
     const Softness soft = Softness::make(hertz, settings_.dampingRatio, h);
-    const Softness staticSoft = Softness::make(2.0 * hertz, settings_.dampingRatio, h);
+    const Softness staticSoft = Softness::make(std::min(2.0 * hertz, 0.25 / h), settings_.dampingRatio, h);
 
     // A row of n touching bodies needs up to n passes; 64 bounds the cost.
     propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, 64);
     if (settings_.warmStart) warmStart(constraints_, bodies_);
-    for (int it = 0; it < settings_.iterations; ++it)
-        solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true);
+    bool reverse = false;
+    for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse)
+        solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
 
     // Positions: the integrator moved x with the unconstrained velocity; add
     // the contact velocity change over the substep. Angles integrate here
@@ -197,8 +206,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         b.dp = x[body] - stepStart_[i];
         b.dq = Rot::fromAngle(angles_[i] - stepStartAngle_[i]);
     }
-    for (int it = 0; it < settings_.relaxIterations; ++it)
-        solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false);
+    for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse)
+        solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
 
     for (std::size_t i = 0; i < n; ++i) {
         const std::uint32_t s = solverIndex_[i];
@@ -227,6 +236,12 @@ void CollisionSystem::endStep() {
             r.b = colliders_[d.colliderB].entity;
             r.point = d.point[i];
             r.normal = c.normal;
+            // Records put the static side (a plane or static body) second,
+            // as world.hpp promises, with the normal still pointing a -> b.
+            if (c.bodyA == 0 && c.bodyB != 0) {
+                std::swap(r.a, r.b);
+                r.normal = -r.normal;
+            }
             r.depth = -d.separation[i];
             r.normalImpulse = p.normalImpulse + d.restitutionImpulse[i];
             r.tangentImpulse = p.tangentImpulse;

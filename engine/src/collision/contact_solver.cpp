@@ -8,24 +8,38 @@ namespace stepwise::collision {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
-/// Velocity of the material point at offset r of body b.
-inline Vec2 pointVelocity(const SolverBody& b, Vec2 r) { return b.v + crossSV(b.w, r); }
-
-inline void applyImpulse(SolverBody& a, SolverBody& b, Vec2 rA, Vec2 rB, Vec2 impulse) {
-    a.v -= a.invMass * impulse;
-    a.w -= a.invInertia * cross(rA, impulse);
-    b.v += b.invMass * impulse;
-    b.w += b.invInertia * cross(rB, impulse);
-}
-
-inline double effectiveMass(const SolverBody& a, const SolverBody& b, Vec2 rA, Vec2 rB, Vec2 dir) {
-    const double rnA = cross(rA, dir), rnB = cross(rB, dir);
-    const double k = a.invMass + b.invMass + a.invInertia * rnA * rnA + b.invInertia * rnB * rnB;
-    return k > 0.0 ? 1.0 / k : 0.0;
-}
-
 /// Tangent direction: the normal turned clockwise, as Box2D.
 inline Vec2 tangentOf(Vec2 n) { return {n.y, -n.x}; }
+
+/// Relative normal velocity of B against A at a point with projections
+/// (rnA, rnB): dot(vB + wB x rB - vA - wA x rA, n), since dot(w x r, n) =
+/// w cross(r, n).
+inline double normalSpeed(const SolverBody& a, const SolverBody& b, Vec2 n, double rnA, double rnB) {
+    return dot(b.v - a.v, n) + b.w * rnB - a.w * rnA;
+}
+/// Same along the tangent, where cross(r, t) = -dot(r, n).
+inline double tangentSpeed(const SolverBody& a, const SolverBody& b, Vec2 t, double dnA, double dnB) {
+    return dot(b.v - a.v, t) - b.w * dnB + a.w * dnA;
+}
+/// Applies impulse magnitude `j` along unit `dir`, whose lever arms are
+/// cross(rA, dir) = armA and cross(rB, dir) = armB.
+inline void applyImpulse(SolverBody& a, SolverBody& b, Vec2 dir, double armA, double armB, double j) {
+    a.v -= (a.invMass * j) * dir;
+    a.w -= a.invInertia * armA * j;
+    b.v += (b.invMass * j) * dir;
+    b.w += b.invInertia * armB * j;
+}
+inline double effectiveMass(const SolverBody& a, const SolverBody& b, double armA, double armB) {
+    const double k = a.invMass + b.invMass + a.invInertia * armA * armA + b.invInertia * armB * armB;
+    return k > 0.0 ? 1.0 / k : 0.0;
+}
+/// Separation now: the step-start value plus the bodies' motion since, with
+/// the anchors turned by each body's rotation so far: dot(rotate(q, r), n) =
+/// q.c dn + q.s rn.
+inline double currentSeparation(const SolverBody& a, const SolverBody& b, Vec2 n, const ContactPoint& p) {
+    return dot(b.dp - a.dp, n) + (b.dq.c * p.dnB + b.dq.s * p.rnB) - (a.dq.c * p.dnA + a.dq.s * p.rnA) +
+           p.adjustedSeparation;
+}
 } // namespace
 
 Softness Softness::make(double hertz, double dampingRatio, double h) {
@@ -43,13 +57,11 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
         ContactConstraint& c = contacts[k];
         const SolverBody& a = bodies[c.bodyA];
         const SolverBody& b = bodies[c.bodyB];
-        const Vec2 t = tangentOf(c.normal);
         for (int i = 0; i < c.pointCount; ++i) {
             ContactPoint& p = c.points[i];
-            p.normalMass = effectiveMass(a, b, p.anchorA, p.anchorB, c.normal);
-            p.tangentMass = effectiveMass(a, b, p.anchorA, p.anchorB, t);
-            // Separation later is this plus the change in the anchors' gap.
-            p.adjustedSeparation = details[k].separation[i] - dot(p.anchorB - p.anchorA, c.normal);
+            p.normalMass = effectiveMass(a, b, p.rnA, p.rnB);
+            p.tangentMass = effectiveMass(a, b, -p.dnA, -p.dnB);
+            p.adjustedSeparation = details[k].separation[i] - (p.dnB - p.dnA);
         }
     }
 }
@@ -68,36 +80,35 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
             SolverBody& a = bodies[c.bodyA];
             SolverBody& b = bodies[c.bodyB];
             // The approaching points that touch within this substep; the
-            // impulse acts at their centroid so a flat landing box does not
-            // pick up spin from the order of its two corners.
-            Vec2 rA{}, rB{};
-            double gap = 0.0;
+            // impulse acts at their centroid (the projections are linear in
+            // the anchor, so the centroid's are the mean) so a flat landing
+            // box does not pick up spin from the order of its two corners.
+            double rnA = 0.0, rnB = 0.0, gap = 0.0;
             int count = 0;
             for (int i = 0; i < c.pointCount; ++i) {
                 const ContactPoint& p = c.points[i];
-                const Vec2 pA = rotate(a.dq, p.anchorA), pB = rotate(b.dq, p.anchorB);
-                const double separation = dot((b.dp - a.dp) + (pB - pA), c.normal) + p.adjustedSeparation;
-                const double vn = dot(c.normal, pointVelocity(b, pB) - pointVelocity(a, pA));
-                if (vn < -threshold && separation + vn * h < kSlop) {
-                    rA += pA;
-                    rB += pB;
+                const double vn = normalSpeed(a, b, c.normal, p.rnA, p.rnB);
+                if (vn >= -threshold) continue;  // resting contacts leave here
+                const double separation = currentSeparation(a, b, c.normal, p);
+                if (separation + vn * h < kSlop) {
+                    rnA += p.rnA;
+                    rnB += p.rnB;
                     gap += separation;
                     ++count;
                 }
             }
             if (count == 0) continue;
-            rA = rA / double(count);
-            rB = rB / double(count);
+            rnA /= double(count);
+            rnB /= double(count);
             gap = std::max(gap / double(count), 0.0);
-            const double vn = dot(c.normal, pointVelocity(b, rB) - pointVelocity(a, rA));
+            const double vn = normalSpeed(a, b, c.normal, rnA, rnB);
             // Bouncy pairs leave at e times the approach speed. Inelastic ones
             // close exactly the remaining gap this substep, so a fast body
             // stopped by a speculative contact ends up touching, not hovering.
             const double target = detail.restitution > 0.0 ? -detail.restitution * vn : -gap / h;
             if (vn >= target) continue;
-            const double mass = effectiveMass(a, b, rA, rB, c.normal);
-            const double impulse = (target - vn) * mass;
-            applyImpulse(a, b, rA, rB, impulse * c.normal);
+            const double impulse = (target - vn) * effectiveMass(a, b, rnA, rnB);
+            applyImpulse(a, b, c.normal, rnA, rnB, impulse);
             for (int i = 0; i < c.pointCount; ++i) detail.restitutionImpulse[i] += impulse / double(c.pointCount);
             any = true;
         }
@@ -112,26 +123,29 @@ void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodi
         const Vec2 t = tangentOf(c.normal);
         for (int i = 0; i < c.pointCount; ++i) {
             const ContactPoint& p = c.points[i];
-            const Vec2 rA = rotate(a.dq, p.anchorA), rB = rotate(b.dq, p.anchorB);
-            applyImpulse(a, b, rA, rB, p.normalImpulse * c.normal + p.tangentImpulse * t);
+            applyImpulse(a, b, c.normal, p.rnA, p.rnB, p.normalImpulse);
+            applyImpulse(a, b, t, -p.dnA, -p.dnB, p.tangentImpulse);
         }
     }
 }
 
 void solveContacts(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h,
-                   const Softness& soft, const Softness& staticSoft, double pushMaxVelocity, bool useBias) {
+                   const Softness& soft, const Softness& staticSoft, double pushMaxVelocity, bool useBias,
+                   bool reverse) {
     const double invH = 1.0 / h;
-    for (ContactConstraint& c : contacts) {
+    const std::size_t count = contacts.size();
+    for (std::size_t k = 0; k < count; ++k) {
+        ContactConstraint& c = contacts[reverse ? count - 1 - k : k];
         SolverBody& a = bodies[c.bodyA];
         SolverBody& b = bodies[c.bodyB];
         const Softness& s = c.touchesStatic ? staticSoft : soft;
         const Vec2 n = c.normal;
         for (int i = 0; i < c.pointCount; ++i) {
             ContactPoint& p = c.points[i];
-            const Vec2 rA = rotate(a.dq, p.anchorA), rB = rotate(b.dq, p.anchorB);
-            // Current separation from the step-start value and the motion since.
-            const Vec2 d = (b.dp - a.dp) + (rB - rA);
-            const double separation = dot(d, n) + p.adjustedSeparation;
+            // The Jacobian keeps the step-start anchors (as Box2D v3): the
+            // rotation within one step is small. Only the separation follows
+            // the motion.
+            const double separation = currentSeparation(a, b, n, p);
             double bias = 0.0, massScale = 1.0, impulseScale = 0.0;
             if (separation > 0.0) {
                 bias = separation * invH;  // speculative: close at most the gap this substep
@@ -140,24 +154,23 @@ void solveContacts(std::span<ContactConstraint> contacts, std::span<SolverBody> 
                 massScale = s.massScale;
                 impulseScale = s.impulseScale;
             }
-            const double vn = dot(pointVelocity(b, rB) - pointVelocity(a, rA), n);
+            const double vn = normalSpeed(a, b, n, p.rnA, p.rnB);
             double impulse = -p.normalMass * massScale * (vn + bias) - impulseScale * p.normalImpulse;
             const double total = std::max(p.normalImpulse + impulse, 0.0);
             impulse = total - p.normalImpulse;
             p.normalImpulse = total;
-            applyImpulse(a, b, rA, rB, impulse * n);
+            applyImpulse(a, b, n, p.rnA, p.rnB, impulse);
         }
         const Vec2 t = tangentOf(n);
         for (int i = 0; i < c.pointCount; ++i) {
             ContactPoint& p = c.points[i];
-            const Vec2 rA = rotate(a.dq, p.anchorA), rB = rotate(b.dq, p.anchorB);
-            const double vt = dot(pointVelocity(b, rB) - pointVelocity(a, rA), t);
+            const double vt = tangentSpeed(a, b, t, p.dnA, p.dnB);
             const double maxFriction = c.friction * p.normalImpulse;
             double impulse = -p.tangentMass * vt;
             const double total = std::clamp(p.tangentImpulse + impulse, -maxFriction, maxFriction);
             impulse = total - p.tangentImpulse;
             p.tangentImpulse = total;
-            applyImpulse(a, b, rA, rB, impulse * t);
+            applyImpulse(a, b, t, -p.dnA, -p.dnB, impulse);
         }
     }
 }

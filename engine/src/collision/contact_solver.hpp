@@ -37,8 +37,13 @@ struct Softness {
 /// write, so a pass over thousands of contacts streams as few bytes as
 /// possible (the solve is memory-bound; see ContactDetail for the rest).
 struct ContactPoint {
-    Vec2 anchorA, anchorB;        ///< world-frame offsets from the centres at step start, metres
-    double adjustedSeparation = 0.0;  ///< separation minus the anchors' gap, metres
+    /// The anchors r (contact point minus body centre at step start, metres)
+    /// enter every formula only through two projections on the normal n:
+    /// rn = cross(r, n) and dn = dot(r, n). The tangent t = (n.y, -n.x) needs
+    /// no more, since cross(r, t) = -dot(r, n). So four doubles replace the
+    /// two anchor vectors and no iteration rotates a vector.
+    double rnA = 0.0, rnB = 0.0, dnA = 0.0, dnB = 0.0;
+    double adjustedSeparation = 0.0;  ///< separation minus (dnB - dnA), metres
     double normalMass = 0.0, tangentMass = 0.0;        ///< kg
     double normalImpulse = 0.0, tangentImpulse = 0.0;  ///< accumulated, N*s
 };
@@ -91,8 +96,11 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
                       std::span<SolverBody> bodies, double h, double threshold, int maxPasses);
 
 void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies);
-/// One Gauss-Seidel pass: normal (soft when useBias) then friction.
+/// One Gauss-Seidel pass: normal (soft when useBias) then friction, in
+/// contact order or (reverse) backwards. Alternating the direction between
+/// passes cancels the drift a fixed order feeds into stacks.
 void solveContacts(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h,
-                   const Softness& soft, const Softness& staticSoft, double pushMaxVelocity, bool useBias);
+                   const Softness& soft, const Softness& staticSoft, double pushMaxVelocity, bool useBias,
+                   bool reverse);
 
 } // namespace stepwise::collision

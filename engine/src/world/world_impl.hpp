@@ -2,6 +2,7 @@
 // Internals of World (world.hpp). Tests and benchmarks reach them through
 // the stepwise_engine_internal include path.
 
+#include "collision/collision_system.hpp"
 #include "forces/force_model.hpp"
 #include "integrators/integrator.hpp"
 #include "stepwise/world.hpp"
@@ -39,7 +40,11 @@ public:
 
     std::vector<std::string_view> active;
     StepStats stats;
-    std::vector<ContactRecord> contacts;  ///< empty: collisions are another issue
+    /// Broad phase, narrow phase and contact solve; null when the scene has
+    /// no shapes (then the step has no collision stages). It owns the
+    /// rotation of the bodies that have shapes: only contacts make torque.
+    std::unique_ptr<collision::CollisionSystem> collision;
+    std::vector<double> collisionAngleBackup, collisionSpinBackup;  ///< undo after a divergence
     bool profiling = true;
 
     const double* xs() const { return x[current].data(); }

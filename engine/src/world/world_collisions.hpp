@@ -1,0 +1,33 @@
+#pragma once
+// The collision stages inside the World: which entities become colliders,
+// and the hooks the step pipeline calls. Kept apart from world.cpp so the
+// force/integrator pipeline reads on its own.
+
+#include "collision/collision_system.hpp"
+#include "stepwise/scene.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace stepwise::detail {
+
+/// Builds the collision system for every entity with a shape (radius, box,
+/// plane), or returns nullptr when the scene has none: then the step runs no
+/// collision stage at all. `bodyOf` maps an entity to its index in the
+/// state vector, or kNoBody when it is static.
+std::unique_ptr<collision::CollisionSystem> buildCollisions(
+    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody);
+
+/// Views an interleaved (x0, y0, x1, y1, ...) state array as Vec2s. Vec2 is
+/// exactly two doubles (asserted), the layout the integrators use.
+inline std::span<Vec2> asVec2(double* p, std::size_t bodies) {
+    static_assert(sizeof(Vec2) == 2 * sizeof(double) && alignof(Vec2) == alignof(double));
+    return {reinterpret_cast<Vec2*>(p), bodies};
+}
+inline std::span<const Vec2> asVec2(const double* p, std::size_t bodies) {
+    return {reinterpret_cast<const Vec2*>(p), bodies};
+}
+
+} // namespace stepwise::detail
