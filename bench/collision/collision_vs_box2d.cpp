@@ -5,6 +5,9 @@
 // Box2D's polygon skin does not flatter or penalise it.
 //
 //   collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR]
+//
+// --quick runs a fifth of the simulated time, once; otherwise each engine
+// runs three times, alternating, and the fastest run counts.
 
 #include "collision/collision_scenes.hpp"
 
@@ -239,8 +242,15 @@ int main(int argc, char** argv) {
         // The pyramid's top box is the last one created; other scenes report
         // the drift of their last body, which is not meaningful and shown as -.
         const std::size_t top = poses.size() - 1;
-        const Outcome mine = runStepwise(s.scene, steps, top);
-        const Outcome peer = runBox2d(s.scene, steps, top);
+        // The machine is shared and noisy: run the engines alternately three
+        // times and keep each one's fastest run (the quality figures are
+        // deterministic, the same every run).
+        Outcome mine = runStepwise(s.scene, steps, top);
+        Outcome peer = runBox2d(s.scene, steps, top);
+        for (int repeat = 1; repeat < (quick ? 1 : 3); ++repeat) {
+            mine.msPerStep = std::min(mine.msPerStep, runStepwise(s.scene, steps, top).msPerStep);
+            peer.msPerStep = std::min(peer.msPerStep, runBox2d(s.scene, steps, top).msPerStep);
+        }
         const bool pyramid = s.name == "pyramid";
         char line[512];
         std::snprintf(line, sizeof line, "| %s | %zu | %d | %.3f | %.3f | %.2fx | %.2f / %.2f | %s | %.3g / %.3g |\n",

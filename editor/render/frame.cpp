@@ -79,12 +79,17 @@ double niceFloor(double x) {
     return decade;
 }
 
-/// Reference magnitude for a set of arrows: the median non-zero magnitude
-/// rounded up to a 1-2-5 number, so a typical arrow is about the reference
-/// length and the legend reads as a round number.
+/// Reference magnitude for a set of arrows: the median magnitude rounded up
+/// to a 1-2-5 number, so a typical arrow is about the reference length and
+/// the legend reads as a round number. Magnitudes under 1% of the largest
+/// are left out: bodies at rest (a settled pile, a standing pyramid) carry
+/// 1e-7 m/s of solver noise, and counting them would set the reference there
+/// and clamp every moving body's arrow.
 double autoReference(std::vector<double> magnitudes) {
     std::erase_if(magnitudes, [](double m) { return !(m > 0.0) || !std::isfinite(m); });
     if (magnitudes.empty()) return 1.0;
+    const double largest = *std::max_element(magnitudes.begin(), magnitudes.end());
+    std::erase_if(magnitudes, [&](double m) { return m < 0.01 * largest; });
     auto mid = magnitudes.begin() + std::ptrdiff_t(magnitudes.size() / 2);
     std::nth_element(magnitudes.begin(), mid, magnitudes.end());
     return niceCeil(*mid);
