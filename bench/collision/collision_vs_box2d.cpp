@@ -17,6 +17,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
+#include "world/world_impl.hpp"
 
 #include <box2d/box2d.h>
 
@@ -46,6 +47,7 @@ struct Pose {
 };
 
 struct Outcome {
+    std::vector<Pose> finalPoses;
     double msPerStep = 0.0;
     double deepestOverlap = 0.0;  ///< metres
     double kinetic = 0.0;         ///< joules, translational + rotational
@@ -110,6 +112,9 @@ void measure(const std::vector<Pose>& poses, Outcome& out) {
     }
 }
 
+/// Empty: the engine chooses per step; else "sap" or "grid" (--broad-phase).
+std::string g_broadPhase;
+
 Outcome runStepwise(const Scene& initial, int steps, std::size_t topIndex) {
     Scene scene = initial;
     Result<World> built = World::build(scene);
@@ -119,6 +124,9 @@ Outcome runStepwise(const Scene& initial, int steps, std::size_t topIndex) {
     }
     World& world = built.value();
     world.setProfiling(false);
+    if (!g_broadPhase.empty() && world.impl().collision)
+        world.impl().collision->setBroadPhase(g_broadPhase == "sap" ? collision::BroadPhaseKind::SweepAndPrune
+                                                                    : collision::BroadPhaseKind::UniformGrid);
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; i < steps; ++i) {
         if (Result<void> r = world.step(); !r) {
@@ -140,6 +148,7 @@ Outcome runStepwise(const Scene& initial, int steps, std::size_t topIndex) {
     const std::vector<Pose> start0 = initialPoses(initial);
     out.topDrift = length(poses[topIndex].p - start0[topIndex].p);
     measure(poses, out);
+    out.finalPoses = std::move(poses);
     return out;
 }
 
@@ -201,6 +210,46 @@ Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex) {
     return out;
 }
 
+/// Microseconds per findPairs call for each broad-phase strategy on the
+/// boxes of `poses` (fattened by the 2 cm speculative base, as in a step).
+struct BroadPhaseTimes {
+    double sweepAndPrune = 0.0, uniformGrid = 0.0, bruteForce = 0.0;
+    std::size_t pairs = 0;
+};
+
+BroadPhaseTimes timeBroadPhases(const std::vector<Pose>& poses) {
+    std::vector<collision::Aabb> boxes;
+    std::vector<std::uint8_t> movable;
+    for (const Pose& p : poses) {
+        collision::Aabb box = collision::computeAabb(p.shape, p.p, collision::Rot::fromAngle(p.angle));
+        box.lower -= Vec2{0.02, 0.02};
+        box.upper += Vec2{0.02, 0.02};
+        boxes.push_back(box);
+        movable.push_back(p.dynamic);
+    }
+    auto time = [&](collision::BroadPhaseKind kind, std::size_t& pairCount) {
+        collision::BroadPhase phase(kind);
+        std::vector<collision::ProxyPair> pairs;
+        phase.findPairs(boxes, movable, pairs);  // warm: SAP keeps its sorted order
+        const int runs = kind == collision::BroadPhaseKind::BruteForce ? 5 : 50;
+        const auto start = std::chrono::steady_clock::now();
+        for (int i = 0; i < runs; ++i) phase.findPairs(boxes, movable, pairs);
+        pairCount = pairs.size();
+        return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count() / runs;
+    };
+    BroadPhaseTimes t;
+    std::size_t a = 0, b = 0, c = 0;
+    t.sweepAndPrune = time(collision::BroadPhaseKind::SweepAndPrune, a);
+    t.uniformGrid = time(collision::BroadPhaseKind::UniformGrid, b);
+    t.bruteForce = time(collision::BroadPhaseKind::BruteForce, c);
+    if (a != b || a != c) {
+        std::cerr << "broad phases disagree: " << a << " / " << b << " / " << c << " pairs\n";
+        std::exit(1);
+    }
+    t.pairs = a;
+    return t;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -211,9 +260,11 @@ int main(int argc, char** argv) {
         if (arg == "--quick") quick = true;
         else if (arg == "--out" && i + 1 < argc) outDir = argv[++i];
         else if (arg == "--write-levels" && i + 1 < argc) levelsDir = argv[++i];
+        else if (arg == "--broad-phase" && i + 1 < argc && (std::string(argv[i + 1]) == "sap" || std::string(argv[i + 1]) == "grid"))
+            g_broadPhase = argv[++i];
         else {
             std::cerr << "collision_vs_box2d: error: unknown argument \"" << arg
-                      << "\"; usage: collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR]\n";
+                      << "\"; usage: collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid]\n";
             return 2;
         }
     }
@@ -265,6 +316,19 @@ int main(int argc, char** argv) {
             << peer.msPerStep / mine.msPerStep << "," << mine.deepestOverlap << "," << peer.deepestOverlap << ","
             << mine.topDrift << "," << peer.topDrift << "," << mine.kinetic << "," << peer.kinetic << "\n";
         std::cout << line << std::flush;
+    }
+    // Broad-phase strategies on each scene's settled state (the dense case).
+    md << "\nBroad phase, microseconds per call on the settled scenes (all three return the same pairs):\n\n"
+       << "| scene | pairs | sweep and prune | uniform grid | brute force |\n|---|---|---|---|---|\n";
+    for (const auto& s : scenes) {
+        const int steps = int(std::lround((quick ? 0.2 : 1.0) * s.seconds / s.scene.world.dt));
+        const Outcome settled = runStepwise(s.scene, steps, initialPoses(s.scene).size() - 1);
+        const BroadPhaseTimes t = timeBroadPhases(settled.finalPoses);
+        char line[256];
+        std::snprintf(line, sizeof line, "| %s | %zu | %.1f | %.1f | %.1f |\n", s.name.c_str(), t.pairs,
+                      t.sweepAndPrune, t.uniformGrid, t.bruteForce);
+        md << line;
+        std::cout << "broad phase " << line << std::flush;
     }
     if (!outDir.empty()) {
         fs::create_directories(outDir);

@@ -40,7 +40,13 @@ private:
     void uniformGrid(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
 
     BroadPhaseKind kind_;
+    struct SortedBox {
+        double lowerX, upperX, lowerY, upperY;
+        std::uint32_t index;
+        std::uint8_t movable;
+    };
     std::vector<std::uint32_t> order_;  // SAP: proxies sorted by lower.x (kept between steps: nearly sorted)
+    std::vector<SortedBox> sorted_;     // SAP: the boxes in that order, packed for the sweep
     std::vector<std::uint64_t> cellKeys_;  // grid: (cell, proxy) entries
 };
 

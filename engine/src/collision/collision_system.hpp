@@ -48,7 +48,13 @@ public:
     double angularVelocity(std::size_t i) const { return angularVelocities_[i]; }
 
     SolverSettings& settings() { return settings_; }
-    BroadPhase& broadPhase() { return broadPhase_; }
+    /// Fixes the broad-phase strategy (tests, benchmarks); by default it is
+    /// chosen per step from the number of shapes.
+    void setBroadPhase(BroadPhaseKind kind) {
+        autoBroadPhase_ = false;
+        broadPhase_.setKind(kind);
+    }
+    const BroadPhase& broadPhase() const { return broadPhase_; }
 
     /// Detection for the whole step: margins cover the motion of `dt`, so
     /// contacts exist before fast bodies reach a surface.
@@ -90,6 +96,7 @@ private:
 
     SolverSettings settings_;
     BroadPhase broadPhase_;
+    bool autoBroadPhase_ = true;
     std::vector<Aabb> boxes_;
     std::vector<std::uint8_t> movable_;
     std::vector<ProxyPair> pairs_;
