@@ -234,6 +234,36 @@ private:
     double ppm_;        ///< pixels per metre at this image height
     int textScale_;     ///< integer pixel scale of the bitmap font
     double arrowRef_;   ///< pixels drawn for a reference-magnitude arrow
+
+    /// Level of detail for per-body overlays in dense scenes: at most one
+    /// arrow (or trail) starts in each kThinCellPx-square cell of the image,
+    /// taken in scene order, so the choice is deterministic. 10,000 bodies
+    /// on a 1080p image are ~14 px apart and their arrows overlap into a
+    /// texture; keeping one per cell reads better and halves llvmpipe's
+    /// per-primitive work (its cost at this size, not the pixels).
+    static constexpr double kThinCellPx = 14.0;
+    class CellThinner {
+    public:
+        CellThinner(int w, int h, bool active)
+            : cols_(int(w / kThinCellPx) + 1), rows_(int(h / kThinCellPx) + 1), active_(active),
+              used_(active ? std::size_t(cols_) * std::size_t(rows_) : 0, false) {}
+        /// True when a body at pixel p should be drawn (on screen, and the
+        /// first in its cell when thinning).
+        bool take(Vec2 p) {
+            if (!active_) return true;
+            const int cx = int(std::floor(p.x / kThinCellPx)), cy = int(std::floor(p.y / kThinCellPx));
+            if (cx < 0 || cy < 0 || cx >= cols_ || cy >= rows_) return false;
+            const std::size_t k = std::size_t(cy) * std::size_t(cols_) + std::size_t(cx);
+            if (used_[k]) return false;
+            used_[k] = true;
+            return true;
+        }
+
+    private:
+        int cols_, rows_;
+        bool active_;
+        std::vector<bool> used_;
+    };
     bool dense_ = false;  ///< thousands of bodies: thinner per-body lines
     std::unordered_set<Entity> selected_;
     std::unordered_map<std::string, Entity> byName_;
@@ -485,8 +515,10 @@ void Builder::trails() {
         out_.notes.push_back("trails: nothing recorded (use --steps)");
         return;
     }
+    CellThinner thin(w_, h_, dense_);
     for (const TrailRecorder::Trail& t : in_.trails->trails()) {
         if (t.points.size() < 2 || !scene_.registry.alive(t.entity)) continue;
+        if (!thin.take(toPx(t.points.back()))) continue;
         const Rgba c = colourOf(scene_, t.entity, kDefaultBody);
         const std::size_t n = t.points.size();
         Vec2 prev = toPx(t.points[0]);
@@ -605,9 +637,11 @@ void Builder::bodyArrows() {
             for (Vec2 f : forces) mags.push_back(length(f));
             const double ref = in_.scales.force > 0 ? in_.scales.force : autoReference(mags);
             out_.scales.force = ref;
+            CellThinner thin(w_, h_, dense_);
             for (std::size_t i = 0; i < forces.size(); ++i) {
                 if (!(mags[i] > 0.0) || !std::isfinite(mags[i])) continue;
                 const Vec2 from = toPx(in_.world->bodyPosition(i));
+                if (!thin.take(from)) continue;
                 const double len = arrowLength(mags[i], ref, arrowRef_, maxPx);
                 arrow(from, from + forces[i] / mags[i] * len, dense_ ? 1.0 : 2.0, kForce);
             }
@@ -626,9 +660,11 @@ void Builder::bodyArrows() {
         }
         const double ref = in_.scales.velocity > 0 ? in_.scales.velocity : autoReference(mags);
         out_.scales.velocity = ref;
+        CellThinner thin(w_, h_, dense_);
         for (std::size_t i = 0; i < arrows.size(); ++i) {
             if (!(mags[i] > 0.0) || !std::isfinite(mags[i])) continue;
             const Vec2 from = toPx(arrows[i].first);
+            if (!thin.take(from)) continue;
             const double len = arrowLength(mags[i], ref, arrowRef_, maxPx);
             arrow(from, from + arrows[i].second / mags[i] * len, dense_ ? 1.0 : 2.0, kVelocity);
         }
