@@ -94,6 +94,22 @@ TEST_F(Cli, ValidatePrintsASummaryOfAGoodLevel) {
     EXPECT_EQ(o.out.find("boids"), std::string::npos) << "a scene without boids must not run the boid system";
 }
 
+TEST_F(Cli, ValidateWarnsAboutComponentsThatHaveNoEffect) {
+    const fs::path file = write("ineffective.json", R"({"entities": [
+      {"name": "wall", "position": {"x": 0, "y": 0}, "static": true, "velocity": {"x": 1, "y": 0}, "mass": 3},
+      {"name": "sun", "position": {"x": 5, "y": 0}, "static": true, "mass": 50, "attractor": {}},
+      {"name": "dot", "position": {"x": 0, "y": 2}, "friction": 0.5}]})");
+    Outcome o = stepwise("validate " + file.string());
+    EXPECT_EQ(o.exitCode, 0) << "a valid file stays valid; the notes are warnings";
+    EXPECT_EQ(o.err, file.string() + ": warning: entity 0 (\"wall\"): \"velocity\" on a static body has no effect "
+                                     "(static bodies never move)\n" +
+                         file.string() + ": warning: entity 0 (\"wall\"): \"mass\" on a static body has no effect "
+                                         "(static mass is infinite)\n" +
+                         file.string() + ": warning: entity 2 (\"dot\"): \"friction\" has no effect: the entity has "
+                                         "no shape, so it never collides\n")
+        << "a static attractor's mass sets its pull, so it gets no warning";
+}
+
 TEST_F(Cli, ValidateRefusesABadFileWithExitTwoAndTheLoaderMessage) {
     const fs::path file = write("bad.json", R"({"entities": [{"name": "ball", "position": {"x": 0, "y": 0}, "mass": -1}]})");
     Outcome o = stepwise("validate " + file.string());

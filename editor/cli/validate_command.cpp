@@ -4,12 +4,52 @@
 #include "cli/cli_common.hpp"
 #include "cli/commands.hpp"
 
+#include "stepwise/components.hpp"
 #include "stepwise/world.hpp"
 
 #include <iostream>
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace stepwise::cli {
+
+namespace {
+
+/// Components that are valid but have no effect where they are: said, so
+/// nothing in a level is ignored silently.
+std::vector<std::string> ineffectiveComponents(const Scene& scene) {
+    std::vector<std::string> notes;
+    const Registry& r = scene.registry;
+    const auto& order = r.entities();
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        const Entity e = order[i];
+        std::string label = "entity " + std::to_string(i);
+        if (const Name* n = r.tryGet<Name>(e)) label += " (\"" + n->value + "\")";
+        const bool isStatic = r.has<Static>(e) && r.tryGet<Static>(e)->value;
+        const bool hasShape = r.has<Radius>(e) || r.has<Box>(e) || r.has<Plane>(e);
+        if (isStatic) {
+            if (const Velocity* v = r.tryGet<Velocity>(e); v && (v->value.x != 0.0 || v->value.y != 0.0))
+                notes.push_back(label + ": \"velocity\" on a static body has no effect (static bodies never move)");
+            if (const AngularVelocity* w = r.tryGet<AngularVelocity>(e); w && w->value != 0.0)
+                notes.push_back(label + ": \"angular_velocity\" on a static body has no effect");
+            if (r.has<Drag>(e)) notes.push_back(label + ": \"drag\" on a static body has no effect (it never moves)");
+            // A static attractor's mass sets its pull; otherwise a static
+            // body's mass is infinite whatever the file says.
+            if (r.has<Mass>(e) && !r.has<Attractor>(e))
+                notes.push_back(label + ": \"mass\" on a static body has no effect (static mass is infinite)");
+        }
+        if (!hasShape) {
+            if (r.has<Restitution>(e))
+                notes.push_back(label + ": \"restitution\" has no effect: the entity has no shape, so it never collides");
+            if (r.has<Friction>(e))
+                notes.push_back(label + ": \"friction\" has no effect: the entity has no shape, so it never collides");
+        }
+    }
+    return notes;
+}
+
+} // namespace
 
 void addValidateCommand(CLI::App& app, int& exitCode) {
     auto level = std::make_shared<std::string>();
@@ -34,6 +74,8 @@ void addValidateCommand(CLI::App& app, int& exitCode) {
             std::cout << summary << "\n";
             for (const StiffnessHint& hint : world->stiffnessHints())
                 std::cerr << *level << ": warning: " << hint.message() << "\n";
+            for (const std::string& note : ineffectiveComponents(*scene))
+                std::cerr << *level << ": warning: " << note << "\n";
         } else {
             // The file is valid but asks for something this build cannot
             // simulate: say so, without failing validation of the format.
