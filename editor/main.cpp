@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     addBenchCommand(app, exitCode);
     addRenderCommand(app, exitCode);
     addSchemaCommand(app, exitCode);
+    addEditCommand(app, exitCode);
     // CLI11 reports an unknown first word only as "A subcommand is
     // required"; name the word and the choices instead.
     if (argc > 1 && argv[1][0] != '-') {

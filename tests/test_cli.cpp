@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -254,6 +255,169 @@ TEST_F(Cli, SchemaCommandMatchesTheCommittedSchema) {
 
 TEST_F(Cli, EverySubcommandHasHelp) {
     for (const char* sub : {"validate", "run", "schema"}) {
+        Outcome o = stepwise(std::string(sub) + " --help");
+        EXPECT_EQ(o.exitCode, 0) << sub;
+        EXPECT_NE(o.out.find("Usage:"), std::string::npos) << sub << ": " << o.out;
+    }
+}
+
+// ---- Limits and bad input everywhere (issue 7) ------------------------------
+
+TEST_F(Cli, ValidateRefusesOneEntityPastTheDocumentedLimitAndAcceptsTheLimit) {
+    // README "Limits": 1,000,000 entities. Empty entities keep the file at
+    // 3 MB; the count is checked while parsing.
+    const auto levelWith = [&](std::size_t n) {
+        std::string text = "{\"entities\": [";
+        text.reserve(16 + 3 * n);
+        for (std::size_t i = 0; i < n; ++i) text += i ? ",{}" : "{}";
+        return write("n" + std::to_string(n) + ".json", text + "]}\n");
+    };
+    const fs::path over = levelWith(1'000'001);
+    Outcome o = stepwise("validate " + over.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, over.string() + ": error: more than 1000000 entities; the limit is 1000000\n");
+    EXPECT_EQ(o.out, "");
+    const fs::path at = levelWith(1'000'000);
+    o = stepwise("validate " + at.string());
+    EXPECT_EQ(o.exitCode, 0) << o.err;
+    EXPECT_EQ(o.out, at.string() + ": ok: 1000000 entities; components: none; systems: none; integrator "
+                                   "semi_implicit_euler\n");
+}
+
+TEST_F(Cli, ValidateRefusesAFileOverTheSizeLimitBeforeReadingIt) {
+    const fs::path huge = write("huge.json", "{}");
+    fs::resize_file(huge, (256ull << 20) + 1);  // sparse: no disk, and never read
+    Outcome o = stepwise("validate " + huge.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, huge.string() + ": error: file is 268435457 bytes; the limit is 268435456 bytes\n");
+}
+
+TEST_F(Cli, ValidateAndSchemaBadArguments) {
+    Outcome o = stepwise("validate");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("LEVEL is required\n", 0), 0u) << o.err;
+    o = stepwise("validate " + level("orbit.json") + " extra.json");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("The following argument was not expected: extra.json\n", 0), 0u) << o.err;
+
+    o = stepwise("schema extra");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("The following argument was not expected: extra\n", 0), 0u) << o.err;
+    o = stepwise("schema --bogus");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("The following argument was not expected: --bogus\n", 0), 0u) << o.err;
+    // --out under a regular file, and --out naming a folder: the message
+    // names the path given, and nothing is written.
+    const fs::path file = write("file.txt", "keep");
+    o = stepwise("schema --out " + (file / "s.json").string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, (file / "s.json").string() + ": error: cannot write: Not a directory\n");
+    o = stepwise("schema --out " + dir_.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, dir_.string() + ": error: cannot replace the file: Is a directory\n");
+    EXPECT_EQ(readFile(file), "keep");
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1) << "a temporary was left";
+}
+
+TEST_F(Cli, RunBadArgumentsNameTheArgument) {
+    const fs::path file = write("forces.json", kForces);
+    Outcome o = stepwise("run " + file.string() + " --steps -5");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("--steps: expected a whole number >= 0, got \"-5\"\n", 0), 0u) << o.err;
+    o = stepwise("run " + file.string() + " --steps abc");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("--steps: expected a whole number >= 0, got \"abc\"\n", 0), 0u) << o.err;
+    o = stepwise("run " + file.string() + " --steps 99999999999999999999");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("--steps: expected a whole number >= 0, got \"99999999999999999999\"\n", 0), 0u) << o.err;
+    const fs::path notAFolder = write("file.txt", "");
+    for (const char* option : {"--out", "--trace", "--contacts"}) {
+        const fs::path target = notAFolder / "x";
+        o = stepwise("run " + file.string() + " --steps 2 " + option + " " + target.string());
+        EXPECT_EQ(o.exitCode, 2) << option;
+        EXPECT_EQ(o.err, target.string() + ": error: cannot write: Not a directory\n") << option;
+    }
+}
+
+TEST_F(Cli, RenderBadArgumentsExitTwoNameTheArgumentAndWriteNothing) {
+    const std::string orbit = level("orbit.json");
+    const fs::path png = dir_ / "x.png";
+    const fs::path notAFolder = write("file.txt", "");
+    struct Case {
+        std::string args;
+        std::string firstLine;  // exact first line of stderr
+    };
+    const std::vector<Case> cases = {
+        {orbit, "--out is required"},
+        {orbit + " --out " + png.string() + " --steps -1", "--steps: expected a whole number >= 0, got \"-1\""},
+        {orbit + " --out " + png.string() + " --steps 1.5", "--steps: expected a whole number >= 0, got \"1.5\""},
+        {orbit + " --out " + png.string() + " --width 8", "--width: Value 8 not in range 16 to 16384"},
+        {orbit + " --out " + png.string() + " --height 20000", "--height: Value 20000 not in range 16 to 16384"},
+        {orbit + " --out " + png.string() + " --frames 0", "--frames: Value 0 not in range 1 to 100000"},
+        {orbit + " --out " + png.string() + " --every 0", "--every: Value 0 not in range 1 to 1000000000"},
+        {orbit + " --out " + png.string() + " --trail 1", "--trail: Value 1 not in range 2 to 100000"},
+        {orbit + " --out " + png.string() + " --integrator rk5",
+         "--integrator: rk5 not in {explicit_euler,semi_implicit_euler,midpoint,trapezoid,rk4,velocity_verlet,"
+         "implicit_euler,implicit_midpoint}"},
+        {orbit + " --out " + png.string() + " --overlay velocity,bogus",
+         "stepwise: error: --overlay: unknown overlay \"bogus\"; known overlays: velocity, velocity-field, "
+         "force-field, force, contacts, aabb, trails, all, none"},
+        {orbit + " --out " + png.string() + " --camera 1,2",
+         "stepwise: error: --camera: expected X,Y,ZOOM (metres, metres, pixels per metre at 720 px height), got "
+         "\"1,2\""},
+        {orbit + " --out " + png.string() + " --camera 1,2,0", "stepwise: error: --camera: ZOOM must be > 0, got 0"},
+        {orbit + " --out " + png.string() + " --camera 1,2,nan",
+         "stepwise: error: --camera: expected X,Y,ZOOM (metres, metres, pixels per metre at 720 px height), got "
+         "\"1,2,nan\""},
+        {orbit + " --out " + png.string() + " --select sun,nobody",
+         "stepwise: error: --select: " + orbit + " has no entity named \"nobody\""},
+        {orbit + " --out " + png.string() + " --steps 9223372036854775807 --frames 3 --every 5",
+         "stepwise: error: --steps: 9223372036854775807 plus 2 x --every 5 steps does not fit in a 64-bit count"},
+        {orbit + " --out " + (dir_ / "missing" / "x.png").string(),
+         "stepwise: error: --out: folder " + (dir_ / "missing").string() + " does not exist"},
+        {orbit + " --out " + (notAFolder / "x.png").string(),
+         "stepwise: error: --out: folder " + notAFolder.string() + " is not a folder"},
+        {(dir_ / "nope.json").string() + " --out " + png.string(), (dir_ / "nope.json").string() + ": error: no such file"},
+        {orbit + " --out " + png.string() + " --bogus", "The following argument was not expected: --bogus"},
+    };
+    for (const Case& c : cases) {
+        Outcome o = stepwise("render " + c.args);
+        EXPECT_EQ(o.exitCode, 2) << c.args << "\n" << o.err;
+        EXPECT_EQ(o.err.substr(0, o.err.find('\n')), c.firstLine) << c.args;
+        EXPECT_FALSE(fs::exists(png)) << c.args;
+    }
+}
+
+TEST_F(Cli, BenchBadArgumentsExitTwoNamingTheArgument) {
+    Outcome o = stepwise("bench");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, "stepwise: error: bench: expected a report to run: accuracy (see stepwise bench --help)\n");
+    o = stepwise("bench frob");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, "stepwise: error: bench: unknown report \"frob\"; expected one of: accuracy\n");
+    o = stepwise("bench accuracy --quick");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("--out is required\n", 0), 0u) << o.err;
+    o = stepwise("bench accuracy --quick --out");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("--out: 1 required TEXT missing\n", 0), 0u) << o.err;
+    o = stepwise("bench accuracy --quick --out " + (dir_ / "r").string() + " --repeat 3");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("The following arguments were not expected: 3 --repeat\n", 0), 0u) << o.err;
+    // Checked before any measuring: fails at once and creates nothing.
+    const fs::path notAFolder = write("file.txt", "");
+    o = stepwise("bench accuracy --quick --out " + (notAFolder / "report").string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, "stepwise: error: --out: cannot create the folder " + (notAFolder / "report").string() +
+                         ": Not a directory\n");
+    o = stepwise("bench accuracy --quick --out " + notAFolder.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, "stepwise: error: --out: cannot create the folder " + notAFolder.string() + ": Not a directory\n");
+    EXPECT_FALSE(fs::exists(dir_ / "r"));
+}
+
+TEST_F(Cli, RenderAndBenchHaveHelp) {
+    for (const char* sub : {"render", "bench", "bench accuracy"}) {
         Outcome o = stepwise(std::string(sub) + " --help");
         EXPECT_EQ(o.exitCode, 0) << sub;
         EXPECT_NE(o.out.find("Usage:"), std::string::npos) << sub << ": " << o.out;

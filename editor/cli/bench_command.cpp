@@ -7,6 +7,7 @@
 
 #include "accuracy/accuracy.hpp"
 
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -14,7 +15,17 @@ namespace stepwise::cli {
 
 void addBenchCommand(CLI::App& app, int& exitCode) {
     CLI::App* bench = app.add_subcommand("bench", "Benchmarks and reports");
-    bench->require_subcommand(1);
+    // Not require_subcommand(1): CLI11 then says only "A subcommand is
+    // required" for `bench frob`. A positional catches the unknown word so
+    // the message can name it (main.cpp does the same one level up).
+    auto unknown = std::make_shared<std::string>();
+    bench->add_option("REPORT", *unknown, "The report to run: accuracy");
+    bench->callback([bench, unknown, &exitCode] {
+        if (bench->got_subcommand("accuracy")) return;  // its own callback set exitCode
+        if (unknown->empty()) reportError("bench: expected a report to run: accuracy (see stepwise bench --help)");
+        else reportError("bench: unknown report \"" + *unknown + "\"; expected one of: accuracy");
+        exitCode = kExitBadInput;
+    });
     auto options = std::make_shared<bench::AccuracyOptions>();
     auto out = std::make_shared<std::string>();
     CLI::App* accuracy = bench->add_subcommand(
@@ -23,6 +34,16 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
     accuracy->add_option("--out", *out, "Directory for accuracy.csv, accuracy.md and accuracy.png")->required();
     accuracy->callback([options, out, &exitCode] {
         options->out = *out;
+        // Checked before minutes of measuring, and named as the argument.
+        std::error_code ec;
+        std::filesystem::create_directories(options->out, ec);
+        if (ec || !std::filesystem::is_directory(options->out, ec)) {
+            // An existing file of that name is ENOTDIR ("Not a directory").
+            reportError("--out: cannot create the folder " + *out + ": " +
+                        (ec ? ec.message() : std::string("not a directory")));
+            exitCode = kExitBadInput;
+            return;
+        }
         try {
             const std::string problem = bench::runAccuracyReport(*options, std::cerr);
             if (!problem.empty()) {

@@ -4,6 +4,8 @@
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
 
+#include <cerrno>
+#include <cstdlib>
 #include <iostream>
 
 namespace stepwise::cli {
@@ -33,6 +35,19 @@ std::string sceneSummary(const Scene& scene) {
     std::string line = std::to_string(registry.size()) + " entities; components: " +
                        (components.empty() ? "none" : components);
     return line;
+}
+
+CLI::Validator wholeNumberAtLeastZero() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            errno = 0;
+            char* end = nullptr;
+            const long long value = std::strtoll(text.c_str(), &end, 10);
+            if (text.empty() || *end != '\0' || errno == ERANGE || value < 0)
+                return "expected a whole number >= 0, got \"" + text + "\"";
+            return {};
+        },
+        "INT>=0");
 }
 
 } // namespace stepwise::cli

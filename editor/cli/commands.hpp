@@ -20,5 +20,7 @@ void addRunCommand(CLI::App& app, int& exitCode);
 void addBenchCommand(CLI::App& app, int& exitCode);
 void addRenderCommand(CLI::App& app, int& exitCode);
 void addSchemaCommand(CLI::App& app, int& exitCode);
+/// `stepwise edit [LEVEL]`: the editor (SDL2 window, or headless with --script/--screenshot).
+void addEditCommand(CLI::App& app, int& exitCode);
 
 } // namespace stepwise::cli

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -51,7 +52,11 @@ Result<render::Camera> parseCamera(const std::string& text) {
         !std::isfinite(v[1]) || !std::isfinite(v[2]))
         return Error{"--camera: expected X,Y,ZOOM (metres, metres, pixels per metre at 720 px height), got \"" + text +
                      "\""};
-    if (!(v[2] > 0.0)) return Error{"--camera: ZOOM must be > 0, got " + std::to_string(v[2])};
+    if (!(v[2] > 0.0)) {
+        char zoom[32];
+        std::snprintf(zoom, sizeof zoom, "%g", v[2]);  // "0", not to_string's "0.000000"
+        return Error{"--camera: ZOOM must be > 0, got " + std::string(zoom)};
+    }
     cam.center = {v[0], v[1]};
     cam.zoom = v[2];
     return cam;
@@ -102,9 +107,16 @@ int render(const RenderOptions& o) {
         const std::filesystem::path parent = std::filesystem::path(o.out).parent_path();
         std::error_code ec;
         if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
-            reportError("--out: folder " + parent.string() + " does not exist");
+            reportError("--out: folder " + parent.string() +
+                        (std::filesystem::exists(parent, ec) ? " is not a folder" : " does not exist"));
             return kExitBadInput;
         }
+    }
+    // The last frame's step count must fit in a long long.
+    if (o.frames > 1 && o.steps > std::numeric_limits<long long>::max() - (long long)(o.frames - 1) * o.every) {
+        reportError("--steps: " + std::to_string(o.steps) + " plus " + std::to_string(o.frames - 1) + " x --every " +
+                    std::to_string(o.every) + " steps does not fit in a 64-bit count");
+        return kExitBadInput;
     }
 
     std::optional<Scene> scene = loadLevelOrReport(o.level);
@@ -219,7 +231,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--out", o->out, "Output PNG (a sequence adds -0000, -0001, ... before the extension)")
         ->required();
     cmd->add_option("--steps", o->steps, "Steps to simulate before the (first) frame")
-        ->check(CLI::NonNegativeNumber);
+        ->check(wholeNumberAtLeastZero());
     cmd->add_option("--integrator", o->integrator, "Integrator (overrides world.integrator)")
         ->check(CLI::IsMember(std::vector<std::string>(integratorNames().begin(), integratorNames().end())));
     cmd->add_option("--width", o->width, "Image width, pixels")->check(CLI::Range(16, 16384));

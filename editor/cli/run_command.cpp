@@ -151,7 +151,7 @@ void addRunCommand(CLI::App& app, int& exitCode) {
     auto options = std::make_shared<RunOptions>();
     CLI::App* cmd = app.add_subcommand("run", "Step a level headlessly and write the resulting scene");
     cmd->add_option("LEVEL", options->level, "Level file (JSON)")->required();
-    cmd->add_option("--steps", options->steps, "Number of steps to take")->required()->check(CLI::NonNegativeNumber);
+    cmd->add_option("--steps", options->steps, "Number of steps to take")->required()->check(wholeNumberAtLeastZero());
     cmd->add_option("--dt", options->dt, "Seconds per step (overrides world.dt)")
         ->check(CLI::PositiveNumber & CLI::Range(0.0, 10.0));
     cmd->add_option("--integrator", options->integrator, "Integrator (overrides world.integrator)")

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <type_traits>
 
@@ -84,14 +85,32 @@ ComponentInfo row(std::string_view name, std::string_view description, bool inli
     return info;
 }
 
+/// A number as the loader's messages show it ("%g"-like, short).
+std::string describeNumber(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
 std::string finishPlane(void* component) {
     auto& plane = *static_cast<Plane*>(component);
-    const double len = length(plane.normal);
+    // hypot, not sqrt(x*x + y*y): a normal of 1e200 would overflow to inf
+    // and normalise to (0, 0).
+    const double len = std::hypot(plane.normal.x, plane.normal.y);
     if (!(len > 1e-12)) return "normal: expected a non-zero vector, got {\"x\": 0, \"y\": 0}";
+    // A normal that is already unit length up to rounding is kept bit for
+    // bit. Dividing it by its own rounded length would move its last bits on
+    // every load, so load -> save -> load -> save would not give the same
+    // bytes: {1, 2} did. 8 ulp covers the rounding of n / |n|.
+    if (std::abs(len - 1.0) <= 8.0 * std::numeric_limits<double>::epsilon()) return {};
     // The offset is measured along the normal as written (n.p >= d); keep the
     // same half-plane after normalising n by scaling d with it.
+    const double offset = plane.offset / len;
+    if (!std::isfinite(offset))
+        return "offset: expected an offset that stays finite once the normal is normalised (offset / |normal|), "
+               "got " + describeNumber(plane.offset) + " with |normal| = " + describeNumber(len);
     plane.normal = plane.normal / len;
-    plane.offset = plane.offset / len;
+    plane.offset = offset;
     return {};
 }
 

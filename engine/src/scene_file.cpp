@@ -5,6 +5,7 @@
 #include "stepwise/scene_io.hpp"
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -95,10 +96,41 @@ Result<void> writeFileAtomically(const fs::path& path, std::string_view bytes) {
     return {};
 }
 
+namespace {
+
+/// A save killed between mkstemp and rename (SIGKILL, power loss) leaves its
+/// hidden temporary `.NAME.tmp-XXXXXX` behind; the level itself is intact
+/// and no loader ever reads such a file. Each later save of the same level
+/// removes the ones older than an hour. Younger ones are left alone: they
+/// may belong to a save still running in another process (the editor's
+/// autosave and a CLI run on the same file), and deleting that one's
+/// temporary would make its rename fail. Only level saves do this, not
+/// every writeFileAtomically: `render --frames` writes thousands of files
+/// into one folder, and a scan per file would make that quadratic.
+void removeStaleTemporaries(const fs::path& path) {
+    const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    const std::string prefix = "." + path.filename().string() + ".tmp-";
+    const auto now = fs::file_time_type::clock::now();
+    std::error_code ec;
+    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.size() != prefix.size() + 6 || name.compare(0, prefix.size(), prefix) != 0) continue;
+        std::error_code fileEc;
+        if (it->symlink_status(fileEc).type() != fs::file_type::regular) continue;
+        const auto modified = it->last_write_time(fileEc);
+        if (fileEc || now - modified < std::chrono::hours(1)) continue;
+        fs::remove(it->path(), fileEc);  // best effort: a leftover costs only disk space
+    }
+}
+
+} // namespace
+
 Result<void> saveSceneFile(const Scene& scene, const fs::path& path) {
     if (std::string problem = checkSceneRelations(scene); !problem.empty())
         return Error{path.string() + ": error: not saved, the scene is invalid: " + problem};
-    return writeFileAtomically(path, sceneToJsonText(scene));
+    Result<void> written = writeFileAtomically(path, sceneToJsonText(scene));
+    if (written) removeStaleTemporaries(path);
+    return written;
 }
 
 } // namespace stepwise

@@ -57,7 +57,12 @@ std::string describeFound(const Json& v) {
         [[fallthrough]];
     default: {
         std::string s = v.dump();
-        if (s.size() > 60) s = s.substr(0, 57) + "...";
+        if (s.size() > 60) {
+            // Cut on a UTF-8 character boundary, never inside a character.
+            std::size_t cut = 57;
+            while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;
+            s = s.substr(0, cut) + "...";
+        }
         return s;
     }
     }
@@ -213,8 +218,11 @@ void readComponent(const ComponentInfo& info, const Json& value, Registry& regis
             refuse(pointer, "expected an object for component \"" + std::string(info.name) + "\", got " +
                                 describeFound(value));
         for (const auto& [key, fieldValue] : value.items()) {
+            // Not captured directly: clang 14 (the fuzz build) cannot capture
+            // a structured binding in a lambda.
+            const std::string& fieldKey = key;
             const auto it = std::find_if(info.fields.begin(), info.fields.end(),
-                                         [&](const FieldInfo& f) { return f.key == key; });
+                                         [&](const FieldInfo& f) { return f.key == fieldKey; });
             if (it == info.fields.end()) {
                 std::vector<std::string_view> known;
                 for (const FieldInfo& f : info.fields) known.push_back(f.key);
@@ -414,6 +422,55 @@ void writeJson(const Json& v, int indent, std::string& out) {
     }
 }
 
+/// Refusals are printed on a terminal and shown in the editor: one line of
+/// valid UTF-8. The parser's messages quote the bytes it stopped at, which
+/// may be any bytes of a broken file, and keys may hold escaped control
+/// characters; such bytes are shown as \xNN (found by fuzzing).
+std::string printableMessage(std::string_view message) {
+    std::string out;
+    out.reserve(message.size());
+    const auto hex = [&](unsigned char c) {
+        static constexpr char kDigits[] = "0123456789ABCDEF";
+        out += "\\x";
+        out += kDigits[c >> 4];
+        out += kDigits[c & 0xF];
+    };
+    std::size_t i = 0;
+    while (i < message.size()) {
+        const auto c = static_cast<unsigned char>(message[i]);
+        if (c < 0x20 || c == 0x7F) {
+            hex(c);
+            ++i;
+            continue;
+        }
+        if (c < 0x80) {
+            out += char(c);
+            ++i;
+            continue;
+        }
+        // Length from the lead byte; continuation bytes are 10xxxxxx. No
+        // overlong forms, surrogates or values past U+10FFFF.
+        const std::size_t n = (c >= 0xC2 && c <= 0xDF) ? 2 : (c >= 0xE0 && c <= 0xEF) ? 3 : (c >= 0xF0 && c <= 0xF4) ? 4 : 0;
+        bool valid = n != 0 && i + n <= message.size();
+        for (std::size_t k = 1; valid && k < n; ++k)
+            valid = (static_cast<unsigned char>(message[i + k]) & 0xC0) == 0x80;
+        if (valid && n >= 3) {
+            const auto c1 = static_cast<unsigned char>(message[i + 1]);
+            if ((c == 0xE0 && c1 < 0xA0) || (c == 0xED && c1 >= 0xA0) || (c == 0xF0 && c1 < 0x90) ||
+                (c == 0xF4 && c1 >= 0x90))
+                valid = false;
+        }
+        if (!valid) {
+            hex(c);
+            ++i;
+            continue;
+        }
+        out.append(message.substr(i, n));
+        i += n;
+    }
+    return out;
+}
+
 } // namespace
 
 std::string checkSceneRelations(const Scene& scene) {
@@ -453,33 +510,94 @@ std::string checkSceneRelations(const Scene& scene) {
     return {};
 }
 
-Result<Scene> parseScene(std::string_view text, std::string_view sourceName, const LoadLimits& limits) {
+namespace {
+
+/// Thrown by LimitedDomParser when a limit is passed; caught in parseScene.
+struct LimitHit {
+    std::string message;
+};
+
+/// nlohmann's DOM builder (the one Json::parse uses) with the loader's
+/// limits checked on the way: nesting depth on every container, and the
+/// entity count on every object that opens inside the top-level
+/// "entities" array. Errors are thrown as by Json::parse.
+class LimitedDomParser {
+public:
+    using Dom = nlohmann::detail::json_sax_dom_parser<Json>;
+
+    LimitedDomParser(Json& root, const LoadLimits& limits) : dom_(root, /*allow_exceptions=*/true), limits_(limits) {}
+
+    bool null() { return dom_.null(); }
+    bool boolean(bool v) { return dom_.boolean(v); }
+    bool number_integer(Json::number_integer_t v) { return dom_.number_integer(v); }
+    bool number_unsigned(Json::number_unsigned_t v) { return dom_.number_unsigned(v); }
+    bool number_float(Json::number_float_t v, const Json::string_t& s) { return dom_.number_float(v, s); }
+    bool string(Json::string_t& v) { return dom_.string(v); }
+    bool binary(Json::binary_t& v) { return dom_.binary(v); }
+    bool key(Json::string_t& k) {
+        if (open_ == 1) rootKey_ = k;
+        return dom_.key(k);
+    }
+    bool start_object(std::size_t n) {
+        enter();
+        if (open_ == 3 && inEntities_ && ++entities_ > limits_.maxEntities)
+            throw LimitHit{"more than " + std::to_string(limits_.maxEntities) + " entities; the limit is " +
+                           std::to_string(limits_.maxEntities)};
+        return dom_.start_object(n);
+    }
+    bool end_object() {
+        --open_;
+        return dom_.end_object();
+    }
+    bool start_array(std::size_t n) {
+        enter();
+        if (open_ == 2 && rootKey_ == "entities") inEntities_ = true;
+        return dom_.start_array(n);
+    }
+    bool end_array() {
+        if (open_ == 2) inEntities_ = false;
+        --open_;
+        return dom_.end_array();
+    }
+    template <class Exception>
+    bool parse_error(std::size_t position, const std::string& token, const Exception& e) {
+        return dom_.parse_error(position, token, e);
+    }
+
+private:
+    void enter() {
+        // open_ counts the containers open including this one: the root
+        // object is level 1, an entity level 3, a vector in it level 4.
+        if (++open_ > limits_.maxDepth)
+            throw LimitHit{"JSON nesting deeper than " + std::to_string(limits_.maxDepth) +
+                           " levels; a level file needs 4"};
+    }
+
+    Dom dom_;
+    const LoadLimits& limits_;
+    int open_ = 0;
+    std::string rootKey_;
+    bool inEntities_ = false;
+    std::size_t entities_ = 0;
+};
+
+Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view sourceName, const LoadLimits& limits) {
     const std::string prefix = std::string(sourceName) + ": error: ";
     if (text.size() > limits.maxFileBytes)
         return Error{prefix + "file is " + std::to_string(text.size()) + " bytes; the limit is " +
                      std::to_string(limits.maxFileBytes) + " bytes"};
 
-    // The parser callback enforces the depth and entity limits while parsing,
-    // so a hostile file is refused before its DOM is built.
-    std::size_t entityCount = 0;
-    struct LimitHit {
-        std::string message;
-    };
+    // The depth and entity limits are enforced while parsing, so a hostile
+    // file is refused before its DOM is built. Not with nlohmann's parser
+    // callback: after every value it scans the whole enclosing array for a
+    // discarded element, so 1,000,001 entities took 3 minutes to refuse
+    // (quadratic; 200,000 took 7 s). LimitedDomParser forwards to the plain
+    // DOM builder, which is linear.
     Json root;
     try {
-        root = Json::parse(
-            text.begin(), text.end(),
-            [&](int depth, Json::parse_event_t event, Json&) {
-                if (depth > limits.maxDepth && (event == Json::parse_event_t::object_start ||
-                                                event == Json::parse_event_t::array_start))
-                    throw LimitHit{"JSON nesting deeper than " + std::to_string(limits.maxDepth) +
-                                   " levels; a level file needs 4"};
-                if (depth == 2 && event == Json::parse_event_t::object_end && ++entityCount > limits.maxEntities)
-                    throw LimitHit{"more than " + std::to_string(limits.maxEntities) +
-                                   " entities; the limit is " + std::to_string(limits.maxEntities)};
-                return true;
-            },
-            /*allow_exceptions=*/true, /*ignore_comments=*/false);
+        LimitedDomParser sax(root, limits);
+        Json::sax_parse(text.begin(), text.end(), &sax, nlohmann::detail::input_format_t::json, /*strict=*/true,
+                        /*ignore_comments=*/false);
     } catch (const LimitHit& hit) {
         return Error{prefix + hit.message};
     } catch (const Json::parse_error& e) {
@@ -541,12 +659,30 @@ Result<Scene> parseScene(std::string_view text, std::string_view sourceName, con
     scene.registry.each<Name, Position>([&](Entity, const Name& n, const Position& p) {
         positionByName.emplace(n.value, p.value);
     });
-    scene.registry.each<Spring>([&](Entity, Spring& s) {
-        if (s.restLength) return;
-        const Vec2 a = positionByName.at(s.a);
-        const Vec2 b = s.anchor ? *s.anchor : positionByName.at(s.b);
-        s.restLength = length(b - a);
-    });
+    const auto& entities = scene.registry.entities();
+    for (std::size_t i = 0; i < entities.size(); ++i) {
+        Spring* s = scene.registry.tryGet<Spring>(entities[i]);
+        if (!s || s->restLength) continue;
+        const Vec2 a = positionByName.at(s->a);
+        const Vec2 b = s->anchor ? *s->anchor : positionByName.at(s->b);
+        const double rest = length(b - a);
+        // Ends more than about 1e154 m apart: the squared length overflows,
+        // and an infinite rest_length would be saved as null, which does not
+        // load. The force code computes the length the same way.
+        if (!std::isfinite(rest))
+            return Error{prefix + child("/entities", i) +
+                         "/spring: the ends are too far apart to compute the length (over 1e154 m); give "
+                         "\"rest_length\""};
+        s->restLength = rest;
+    }
+    return scene;
+}
+
+} // namespace
+
+Result<Scene> parseScene(std::string_view text, std::string_view sourceName, const LoadLimits& limits) {
+    Result<Scene> scene = parseSceneUnchecked(text, sourceName, limits);
+    if (!scene) return Error{printableMessage(scene.error())};
     return scene;
 }
 

@@ -42,7 +42,11 @@ std::string sceneToJsonText(const Scene& scene);
 /// file is untouched and no temporary is left behind.
 Result<void> writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 
-/// sceneToJsonText + writeFileAtomically.
+/// sceneToJsonText + writeFileAtomically. A save killed outright (SIGKILL,
+/// power loss) leaves the old file and its hidden `.NAME.tmp-XXXXXX`; a
+/// later successful save of the same file removes such temporaries once they
+/// are over an hour old (younger ones may be another process's save in
+/// progress).
 Result<void> saveSceneFile(const Scene& scene, const std::filesystem::path& path);
 
 /// Checks the relations between entities that no single component can check:

@@ -1,0 +1,100 @@
+#include "app/document.hpp"
+
+#include "app/scene_edit.hpp"
+
+#include "stepwise/scene_io.hpp"
+
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+namespace stepwise::editor {
+
+Scene makeNewScene() {
+    Scene s;
+    s.view = View{{0.0, 3.0}, 40.0};
+    addPlane(s, {0.0, 0.0}, {0.0, 1.0});
+    return s;
+}
+
+Result<void> Document::open(const std::filesystem::path& file) {
+    Result<Scene> loaded = loadSceneFile(file);
+    if (!loaded) return Error{loaded.error()};
+    scene = std::move(*loaded);
+    path = file;
+    dirty_ = false;
+    return {};
+}
+
+void Document::reset(Scene fresh) {
+    scene = std::move(fresh);
+    path.clear();
+    dirty_ = false;
+}
+
+Result<void> Document::saveAs(const Scene& what, const std::filesystem::path& file) {
+    if (file.empty()) return Error{"no file name given"};
+    if (std::string problem = checkSceneRelations(what); !problem.empty())
+        return Error{"not saved: the level is not valid: " + problem};
+    Result<void> saved = saveSceneFile(what, file);
+    if (!saved) return saved;
+    path = file;
+    dirty_ = false;
+    return {};
+}
+
+std::string Document::title() const { return path.empty() ? std::string("untitled") : path.filename().string(); }
+
+std::filesystem::path Document::recoveryPath(const std::filesystem::path& configDir) const {
+    // Hash of the absolute path: two editors on two levels do not share a
+    // recovery file. std::hash of a string is stable within one library build,
+    // which is all a crash-recovery file needs.
+    std::error_code ec;
+    const std::string key = path.empty() ? std::string("untitled") : std::filesystem::absolute(path, ec).string();
+    std::ostringstream name;
+    name << "recovery-" << std::hex << (std::hash<std::string>{}(key) & 0xFFFFFFFFull) << ".json";
+    return configDir / "recovery" / name.str();
+}
+
+std::filesystem::path configDirectory() {
+    if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "stepwise";
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return std::filesystem::path(home) / ".config" / "stepwise";
+    return std::filesystem::path(".stepwise");
+}
+
+void Settings::addRecent(const std::string& file) {
+    std::erase(recentFiles, file);
+    recentFiles.insert(recentFiles.begin(), file);
+    if (recentFiles.size() > 10) recentFiles.resize(10);
+}
+
+Settings Settings::load(const std::filesystem::path& configDir) {
+    Settings s;
+    std::ifstream in(configDir / "settings.txt");
+    for (std::string line; std::getline(in, line);) {
+        const auto space = line.find(' ');
+        if (space == std::string::npos) continue;
+        const std::string key = line.substr(0, space), value = line.substr(space + 1);
+        if (key == "recent" && !value.empty() && s.recentFiles.size() < 10) s.recentFiles.push_back(value);
+        else if (key == "font_size") {
+            char* end = nullptr;
+            const float f = std::strtof(value.c_str(), &end);
+            if (end != value.c_str() && f >= 6.0f && f <= 64.0f) s.fontSize = f;
+        }
+    }
+    return s;
+}
+
+Result<void> Settings::save(const std::filesystem::path& configDir) const {
+    std::error_code ec;
+    std::filesystem::create_directories(configDir, ec);
+    if (ec) return Error{"cannot create " + configDir.string() + ": " + ec.message()};
+    std::string text;
+    for (const std::string& f : recentFiles) text += "recent " + f + "\n";
+    if (fontSize > 0.0f) text += "font_size " + std::to_string(fontSize) + "\n";
+    return writeFileAtomically(configDir / "settings.txt", text);
+}
+
+} // namespace stepwise::editor

@@ -1,0 +1,61 @@
+#pragma once
+/// \file document.hpp
+/// The level being edited: the scene, where it lives on disk, whether it
+/// has unsaved changes, and the crash-recovery autosave. Saving goes through
+/// the engine's atomic writer, after the same relation checks the loader
+/// runs, so the editor can never write a file the loader would refuse.
+
+#include "stepwise/result.hpp"
+#include "stepwise/scene.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace stepwise::editor {
+
+/// A fresh level: default world, a floor, a few bodies (what "New" gives).
+Scene makeNewScene();
+
+class Document {
+public:
+    Scene scene;
+    std::filesystem::path path;  ///< empty for an unsaved new level
+
+    /// Replaces the document with `path`'s level. On failure nothing changes
+    /// and the message is the loader's.
+    Result<void> open(const std::filesystem::path& file);
+    /// New level, no path.
+    void reset(Scene fresh);
+    /// Saves `what` (normally `scene`) to `file` (normally `path`).
+    Result<void> saveAs(const Scene& what, const std::filesystem::path& file);
+
+    bool dirty() const { return dirty_; }
+    void markDirty() { dirty_ = true; }
+    void markClean() { dirty_ = false; }
+    /// "name.json" or "untitled".
+    std::string title() const;
+
+    /// Where the recovery copy of this document goes (one per document
+    /// path, inside the config folder).
+    std::filesystem::path recoveryPath(const std::filesystem::path& configDir) const;
+
+private:
+    bool dirty_ = false;
+};
+
+/// $XDG_CONFIG_HOME/stepwise, else $HOME/.config/stepwise, else ./.stepwise.
+std::filesystem::path configDirectory();
+
+/// What persists between runs: recent files and the font size. Kept in
+/// CONFIG/settings.txt as "key value" lines (a format that tolerates being
+/// hand-edited or truncated: unknown or bad lines are skipped).
+struct Settings {
+    std::vector<std::string> recentFiles;  ///< newest first, at most 10
+    float fontSize = 0.0f;                 ///< pixels; 0 = from the display's DPI
+    void addRecent(const std::string& file);
+    static Settings load(const std::filesystem::path& configDir);
+    Result<void> save(const std::filesystem::path& configDir) const;
+};
+
+} // namespace stepwise::editor

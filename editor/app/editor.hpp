@@ -1,0 +1,178 @@
+#pragma once
+/// \file editor.hpp
+/// The editor model, with no window: document, undo stack, selection,
+/// tools, simulation controller, camera and clipboard. The ImGui panels
+/// (editor/ui) and the scripted mode drive it through these calls and
+/// through InputEvents, and the unit tests drive it the same way.
+
+#include "app/command_stack.hpp"
+#include "app/document.hpp"
+#include "app/events.hpp"
+#include "app/simulation.hpp"
+#include "app/view_camera.hpp"
+
+#include "render/frame.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stepwise::editor {
+
+enum class Tool : std::uint8_t { Select, Rotate, Circle, Box, Plane, Spring, Attractor, Boids, Count };
+std::string_view toolName(Tool t);
+/// Shortcut key of each tool ("1" .. "8").
+Key toolKey(Tool t);
+
+/// Actions the model cannot finish alone: they need a dialog.
+enum class UiRequest : std::uint8_t { None, OpenDialog, SaveAsDialog, ConfirmDiscard, Help };
+
+/// What waits behind an unsaved-changes question.
+enum class PendingAction : std::uint8_t { None, New, Open, Quit };
+
+class Editor {
+public:
+    Editor();
+
+    // ---- document -------------------------------------------------------
+    Document doc;
+    CommandStack commands;
+    Simulation sim;
+    ViewCamera view;
+    std::vector<Entity> selection;
+    Tool tool = Tool::Select;
+    bool snap = false;
+    double snapSpacing = 0.25;   ///< metres
+    render::OverlaySet overlays;
+    render::TrailRecorder trails{64};
+
+    /// Opens a level; on failure sets errorModal to the loader's message and
+    /// keeps the current document. Respects nothing: ask first (requestOpen).
+    bool open(const std::filesystem::path& file);
+    /// Replaces the document with a new level.
+    void newDocument();
+    /// Saves to the document's path; with none, asks for one (SaveAsDialog).
+    bool save();
+    bool saveAs(const std::filesystem::path& file);
+    /// Saves the current simulation state (not the edited level) to `file`.
+    bool saveStateAs(const std::filesystem::path& file);
+    /// True when the document differs from what is on disk.
+    bool dirty() const;
+    /// The scene that Save writes: the edited level (the scene kept at Play
+    /// while the simulation runs, with edits made while paused not included).
+    const Scene& levelToSave() const;
+
+    /// Unsaved-changes guard: runs `action` now when clean, else records it
+    /// and asks (UiRequest::ConfirmDiscard). The UI then calls
+    /// resolvePending(save / discard / cancel).
+    void request(PendingAction action, std::filesystem::path file = {});
+    enum class Resolution { Save, Discard, Cancel };
+    void resolvePending(Resolution r);
+    PendingAction pending() const { return pending_; }
+    bool quitRequested() const { return quit_; }
+
+    // ---- editing --------------------------------------------------------
+    /// Runs an edit through the undo stack (see CommandStack::apply) and
+    /// tells the simulation. `mergeKey` != 0 coalesces (use newMergeKey()).
+    bool applyEdit(const std::string& label, const std::function<bool(Scene&)>& edit, std::uint64_t mergeKey = 0);
+    void endEdit() { commands.closeMerge(); }
+    std::uint64_t newMergeKey() { return ++mergeCounter_; }
+    bool undo();
+    bool redo();
+
+    void select(std::vector<Entity> entities);
+    void selectAll();
+    bool deleteSelection();
+    bool duplicateSelection();
+    void copySelection();
+    bool paste();
+    bool hasClipboard() const { return !clipboardEntities_.empty(); }
+
+    // ---- simulation -----------------------------------------------------
+    void togglePlay();
+    void stepForward();
+    void stepBack();
+    void resetSimulation();
+    /// Per displayed frame: advances the simulation, records trails.
+    void update(double frameSeconds);
+
+    // ---- input ----------------------------------------------------------
+    /// Keyboard shortcut; returns true when it did something.
+    bool handleShortcut(Key key, std::uint8_t mods);
+    /// Mouse event in viewport pixels (origin top-left of the viewport).
+    void handleViewportEvent(const InputEvent& e);
+    /// Where the mouse is in the viewport (pixels), for the cursor readout.
+    Vec2 mouseViewport() const { return mouse_; }
+    /// Box-select rectangle in viewport pixels while dragging one.
+    std::optional<std::pair<Vec2, Vec2>> selectionRect() const;
+    /// First end of a spring being placed.
+    Entity springStart() const { return springStart_; }
+    /// Sets the viewport size; the first call (or fitView) frames the scene.
+    void setViewportSize(int width, int height);
+    void fitView();
+
+    // ---- messages -------------------------------------------------------
+    std::string status;          ///< one line, bottom of the window
+    std::string errorModal;      ///< non-empty: shown as a modal until dismissed
+    UiRequest uiRequest = UiRequest::None;
+    std::vector<std::string> log;  ///< newest last
+    void note(std::string text);
+
+    // ---- autosave -------------------------------------------------------
+    std::filesystem::path configDir;
+    double autosaveSeconds = 30.0;
+    /// Writes the recovery file when dirty and `autosaveSeconds` passed since
+    /// the last one (clock in seconds from any origin). Returns true when it wrote.
+    bool tickAutosave(double nowSeconds);
+    /// A recovery file for the current document that is newer than it.
+    std::optional<std::filesystem::path> recoveryAvailable() const;
+    bool recover(const std::filesystem::path& recoveryFile);
+    void discardRecovery();
+
+    /// Frame input for the renderer: scene, world, overlays, camera, selection.
+    render::FrameInput frameInput() const;
+
+    /// Changes the scene was through since the last call (undo, edit, step):
+    /// views compare it to refresh caches.
+    std::uint64_t revision() const { return commands.revision() + revisionExtra_; }
+
+private:
+    void afterSceneReplaced();
+    void pruneSelection();
+    Vec2 snapped(Vec2 world) const;
+    double pickRadius() const;
+    void placeAt(Vec2 world);
+
+    enum class Drag : std::uint8_t { None, Pan, Move, Rotate, BoxSelect, Plane, Boids, MouseSpring };
+    Drag drag_ = Drag::None;
+    MouseButton dragButton_ = MouseButton::Left;
+    Vec2 mouse_, dragStartPx_, dragStartWorld_, lastBoid_;
+    std::uint64_t dragKey_ = 0;
+    std::vector<std::pair<Entity, Vec2>> dragStart_;  // entity, position at press
+    std::vector<std::pair<Entity, double>> angleStart_;
+    std::vector<std::pair<Entity, double>> planeStart_;
+    Entity dragPrimary_;
+    bool additive_ = false;
+    Entity springStart_;
+    std::uint32_t boidSeed_ = 12345u;
+
+    Scene clipboard_;
+    std::vector<Entity> clipboardEntities_;
+    int pasteCount_ = 0;
+
+    std::uint64_t savedCursor_ = 0;
+    bool savedReachable_ = true;
+    std::size_t playMark_ = 0;
+    std::uint64_t mergeCounter_ = 0;
+    std::uint64_t revisionExtra_ = 0;
+    bool viewInitialised_ = false;
+
+    PendingAction pending_ = PendingAction::None;
+    std::filesystem::path pendingFile_;
+    bool quit_ = false;
+    double lastAutosave_ = -1.0;
+};
+
+} // namespace stepwise::editor

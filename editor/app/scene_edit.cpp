@@ -1,0 +1,394 @@
+#include "app/scene_edit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <type_traits>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace stepwise::editor {
+
+void copyField(const FieldInfo& field, const void* src, void* dst) {
+    // FieldInfo::address takes a non-const pointer; reading through it does
+    // not modify the source.
+    void* from = field.address(const_cast<void*>(src));
+    void* to = field.address(dst);
+    switch (field.kind) {
+    case FieldKind::Number: *static_cast<double*>(to) = *static_cast<const double*>(from); break;
+    case FieldKind::OptionalNumber:
+        *static_cast<std::optional<double>*>(to) = *static_cast<const std::optional<double>*>(from);
+        break;
+    case FieldKind::Vector: *static_cast<Vec2*>(to) = *static_cast<const Vec2*>(from); break;
+    case FieldKind::OptionalVector:
+        *static_cast<std::optional<Vec2>*>(to) = *static_cast<const std::optional<Vec2>*>(from);
+        break;
+    case FieldKind::Color: *static_cast<Rgb*>(to) = *static_cast<const Rgb*>(from); break;
+    case FieldKind::Bool: *static_cast<bool*>(to) = *static_cast<const bool*>(from); break;
+    case FieldKind::String:
+    case FieldKind::EntityName:
+        *static_cast<std::string*>(to) = *static_cast<const std::string*>(from);
+        break;
+    }
+}
+
+FieldValue readField(const FieldInfo& field, const void* component) {
+    const void* at = field.address(const_cast<void*>(component));
+    switch (field.kind) {
+    case FieldKind::Number: return *static_cast<const double*>(at);
+    case FieldKind::OptionalNumber: return *static_cast<const std::optional<double>*>(at);
+    case FieldKind::Vector: return *static_cast<const Vec2*>(at);
+    case FieldKind::OptionalVector: return *static_cast<const std::optional<Vec2>*>(at);
+    case FieldKind::Color: return *static_cast<const Rgb*>(at);
+    case FieldKind::Bool: return *static_cast<const bool*>(at);
+    case FieldKind::String:
+    case FieldKind::EntityName: return *static_cast<const std::string*>(at);
+    }
+    return 0.0;
+}
+
+void writeField(const FieldInfo& field, void* component, const FieldValue& value) {
+    void* at = field.address(component);
+    std::visit(
+        [&](const auto& v) {
+            using V = std::decay_t<decltype(v)>;
+            // The kind decides the member's type; a mismatched value is a
+            // programmer error in the caller and is ignored here.
+            const bool matches =
+                (std::is_same_v<V, double> && field.kind == FieldKind::Number) ||
+                (std::is_same_v<V, std::optional<double>> && field.kind == FieldKind::OptionalNumber) ||
+                (std::is_same_v<V, Vec2> && field.kind == FieldKind::Vector) ||
+                (std::is_same_v<V, std::optional<Vec2>> && field.kind == FieldKind::OptionalVector) ||
+                (std::is_same_v<V, Rgb> && field.kind == FieldKind::Color) ||
+                (std::is_same_v<V, bool> && field.kind == FieldKind::Bool) ||
+                (std::is_same_v<V, std::string> &&
+                 (field.kind == FieldKind::String || field.kind == FieldKind::EntityName));
+            if (matches) *static_cast<V*>(at) = v;
+        },
+        value);
+}
+
+std::string checkField(const FieldInfo& field, const FieldValue& value) {
+    auto number = [&](double v) -> std::string {
+        if (!std::isfinite(v)) return std::string(field.key) + ": expected a finite number";
+        if (!field.range.contains(v)) return std::string(field.key) + ": expected " + field.range.describe();
+        return {};
+    };
+    if (const double* d = std::get_if<double>(&value)) return number(*d);
+    if (const auto* od = std::get_if<std::optional<double>>(&value)) return *od ? number(**od) : std::string();
+    if (const Vec2* v = std::get_if<Vec2>(&value))
+        return isFinite(*v) ? std::string() : std::string(field.key) + ": expected finite numbers";
+    if (const auto* ov = std::get_if<std::optional<Vec2>>(&value))
+        return !*ov || isFinite(**ov) ? std::string() : std::string(field.key) + ": expected finite numbers";
+    if (const Rgb* c = std::get_if<Rgb>(&value))
+        return c->r >= 0 && c->r <= 1 && c->g >= 0 && c->g <= 1 && c->b >= 0 && c->b <= 1
+                   ? std::string()
+                   : std::string(field.key) + ": colour channels must be in 0..1";
+    return {};
+}
+
+std::size_t setFieldOnAll(Scene& scene, const ComponentInfo& component, const FieldInfo& field,
+                          const FieldValue& value, const std::vector<Entity>& entities, std::string* problem) {
+    if (std::string why = checkField(field, value); !why.empty()) {
+        if (problem) *problem = std::string(component.name) + "." + why;
+        return 0;
+    }
+    std::size_t changed = 0;
+    for (Entity e : entities) {
+        void* c = component.get(scene.registry, e);
+        if (!c) continue;
+        writeField(field, c, value);
+        if (component.finish) {
+            if (std::string why = component.finish(c); !why.empty() && problem) *problem = std::string(component.name) + ": " + why;
+        }
+        ++changed;
+    }
+    return changed;
+}
+
+std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities) {
+    std::size_t n = 0;
+    for (Entity e : entities)
+        if (scene.registry.alive(e) && !component.has(scene.registry, e)) {
+            component.emplaceDefault(scene.registry, e);
+            ++n;
+        }
+    return n;
+}
+
+std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities) {
+    std::size_t n = 0;
+    for (Entity e : entities) n += component.remove(scene.registry, e) ? 1 : 0;
+    return n;
+}
+
+void copyEntity(const Registry& src, Entity from, Registry& dst, Entity to) {
+    for (const ComponentInfo& info : componentTable()) {
+        const void* c = info.getConst(src, from);
+        if (!c) continue;
+        void* d = info.emplaceDefault(dst, to);
+        for (const FieldInfo& f : info.fields) copyField(f, c, d);
+    }
+}
+
+Entity findByName(const Registry& registry, std::string_view name) {
+    if (name.empty()) return {};
+    for (Entity e : registry.entities())
+        if (const Name* n = registry.tryGet<Name>(e); n && n->value == name) return e;
+    return {};
+}
+
+std::string uniqueName(const Registry& registry, const std::string& base) {
+    std::unordered_set<std::string> used;
+    for (Entity e : registry.entities())
+        if (const Name* n = registry.tryGet<Name>(e)) used.insert(n->value);
+    if (!used.count(base)) return base;
+    // "ball_3" -> stem "ball" so copies of copies count on, not "ball_3_2".
+    std::string stem = base;
+    if (const auto u = stem.rfind('_'); u != std::string::npos && u + 1 < stem.size() &&
+                                        std::all_of(stem.begin() + std::ptrdiff_t(u) + 1, stem.end(), ::isdigit))
+        stem.resize(u);
+    for (int i = 2;; ++i) {
+        std::string candidate = stem + "_" + std::to_string(i);
+        if (!used.count(candidate)) return candidate;
+    }
+}
+
+std::string displayName(const Registry& registry, Entity e) {
+    if (const Name* n = registry.tryGet<Name>(e); n && !n->value.empty()) return n->value;
+    const auto& order = registry.entities();
+    const auto it = std::find(order.begin(), order.end(), e);
+    return "entity " + std::to_string(it - order.begin());
+}
+
+bool isBody(const Registry& registry, Entity e) { return registry.has<Position>(e) && !registry.has<Spring>(e); }
+
+namespace {
+
+double distanceToSegment(Vec2 p, Vec2 a, Vec2 b) {
+    const Vec2 ab = b - a;
+    const double l2 = lengthSquared(ab);
+    const double t = l2 > 0.0 ? std::clamp(dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
+    return length(p - (a + t * ab));
+}
+
+/// Spring end points (metres); false when an end cannot be found.
+bool springEnds(const Registry& reg, const Spring& s, Vec2& pa, Vec2& pb) {
+    const Entity a = findByName(reg, s.a);
+    const Position* A = reg.tryGet<Position>(a);
+    if (!A) return false;
+    pa = A->value;
+    if (s.anchor) {
+        pb = *s.anchor;
+        return true;
+    }
+    const Position* B = reg.tryGet<Position>(findByName(reg, s.b));
+    if (!B) return false;
+    pb = B->value;
+    return true;
+}
+
+} // namespace
+
+Entity pick(const Scene& scene, Vec2 world, double pickRadius) {
+    const Registry& reg = scene.registry;
+    const auto& order = reg.entities();
+    // Bodies first (topmost = drawn last), then springs, then planes: a
+    // plane under a body should not steal its clicks.
+    for (auto it = order.rbegin(); it != order.rend(); ++it) {
+        const Entity e = *it;
+        const Position* p = reg.tryGet<Position>(e);
+        if (!p || reg.has<Spring>(e)) continue;
+        const Vec2 d = world - p->value;
+        if (const Radius* r = reg.tryGet<Radius>(e)) {
+            if (length(d) <= r->value) return e;
+        } else if (const Box* b = reg.tryGet<Box>(e)) {
+            const Angle* a = reg.tryGet<Angle>(e);
+            const double th = a ? a->value : 0.0;
+            // Rotate the offset into the box frame.
+            const double lx = std::cos(th) * d.x + std::sin(th) * d.y;
+            const double ly = -std::sin(th) * d.x + std::cos(th) * d.y;
+            if (std::abs(lx) <= 0.5 * b->width && std::abs(ly) <= 0.5 * b->height) return e;
+        } else if (length(d) <= pickRadius) {
+            return e;
+        }
+    }
+    for (auto it = order.rbegin(); it != order.rend(); ++it)
+        if (const Spring* s = reg.tryGet<Spring>(*it)) {
+            Vec2 a, b;
+            if (springEnds(reg, *s, a, b) && distanceToSegment(world, a, b) <= pickRadius) return *it;
+        }
+    for (auto it = order.rbegin(); it != order.rend(); ++it)
+        if (const Plane* pl = reg.tryGet<Plane>(*it))
+            if (std::abs(dot(pl->normal, world) - pl->offset) <= pickRadius) return *it;
+    return {};
+}
+
+std::vector<Entity> entitiesInRect(const Scene& scene, Vec2 cornerA, Vec2 cornerB) {
+    const Vec2 lo{std::min(cornerA.x, cornerB.x), std::min(cornerA.y, cornerB.y)};
+    const Vec2 hi{std::max(cornerA.x, cornerB.x), std::max(cornerA.y, cornerB.y)};
+    auto inside = [&](Vec2 p) { return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y; };
+    std::vector<Entity> out;
+    const Registry& reg = scene.registry;
+    for (Entity e : reg.entities()) {
+        if (const Spring* s = reg.tryGet<Spring>(e)) {
+            Vec2 a, b;
+            if (springEnds(reg, *s, a, b) && inside(0.5 * (a + b))) out.push_back(e);
+        } else if (const Position* p = reg.tryGet<Position>(e); p && inside(p->value)) {
+            out.push_back(e);
+        }
+    }
+    return out;
+}
+
+std::vector<Entity> springsAttachedTo(const Registry& registry, Entity e) {
+    std::vector<Entity> out;
+    const Name* n = registry.tryGet<Name>(e);
+    if (!n || n->value.empty()) return out;
+    for (Entity s : registry.entities())
+        if (const Spring* sp = registry.tryGet<Spring>(s); sp && (sp->a == n->value || sp->b == n->value))
+            out.push_back(s);
+    return out;
+}
+
+std::size_t destroyWithSprings(Scene& scene, const std::vector<Entity>& entities) {
+    std::vector<Entity> doomed = entities;
+    for (Entity e : entities)
+        for (Entity s : springsAttachedTo(scene.registry, e)) doomed.push_back(s);
+    std::size_t count = 0;
+    for (Entity e : doomed) count += scene.registry.destroy(e) ? 1 : 0;  // duplicates are stale the second time
+    return count;
+}
+
+std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>& entities, Scene& dst, Vec2 offset) {
+    std::vector<Entity> created;
+    std::unordered_map<std::string, std::string> renamed;  // old name -> new name
+    for (Entity e : entities) {
+        if (!src.alive(e)) continue;
+        const Entity c = dst.registry.create();
+        copyEntity(src, e, dst.registry, c);
+        if (Name* n = dst.registry.tryGet<Name>(c)) {
+            const std::string old = n->value;
+            n->value = "";  // so uniqueName does not see the copy itself
+            n->value = uniqueName(dst.registry, old.empty() ? std::string("entity") : old);
+            if (!old.empty()) renamed[old] = n->value;
+        }
+        if (Position* p = dst.registry.tryGet<Position>(c)) p->value += offset;
+        if (Plane* pl = dst.registry.tryGet<Plane>(c)) pl->offset += dot(pl->normal, offset);
+        created.push_back(c);
+    }
+    // Springs follow their ends when those were copied too; an anchored end
+    // moves with the copy.
+    for (Entity c : created)
+        if (Spring* s = dst.registry.tryGet<Spring>(c)) {
+            if (auto it = renamed.find(s->a); it != renamed.end()) s->a = it->second;
+            if (auto it = renamed.find(s->b); it != renamed.end()) s->b = it->second;
+            if (s->anchor) *s->anchor += offset;
+        }
+    return created;
+}
+
+namespace {
+Entity newBody(Scene& scene, const std::string& base, Vec2 at, Rgb color) {
+    Registry& reg = scene.registry;
+    const std::string name = uniqueName(reg, base);
+    const Entity e = reg.create();
+    reg.emplace(e, Name{name});
+    reg.emplace(e, Position{at});
+    reg.emplace(e, Velocity{});
+    reg.emplace(e, Mass{1.0});
+    reg.emplace(e, Color{color});
+    return e;
+}
+} // namespace
+
+Entity addCircle(Scene& scene, Vec2 at, double radius) {
+    const Entity e = newBody(scene, "circle", at, Rgb{0.35, 0.65, 0.95});
+    scene.registry.emplace(e, Radius{radius});
+    return e;
+}
+
+Entity addBox(Scene& scene, Vec2 at, double width, double height) {
+    const Entity e = newBody(scene, "box", at, Rgb{0.95, 0.6, 0.3});
+    scene.registry.emplace(e, Box{width, height});
+    scene.registry.emplace(e, Angle{0.0});
+    return e;
+}
+
+Entity addPlane(Scene& scene, Vec2 through, Vec2 normal) {
+    const double l = length(normal);
+    const Vec2 n = l > 0.0 && std::isfinite(l) ? normal / l : Vec2{0.0, 1.0};
+    Registry& reg = scene.registry;
+    const Entity e = reg.create();
+    reg.emplace(e, Name{uniqueName(reg, "wall")});
+    reg.emplace(e, Plane{n, dot(n, through)});
+    reg.emplace(e, Color{Rgb{0.55, 0.58, 0.62}});
+    return e;
+}
+
+Entity addSpring(Scene& scene, Entity a, Entity b) {
+    Registry& reg = scene.registry;
+    // Springs name their ends: give unnamed bodies a name first.
+    for (Entity end : {a, b})
+        if (const Name* n = reg.tryGet<Name>(end); !n || n->value.empty())
+            reg.emplace(end, Name{uniqueName(reg, "body")});
+    Spring s;
+    s.a = reg.tryGet<Name>(a)->value;
+    s.b = reg.tryGet<Name>(b)->value;
+    s.k = 50.0;
+    s.damping = 0.5;
+    s.restLength = length(reg.tryGet<Position>(a)->value - reg.tryGet<Position>(b)->value);
+    const Entity e = reg.create();
+    reg.emplace(e, Name{uniqueName(reg, "spring")});
+    reg.emplace(e, std::move(s));
+    return e;
+}
+
+Entity addAnchoredSpring(Scene& scene, Entity a, Vec2 anchor) {
+    Registry& reg = scene.registry;
+    if (const Name* n = reg.tryGet<Name>(a); !n || n->value.empty()) reg.emplace(a, Name{uniqueName(reg, "body")});
+    Spring s;
+    s.a = reg.tryGet<Name>(a)->value;
+    s.anchor = anchor;
+    s.k = 50.0;
+    s.damping = 0.5;
+    s.restLength = length(reg.tryGet<Position>(a)->value - anchor);
+    const Entity e = reg.create();
+    reg.emplace(e, Name{uniqueName(reg, "spring")});
+    reg.emplace(e, std::move(s));
+    return e;
+}
+
+Entity addAttractor(Scene& scene, Vec2 at, double mass) {
+    Registry& reg = scene.registry;
+    const Entity e = reg.create();
+    reg.emplace(e, Name{uniqueName(reg, "attractor")});
+    reg.emplace(e, Position{at});
+    reg.emplace(e, Static{true});
+    reg.emplace(e, Mass{mass});
+    reg.emplace(e, Attractor{0.1});
+    reg.emplace(e, Color{Rgb{1.0, 0.8, 0.2}});
+    return e;
+}
+
+Entity addBoid(Scene& scene, Vec2 at, Vec2 velocity) {
+    const Entity e = newBody(scene, "boid", at, Rgb{0.6, 0.9, 0.6});
+    scene.registry.emplace(e, Velocity{velocity});
+    scene.registry.emplace(e, Boid{});
+    return e;
+}
+
+bool entityBounds(const Registry& registry, Entity e, Vec2& lo, Vec2& hi) {
+    const Position* p = registry.tryGet<Position>(e);
+    if (!p || registry.has<Spring>(e)) return false;
+    double rx = 0.0, ry = 0.0;
+    if (const Radius* r = registry.tryGet<Radius>(e)) rx = ry = r->value;
+    if (const Box* b = registry.tryGet<Box>(e)) {
+        // Circumscribed: enough for box select and framing.
+        rx = ry = 0.5 * std::hypot(b->width, b->height);
+    }
+    lo = {p->value.x - rx, p->value.y - ry};
+    hi = {p->value.x + rx, p->value.y + ry};
+    return true;
+}
+
+} // namespace stepwise::editor

@@ -1,0 +1,95 @@
+#pragma once
+/// \file scene_edit.hpp
+/// Scene operations the tools are made of, all driven by the component
+/// table (no list of component types here): copying an entity field by field
+/// (each FieldInfo says where its value lives and what type it is), unique
+/// names, picking under the cursor, and the entity builders of the palette.
+
+#include "stepwise/component_table.hpp"
+#include "stepwise/components.hpp"
+#include "stepwise/scene.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace stepwise::editor {
+
+/// Copies field `field` of a component from `src` to `dst` (both point at
+/// the component structs). The field's kind gives the C++ type.
+void copyField(const FieldInfo& field, const void* src, void* dst);
+
+/// Copies every component of `from` (in `src`) onto `to` (in `dst`),
+/// replacing what `to` had for those components. Works across registries.
+void copyEntity(const Registry& src, Entity from, Registry& dst, Entity to);
+
+/// A field's value, by kind (FieldKind -> alternative).
+using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string>;
+FieldValue readField(const FieldInfo& field, const void* component);
+void writeField(const FieldInfo& field, void* component, const FieldValue& value);
+/// "" when `value` is acceptable for `field` (finite, in range), else why not.
+std::string checkField(const FieldInfo& field, const FieldValue& value);
+
+/// Sets one field on every entity of `entities` that has the component, then
+/// runs the component's own check (`finish`, which e.g. normalises a plane's
+/// normal). Returns how many were changed; with `problem` set (and nothing
+/// changed) when the value is refused.
+std::size_t setFieldOnAll(Scene& scene, const ComponentInfo& component, const FieldInfo& field,
+                          const FieldValue& value, const std::vector<Entity>& entities, std::string* problem = nullptr);
+/// Adds the component (default value) to each entity that lacks it.
+std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities);
+/// Removes it from each that has it.
+std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities);
+
+/// `base` if no entity is called that, else base_2, base_3, ...
+std::string uniqueName(const Registry& registry, const std::string& base);
+/// Entity called `name`, or a null handle.
+Entity findByName(const Registry& registry, std::string_view name);
+/// Name, or "entity N" (N its place in the scene order).
+std::string displayName(const Registry& registry, Entity e);
+
+/// True when the entity is a body: has a position and is not a spring.
+bool isBody(const Registry& registry, Entity e);
+
+/// The topmost (last in scene order) entity under `world` (metres). Circles
+/// and boxes by their shape; shapeless bodies within `pickRadius` metres of
+/// their position; planes within `pickRadius` of their line; springs within
+/// `pickRadius` of their segment.
+Entity pick(const Scene& scene, Vec2 world, double pickRadius);
+
+/// Entities whose position (bodies) or midpoint (springs) lies in the box.
+std::vector<Entity> entitiesInRect(const Scene& scene, Vec2 cornerA, Vec2 cornerB);
+
+/// Springs that name `e` as one of their ends.
+std::vector<Entity> springsAttachedTo(const Registry& registry, Entity e);
+
+/// Destroys the entities and every spring attached to them (a spring whose
+/// end disappears would make the level invalid). Returns how many went.
+std::size_t destroyWithSprings(Scene& scene, const std::vector<Entity>& entities);
+
+/// Copies `entities` (and their components) into `dst` with fresh unique
+/// names, moved by `offset` metres. Springs among them are rewired to the
+/// copies when both ends are copied too. Returns the new entities.
+std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>& entities, Scene& dst, Vec2 offset);
+
+/// Palette builders: each returns the new entity. Names are unique.
+Entity addCircle(Scene& scene, Vec2 at, double radius = 0.5);
+Entity addBox(Scene& scene, Vec2 at, double width = 1.0, double height = 1.0);
+/// A wall through `through` with the given normal (normalised here).
+Entity addPlane(Scene& scene, Vec2 through, Vec2 normal);
+/// A spring between two named bodies, rest length = current distance.
+Entity addSpring(Scene& scene, Entity a, Entity b);
+/// A spring from a body to a fixed world point.
+Entity addAnchoredSpring(Scene& scene, Entity a, Vec2 anchor);
+/// A static attractor of `mass` kg.
+Entity addAttractor(Scene& scene, Vec2 at, double mass = 100.0);
+/// A boid at `at` with velocity `velocity`.
+Entity addBoid(Scene& scene, Vec2 at, Vec2 velocity);
+
+/// Axis-aligned bounds of an entity's shape (or its point), metres; false
+/// when it has no position (planes, springs).
+bool entityBounds(const Registry& registry, Entity e, Vec2& lo, Vec2& hi);
+
+} // namespace stepwise::editor

@@ -1,0 +1,128 @@
+#pragma once
+/// \file simulation.hpp
+/// Edit / play / pause / step / step back / reset, on top of World.
+///
+/// * Play from editing keeps a copy of the edited scene; reset() hands it
+///   back, so playing never loses the designer's edits.
+/// * While running, the document's scene *is* the current state (World::
+///   writeBack after every step): the viewport, inspector and overlays show
+///   it, and an edit while paused edits that state, deliberately.
+/// * Every step first stores the scene it starts from in a bounded history
+///   (full snapshots: exact, and cheap next to a step), so stepping back
+///   returns the same bytes.
+/// * The World is rebuilt lazily when the scene was changed from outside
+///   (an edit, a step back, a switched-off system). Determinism of the engine
+///   (build from a written-back scene == keep stepping) makes this exact.
+/// * System switches: the World is built from a copy of the scene with the
+///   components of switched-off systems removed (gravity set to zero), so
+///   the engine itself decides what each remaining system costs.
+
+#include "stepwise/scene.hpp"
+#include "stepwise/world.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace stepwise::editor {
+
+enum class SimState { Editing, Playing, Paused };
+
+/// One sample per step for the plots.
+struct SimSample {
+    double time = 0.0;
+    double kinetic = 0.0, potential = 0.0, total = 0.0;
+    double momentum = 0.0;  ///< |p|, kg*m/s
+    double contacts = 0.0;
+};
+
+class Simulation {
+public:
+    SimState state() const { return state_; }
+    bool running() const { return state_ != SimState::Editing; }
+
+    /// Editing -> Playing (keeps `scene` as the edited scene), Paused -> Playing.
+    /// False (and a message) when the World refuses the scene.
+    bool play(Scene& scene);
+    void pause();
+    /// One step. From editing it first enters the paused state.
+    bool step(Scene& scene);
+    /// Restores the state before the last step. False when there is none.
+    bool stepBack(Scene& scene);
+    /// Back to the edited scene and editing. False when not running.
+    bool reset(Scene& scene);
+    /// Called once per displayed frame: takes timeScale * frameSeconds / dt
+    /// steps (at most maxStepsPerFrame) while playing.
+    void advance(Scene& scene, double frameSeconds);
+
+    /// The scene was changed from outside (edit, undo): rebuild before the
+    /// next step.
+    void sceneChanged() { stale_ = true; }
+    /// Builds the World now if it is stale (for overlays while paused).
+    bool ensureWorld(const Scene& scene);
+
+    /// nullptr when editing or when the World could not be built.
+    const World* world() const { return world_ ? &*world_ : nullptr; }
+    World* world() { return world_ ? &*world_ : nullptr; }
+    const Scene& editedScene() const { return edited_; }
+
+    double timeScale = 1.0;       ///< simulated seconds per real second
+    int maxStepsPerFrame = 8;     ///< past this a frame drops time (no spiral of death)
+    /// Pause when this body starts touching something (null: off).
+    Entity breakOnContact;
+    /// Mouse spring while playing: pulls `dragBody` toward `dragTarget`.
+    std::optional<std::pair<Entity, Vec2>> mouseSpring;
+
+    /// Systems switched off by the user ("gravity", "springs", ...).
+    std::set<std::string, std::less<>> disabledSystems;
+    /// Systems whose switch works: the names the editor knows how to remove.
+    static bool canDisable(std::string_view system);
+    /// The scene the World is built from: switched-off systems removed,
+    /// the mouse spring added.
+    Scene simulationScene(const Scene& scene) const;
+
+    /// Last message: divergence, break on contact, refusal. Empty when none.
+    const std::string& message() const { return message_; }
+    bool diverged() const { return diverged_; }
+    /// The pair a break on contact stopped at.
+    std::optional<std::pair<Entity, Entity>> contactPair;
+
+    std::size_t historySize() const { return history_.size(); }
+    std::size_t historyCapacity() const { return historyCapacity_; }
+    /// Memory budget of the step-back history, bytes (estimated per snapshot).
+    std::size_t historyBudgetBytes = std::size_t(128) << 20;
+
+    const std::vector<SimSample>& samples() const { return samples_; }
+    /// Energy at the start of the run, joules (the drift reference).
+    double initialEnergy() const { return initialEnergy_; }
+    /// Steps taken since play started.
+    std::uint64_t steps() const { return steps_; }
+    /// Wall time of the last frame's steps, ms.
+    double lastFrameStepMs() const { return frameStepMs_; }
+
+private:
+    bool rebuild(const Scene& scene);
+    bool stepOnce(Scene& scene);
+    void record();
+
+    SimState state_ = SimState::Editing;
+    Scene edited_;
+    std::optional<World> world_;
+    bool stale_ = true;
+    double accumulator_ = 0.0;
+    std::deque<Scene> history_;
+    std::size_t historyCapacity_ = 600;
+    std::vector<SimSample> samples_;
+    double initialEnergy_ = 0.0;
+    std::uint64_t steps_ = 0;
+    double frameStepMs_ = 0.0;
+    std::string message_;
+    bool diverged_ = false;
+    bool touchingBefore_ = false;
+};
+
+} // namespace stepwise::editor

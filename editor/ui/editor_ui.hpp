@@ -1,0 +1,83 @@
+#pragma once
+/// \file editor_ui.hpp
+/// The Dear ImGui panels of the editor: menu bar, tools, entity list,
+/// viewport, inspector, world panel (settings, integrator + stiffness hint,
+/// system switches with their cost per step), contacts table, plots, help
+/// and the file dialogs. Panels only read the Editor and call its
+/// functions; every change to the level goes through Editor::applyEdit.
+
+#include "app/editor.hpp"
+
+#include <imgui.h>
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stepwise::ui {
+
+/// Default positions of the panels for a window of w x h at UI scale s
+/// (pixels). Panels start there (ImGuiCond_FirstUseEver); imgui.ini then
+/// remembers where the user put them.
+struct PanelRects {
+    ImVec2 toolsPos, toolsSize, entitiesPos, entitiesSize, viewportPos, viewportSize, inspectorPos, inspectorSize,
+        worldPos, worldSize, debugPos, debugSize;
+};
+PanelRects defaultLayout(float width, float height, float scale);
+
+struct UiState {
+    float scale = 1.0f;                 ///< UI scale (DPI or font size / 13)
+    bool deterministic = false;         ///< scripted mode: hide wall-clock numbers
+    std::string levelsDir = "levels";
+    std::vector<std::string>* recentFiles = nullptr;  ///< owned by the session's Settings
+    float* fontSizeSetting = nullptr;
+    bool fontChanged = false;
+
+    // Windows
+    bool showTools = true, showEntities = true, showInspector = true, showWorld = true, showDebug = true;
+    bool showHelp = false;
+    int debugTab = 0;                   ///< 0 contacts, 1 plots, 2 profile, 3 history
+
+    // Viewport, filled by drawEditorUi each frame
+    ImVec2 viewportPos{0, 0}, viewportSize{1, 1};
+    bool viewportHovered = false;
+    std::uintptr_t viewportTexture = 0;
+
+    // Dialog buffers
+    std::string openPath, saveAsPath, entityFilter;
+    bool openDialogRequested = false, saveAsDialogRequested = false, saveStateRequested = false;
+    std::optional<std::string> recoveryOffer;  ///< path of a recovery file to offer once
+
+    // Inspector edit coalescing: the widget being dragged and its merge key.
+    ImGuiID activeWidget = 0;
+    std::uint64_t activeKey = 0;
+
+    // Timing (ms), averaged, for the status bar and the profile
+    double frameMs = 0.0, uiMs = 0.0, sceneMs = 0.0, stepMs = 0.0;
+    std::map<std::string, double, std::less<>> stageAverage;  ///< ms per step, moving average
+
+    // A World built from the edited scene while editing (hints, active
+    // systems, force field): rebuilt when the scene's revision changes.
+    std::optional<World> preview;
+    std::string previewError;
+    std::uint64_t previewRevision = ~0ull;
+    /// Entities past which the preview World is not built every edit (cost).
+    std::size_t previewLimit = 20000;
+};
+
+/// Applies the theme (dark, matching the renderer's background) at `scale`.
+void applyTheme(float scale);
+
+/// Builds every panel for this frame. Call between ImGui::NewFrame and
+/// ImGui::Render.
+void drawEditorUi(UiState& ui, editor::Editor& ed);
+
+/// The inspector panel (inspector.cpp): driven by the component table.
+void drawInspector(UiState& ui, editor::Editor& ed);
+
+/// The World the panels read: the running one, else the edit-mode preview.
+const World* panelWorld(UiState& ui, editor::Editor& ed);
+
+} // namespace stepwise::ui

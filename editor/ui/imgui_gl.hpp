@@ -1,0 +1,45 @@
+#pragma once
+/// \file imgui_gl.hpp
+/// Draws Dear ImGui's draw lists with OpenGL 3.3 core, and owns the
+/// viewport's offscreen target. Written for the editor instead of using
+/// libimgui's imgui_impl_opengl3 because that backend loads GL through
+/// libGL/GLX itself, which does not reach an OSMesa context; this one loads
+/// its entry points through the context's own GetProcAddress (as the scene
+/// renderer does), so the window and the headless screenshot share one path.
+
+#include "render/gl_api.hpp"
+#include "stepwise/result.hpp"
+
+#include <cstdint>
+#include <memory>
+
+struct ImDrawData;
+
+namespace stepwise::ui {
+
+class ImGuiGl {
+public:
+    /// Loads GL entry points, compiles the shader and uploads the font atlas
+    /// of the current ImGui context.
+    static Result<std::unique_ptr<ImGuiGl>> create(render::GetProcAddress getProc);
+    ~ImGuiGl();
+
+    /// Draws `data` into the default framebuffer (0) of size fbWidth x fbHeight.
+    void render(const ImDrawData* data, int fbWidth, int fbHeight);
+
+    /// Binds (creating or resizing) the offscreen colour target of the
+    /// viewport; the scene renderer then draws into it. Returns its texture
+    /// id for ImGui::Image.
+    std::uintptr_t bindViewportTarget(int width, int height);
+    /// Back to the default framebuffer.
+    void unbindViewportTarget();
+    /// Rebuilds the font texture (after a font size change).
+    void rebuildFonts();
+
+private:
+    ImGuiGl() = default;
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace stepwise::ui

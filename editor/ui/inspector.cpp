@@ -1,0 +1,214 @@
+// The inspector: one generic editor per FieldKind, driven entirely by the
+// component table (names, fields, units, ranges, descriptions). Adding a
+// component to the engine's table makes it editable here with no UI code.
+// An edit applies to every selected entity that has the component, as one
+// undo step per widget drag.
+
+#include "ui/editor_ui.hpp"
+
+#include "app/scene_edit.hpp"
+
+#include "stepwise/component_table.hpp"
+#include "stepwise/components.hpp"
+
+#include <imgui_stdlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace stepwise::ui {
+
+using editor::Editor;
+using editor::FieldValue;
+
+namespace {
+
+const ImVec4 kDim{0.60f, 0.63f, 0.68f, 1.0f};
+const ImVec4 kRed{0.95f, 0.42f, 0.38f, 1.0f};
+
+/// Drag speed: about 0.5% of the value per pixel, at least 0.001.
+float speedFor(double v) { return float(std::max(1e-3, std::abs(v) * 0.005)); }
+
+/// Shows the widget for one field; returns true with `value` updated when
+/// the user changed it.
+bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label) {
+    const double* lo = std::isfinite(f.range.min) ? &f.range.min : nullptr;
+    const double* hi = std::isfinite(f.range.max) ? &f.range.max : nullptr;
+    switch (f.kind) {
+    case FieldKind::Number: {
+        double& v = std::get<double>(value);
+        return ImGui::DragScalar(label, ImGuiDataType_Double, &v, speedFor(v), lo, hi, "%.6g");
+    }
+    case FieldKind::OptionalNumber: {
+        auto& v = std::get<std::optional<double>>(value);
+        bool set = v.has_value();
+        bool changed = ImGui::Checkbox((std::string("##set") + label).c_str(), &set);
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("unset: the engine's default (see the description)");
+        ImGui::SameLine();
+        if (changed) v = set ? std::optional<double>(lo ? std::max(*lo, 1.0) : 1.0) : std::nullopt;
+        if (!v) {
+            ImGui::TextColored(kDim, "%s: default", label);
+            return changed;
+        }
+        double d = *v;
+        if (ImGui::DragScalar(label, ImGuiDataType_Double, &d, speedFor(d), lo, hi, "%.6g")) {
+            v = d;
+            changed = true;
+        }
+        return changed;
+    }
+    case FieldKind::Vector: {
+        Vec2& v = std::get<Vec2>(value);
+        double xy[2] = {v.x, v.y};
+        if (!ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, speedFor(std::max(std::abs(v.x), std::abs(v.y))),
+                                nullptr, nullptr, "%.5g"))
+            return false;
+        v = {xy[0], xy[1]};
+        return true;
+    }
+    case FieldKind::OptionalVector: {
+        auto& v = std::get<std::optional<Vec2>>(value);
+        bool set = v.has_value();
+        bool changed = ImGui::Checkbox((std::string("##set") + label).c_str(), &set);
+        ImGui::SameLine();
+        if (changed) v = set ? std::optional<Vec2>(Vec2{}) : std::nullopt;
+        if (!v) {
+            ImGui::TextColored(kDim, "%s: none", label);
+            return changed;
+        }
+        double xy[2] = {v->x, v->y};
+        if (ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, 0.01f, nullptr, nullptr, "%.5g")) {
+            v = Vec2{xy[0], xy[1]};
+            changed = true;
+        }
+        return changed;
+    }
+    case FieldKind::Color: {
+        Rgb& c = std::get<Rgb>(value);
+        float rgb[3] = {float(c.r), float(c.g), float(c.b)};
+        if (!ImGui::ColorEdit3(label, rgb, ImGuiColorEditFlags_Float)) return false;
+        c = {double(std::clamp(rgb[0], 0.0f, 1.0f)), double(std::clamp(rgb[1], 0.0f, 1.0f)),
+             double(std::clamp(rgb[2], 0.0f, 1.0f))};
+        return true;
+    }
+    case FieldKind::Bool: return ImGui::Checkbox(label, &std::get<bool>(value));
+    case FieldKind::String:
+    case FieldKind::EntityName: return ImGui::InputText(label, &std::get<std::string>(value));
+    }
+    return false;
+}
+
+} // namespace
+
+void drawInspector(UiState& ui, Editor& ed) {
+    if (!ImGui::Begin("Inspector", &ui.showInspector)) {
+        ImGui::End();
+        return;
+    }
+    Registry& reg = ed.doc.scene.registry;
+    if (ed.selection.empty()) {
+        ImGui::TextColored(kDim, "Nothing selected.");
+        ImGui::TextWrapped("Click a body in the viewport or the entity list; shift-click or drag a box for several. "
+                           "Place new ones with the tools (1-8).");
+        ImGui::End();
+        return;
+    }
+    const Entity primary = ed.selection.front();
+    const std::vector<Entity> selection = ed.selection;
+    if (selection.size() == 1) ImGui::Text("%s", editor::displayName(reg, primary).c_str());
+    else ImGui::Text("%zu selected (edits apply to all that have the component)", selection.size());
+    ImGui::Separator();
+
+    const ComponentInfo* toRemove = nullptr;
+    for (const ComponentInfo& info : componentTable()) {
+        std::size_t having = 0;
+        Entity first;
+        for (Entity e : selection)
+            if (info.has(reg, e)) {
+                if (!having) first = e;
+                ++having;
+            }
+        if (!having) continue;
+        ImGui::PushID(info.name.data());
+        const std::string header = std::string(info.name) +
+                                   (having < selection.size() ? " (" + std::to_string(having) + " of " +
+                                                                    std::to_string(selection.size()) + ")"
+                                                              : "");
+        const bool open = ImGui::CollapsingHeader(header.c_str(), ImGuiTreeNodeFlags_DefaultOpen | ImGuiTreeNodeFlags_AllowItemOverlap);
+        if (ImGui::IsItemHovered() && !info.description.empty())
+            ImGui::SetTooltip("%.*s", int(info.description.size()), info.description.data());
+        ImGui::SameLine(ImGui::GetContentRegionMax().x - ImGui::GetFrameHeight());
+        if (ImGui::SmallButton("x")) toRemove = &info;
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("Remove %.*s", int(info.name.size()), info.name.data());
+        if (open) {
+            const void* component = info.getConst(reg, first);
+            ImGui::PushItemWidth(-ImGui::GetContentRegionAvail().x * 0.38f);
+            for (const FieldInfo& f : info.fields) {
+                FieldValue value = editor::readField(f, component);
+                // Mixed values across the selection are marked; the widget
+                // shows the first entity's.
+                bool mixed = false;
+                for (Entity e : selection)
+                    if (const void* other = info.getConst(reg, e); other && e != first)
+                        mixed = mixed || !(editor::readField(f, other) == value);
+                std::string label = f.key.empty() ? std::string(info.name) : std::string(f.key);
+                if (!f.unit.empty()) label += " [" + std::string(f.unit) + "]";
+                if (mixed) label += " (mixed)";
+                ImGui::PushID(f.key.empty() ? "value" : f.key.data());
+                const ImGuiID id = ImGui::GetID(label.c_str());
+                const bool changed = fieldWidget(f, value, label.c_str());
+                if (ImGui::IsItemHovered() && !f.description.empty())
+                    ImGui::SetTooltip("%.*s%s%s", int(f.description.size()), f.description.data(),
+                                      f.kind == FieldKind::Number ? "\nrange: " : "",
+                                      f.kind == FieldKind::Number ? f.range.describe().c_str() : "");
+                if (changed) {
+                    if (ImGui::IsItemActivated() || ui.activeWidget != id) {
+                        ui.activeWidget = id;
+                        ui.activeKey = ed.newMergeKey();
+                    }
+                    std::string problem;
+                    std::string what = "edit ";
+                    what += info.name;
+                    if (!f.key.empty()) {
+                        what += '.';
+                        what += f.key;
+                    }
+                    if (!ed.applyEdit(what, [&](Scene& s) {
+                            return editor::setFieldOnAll(s, info, f, value, selection, &problem) > 0;
+                        }, ui.activeKey) &&
+                        !problem.empty())
+                        ed.status = "refused: " + problem;
+                }
+                if (ImGui::IsItemDeactivated()) ed.endEdit();
+                ImGui::PopID();
+            }
+            ImGui::PopItemWidth();
+        }
+        ImGui::PopID();
+    }
+    if (toRemove) {
+        const ComponentInfo& info = *toRemove;
+        ed.applyEdit("remove " + std::string(info.name),
+                     [&](Scene& s) { return editor::removeComponentFromAll(s, info, selection) > 0; });
+    }
+
+    ImGui::Separator();
+    ImGui::SetNextItemWidth(-1);
+    if (ImGui::BeginCombo("##add", "Add component...")) {
+        for (const ComponentInfo& info : componentTable()) {
+            const bool all = std::all_of(selection.begin(), selection.end(), [&](Entity e) { return info.has(reg, e); });
+            if (all) continue;
+            if (ImGui::Selectable(std::string(info.name).c_str()))
+                ed.applyEdit("add " + std::string(info.name),
+                             [&](Scene& s) { return editor::addComponentToAll(s, info, selection) > 0; });
+            if (ImGui::IsItemHovered() && !info.description.empty())
+                ImGui::SetTooltip("%.*s", int(info.description.size()), info.description.data());
+        }
+        ImGui::EndCombo();
+    }
+    if (!ed.status.empty() && ed.status.rfind("refused", 0) == 0) ImGui::TextColored(kRed, "%s", ed.status.c_str());
+    ImGui::End();
+}
+
+} // namespace stepwise::ui

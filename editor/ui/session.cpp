@@ -1,0 +1,274 @@
+#include "ui/session.hpp"
+
+#include "ui/imgui_gl.hpp"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+namespace stepwise::ui {
+
+using editor::InputEvent;
+using editor::Key;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+/// Exponential moving average: recent steps weigh most, noise is damped.
+void average(double& into, double sample) { into = into == 0.0 ? sample : 0.9 * into + 0.1 * sample; }
+
+const char* kFontPaths[] = {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+                            "/usr/share/fonts/TTF/DejaVuSans.ttf"};
+
+} // namespace
+
+Result<std::unique_ptr<Session>> Session::create(render::GetProcAddress getProc, const SessionOptions& options) {
+    std::unique_ptr<Session> s(new Session());
+    s->options_ = options;
+    editor::Editor& ed = s->editor_;
+    if (!options.configDir.empty()) ed.configDir = options.configDir;
+    if (options.persist) s->settings_ = editor::Settings::load(ed.configDir);
+    s->ui_.deterministic = options.deterministic;
+    s->ui_.levelsDir = options.levelsDir;
+    s->ui_.recentFiles = &s->settings_.recentFiles;
+    s->ui_.fontSizeSetting = &s->settings_.fontSize;
+
+    IMGUI_CHECKVERSION();
+    s->imgui_ = ImGui::CreateContext();
+    ImGuiIO& io = ImGui::GetIO();
+    if (options.persist) {
+        std::error_code ec;
+        std::filesystem::create_directories(ed.configDir, ec);
+        s->iniPath_ = (ed.configDir / "imgui.ini").string();
+        io.IniFilename = s->iniPath_.c_str();
+    } else {
+        io.IniFilename = nullptr;  // scripted runs: the same layout every time
+    }
+    if (options.deterministic) io.ConfigInputTextCursorBlink = false;
+    io.ConfigWindowsMoveFromTitleBarOnly = true;  // dragging inside a panel is for its widgets
+    // Our Key enum values index KeysDown directly.
+    io.KeyMap[ImGuiKey_Tab] = int(Key::Tab);
+    io.KeyMap[ImGuiKey_LeftArrow] = int(Key::Left);
+    io.KeyMap[ImGuiKey_RightArrow] = int(Key::Right);
+    io.KeyMap[ImGuiKey_UpArrow] = int(Key::Up);
+    io.KeyMap[ImGuiKey_DownArrow] = int(Key::Down);
+    io.KeyMap[ImGuiKey_PageUp] = int(Key::PageUp);
+    io.KeyMap[ImGuiKey_PageDown] = int(Key::PageDown);
+    io.KeyMap[ImGuiKey_Home] = int(Key::Home);
+    io.KeyMap[ImGuiKey_End] = int(Key::End);
+    io.KeyMap[ImGuiKey_Delete] = int(Key::Delete);
+    io.KeyMap[ImGuiKey_Backspace] = int(Key::Backspace);
+    io.KeyMap[ImGuiKey_Space] = int(Key::Space);
+    io.KeyMap[ImGuiKey_Enter] = int(Key::Enter);
+    io.KeyMap[ImGuiKey_Escape] = int(Key::Escape);
+    io.KeyMap[ImGuiKey_A] = int(Key::A);
+    io.KeyMap[ImGuiKey_C] = int(Key::C);
+    io.KeyMap[ImGuiKey_V] = int(Key::V);
+    io.KeyMap[ImGuiKey_X] = int(Key::X);
+    io.KeyMap[ImGuiKey_Y] = int(Key::Y);
+    io.KeyMap[ImGuiKey_Z] = int(Key::Z);
+    s->loadFonts();
+    Result<std::unique_ptr<ImGuiGl>> gl = ImGuiGl::create(getProc);
+    if (!gl) return Error{gl.error()};
+    s->gl_ = std::move(*gl);
+    Result<std::unique_ptr<render::Renderer>> r = render::Renderer::create(getProc);
+    if (!r) return Error{r.error()};
+    s->renderer_ = std::move(*r);
+    return s;
+}
+
+Session::~Session() {
+    gl_.reset();
+    renderer_.reset();
+    if (imgui_) ImGui::DestroyContext(imgui_);
+}
+
+void Session::loadFonts() {
+    ImGuiIO& io = ImGui::GetIO();
+    io.Fonts->Clear();
+    float size = options_.fontSize > 0 ? options_.fontSize
+                 : settings_.fontSize > 0 ? settings_.fontSize
+                                          : 13.0f * options_.dpiScale;
+    size = std::clamp(size, 8.0f, 48.0f);
+    ui_.scale = size / 13.0f;
+    bool loaded = false;
+    if (!options_.builtinFont) {
+        std::error_code ec;
+        for (const char* path : kFontPaths)
+            if (std::filesystem::exists(path, ec) && io.Fonts->AddFontFromFileTTF(path, std::round(size * 1.1f))) {
+                loaded = true;
+                break;
+            }
+    }
+    if (!loaded) {
+        ImFontConfig config;
+        config.SizePixels = std::round(size);
+        io.Fonts->AddFontDefault(&config);
+    }
+    applyTheme(ui_.scale);
+}
+
+bool Session::openAtStart(const std::filesystem::path& level) {
+    if (!editor_.open(level)) return false;
+    settings_.addRecent(level.string());
+    lastRecentPath_ = level.string();
+    if (options_.persist)
+        if (auto recovery = editor_.recoveryAvailable()) ui_.recoveryOffer = recovery->string();
+    return true;
+}
+
+void Session::saveSettings() {
+    if (!options_.persist) return;
+    (void)settings_.save(editor_.configDir);
+    if (!iniPath_.empty()) ImGui::SaveIniSettingsToDisk(iniPath_.c_str());
+}
+
+void Session::feedImGui(const std::vector<InputEvent>& events, int width, int height, double frameSeconds) {
+    ImGuiIO& io = ImGui::GetIO();
+    io.DisplaySize = ImVec2(float(width), float(height));
+    io.DeltaTime = float(std::max(frameSeconds, 1e-4));
+    io.MouseWheel = 0.0f;
+    for (const InputEvent& e : events) {
+        switch (e.type) {
+        case InputEvent::Type::MouseMove: io.MousePos = ImVec2(float(e.x), float(e.y)); break;
+        case InputEvent::Type::MouseDown:
+        case InputEvent::Type::MouseUp:
+            io.MousePos = ImVec2(float(e.x), float(e.y));
+            io.MouseDown[int(e.button)] = e.type == InputEvent::Type::MouseDown;
+            break;
+        case InputEvent::Type::Wheel: io.MouseWheel += float(e.wheel); break;
+        case InputEvent::Type::KeyDown:
+        case InputEvent::Type::KeyUp:
+            if (e.key != Key::None) io.KeysDown[int(e.key)] = e.type == InputEvent::Type::KeyDown;
+            mods_ = e.mods;
+            break;
+        case InputEvent::Type::Text: io.AddInputCharactersUTF8(e.text.c_str()); break;
+        }
+        if (e.type == InputEvent::Type::KeyDown || e.type == InputEvent::Type::KeyUp) {
+            io.KeyCtrl = (e.mods & editor::kModCtrl) != 0;
+            io.KeyShift = (e.mods & editor::kModShift) != 0;
+            io.KeyAlt = (e.mods & editor::kModAlt) != 0;
+        }
+    }
+}
+
+void Session::route(const std::vector<InputEvent>& events) {
+    const ImGuiIO& io = ImGui::GetIO();
+    const ImVec2 o = ui_.viewportPos;
+    // Any open popup (modal, menu, combo) owns the input until it closes.
+    const bool modal = ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId);
+    for (const InputEvent& e : events) {
+        switch (e.type) {
+        case InputEvent::Type::KeyDown:
+            // Keys belong to a text field while one is active, and to a
+            // modal while one is open.
+            if (!io.WantTextInput && !modal) editor_.handleShortcut(e.key, e.mods);
+            break;
+        case InputEvent::Type::MouseDown:
+        case InputEvent::Type::MouseUp:
+        case InputEvent::Type::MouseMove:
+        case InputEvent::Type::Wheel: {
+            const bool inside = e.x >= o.x && e.y >= o.y && e.x < o.x + ui_.viewportSize.x && e.y < o.y + ui_.viewportSize.y;
+            const bool ours = viewportCapture_ || (ui_.viewportHovered && inside && !modal);
+            if (e.type == InputEvent::Type::MouseDown && ours) viewportCapture_ = true;
+            if (!ours) break;
+            InputEvent local = e;
+            local.x = e.x - o.x;
+            local.y = e.y - o.y;
+            if (e.type == InputEvent::Type::MouseDown || e.type == InputEvent::Type::MouseUp) local.mods = mods_;
+            editor_.handleViewportEvent(local);
+            if (e.type == InputEvent::Type::MouseUp) viewportCapture_ = false;
+            break;
+        }
+        default: break;
+        }
+    }
+}
+
+void Session::frame(int width, int height, double frameSeconds) {
+    const auto t0 = Clock::now();
+    // This frame's events: stop before a second mouse-button change.
+    std::vector<InputEvent> batch;
+    int buttonChanges = 0;
+    while (!events_.empty()) {
+        const InputEvent& e = events_.front();
+        const bool button = e.type == InputEvent::Type::MouseDown || e.type == InputEvent::Type::MouseUp;
+        const bool key = e.type == InputEvent::Type::KeyDown || e.type == InputEvent::Type::KeyUp;
+        if ((button || key) && buttonChanges == 1) break;
+        if (button || key) ++buttonChanges;
+        batch.push_back(e);
+        events_.pop_front();
+    }
+    for (const InputEvent& e : batch)
+        if (e.type == InputEvent::Type::KeyDown || e.type == InputEvent::Type::KeyUp) mods_ = e.mods;
+
+    feedImGui(batch, width, height, frameSeconds);
+    ImGui::NewFrame();
+    drawEditorUi(ui_, editor_);
+    // Route after the panels so we know whether the viewport is under the
+    // mouse (this frame's layout) and whether a text field has the keys.
+    route(batch);
+    if (ui_.fontChanged) ui_.fontChanged = false;  // applied below, outside the frame
+    ImGui::Render();
+    const double uiMs = msSince(t0);
+
+    const auto t1 = Clock::now();
+    editor_.update(frameSeconds);
+    if (editor_.sim.state() == editor::SimState::Playing) average(ui_.stepMs, editor_.sim.lastFrameStepMs());
+    if (const World* w = editor_.sim.world(); w && editor_.sim.state() == editor::SimState::Playing) {
+        for (const StageTime& s : w->lastStats().stages) average(ui_.stageAverage["stage:" + std::string(s.name)], s.milliseconds);
+        for (const StageTime& s : w->lastStats().systems) average(ui_.stageAverage["system:" + std::string(s.name)], s.milliseconds);
+    }
+    (void)t1;
+
+    // Viewport: the shared renderer into an offscreen target of the image's size.
+    const auto t2 = Clock::now();
+    const int vw = std::max(16, int(ui_.viewportSize.x)), vh = std::max(16, int(ui_.viewportSize.y));
+    editor_.setViewportSize(vw, vh);
+    if (editor_.sim.running()) editor_.sim.ensureWorld(editor_.doc.scene);
+    render::FrameInput input = editor_.frameInput();
+    if (!input.world && (editor_.overlays.has(render::Overlay::ForceField) || editor_.overlays.has(render::Overlay::Force))) {
+        // Editing: the preview World gives the force overlays.
+        input.world = panelWorld(ui_, editor_);
+        if (input.world) {
+            if (editor_.overlays.has(render::Overlay::ForceField)) input.overlays.add(render::Overlay::ForceField);
+            if (editor_.overlays.has(render::Overlay::Force)) input.overlays.add(render::Overlay::Force);
+        }
+    }
+    input.caption.clear();
+    ui_.viewportTexture = gl_->bindViewportTarget(vw, vh);
+    renderer_->render(input, vw, vh);
+    gl_->unbindViewportTarget();
+    const double sceneMs = msSince(t2);
+    // The font rebuild must happen between frames.
+    gl_->render(ImGui::GetDrawData(), width, height);
+    average(ui_.uiMs, uiMs);
+    average(ui_.sceneMs, sceneMs);
+    average(ui_.frameMs, msSince(t0));
+
+    // Recent files follow what is open.
+    if (!editor_.doc.path.empty() && editor_.doc.path.string() != lastRecentPath_) {
+        lastRecentPath_ = editor_.doc.path.string();
+        settings_.addRecent(lastRecentPath_);
+        if (options_.persist) (void)settings_.save(editor_.configDir);
+    }
+    if (settings_.fontSize > 0 && std::abs(settings_.fontSize / 13.0f - ui_.scale) > 1e-3f && !ImGui::IsAnyItemActive()) {
+        options_.fontSize = settings_.fontSize;
+        loadFonts();
+        gl_->rebuildFonts();
+        if (options_.persist) (void)settings_.save(editor_.configDir);
+    }
+}
+
+render::Image Session::capture(int width, int height) {
+    gl_->unbindViewportTarget();
+    return renderer_->readPixels(width, height);
+}
+
+} // namespace stepwise::ui

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer target for the level loader with clang and runs it.
+#   bash tests/fuzz/run.sh [SECONDS]      (default 60; CI runs 60)
+# Seeds: every levels/*.json plus tests/fuzz/corpus/ (kept findings and inputs
+# worth keeping). New inputs the fuzzer finds go to build-fuzz/corpus/, so
+# the repository's corpus only grows by hand. A crash, leak, sanitizer
+# report, timeout (5 s) or out-of-memory (2 GiB) leaves build-fuzz/crash-*
+# (or timeout-*/oom-*) and makes this script exit non-zero; replay one with
+#   build-fuzz/tests/fuzz/fuzz_scene_loader build-fuzz/crash-...
+# Set FUZZ_EXTRA for more libFuzzer flags (e.g. FUZZ_EXTRA=-jobs=2).
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+cd "$root"
+seconds=${1:-60}
+build=build-fuzz
+cmake -S . -B "$build" -DSTEPWISE_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DSTEPWISE_BUILD_TESTS=OFF -DSTEPWISE_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" --target fuzz_scene_loader -j "$(nproc)"
+mkdir -p "$build/corpus" "$build/seeds"
+# Levels up to 64 KiB are seeds as they are; the big benchmark levels
+# (pile, rain, cloth: 250-380 KB) would make every execution slow, and their
+# structure is in the small ones. -max_len keeps mutations small as well.
+find levels -name '*.json' ! -name scene.schema.json -size -65537c -exec cp {} "$build/seeds/" \;
+# shellcheck disable=SC2086
+exec "$build/tests/fuzz/fuzz_scene_loader" "$build/corpus" "$build/seeds" tests/fuzz/corpus \
+  -dict=tests/fuzz/scene.dict -max_len=65536 -max_total_time="$seconds" -timeout=5 -rss_limit_mb=2048 \
+  -artifact_prefix="$build/" -print_final_stats=1 ${FUZZ_EXTRA:-}

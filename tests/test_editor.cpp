@@ -1,0 +1,563 @@
+// Unit tests of the editor model (editor/app): commands and the undo stack,
+// tools driven by viewport events, the simulation controller, saving. No
+// window and no GL: the same Editor the UI drives.
+
+#include "app/editor.hpp"
+#include "app/scene_edit.hpp"
+#include "app/script.hpp"
+
+#include "stepwise/components.hpp"
+#include "stepwise/scene_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using namespace stepwise;
+using namespace stepwise::editor;
+
+namespace {
+
+const std::filesystem::path kLevels = std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels";
+
+std::string textOf(const Scene& s) { return sceneToJsonText(s); }
+
+std::string readFile(const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// A fresh temporary folder per test, removed afterwards.
+struct TempDir {
+    std::filesystem::path path;
+    TempDir() {
+        path = std::filesystem::temp_directory_path() /
+               ("stepwise-editor-test-" + std::to_string(::getpid()) + "-" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        std::filesystem::remove_all(path);
+        std::filesystem::create_directories(path);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::permissions(path, std::filesystem::perms::owner_all, ec);
+        std::filesystem::remove_all(path, ec);
+    }
+};
+
+/// Editor with a level open, a 800x600 viewport, config in a temp folder.
+struct Fixture {
+    TempDir tmp;
+    Editor ed;
+    explicit Fixture(const std::string& level) {
+        ed.configDir = tmp.path / "config";
+        EXPECT_TRUE(ed.open(kLevels / level)) << ed.errorModal;
+        ed.setViewportSize(800, 600);
+        ed.fitView();
+    }
+    InputEvent mouse(InputEvent::Type t, Vec2 world, std::uint8_t mods = 0) const {
+        InputEvent e;
+        e.type = t;
+        const Vec2 px = ed.view.toPixels(world);
+        e.x = px.x;
+        e.y = px.y;
+        e.mods = mods;
+        return e;
+    }
+    void click(Vec2 world, std::uint8_t mods = 0) {
+        ed.handleViewportEvent(mouse(InputEvent::Type::MouseDown, world, mods));
+        ed.handleViewportEvent(mouse(InputEvent::Type::MouseUp, world, mods));
+    }
+    void drag(Vec2 from, Vec2 to, int moves) {
+        ed.handleViewportEvent(mouse(InputEvent::Type::MouseDown, from));
+        for (int i = 1; i <= moves; ++i)
+            ed.handleViewportEvent(mouse(InputEvent::Type::MouseMove, from + (to - from) * (double(i) / moves)));
+        ed.handleViewportEvent(mouse(InputEvent::Type::MouseUp, to));
+    }
+    Entity named(const std::string& n) const { return findByName(ed.doc.scene.registry, n); }
+    Vec2 positionOf(const std::string& n) const {
+        return ed.doc.scene.registry.tryGet<Position>(named(n))->value;
+    }
+};
+
+} // namespace
+
+TEST(CommandStack, UndoRedoRestoreExactBytes) {
+    Fixture f("course_notes.json");
+    const std::string original = textOf(f.ed.doc.scene);
+    ASSERT_TRUE(f.ed.applyEdit("add", [](Scene& s) {
+        addCircle(s, {1.25, 2.5}, 0.75);
+        return true;
+    }));
+    const std::string afterAdd = textOf(f.ed.doc.scene);
+    ASSERT_NE(afterAdd, original);
+    ASSERT_TRUE(f.ed.applyEdit("gravity", [](Scene& s) {
+        s.world.gravity.y = -3.5;
+        return true;
+    }));
+    const std::string afterGravity = textOf(f.ed.doc.scene);
+    EXPECT_TRUE(f.ed.undo());
+    EXPECT_EQ(textOf(f.ed.doc.scene), afterAdd);
+    EXPECT_TRUE(f.ed.undo());
+    EXPECT_EQ(textOf(f.ed.doc.scene), original);
+    EXPECT_FALSE(f.ed.undo());
+    EXPECT_FALSE(f.ed.dirty());
+    EXPECT_TRUE(f.ed.redo());
+    EXPECT_TRUE(f.ed.redo());
+    EXPECT_EQ(textOf(f.ed.doc.scene), afterGravity);
+    EXPECT_TRUE(f.ed.dirty());
+    // A new edit after an undo forgets the redo branch.
+    EXPECT_TRUE(f.ed.undo());
+    ASSERT_TRUE(f.ed.applyEdit("G", [](Scene& s) {
+        s.world.G = 2.0;
+        return true;
+    }));
+    EXPECT_FALSE(f.ed.redo());
+}
+
+TEST(CommandStack, EditThatChangesNothingIsNotRecorded) {
+    Scene s;
+    CommandStack stack;
+    EXPECT_FALSE(stack.apply(s, "nothing", [](Scene&) { return false; }));
+    EXPECT_FALSE(stack.canUndo());
+}
+
+TEST(CommandStack, CapacityDropsOldest) {
+    Scene s;
+    CommandStack stack(3);
+    for (int i = 0; i < 5; ++i)
+        ASSERT_TRUE(stack.apply(s, std::to_string(i), [i](Scene& sc) {
+            sc.world.G = double(i + 10);
+            return true;
+        }));
+    EXPECT_EQ(stack.size(), 3u);
+    while (stack.canUndo()) (void)stack.undo(s);
+    EXPECT_EQ(s.world.G, 11.0);  // state before the oldest kept command ("g2")
+}
+
+TEST(Tools, OneDragIsOneUndoStep) {
+    Fixture f("spring_chain.json");
+    const std::string before = textOf(f.ed.doc.scene);
+    const Vec2 start = f.positionOf("link2");
+    const std::size_t undoDepth = f.ed.commands.size();
+    f.drag(start, start + Vec2{1.0, 0.5}, 10);
+    const Vec2 moved = f.positionOf("link2");
+    EXPECT_NEAR(moved.x, start.x + 1.0, 1e-9);
+    EXPECT_NEAR(moved.y, start.y + 0.5, 1e-9);
+    EXPECT_EQ(f.ed.commands.size(), undoDepth + 1);  // ten moves, one command
+    ASSERT_TRUE(f.ed.undo());
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+    // A second drag is a second step.
+    f.drag(start, start + Vec2{0.0, 1.0}, 3);
+    f.drag(start + Vec2{0.0, 1.0}, start + Vec2{0.0, 2.0}, 3);
+    EXPECT_EQ(f.ed.commands.size(), undoDepth + 2);
+}
+
+TEST(Tools, SnapPutsTheGrabbedBodyOnTheGrid) {
+    Fixture f("spring_chain.json");
+    f.ed.snap = true;
+    f.ed.snapSpacing = 0.25;
+    const Vec2 start = f.positionOf("link1");
+    f.drag(start, start + Vec2{0.61, 0.37}, 4);
+    const Vec2 p = f.positionOf("link1");
+    EXPECT_NEAR(p.x / 0.25, std::round(p.x / 0.25), 1e-9);
+    EXPECT_NEAR(p.y / 0.25, std::round(p.y / 0.25), 1e-9);
+}
+
+TEST(Tools, ClickSelectsShiftAddsBoxSelects) {
+    Fixture f("spring_chain.json");
+    f.click(f.positionOf("link0"));
+    ASSERT_EQ(f.ed.selection.size(), 1u);
+    EXPECT_EQ(f.ed.selection[0], f.named("link0"));
+    f.click(f.positionOf("link3"), kModShift);
+    EXPECT_EQ(f.ed.selection.size(), 2u);
+    f.click(f.positionOf("link3"), kModShift);  // toggles off
+    EXPECT_EQ(f.ed.selection.size(), 1u);
+    // Box around link0..link2 only.
+    const Vec2 a = f.positionOf("link0"), c = f.positionOf("link2");
+    const Vec2 from{std::min(a.x, c.x) - 0.2, std::max(a.y, c.y) + 0.2};
+    ASSERT_TRUE(pick(f.ed.doc.scene, from, 0.15).isNull()) << "the box must start on empty space";
+    f.drag(from, Vec2{std::max(a.x, c.x) + 0.2, std::min(a.y, c.y) - 0.2}, 2);
+    std::vector<std::string> names;
+    for (Entity e : f.ed.selection) names.push_back(displayName(f.ed.doc.scene.registry, e));
+    EXPECT_NE(std::find(names.begin(), names.end(), "link0"), names.end());
+    EXPECT_NE(std::find(names.begin(), names.end(), "link2"), names.end());
+    EXPECT_EQ(std::find(names.begin(), names.end(), "link5"), names.end());
+}
+
+TEST(Tools, PlaceCircleThenUndo) {
+    Fixture f("orbit.json");
+    const std::string before = textOf(f.ed.doc.scene);
+    const std::size_t n = f.ed.doc.scene.registry.size();
+    f.ed.tool = Tool::Circle;
+    f.click({3.0, -2.0});
+    ASSERT_EQ(f.ed.doc.scene.registry.size(), n + 1);
+    const Entity e = f.ed.doc.scene.registry.entities().back();
+    EXPECT_TRUE(f.ed.doc.scene.registry.has<Radius>(e));
+    EXPECT_NEAR(f.ed.doc.scene.registry.tryGet<Position>(e)->value.x, 3.0, 1e-9);
+    EXPECT_EQ(f.ed.selection, std::vector<Entity>{e});
+    ASSERT_TRUE(f.ed.handleShortcut(Key::Z, kModCtrl));
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+    EXPECT_TRUE(f.ed.selection.empty());
+}
+
+TEST(Tools, SpringBetweenTwoBodiesAndToAnAnchor) {
+    Fixture f("orbit.json");
+    f.ed.tool = Tool::Spring;
+    f.click(f.positionOf("planet"));
+    f.click(f.positionOf("comet"));
+    const Registry& reg = f.ed.doc.scene.registry;
+    const Spring* s = reg.tryGet<Spring>(reg.entities().back());
+    ASSERT_NE(s, nullptr);
+    EXPECT_EQ(s->a, "planet");
+    EXPECT_EQ(s->b, "comet");
+    ASSERT_TRUE(s->restLength);
+    EXPECT_NEAR(*s->restLength, 6.5, 1e-9);
+    f.click(f.positionOf("dust"));
+    f.click({5.0, 5.0});
+    const Spring* anchored = reg.tryGet<Spring>(reg.entities().back());
+    ASSERT_NE(anchored, nullptr);
+    EXPECT_EQ(anchored->a, "dust");
+    ASSERT_TRUE(anchored->anchor);
+    EXPECT_NEAR(anchored->anchor->x, 5.0, 1e-9);
+    EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), "");
+}
+
+TEST(Tools, PlaneBoidBrushAttractorAndRotate) {
+    Fixture f("orbit.json");
+    f.ed.tool = Tool::Plane;
+    f.drag({0.0, -8.0}, {0.0, -6.0}, 2);  // normal points up from y = -8
+    const Registry& reg = f.ed.doc.scene.registry;
+    const Plane* pl = reg.tryGet<Plane>(reg.entities().back());
+    ASSERT_NE(pl, nullptr);
+    EXPECT_NEAR(pl->normal.y, 1.0, 1e-12);
+    EXPECT_NEAR(pl->offset, -8.0, 1e-9);
+
+    const std::size_t n = reg.size();
+    const std::size_t depth = f.ed.commands.size();
+    f.ed.tool = Tool::Boids;
+    f.drag({-6.0, 6.0}, {0.0, 6.0}, 30);
+    EXPECT_GE(reg.size(), n + 8);  // 6 m at 0.6 m spacing, plus the first
+    EXPECT_EQ(f.ed.commands.size(), depth + 1);  // one stroke, one undo step
+
+    f.ed.tool = Tool::Box;
+    f.click({6.0, 6.0});
+    const Entity box = reg.entities().back();
+    f.ed.tool = Tool::Rotate;
+    f.drag({7.0, 6.0}, {6.0, 7.0}, 5);  // a quarter turn counter-clockwise about the centre
+    ASSERT_TRUE(reg.has<Angle>(box));
+    EXPECT_NEAR(reg.tryGet<Angle>(box)->value, std::acos(-1.0) / 2, 1e-6);
+}
+
+TEST(Tools, DeleteTakesAttachedSpringsDuplicateAndPasteRenameAndRewire) {
+    Fixture f("spring_chain.json");
+    const Registry& reg = f.ed.doc.scene.registry;
+    const std::size_t n = reg.size();
+    f.ed.select({f.named("link1"), f.named("link2")});
+    ASSERT_TRUE(f.ed.handleShortcut(Key::D, kModCtrl));
+    ASSERT_EQ(f.ed.selection.size(), 2u);
+    EXPECT_EQ(reg.size(), n + 2);
+    EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), "");
+    // Copy the two links and the spring between them: the pasted spring
+    // joins the pasted links, not the originals.
+    std::vector<Entity> group{f.named("link1"), f.named("link2")};
+    for (Entity s : springsAttachedTo(reg, f.named("link1")))
+        for (Entity t : springsAttachedTo(reg, f.named("link2")))
+            if (s == t) group.push_back(s);
+    ASSERT_EQ(group.size(), 3u) << "spring_chain joins neighbouring links";
+    f.ed.select(group);
+    f.ed.copySelection();
+    ASSERT_TRUE(f.ed.paste());
+    const Spring* pasted = nullptr;
+    for (Entity e : f.ed.selection)
+        if (reg.has<Spring>(e)) pasted = reg.tryGet<Spring>(e);
+    ASSERT_NE(pasted, nullptr);
+    EXPECT_NE(pasted->a, "link1");
+    EXPECT_NE(pasted->b, "link2");
+    EXPECT_TRUE(reg.alive(findByName(reg, pasted->a)));
+    EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), "");
+    // Delete link3: the springs to link2 and link4 go with it.
+    const std::size_t springs = springsAttachedTo(reg, f.named("link3")).size();
+    ASSERT_GT(springs, 0u);
+    const std::size_t before = reg.size();
+    f.ed.select({f.named("link3")});
+    ASSERT_TRUE(f.ed.handleShortcut(Key::Delete, 0));
+    EXPECT_EQ(reg.size(), before - 1 - springs);
+    EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), "");
+}
+
+TEST(Inspector, MultiSelectionEditAppliesToAllAndIsOneUndoStep) {
+    Fixture f("spring_chain.json");
+    const ComponentInfo* mass = findComponent("mass");
+    ASSERT_NE(mass, nullptr);
+    const std::vector<Entity> sel{f.named("link0"), f.named("link1"), f.named("link4")};
+    f.ed.select(sel);
+    const std::string before = textOf(f.ed.doc.scene);
+    const std::uint64_t key = f.ed.newMergeKey();
+    // A slider drag: three values, one command.
+    for (double v : {0.5, 0.7, 2.5})
+        ASSERT_TRUE(f.ed.applyEdit("edit mass", [&](Scene& s) {
+            return setFieldOnAll(s, *mass, mass->fields[0], v, f.ed.selection) > 0;
+        }, key));
+    f.ed.endEdit();
+    for (Entity e : sel) EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Mass>(e)->value, 2.5);
+    EXPECT_NE(f.ed.doc.scene.registry.tryGet<Mass>(f.named("link2"))->value, 2.5);
+    ASSERT_TRUE(f.ed.undo());
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+    // Out of range: refused, nothing changes.
+    std::string problem;
+    EXPECT_EQ(setFieldOnAll(f.ed.doc.scene, *mass, mass->fields[0], -1.0, sel, &problem), 0u);
+    EXPECT_NE(problem.find("mass"), std::string::npos) << problem;
+    // Add and remove a component on the whole selection.
+    const ComponentInfo* drag = findComponent("restitution");
+    ASSERT_NE(drag, nullptr);
+    ASSERT_TRUE(f.ed.applyEdit("add", [&](Scene& s) { return addComponentToAll(s, *drag, sel) > 0; }));
+    for (Entity e : sel) EXPECT_TRUE(drag->has(f.ed.doc.scene.registry, e));
+    ASSERT_TRUE(f.ed.applyEdit("remove", [&](Scene& s) { return removeComponentFromAll(s, *drag, sel) > 0; }));
+    for (Entity e : sel) EXPECT_FALSE(drag->has(f.ed.doc.scene.registry, e));
+}
+
+TEST(Inspector, CopyEntityIsTableDrivenAndExact) {
+    Result<Scene> s = loadSceneFile(kLevels / "render_showcase.json");
+    ASSERT_TRUE(s) << s.error();
+    // Copy every entity into a fresh scene with the same world: same bytes.
+    Scene copy;
+    copy.version = s->version;
+    copy.world = s->world;
+    copy.view = s->view;
+    for (Entity e : s->registry.entities()) copyEntity(s->registry, e, copy.registry, copy.registry.create());
+    EXPECT_EQ(textOf(copy), textOf(*s));
+}
+
+TEST(Simulation, ResetReturnsToTheEditedSceneAndStepBackIsExact) {
+    Fixture f("spring_chain.json");
+    // An edit before playing is part of the level.
+    ASSERT_TRUE(f.ed.applyEdit("gravity", [](Scene& s) {
+        s.world.gravity.y = -5.0;
+        return true;
+    }));
+    const std::string edited = textOf(f.ed.doc.scene);
+    f.ed.stepForward();
+    ASSERT_EQ(f.ed.sim.state(), SimState::Paused) << f.ed.sim.message();
+    const std::string afterOne = textOf(f.ed.doc.scene);
+    EXPECT_NE(afterOne, edited);
+    f.ed.stepForward();
+    f.ed.stepForward();
+    f.ed.stepBack();
+    f.ed.stepBack();
+    EXPECT_EQ(textOf(f.ed.doc.scene), afterOne);
+    f.ed.stepBack();
+    EXPECT_EQ(textOf(f.ed.doc.scene), edited);
+    // Play, then edit while paused: the edit applies to the state ...
+    f.ed.togglePlay();
+    for (int i = 0; i < 10; ++i) f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 10u);
+    f.ed.togglePlay();
+    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
+        s.registry.tryGet<Mass>(f.named("link3"))->value = 9.0;
+        return true;
+    }));
+    f.ed.stepForward();
+    // ... and reset discards it with the simulated state.
+    f.ed.resetSimulation();
+    EXPECT_EQ(f.ed.sim.state(), SimState::Editing);
+    EXPECT_EQ(textOf(f.ed.doc.scene), edited);
+    // The edit from before Play is still undoable.
+    ASSERT_TRUE(f.ed.undo());
+    EXPECT_EQ(f.ed.doc.scene.world.gravity.y, -9.81);
+}
+
+TEST(Simulation, SteppingThroughTheEditorMatchesTheWorld) {
+    Fixture f("orbit.json");
+    Result<World> w = World::build(f.ed.doc.scene);
+    ASSERT_TRUE(w) << w.error();
+    for (int i = 0; i < 30; ++i) ASSERT_TRUE(w->step());
+    Scene expected = f.ed.doc.scene;
+    w->writeBack(expected);
+    // The editor rebuilds its World after a step back; the engine's
+    // determinism makes the result the same bits.
+    for (int i = 0; i < 20; ++i) f.ed.stepForward();
+    for (int i = 0; i < 5; ++i) f.ed.stepBack();
+    for (int i = 0; i < 15; ++i) f.ed.stepForward();
+    EXPECT_EQ(textOf(f.ed.doc.scene), textOf(expected));
+}
+
+TEST(Simulation, DisabledSystemIsLeftOutOfTheWorld) {
+    Fixture f("spring_chain.json");
+    f.ed.sim.disabledSystems.insert("springs");
+    f.ed.stepForward();
+    ASSERT_NE(f.ed.sim.world(), nullptr) << f.ed.sim.message();
+    const auto active = f.ed.sim.world()->activeSystems();
+    EXPECT_EQ(std::find(active.begin(), active.end(), "springs"), active.end());
+    EXPECT_NE(std::find(active.begin(), active.end(), "gravity"), active.end());
+    // The document keeps its springs.
+    EXPECT_GT(f.ed.doc.scene.registry.count<Spring>(), 0u);
+}
+
+TEST(Simulation, DivergencePausesAndNamesEntityAndQuantity) {
+    Fixture f("orbit.json");
+    ASSERT_TRUE(f.ed.applyEdit("blow up", [&](Scene& s) {
+        // G so large that the pull on the planet (first body) overflows to inf in the first step.
+        s.world.G = 1e308;
+        return true;
+    }));
+    f.ed.togglePlay();
+    for (int i = 0; i < 5 && f.ed.sim.state() == SimState::Playing; ++i) f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.state(), SimState::Paused);
+    EXPECT_TRUE(f.ed.sim.diverged());
+    EXPECT_NE(f.ed.sim.message().find("planet"), std::string::npos) << f.ed.sim.message();
+    EXPECT_NE(f.ed.sim.message().find("became"), std::string::npos) << f.ed.sim.message();
+}
+
+TEST(Simulation, TimeScaleSetsStepsPerFrame) {
+    Fixture f("orbit.json");  // dt = 1/240
+    f.ed.sim.timeScale = 0.5;
+    f.ed.togglePlay();
+    for (int i = 0; i < 10; ++i) f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 20u);  // 10 frames * (1/60 * 0.5) / (1/240)
+}
+
+TEST(Files, SaveIsAtomicAndEqualsTheExpectedJson) {
+    Fixture f("orbit.json");
+    const std::filesystem::path out = f.tmp.path / "out.json";
+    ASSERT_TRUE(f.ed.applyEdit("add", [](Scene& s) {
+        addCircle(s, {1.0, 2.0}, 0.25);
+        return true;
+    }));
+    Scene expected = f.ed.doc.scene;
+    ASSERT_TRUE(f.ed.saveAs(out)) << f.ed.errorModal;
+    EXPECT_EQ(readFile(out), sceneToJsonText(expected));
+    EXPECT_FALSE(f.ed.dirty());
+    // No temporaries left next to it.
+    for (const auto& entry : std::filesystem::directory_iterator(f.tmp.path))
+        EXPECT_TRUE(entry.path().filename() == "out.json" || entry.path().filename() == "config") << entry.path();
+    // While playing, Save writes the edited level, not the state.
+    f.ed.togglePlay();
+    for (int i = 0; i < 10; ++i) f.ed.update(1.0 / 60.0);
+    ASSERT_TRUE(f.ed.handleShortcut(Key::S, kModCtrl));
+    EXPECT_EQ(readFile(out), sceneToJsonText(expected));
+}
+
+TEST(Files, UnwritableFolderAndBadLevelGiveMessagesNotCrashes) {
+    Fixture f("orbit.json");
+    const std::string before = textOf(f.ed.doc.scene);
+    EXPECT_FALSE(f.ed.saveAs(f.tmp.path / "missing" / "folder" / "x.json"));
+    EXPECT_FALSE(f.ed.errorModal.empty());
+    f.ed.errorModal.clear();
+    const std::filesystem::path bad = f.tmp.path / "bad.json";
+    { std::ofstream(bad) << "{\"entities\": [ {\"mass\": -1} ]}"; }
+    EXPECT_FALSE(f.ed.open(bad));
+    EXPECT_NE(f.ed.errorModal.find("mass"), std::string::npos) << f.ed.errorModal;
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);  // the document is untouched
+    f.ed.errorModal.clear();
+    EXPECT_FALSE(f.ed.open(f.tmp.path / "no-such-level.json"));
+    EXPECT_FALSE(f.ed.errorModal.empty());
+    // An invalid scene (duplicate names) is refused before writing.
+    ASSERT_TRUE(f.ed.applyEdit("dup", [](Scene& s) {
+        const Entity e = s.registry.create();
+        s.registry.emplace(e, Name{"sun"});
+        s.registry.emplace(e, Position{});
+        return true;
+    }));
+    EXPECT_FALSE(f.ed.saveAs(f.tmp.path / "dup.json"));
+    EXPECT_FALSE(std::filesystem::exists(f.tmp.path / "dup.json"));
+}
+
+TEST(Files, UnsavedChangesAreAskedAbout) {
+    Fixture f("orbit.json");
+    f.ed.request(PendingAction::New);  // clean: happens at once
+    EXPECT_EQ(f.ed.doc.title(), "untitled");
+    ASSERT_TRUE(f.ed.open(kLevels / "orbit.json"));
+    ASSERT_TRUE(f.ed.applyEdit("G", [](Scene& s) {
+        s.world.G = 3.0;
+        return true;
+    }));
+    f.ed.request(PendingAction::Open, kLevels / "spring_chain.json");
+    EXPECT_EQ(f.ed.uiRequest, UiRequest::ConfirmDiscard);
+    EXPECT_EQ(f.ed.doc.title(), "orbit.json");
+    f.ed.resolvePending(Editor::Resolution::Cancel);
+    EXPECT_EQ(f.ed.doc.title(), "orbit.json");
+    f.ed.request(PendingAction::Open, kLevels / "spring_chain.json");
+    f.ed.resolvePending(Editor::Resolution::Discard);
+    EXPECT_EQ(f.ed.doc.title(), "spring_chain.json");
+}
+
+TEST(Files, AutosaveWritesRecoveryAndRecoverRestoresIt) {
+    Fixture f("orbit.json");
+    const std::filesystem::path level = f.tmp.path / "level.json";
+    std::filesystem::copy_file(kLevels / "orbit.json", level);
+    ASSERT_TRUE(f.ed.open(level));
+    EXPECT_FALSE(f.ed.tickAutosave(0.0));
+    ASSERT_TRUE(f.ed.applyEdit("G", [](Scene& s) {
+        s.world.G = 7.0;
+        return true;
+    }));
+    EXPECT_FALSE(f.ed.tickAutosave(10.0));  // not 30 s yet
+    EXPECT_TRUE(f.ed.tickAutosave(31.0));
+    const std::string edited = textOf(f.ed.doc.scene);
+    // A "crash": a new editor on the same level finds the recovery file.
+    Editor again;
+    again.configDir = f.ed.configDir;
+    ASSERT_TRUE(again.open(level));
+    const auto recovery = again.recoveryAvailable();
+    ASSERT_TRUE(recovery);
+    ASSERT_TRUE(again.recover(*recovery));
+    EXPECT_EQ(textOf(again.doc.scene), edited);
+    EXPECT_TRUE(again.dirty());
+    ASSERT_TRUE(again.save());
+    EXPECT_FALSE(again.recoveryAvailable());  // saving removes it
+}
+
+TEST(Camera, ZoomKeepsThePointUnderTheCursor) {
+    ViewCamera v;
+    v.width = 640;
+    v.height = 480;
+    v.camera.center = {1.0, 2.0};
+    const Vec2 cursor{100.0, 400.0};
+    const Vec2 before = v.toWorld(cursor);
+    v.zoomAt(cursor, 3.0);
+    const Vec2 after = v.toWorld(cursor);
+    EXPECT_NEAR(before.x, after.x, 1e-9);
+    EXPECT_NEAR(before.y, after.y, 1e-9);
+    const Vec2 round = v.toWorld(v.toPixels({-3.0, 7.5}));
+    EXPECT_NEAR(round.x, -3.0, 1e-9);
+    EXPECT_NEAR(round.y, 7.5, 1e-9);
+}
+
+TEST(Script, ParsesEveryCommandAndRejectsBadLinesWithTheLineNumber) {
+    const char* text = R"(# demo
+key Space
+key Ctrl+Shift+Z
+click 100 200
+click world 1.5 -2 right
+drag world 0 0 3 4 12
+wheel 2 400 300
+text "mass 3"
+wait 10
+step 5
+tool circle
+overlay velocity on
+saveas /tmp/x.json
+)";
+    Result<std::vector<ScriptCommand>> s = parseScript(text, "demo.txt");
+    ASSERT_TRUE(s) << s.error();
+    ASSERT_EQ(s->size(), 12u);
+    EXPECT_EQ((*s)[1].key, Key::Z);
+    EXPECT_EQ((*s)[1].mods, kModCtrl | kModShift);
+    EXPECT_TRUE((*s)[3].a.world);
+    EXPECT_EQ((*s)[3].button, MouseButton::Right);
+    EXPECT_EQ((*s)[4].count, 12);
+    EXPECT_EQ((*s)[6].text, "mass 3");
+    EXPECT_EQ((*s)[8].count, 5);
+    Result<std::vector<ScriptCommand>> bad = parseScript("wait 1\nclick 10\n", "b.txt");
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().find("b.txt:2:"), std::string::npos) << bad.error();
+    Result<std::vector<ScriptCommand>> badKey = parseScript("key Hyper+Q\n", "c.txt");
+    ASSERT_FALSE(badKey);
+    EXPECT_NE(badKey.error().find("Hyper"), std::string::npos);
+}
