@@ -423,3 +423,23 @@ TEST_F(Cli, RenderAndBenchHaveHelp) {
         EXPECT_NE(o.out.find("Usage:"), std::string::npos) << sub << ": " << o.out;
     }
 }
+
+// The scripted editor refuses a bad line at run time with the script's
+// file:line and what was wrong, and exits 2 (issue 6's scripted mode;
+// issue 7's "bad input everywhere").
+TEST_F(Cli, EditScriptNamesTheBadLineForAnUnknownSystemOrEntity) {
+    const fs::path system = write("system.txt", "play\nsystem gravty off\n");
+    Outcome o = stepwise("edit " + level("orbit.json") + " --builtin-font --size 640x400 --config " +
+                         (dir_ / "cfg").string() + " --script " + system.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_NE(o.err.find(system.string() + ":2: system: unknown system \"gravty\" (gravity, drag, springs, "
+                                           "attractors, boids, collisions)"),
+              std::string::npos)
+        << o.err;
+
+    const fs::path breakon = write("breakon.txt", "# comment\n\nbreakon plnet\n");
+    o = stepwise("edit " + level("orbit.json") + " --builtin-font --size 640x400 --config " +
+                 (dir_ / "cfg").string() + " --script " + breakon.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_NE(o.err.find(breakon.string() + ":3: breakon: no entity named \"plnet\""), std::string::npos) << o.err;
+}

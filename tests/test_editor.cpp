@@ -11,7 +11,13 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <random>
+#include <thread>
 
 #include <filesystem>
 #include <fstream>
@@ -511,6 +517,94 @@ TEST(Files, AutosaveWritesRecoveryAndRecoverRestoresIt) {
     EXPECT_TRUE(again.dirty());
     ASSERT_TRUE(again.save());
     EXPECT_FALSE(again.recoveryAvailable());  // saving removes it
+}
+
+TEST(Files, SaveAsRemovesTheOldPathsRecoveryCopy) {
+    Fixture f("orbit.json");
+    const std::filesystem::path a = f.tmp.path / "a.json", b = f.tmp.path / "b.json";
+    std::filesystem::copy_file(kLevels / "orbit.json", a);
+    ASSERT_TRUE(f.ed.open(a));
+    ASSERT_TRUE(f.ed.applyEdit("G", [](Scene& s) {
+        s.world.G = 5.0;
+        return true;
+    }));
+    EXPECT_FALSE(f.ed.tickAutosave(0.0));
+    ASSERT_TRUE(f.ed.tickAutosave(31.0));
+    const std::filesystem::path recoveryOfA = f.ed.doc.recoveryPath(f.ed.configDir);
+    ASSERT_TRUE(std::filesystem::exists(recoveryOfA));
+    ASSERT_TRUE(f.ed.saveAs(b));
+    // The work is in b.json now; a.json's copy would be offered, stale, the
+    // next time a.json opens.
+    EXPECT_FALSE(std::filesystem::exists(recoveryOfA));
+    Editor again;
+    again.configDir = f.ed.configDir;
+    ASSERT_TRUE(again.open(a));
+    EXPECT_FALSE(again.recoveryAvailable());
+}
+
+// Issue 7: "the same holds for the editor's autosave". A child process
+// runs the editor's real autosave path (Editor::tickAutosave) in a loop,
+// alternating between two edited versions of the level, and is killed with
+// SIGKILL at random points. After every kill the recovery file is absent
+// (killed before the first autosave finished) or exactly one of the two
+// versions, and a fresh editor recovers it.
+TEST(Files, AutosaveKilledAtRandomPointsLeavesAWholeRecoveryFile) {
+    constexpr int kKills = 120;
+    Fixture f("pile.json");  // ~2,000 bodies: a save long enough to be hit mid-write
+    const std::filesystem::path level = f.tmp.path / "level.json";
+    std::filesystem::copy_file(kLevels / "pile.json", level);
+    ASSERT_TRUE(f.ed.open(level));
+    const std::filesystem::path recovery = f.ed.doc.recoveryPath(f.ed.configDir);
+    // The two versions the child alternates between: G = 2 and G = 3.
+    std::string versions[2];
+    for (int v = 0; v < 2; ++v) {
+        Scene s = f.ed.levelToSave();
+        s.world.G = 2.0 + v;
+        versions[v] = sceneToJsonText(s);
+    }
+    ASSERT_NE(versions[0], versions[1]);
+
+    std::mt19937 rng(20261201u);
+    std::uniform_int_distribution<int> delayMicros(0, 40000);
+    int whole = 0, absent = 0;
+    for (int kill = 0; kill < kKills; ++kill) {
+        const pid_t child = ::fork();
+        ASSERT_GE(child, 0);
+        if (child == 0) {
+            double now = 0.0;
+            for (int k = 0;; ++k) {
+                f.ed.applyEdit("G", [k](Scene& s) {
+                    s.world.G = 2.0 + (k % 2);
+                    return true;
+                });
+                now += 31.0;  // past the 30 s autosave period every time
+                f.ed.tickAutosave(now);
+            }
+        }
+        std::this_thread::sleep_for(std::chrono::microseconds(delayMicros(rng)));
+        ASSERT_EQ(::kill(child, SIGKILL), 0);
+        int status = 0;
+        ASSERT_EQ(::waitpid(child, &status, 0), child);
+        ASSERT_TRUE(WIFSIGNALED(status)) << "kill " << kill << ": the autosaving child ended by itself";
+        if (!std::filesystem::exists(recovery)) {
+            ++absent;
+            continue;
+        }
+        const std::string now = readFile(recovery);
+        ASSERT_TRUE(now == versions[0] || now == versions[1])
+            << "kill " << kill << ": the recovery file is neither version (" << now.size() << " bytes)";
+        ++whole;
+    }
+    EXPECT_GT(whole, kKills / 2) << "most kills should land after a first autosave completed";
+    // A fresh editor on the level is offered the recovery copy and gets it whole.
+    Editor again;
+    again.configDir = f.ed.configDir;
+    ASSERT_TRUE(again.open(level));
+    const auto offered = again.recoveryAvailable();
+    ASSERT_TRUE(offered);
+    ASSERT_TRUE(again.recover(*offered));
+    const double g = again.doc.scene.world.G;
+    EXPECT_TRUE(g == 2.0 || g == 3.0) << g;
 }
 
 TEST(Camera, ZoomKeepsThePointUnderTheCursor) {

@@ -110,8 +110,9 @@ TEST(EditorScreenshotDeterminism, SameScriptSameBytes) {
 }
 
 TEST(EditorScreenshotDetects, AMovedBodyFailsTheComparison) {
-    // The tolerance must not hide a real change: the same script with the
-    // planet's mass changed (it then moves differently) differs visibly.
+    // The tolerance must not hide a real change: the same script with one
+    // body's starting velocity changed (it then moves differently) differs
+    // visibly.
     fs::create_directories(kOut);
     const fs::path level = kOut / "orbit_heavy.json";
     std::string text = readFile(kSource / "levels" / "orbit.json");

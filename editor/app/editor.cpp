@@ -89,15 +89,17 @@ bool Editor::saveAs(const std::filesystem::path& file) {
     // While the simulation runs, the level is the scene kept at Play: the
     // commands up to playMark_ are what is saved.
     const bool running = sim.running();
-    const std::filesystem::path previous = doc.path;
+    // The recovery copy is keyed to the document's path: after a Save As
+    // the old path's copy is stale (the work is in the new file), so it
+    // goes too, or it would be offered the next time the old level opens.
+    const std::filesystem::path previousRecovery = doc.recoveryPath(configDir);
     if (Result<void> r = doc.saveAs(levelToSave(), file); !r) {
         errorModal = "Cannot save " + file.string() + ":\n" + r.error();
         note("save failed");
         return false;
     }
-    if (!previous.empty() && previous != file) {
-        // A recovery file keyed to the old path is no longer the document's.
-    }
+    std::error_code ec;
+    std::filesystem::remove(previousRecovery, ec);  // absent is fine
     savedCursor_ = running ? playMark_ : commands.absoluteCursor();
     savedReachable_ = true;
     discardRecovery();

@@ -133,8 +133,9 @@ Result<std::vector<ScriptCommand>> parseScript(std::string_view text, std::strin
                 if (w[i] == "right") c.button = MouseButton::Right;
                 else if (w[i] == "middle") c.button = MouseButton::Middle;
                 else if (w[i] == "shift") c.mods |= kModShift;
+                else if (w[i] == "ctrl") c.mods |= kModCtrl;
                 else if (toNumber(w[i], n) && n >= 1 && n <= 1000) c.count = int(n);
-                else return fail("unexpected \"" + w[i] + "\" (expected a move count 1..1000, right or middle)");
+                else return fail("unexpected \"" + w[i] + "\" (expected a move count 1..1000, right, middle, shift or ctrl)");
             }
             c.hasPoint = true;
         } else if (verb == "wheel") {

@@ -2,13 +2,13 @@
 /// \file script.hpp
 /// The scripted mode's input file: one command per line, replayed as
 /// InputEvents through the same handlers a person's input goes through
-/// (editor/README-editor.md documents the format). Parsing reports the line
+/// (README.md, The editor, documents the format). Parsing reports the line
 /// and what was expected; a bad script is refused whole before anything runs.
 ///
 ///   # comment                     key Space | key Ctrl+Shift+Z
-///   keydown Shift / keyup Shift   move X Y | move world X Y
-///   click X Y [right|middle]      click world X Y
-///   drag X0 Y0 X1 Y1 [N]          drag world X0 Y0 X1 Y1 [N]   (N moves, default 8)
+///   keydown KEY / keyup KEY       move X Y | move world X Y
+///   click [world] X Y [right|middle] [shift] [ctrl]
+///   drag [world] X0 Y0 X1 Y1 [N] [right|middle] [shift] [ctrl]   (N moves, default 8)
 ///   wheel NOTCHES [X Y]           text "hello"
 ///   wait N                        (N frames; every command takes at least one)
 ///   play | pause | step [N] | stepback [N] | reset | undo | redo

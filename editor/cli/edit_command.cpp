@@ -115,15 +115,33 @@ void writeDebugState(const std::string& path, ui::Session& session, std::uint64_
 
 struct FrameTimes {
     std::vector<double> ms;
+    ui::UiState::FrameParts sum;  ///< the parts summed over the recorded frames
+
+    void add(double frameMs, const ui::UiState::FrameParts& parts) {
+        ms.push_back(frameMs);
+        sum.uiMs += parts.uiMs;
+        sum.stepMs += parts.stepMs;
+        sum.sceneMs += parts.sceneMs;
+        sum.drawUiMs += parts.drawUiMs;
+        sum.steps += parts.steps;
+    }
     void report(const char* what, std::size_t bodies) const {
         if (ms.empty()) return;
         std::vector<double> sorted = ms;
         std::sort(sorted.begin(), sorted.end());
-        const double mean = std::accumulate(sorted.begin(), sorted.end(), 0.0) / double(sorted.size());
+        const double n = double(sorted.size());
+        const double mean = std::accumulate(sorted.begin(), sorted.end(), 0.0) / n;
         std::printf("edit bench (%s): %zu entities, %zu frames: mean %.2f ms, median %.2f ms, p95 %.2f ms, max %.2f ms "
                     "(%.1f fps at the mean)\n",
                     what, bodies, sorted.size(), mean, sorted[sorted.size() / 2], sorted[sorted.size() * 95 / 100],
                     sorted.back(), 1000.0 / mean);
+        // Where a frame goes: the rest is event handling, the window's
+        // buffer swap and (under Xvfb) the copy to the X server.
+        const double parts = (sum.uiMs + sum.stepMs + sum.sceneMs + sum.drawUiMs) / n;
+        std::printf("  per frame: ui build %.2f ms, physics %.2f ms (%.2f steps), viewport render %.2f ms, "
+                    "ui draw %.2f ms, swap and rest %.2f ms\n",
+                    sum.uiMs / n, sum.stepMs / n, double(sum.steps) / n, sum.sceneMs / n, sum.drawUiMs / n,
+                    std::max(0.0, mean - parts));
     }
 };
 
@@ -209,7 +227,16 @@ int runScripted(const EditOptions& o, int width, int height) {
         return e;
     };
     auto findEntity = [&](const std::string& name) { return editor::findByName(ed.doc.scene.registry, name); };
-    std::uint8_t held = 0;  // modifiers held by keydown lines
+    // Click and drag lines with shift/ctrl hold the modifiers around the
+    // mouse events, as a person holding the key would.
+    auto pressMods = [&](std::uint8_t mods, bool down) {
+        if (!mods) return;
+        InputEvent k;
+        k.type = down ? InputEvent::Type::KeyDown : InputEvent::Type::KeyUp;
+        k.mods = down ? mods : std::uint8_t(0);
+        session.queue(k);
+        if (!down) frame();
+    };
     int status = kExitOk;
     for (const editor::ScriptCommand& c : commands) {
         using K = editor::ScriptCommand::Kind;
@@ -223,7 +250,7 @@ int runScripted(const EditOptions& o, int width, int height) {
         case K::KeyUp: {
             InputEvent e;
             e.key = c.key;
-            e.mods = std::uint8_t(c.mods | held);
+            e.mods = c.mods;
             if (c.kind != K::KeyUp) {
                 e.type = InputEvent::Type::KeyDown;
                 session.queue(e);
@@ -242,29 +269,19 @@ int runScripted(const EditOptions& o, int width, int height) {
             break;
         case K::Click: {
             const Vec2 at = toWindow(c.a);
-            if (c.mods) {
-                InputEvent k;
-                k.type = InputEvent::Type::KeyDown;
-                k.mods = c.mods;
-                session.queue(k);
-            }
+            pressMods(c.mods, true);
             session.queue(event(InputEvent::Type::MouseMove, at));
             frame();
             session.queue(event(InputEvent::Type::MouseDown, at, c.button));
             frame();
             session.queue(event(InputEvent::Type::MouseUp, at, c.button));
             frame();
-            if (c.mods) {
-                InputEvent k;
-                k.type = InputEvent::Type::KeyUp;
-                k.mods = held;
-                session.queue(k);
-                frame();
-            }
+            pressMods(c.mods, false);
             break;
         }
         case K::Drag: {
             const Vec2 a = toWindow(c.a), b = toWindow(c.b);
+            pressMods(c.mods, true);
             session.queue(event(InputEvent::Type::MouseMove, a));
             frame();
             session.queue(event(InputEvent::Type::MouseDown, a, c.button));
@@ -275,6 +292,7 @@ int runScripted(const EditOptions& o, int width, int height) {
             }
             session.queue(event(InputEvent::Type::MouseUp, b, c.button));
             frame();
+            pressMods(c.mods, false);
             break;
         }
         case K::Wheel: {
@@ -355,7 +373,9 @@ int runScripted(const EditOptions& o, int width, int height) {
                 if (it == names.end() || !onOff(args[1], on)) failLine("overlay: expected a known overlay and on|off");
                 else ed.overlays.bits = on ? ed.overlays.bits | std::uint32_t(it->second) : ed.overlays.bits & ~std::uint32_t(it->second);
             } else if (a == "system") {
-                if (!onOff(args[1], on)) failLine("system: expected on|off");
+                if (!editor::Simulation::canDisable(args[0]))
+                    failLine("system: unknown system \"" + args[0] + "\" (gravity, drag, springs, attractors, boids, collisions)");
+                else if (!onOff(args[1], on)) failLine("system: expected on|off");
                 else {
                     if (on) ed.sim.disabledSystems.erase(args[0]);
                     else ed.sim.disabledSystems.insert(args[0]);
@@ -364,7 +384,11 @@ int runScripted(const EditOptions& o, int width, int height) {
             } else if (a == "snap") {
                 if (!onOff(args[0], ed.snap)) failLine("snap: expected on|off");
             } else if (a == "timescale") ed.sim.timeScale = c.number;
-            else if (a == "breakon") ed.sim.breakOnContact = args[0] == "none" ? Entity{} : findEntity(args[0]);
+            else if (a == "breakon") {
+                const Entity e = args[0] == "none" ? Entity{} : findEntity(args[0]);
+                if (args[0] != "none" && e.isNull()) failLine("breakon: no entity named \"" + args[0] + "\"");
+                else ed.sim.breakOnContact = e;
+            }
             else if (a == "window") {
                 ui::UiState& u = session.ui();
                 bool* flag = args[0] == "inspector" ? &u.showInspector : args[0] == "world" ? &u.showWorld
@@ -398,7 +422,7 @@ int runScripted(const EditOptions& o, int width, int height) {
             const auto t0 = std::chrono::steady_clock::now();
             session.frame(width, height, kFrameSeconds);
             session.capture(1, 1);  // wait for the GPU, as a swap would
-            times.ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            times.add(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count(), session.ui().lastFrame);
         }
         times.report("OSMesa, headless", ed.doc.scene.registry.size());
     }
@@ -563,7 +587,8 @@ int runWindow(const EditOptions& o, int width, int height) {
                 // Real time, clamped: a stall (window drag, debugger) must
                 // not turn into a burst of steps.
                 const double seconds = std::clamp(std::chrono::duration<double>(now - last).count(), 0.0, 0.1);
-                if (o.benchFrames > 0 && frameNo > 0) times.ms.push_back(1e3 * std::chrono::duration<double>(now - last).count());
+                if (o.benchFrames > 0 && frameNo > 0)
+                    times.add(1e3 * std::chrono::duration<double>(now - last).count(), session.ui().lastFrame);
                 last = now;
                 if (o.benchFrames > 0 && !benchPlaying) {
                     ed.togglePlay();
@@ -596,7 +621,7 @@ void addEditCommand(CLI::App& app, int& exitCode) {
     auto o = std::make_shared<EditOptions>();
     CLI::App* cmd = app.add_subcommand("edit", "Open the editor (SDL2 window; headless with --script/--screenshot)");
     cmd->add_option("level", o->level, "Level to open")->default_val("levels/default.json");
-    cmd->add_option("--script", o->script, "Replay input from this file (headless, OSMesa); see editor/README-editor.md");
+    cmd->add_option("--script", o->script, "Replay input from this file (headless, OSMesa); see README.md, The editor");
     cmd->add_option("--screenshot", o->screenshot, "Headless: write the whole editor as a PNG at the end");
     cmd->add_option("--size", o->size, "Window size WxH")->default_val("1280x800");
     cmd->add_option("--font-size", o->fontSize, "UI font size in pixels (default: 13 x display DPI / 96)")

@@ -34,7 +34,8 @@ void helpMarker(const char* text) {
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text);
 }
 
-/// Every shortcut, once: the help window and the menus read this list.
+/// Every shortcut, once, for the help window (the menus show their own
+/// shortcut hints; keep both in step).
 struct Shortcut {
     const char* keys;
     const char* what;

@@ -56,6 +56,12 @@ struct UiState {
 
     // Timing (ms), averaged, for the status bar and the profile
     double frameMs = 0.0, uiMs = 0.0, sceneMs = 0.0, stepMs = 0.0;
+    /// The last frame's parts, unaveraged (for `edit --bench-frames`): ms,
+    /// and the physics steps it took.
+    struct FrameParts {
+        double uiMs = 0.0, stepMs = 0.0, sceneMs = 0.0, drawUiMs = 0.0;
+        int steps = 0;
+    } lastFrame;
     std::map<std::string, double, std::less<>> stageAverage;  ///< ms per step, moving average
 
     // A World built from the edited scene while editing (hints, active

@@ -219,13 +219,15 @@ void Session::frame(int width, int height, double frameSeconds) {
     const double uiMs = msSince(t0);
 
     const auto t1 = Clock::now();
+    const std::uint64_t stepsBefore = editor_.sim.steps();
     editor_.update(frameSeconds);
+    ui_.lastFrame.steps = editor_.sim.steps() >= stepsBefore ? int(editor_.sim.steps() - stepsBefore) : 0;
+    ui_.lastFrame.stepMs = msSince(t1);
     if (editor_.sim.state() == editor::SimState::Playing) average(ui_.stepMs, editor_.sim.lastFrameStepMs());
     if (const World* w = editor_.sim.world(); w && editor_.sim.state() == editor::SimState::Playing) {
         for (const StageTime& s : w->lastStats().stages) average(ui_.stageAverage["stage:" + std::string(s.name)], s.milliseconds);
         for (const StageTime& s : w->lastStats().systems) average(ui_.stageAverage["system:" + std::string(s.name)], s.milliseconds);
     }
-    (void)t1;
 
     // Viewport: the shared renderer into an offscreen target of the image's size.
     const auto t2 = Clock::now();
@@ -247,7 +249,11 @@ void Session::frame(int width, int height, double frameSeconds) {
     gl_->unbindViewportTarget();
     const double sceneMs = msSince(t2);
     // The font rebuild must happen between frames.
+    const auto t3 = Clock::now();
     gl_->render(ImGui::GetDrawData(), width, height);
+    ui_.lastFrame.uiMs = uiMs;
+    ui_.lastFrame.sceneMs = sceneMs;
+    ui_.lastFrame.drawUiMs = msSince(t3);
     average(ui_.uiMs, uiMs);
     average(ui_.sceneMs, sceneMs);
     average(ui_.frameMs, msSince(t0));
@@ -256,6 +262,10 @@ void Session::frame(int width, int height, double frameSeconds) {
     if (!editor_.doc.path.empty() && editor_.doc.path.string() != lastRecentPath_) {
         lastRecentPath_ = editor_.doc.path.string();
         settings_.addRecent(lastRecentPath_);
+        // A level opened from the menu gets the same recovery offer as one
+        // opened at start (after a Save As there is none: it was removed).
+        if (options_.persist)
+            if (auto recovery = editor_.recoveryAvailable()) ui_.recoveryOffer = recovery->string();
         if (options_.persist) (void)settings_.save(editor_.configDir);
     }
     if (settings_.fontSize > 0 && std::abs(settings_.fontSize / 13.0f - ui_.scale) > 1e-3f && !ImGui::IsAnyItemActive()) {
