@@ -1,6 +1,8 @@
 // The `stepwise` command line as a user meets it: exit codes, messages on
 // stderr, outputs written or not written, same bytes for the same input.
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -22,12 +24,7 @@ struct Outcome {
     std::string err;
 };
 
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using stepwise::test::readFile;
 
 class Cli : public ::testing::Test {
 protected:

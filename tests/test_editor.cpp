@@ -9,6 +9,8 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -32,12 +34,7 @@ const std::filesystem::path kLevels = std::filesystem::path(STEPWISE_SOURCE_DIR)
 
 std::string textOf(const Scene& s) { return sceneToJsonText(s); }
 
-std::string readFile(const std::filesystem::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+using stepwise::test::readFile;
 
 /// A fresh temporary folder per test, removed afterwards.
 struct TempDir {

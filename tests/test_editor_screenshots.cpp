@@ -12,6 +12,8 @@
 
 #include "stepwise/scene_io.hpp"
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -45,12 +47,7 @@ const Case kCases[] = {
     {"bad_level", "tests/data/bad_level.json", "", 2},
 };
 
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using stepwise::test::readFile;
 
 /// Runs the scripted editor from the source folder; returns its exit code.
 int runEditor(const Case& c, const fs::path& out) {

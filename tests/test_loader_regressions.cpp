@@ -8,6 +8,8 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -26,12 +28,7 @@ std::string refusal(std::string_view text) {
     return r ? std::string() : r.error();
 }
 
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using stepwise::test::readFile;
 
 std::string saveLoadSave(std::string_view text, std::string* first = nullptr) {
     Result<Scene> a = parseScene(text, "t.json");

@@ -7,6 +7,8 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -26,12 +28,7 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using stepwise::test::readFile;
 
 fs::path freshDir(const std::string& name) {
     fs::path dir = fs::temp_directory_path() / ("stepwise_fault_" + name + "_" + std::to_string(::getpid()));

@@ -12,6 +12,8 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -49,12 +51,7 @@ bool updating() {
     return v && std::string(v) == "1";
 }
 
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using stepwise::test::readFile;
 
 /// Compares against the golden; on failure writes actual + diff images and
 /// returns a message with their paths, the count and the bounding box.

@@ -55,6 +55,19 @@ bool Editor::open(const std::filesystem::path& file) {
         note("open failed: " + file.string());
         return false;
     }
+    replaceDocument(std::move(next));
+    note("opened " + file.string());
+    return true;
+}
+
+void Editor::newDocument() {
+    Document next;
+    next.reset(makeNewScene());
+    replaceDocument(std::move(next));
+    note("new level");
+}
+
+void Editor::replaceDocument(Document next) {
     if (sim.running()) sim.reset(doc.scene);
     doc = std::move(next);
     commands.clear();
@@ -65,22 +78,6 @@ bool Editor::open(const std::filesystem::path& file) {
     viewInitialised_ = false;
     fitView();
     afterSceneReplaced();
-    note("opened " + file.string());
-    return true;
-}
-
-void Editor::newDocument() {
-    if (sim.running()) sim.reset(doc.scene);
-    doc.reset(makeNewScene());
-    commands.clear();
-    savedCursor_ = commands.absoluteCursor();
-    savedReachable_ = true;
-    selection.clear();
-    trails = render::TrailRecorder(trails.capacity());
-    viewInitialised_ = false;
-    fitView();
-    afterSceneReplaced();
-    note("new level");
 }
 
 const Scene& Editor::levelToSave() const { return sim.running() ? sim.editedScene() : doc.scene; }

@@ -140,6 +140,9 @@ public:
 
 private:
     void afterSceneReplaced();
+    /// Open and New: the new document replaces the old one with a fresh
+    /// undo history, selection, trails and view.
+    void replaceDocument(Document next);
     void pruneSelection();
     Vec2 snapped(Vec2 world) const;
     double pickRadius() const;
