@@ -4,10 +4,11 @@
 // engines, from their final positions with Stepwise's narrow phase, so
 // Box2D's polygon skin does not flatter or penalise it.
 //
-//   collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR]
+//   collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR] [--scene NAME]
 //
 // --quick runs a fifth of the simulated time, once; otherwise each engine
-// runs three times, alternating, and the fastest run counts.
+// runs three times, alternating, and the fastest run counts. --scene runs
+// only that scene (pile, pyramid or rain), e.g. while tuning the solver.
 
 #include "collision/collision_scenes.hpp"
 
@@ -49,7 +50,12 @@ struct Pose {
 struct Outcome {
     std::vector<Pose> finalPoses;
     double msPerStep = 0.0;
-    double deepestOverlap = 0.0;  ///< metres
+    double deepestOverlap = 0.0;  ///< metres, of the drawn shapes
+    /// Metres, of the shapes the engine collides: Box2D rounds every
+    /// polygon by b2_polygonRadius (1 cm) and keeps those skins touching,
+    /// so its drawn boxes rest up to 2 cm apart while its collision shapes
+    /// overlap; Stepwise collides the drawn shapes (equal to the above).
+    double deepestShapeOverlap = 0.0;
     double kinetic = 0.0;         ///< joules, translational + rotational
     double topDrift = 0.0;        ///< metres (the pyramid's top box)
 };
@@ -87,23 +93,37 @@ std::vector<Pose> initialPoses(const Scene& scene) {
     return poses;
 }
 
-/// Deepest geometric overlap and kinetic energy of a set of final poses.
-void measure(const std::vector<Pose>& poses, Outcome& out) {
+/// Deepest geometric overlap and kinetic energy of a set of final poses;
+/// `polygonSkin` (metres) is the rounding the engine adds to every box.
+void measure(const std::vector<Pose>& poses, Outcome& out, double polygonSkin) {
     std::vector<collision::Aabb> boxes;
     std::vector<std::uint8_t> movable;
     for (const Pose& p : poses) {
-        boxes.push_back(collision::computeAabb(p.shape, p.p, collision::Rot::fromAngle(p.angle)));
+        collision::Aabb box = collision::computeAabb(p.shape, p.p, collision::Rot::fromAngle(p.angle));
+        if (p.shape.kind == collision::ShapeKind::Box) {  // the skin's reach, so skin contacts pair up
+            box.lower = box.lower - Vec2{polygonSkin, polygonSkin};
+            box.upper = box.upper + Vec2{polygonSkin, polygonSkin};
+        }
+        boxes.push_back(box);
         movable.push_back(p.dynamic);
     }
     std::vector<collision::ProxyPair> pairs;
     collision::BroadPhase(collision::BroadPhaseKind::SweepAndPrune).findPairs(boxes, movable, pairs);
     out.deepestOverlap = 0.0;
+    out.deepestShapeOverlap = 0.0;
     for (const auto& pair : pairs) {
         const Pose& a = poses[pair.a];
         const Pose& b = poses[pair.b];
+        const auto skinOf = [&](const Pose& q) { return q.shape.kind == collision::ShapeKind::Box ? polygonSkin : 0.0; };
+        const double skin = skinOf(a) + skinOf(b);
+        // The margin reports points up to `skin` apart, so the skins'
+        // overlap (skin - separation) is seen too.
         const collision::Manifold m = collision::collide(a.shape, a.p, collision::Rot::fromAngle(a.angle), b.shape, b.p,
-                                                         collision::Rot::fromAngle(b.angle), 0.0);
-        for (int i = 0; i < m.pointCount; ++i) out.deepestOverlap = std::max(out.deepestOverlap, -m.points[i].separation);
+                                                         collision::Rot::fromAngle(b.angle), skin);
+        for (int i = 0; i < m.pointCount; ++i) {
+            out.deepestOverlap = std::max(out.deepestOverlap, -m.points[i].separation);
+            out.deepestShapeOverlap = std::max(out.deepestShapeOverlap, skin - m.points[i].separation);
+        }
     }
     out.kinetic = 0.0;
     for (const Pose& p : poses) {
@@ -147,7 +167,7 @@ Outcome runStepwise(const Scene& initial, int steps, std::size_t topIndex) {
     }
     const std::vector<Pose> start0 = initialPoses(initial);
     out.topDrift = length(poses[topIndex].p - start0[topIndex].p);
-    measure(poses, out);
+    measure(poses, out, 0.0);  // Stepwise collides the drawn shapes
     out.finalPoses = std::move(poses);
     return out;
 }
@@ -206,7 +226,7 @@ Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex) {
         if (poses[i].dynamic) poses[i].mass = bodies[i]->GetMass();
     }
     out.topDrift = length(poses[topIndex].p - poses0[topIndex].p);
-    measure(poses, out);
+    measure(poses, out, double(b2_polygonRadius));
     return out;
 }
 
@@ -254,21 +274,29 @@ BroadPhaseTimes timeBroadPhases(const std::vector<Pose>& poses) {
 
 int main(int argc, char** argv) {
     bool quick = false;
-    std::string outDir, levelsDir;
+    std::string outDir, levelsDir, only;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--quick") quick = true;
         else if (arg == "--out" && i + 1 < argc) outDir = argv[++i];
         else if (arg == "--write-levels" && i + 1 < argc) levelsDir = argv[++i];
+        else if (arg == "--scene" && i + 1 < argc) only = argv[++i];
         else if (arg == "--broad-phase" && i + 1 < argc && (std::string(argv[i + 1]) == "sap" || std::string(argv[i + 1]) == "grid"))
             g_broadPhase = argv[++i];
         else {
             std::cerr << "collision_vs_box2d: error: unknown argument \"" << arg
-                      << "\"; usage: collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid]\n";
+                      << "\"; usage: collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain]\n";
             return 2;
         }
     }
     std::vector<bench::NamedScene> scenes = bench::benchmarkScenes();
+    if (!only.empty()) {
+        std::erase_if(scenes, [&](const bench::NamedScene& s) { return s.name != only; });
+        if (scenes.empty()) {
+            std::cerr << "collision_vs_box2d: error: no scene named \"" << only << "\" (pile, pyramid, rain)\n";
+            return 2;
+        }
+    }
     if (!levelsDir.empty()) {
         for (const auto& s : scenes) {
             const fs::path path = fs::path(levelsDir) / (s.name + ".json");
@@ -282,11 +310,12 @@ int main(int argc, char** argv) {
     }
     std::ostringstream md;
     md << "| scene | bodies | steps | Stepwise ms/step | Box2D 2.4.1 ms/step | speed ratio (Box2D/Stepwise) | deepest overlap "
-          "Stepwise / Box2D (mm) | top-box drift Stepwise / Box2D (mm) | kinetic energy after Stepwise / Box2D (J) |\n"
-       << "|---|---|---|---|---|---|---|---|---|\n";
+          "Stepwise / Box2D (mm) | deepest overlap of the collision shapes Stepwise / Box2D (mm) | top-box drift Stepwise / "
+          "Box2D (mm) | kinetic energy after Stepwise / Box2D (J) |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|\n";
     std::ostringstream csv;
     csv << "scene,bodies,steps,stepwise_ms_per_step,box2d_ms_per_step,speed_ratio,stepwise_overlap_m,box2d_overlap_m,"
-           "stepwise_drift_m,box2d_drift_m,stepwise_kinetic_j,box2d_kinetic_j\n";
+           "stepwise_shape_overlap_m,box2d_shape_overlap_m,stepwise_drift_m,box2d_drift_m,stepwise_kinetic_j,box2d_kinetic_j\n";
     for (const auto& s : scenes) {
         const int steps = int(std::lround((quick ? 0.2 : 1.0) * s.seconds / s.scene.world.dt));
         const std::vector<Pose> poses = initialPoses(s.scene);
@@ -304,9 +333,10 @@ int main(int argc, char** argv) {
         }
         const bool pyramid = s.name == "pyramid";
         char line[512];
-        std::snprintf(line, sizeof line, "| %s | %zu | %d | %.3f | %.3f | %.2fx | %.2f / %.2f | %s | %.3g / %.3g |\n",
+        std::snprintf(line, sizeof line, "| %s | %zu | %d | %.3f | %.3f | %.2fx | %.2f / %.2f | %.2f / %.2f | %s | %.3g / %.3g |\n",
                       s.name.c_str(), poses.size(), steps, mine.msPerStep, peer.msPerStep,
                       peer.msPerStep / mine.msPerStep, 1e3 * mine.deepestOverlap, 1e3 * peer.deepestOverlap,
+                      1e3 * mine.deepestShapeOverlap, 1e3 * peer.deepestShapeOverlap,
                       pyramid ? (std::to_string(std::lround(1e3 * mine.topDrift * 10) / 10.0).substr(0, 5) + " / " +
                                  std::to_string(std::lround(1e3 * peer.topDrift * 10) / 10.0).substr(0, 5)).c_str()
                               : "-",
@@ -314,7 +344,7 @@ int main(int argc, char** argv) {
         md << line;
         csv << s.name << "," << poses.size() << "," << steps << "," << mine.msPerStep << "," << peer.msPerStep << ","
             << peer.msPerStep / mine.msPerStep << "," << mine.deepestOverlap << "," << peer.deepestOverlap << ","
-            << mine.topDrift << "," << peer.topDrift << "," << mine.kinetic << "," << peer.kinetic << "\n";
+            << mine.deepestShapeOverlap << "," << peer.deepestShapeOverlap << "," << mine.topDrift << "," << peer.topDrift << "," << mine.kinetic << "," << peer.kinetic << "\n";
         std::cout << line << std::flush;
     }
     // Broad-phase strategies on each scene's settled state (the dense case).

@@ -58,7 +58,22 @@ using GetProcAddress = void* (*)(const char* name);
     X(PFNGLPIXELSTOREIPROC, PixelStorei)                           \
     X(PFNGLGETERRORPROC, GetError)                                 \
     X(PFNGLGETSTRINGPROC, GetString)                               \
-    X(PFNGLFINISHPROC, Finish)
+    X(PFNGLFINISHPROC, Finish)                                     \
+    /* the editor's ImGui pass and viewport target (ui/imgui_gl.cpp) */ \
+    X(PFNGLSCISSORPROC, Scissor)                                   \
+    X(PFNGLBLENDEQUATIONPROC, BlendEquation)                       \
+    X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                 \
+    X(PFNGLGENTEXTURESPROC, GenTextures)                           \
+    X(PFNGLBINDTEXTUREPROC, BindTexture)                           \
+    X(PFNGLTEXIMAGE2DPROC, TexImage2D)                             \
+    X(PFNGLTEXPARAMETERIPROC, TexParameteri)                       \
+    X(PFNGLDELETETEXTURESPROC, DeleteTextures)                     \
+    X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                       \
+    X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers)                   \
+    X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)                   \
+    X(PFNGLFRAMEBUFFERTEXTURE2DPROC, FramebufferTexture2D)         \
+    X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, CheckFramebufferStatus)     \
+    X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)
 
 /// Function pointers, one per entry point above (`gl.Viewport(...)`).
 struct GlApi {

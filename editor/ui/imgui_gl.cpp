@@ -10,66 +10,8 @@ namespace stepwise::ui {
 
 namespace {
 
-#define STEPWISE_IMGUI_GL(X)                                              \
-    X(PFNGLVIEWPORTPROC, Viewport)                                        \
-    X(PFNGLSCISSORPROC, Scissor)                                          \
-    X(PFNGLENABLEPROC, Enable)                                            \
-    X(PFNGLDISABLEPROC, Disable)                                          \
-    X(PFNGLBLENDEQUATIONPROC, BlendEquation)                              \
-    X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate)                      \
-    X(PFNGLCLEARCOLORPROC, ClearColor)                                    \
-    X(PFNGLCLEARPROC, Clear)                                              \
-    X(PFNGLCREATESHADERPROC, CreateShader)                                \
-    X(PFNGLSHADERSOURCEPROC, ShaderSource)                                \
-    X(PFNGLCOMPILESHADERPROC, CompileShader)                              \
-    X(PFNGLGETSHADERIVPROC, GetShaderiv)                                  \
-    X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog)                        \
-    X(PFNGLDELETESHADERPROC, DeleteShader)                                \
-    X(PFNGLCREATEPROGRAMPROC, CreateProgram)                              \
-    X(PFNGLATTACHSHADERPROC, AttachShader)                                \
-    X(PFNGLLINKPROGRAMPROC, LinkProgram)                                  \
-    X(PFNGLGETPROGRAMIVPROC, GetProgramiv)                                \
-    X(PFNGLDELETEPROGRAMPROC, DeleteProgram)                              \
-    X(PFNGLUSEPROGRAMPROC, UseProgram)                                    \
-    X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)                    \
-    X(PFNGLUNIFORM1IPROC, Uniform1i)                                      \
-    X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                        \
-    X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays)                          \
-    X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                          \
-    X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays)                    \
-    X(PFNGLGENBUFFERSPROC, GenBuffers)                                    \
-    X(PFNGLBINDBUFFERPROC, BindBuffer)                                    \
-    X(PFNGLBUFFERDATAPROC, BufferData)                                    \
-    X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                              \
-    X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)                  \
-    X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)          \
-    X(PFNGLDRAWELEMENTSPROC, DrawElements)                                \
-    X(PFNGLGENTEXTURESPROC, GenTextures)                                  \
-    X(PFNGLBINDTEXTUREPROC, BindTexture)                                  \
-    X(PFNGLTEXIMAGE2DPROC, TexImage2D)                                    \
-    X(PFNGLTEXPARAMETERIPROC, TexParameteri)                              \
-    X(PFNGLDELETETEXTURESPROC, DeleteTextures)                            \
-    X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                              \
-    X(PFNGLPIXELSTOREIPROC, PixelStorei)                                  \
-    X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers)                          \
-    X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)                          \
-    X(PFNGLFRAMEBUFFERTEXTURE2DPROC, FramebufferTexture2D)                \
-    X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, CheckFramebufferStatus)            \
-    X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)
-
-struct Gl {
-#define DECLARE(type, name) type name = nullptr;
-    STEPWISE_IMGUI_GL(DECLARE)
-#undef DECLARE
-    std::string load(render::GetProcAddress getProc) {
-#define LOAD(type, name)                                                     \
-    name = reinterpret_cast<type>(getProc("gl" #name));                      \
-    if (!name) return "gl" #name;
-        STEPWISE_IMGUI_GL(LOAD)
-#undef LOAD
-        return {};
-    }
-};
+// The same loaded entry points as the scene renderer (render/gl_api.hpp).
+using Gl = render::GlApi;
 
 // Positions in pixels -> clip space by uProjection; colours are straight
 // RGBA8 (ImGui's convention), multiplied by the atlas/texture sample.

@@ -81,12 +81,25 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
         p.rnB = cross(anchorB, m.normal);
         p.dnA = dot(anchorA, m.normal);
         p.dnB = dot(anchorB, m.normal);
-        if (settings_.warmStart) {
-            const std::uint64_t key = (std::uint64_t(a) << 40) | (std::uint64_t(b) << 16) | (detail.id[i] & 0xFFFF);
-            const auto it = std::lower_bound(cache_.begin(), cache_.end(), CachedImpulse{key, 0, 0});
-            if (it != cache_.end() && it->key == key) {
-                p.normalImpulse = it->normal;
-                p.tangentImpulse = it->tangent;
+    }
+    if (settings_.warmStart && !cache_.empty()) {
+        // The cache is sorted by key, and pairs arrive sorted by (a, b), so
+        // the search for this pair starts where the last pair's ended (a
+        // plane's pairs, out of that order, search from the start): one
+        // short search per manifold instead of a full one per point.
+        const std::uint64_t pairKey = (std::uint64_t(a) << 40) | (std::uint64_t(b) << 16);
+        const auto from = cacheCursor_ < cache_.size() && cache_[cacheCursor_].key <= pairKey
+                              ? cache_.begin() + std::ptrdiff_t(cacheCursor_)
+                              : cache_.begin();
+        auto it = std::lower_bound(from, cache_.end(), CachedImpulse{pairKey, 0, 0});
+        cacheCursor_ = std::size_t(it - cache_.begin());
+        bool found[2] = {false, false};  // the first entry of a key counts, as lower_bound finds it
+        for (; it != cache_.end() && (it->key >> 16) == (pairKey >> 16); ++it) {
+            for (int i = 0; i < m.pointCount; ++i) {
+                if (found[i] || (it->key & 0xFFFF) != (detail.id[i] & 0xFFFF)) continue;
+                found[i] = true;
+                c.points[i].normalImpulse = it->normal;
+                c.points[i].tangentImpulse = it->tangent;
             }
         }
     }
@@ -142,6 +155,7 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
     const auto narrowStart = std::chrono::steady_clock::now();
     constraints_.clear();
     details_.clear();
+    cacheCursor_ = 0;
     for (const ProxyPair& pair : pairs_) {
         const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
         const Manifold m = collide(colliders_[a].shape, centres_[a], rots[a], colliders_[b].shape, centres_[b],
@@ -255,7 +269,9 @@ void CollisionSystem::endStep() {
             records_.push_back(r);
         }
     }
-    std::sort(cache_.begin(), cache_.end());
+    // Usually already in order (constraints follow the sorted pairs); the
+    // check is cheaper than sorting sorted data.
+    if (!std::is_sorted(cache_.begin(), cache_.end())) std::sort(cache_.begin(), cache_.end());
 }
 
 } // namespace stepwise::collision

@@ -106,6 +106,7 @@ private:
     std::vector<ContactConstraint> constraints_;
     std::vector<ContactDetail> details_;  // parallel to constraints_
     std::vector<CachedImpulse> cache_;
+    std::size_t cacheCursor_ = 0;  // where the previous manifold's cache search ended
     std::vector<Vec2> unconstrainedV_;
     std::vector<ContactRecord> records_;
     std::vector<Rot> rotScratch_;

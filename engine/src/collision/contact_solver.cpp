@@ -63,6 +63,30 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
             p.tangentMass = effectiveMass(a, b, -p.dnA, -p.dnB);
             p.adjustedSeparation = details[k].separation[i] - (p.dnB - p.dnA);
         }
+        c.block = false;
+        if (c.pointCount == 2) {
+            // K of the two normal rows. A box resting on a face gives two
+            // strongly coupled rows (k12 close to k11): solving them
+            // together settles a stack in far fewer passes than one point
+            // after the other. Two points nearly on top of each other make K
+            // almost singular; those stay sequential (condition number cap
+            // 1000, the usual rule for this block solve).
+            const ContactPoint& p1 = c.points[0];
+            const ContactPoint& p2 = c.points[1];
+            BlockMass& bm = c.blockMass;
+            bm.k11 = a.invMass + b.invMass + a.invInertia * p1.rnA * p1.rnA + b.invInertia * p1.rnB * p1.rnB;
+            bm.k22 = a.invMass + b.invMass + a.invInertia * p2.rnA * p2.rnA + b.invInertia * p2.rnB * p2.rnB;
+            bm.k12 = a.invMass + b.invMass + a.invInertia * p1.rnA * p2.rnA + b.invInertia * p1.rnB * p2.rnB;
+            const double det = bm.k11 * bm.k22 - bm.k12 * bm.k12;
+            constexpr double kMaxCondition = 1000.0;
+            if (bm.k11 > 0.0 && bm.k11 * bm.k11 < kMaxCondition * det) {
+                const double invDet = 1.0 / det;
+                bm.i11 = bm.k22 * invDet;
+                bm.i22 = bm.k11 * invDet;
+                bm.i12 = -bm.k12 * invDet;
+                c.block = true;
+            }
+        }
     }
 }
 
@@ -152,27 +176,86 @@ void solveContacts(std::span<ContactConstraint> contacts, std::span<SolverBody> 
         // since the step began; the Jacobian keeps the step-start anchors
         // (as Box2D v3): the rotation within one step is small.
         const double baseGap = dot(b.dp - a.dp, n);
-        for (int i = 0; i < c.pointCount; ++i) {
-            ContactPoint& p = c.points[i];
+        // Velocity bias (m/s) and soft scaling of one point from its current
+        // separation: a speculative point may close its gap this substep; an
+        // overlapping one is pushed out softly (biased passes only).
+        struct Target {
+            double bias = 0.0, massScale = 1.0, impulseScale = 0.0;
+        };
+        const auto targetOf = [&](const ContactPoint& p) {
             const double separation = baseGap + (b.dq.c * p.dnB + b.dq.s * p.rnB) -
                                       (a.dq.c * p.dnA + a.dq.s * p.rnA) + p.adjustedSeparation;
-            double bias = 0.0, massScale = 1.0, impulseScale = 0.0;
+            Target t;
             if (separation > 0.0) {
-                bias = separation * invH;  // speculative: close at most the gap this substep
+                t.bias = separation * invH;
             } else if (useBias) {
-                bias = std::max(s.biasRate * separation, -pushMaxVelocity);
-                massScale = s.massScale;
-                impulseScale = s.impulseScale;
+                t.bias = std::max(s.biasRate * separation, -pushMaxVelocity);
+                t.massScale = s.massScale;
+                t.impulseScale = s.impulseScale;
             }
-            const double vn = dot(vB - vA, n) + wB * p.rnB - wA * p.rnA;
-            double impulse = -p.normalMass * massScale * (vn + bias) - impulseScale * p.normalImpulse;
-            const double total = std::max(p.normalImpulse + impulse, 0.0);
-            impulse = total - p.normalImpulse;
-            p.normalImpulse = total;
-            vA -= (mA * impulse) * n;
-            wA -= iA * p.rnA * impulse;
-            vB += (mB * impulse) * n;
-            wB += iB * p.rnB * impulse;
+            return t;
+        };
+        const Target t0 = targetOf(c.points[0]);
+        const Target t1 = c.pointCount == 2 ? targetOf(c.points[1]) : Target{};
+        if (c.block && t0.massScale == t1.massScale) {
+            // Block solve of both normal rows: the new accumulated impulses
+            // y >= 0 make the normal velocities w = K (y - a) + vn + bias
+            // non-negative with y_i w_i = 0 (a 2x2 linear complementarity
+            // problem, solved by trying its four cases: both points pushing,
+            // only the first, only the second, neither). The soft rule
+            // new = massScale * (a - K^-1 (vn + bias)) of the one-point
+            // solve becomes new = massScale * y (massScale + impulseScale = 1).
+            ContactPoint& p1 = c.points[0];
+            ContactPoint& p2 = c.points[1];
+            const BlockMass& bm = c.blockMass;
+            const Vec2 dv = vB - vA;
+            const double a1 = p1.normalImpulse, a2 = p2.normalImpulse;
+            const double vn1 = dot(dv, n) + wB * p1.rnB - wA * p1.rnA;
+            const double vn2 = dot(dv, n) + wB * p2.rnB - wA * p2.rnA;
+            const double q1 = vn1 + t0.bias - (bm.k11 * a1 + bm.k12 * a2);
+            const double q2 = vn2 + t1.bias - (bm.k12 * a1 + bm.k22 * a2);
+            double y1 = -(bm.i11 * q1 + bm.i12 * q2);
+            double y2 = -(bm.i12 * q1 + bm.i22 * q2);
+            if (!(y1 >= 0.0 && y2 >= 0.0)) {
+                y1 = -q1 / bm.k11;
+                y2 = 0.0;
+                if (!(y1 >= 0.0 && bm.k12 * y1 + q2 >= 0.0)) {
+                    y1 = 0.0;
+                    y2 = -q2 / bm.k22;
+                    if (!(y2 >= 0.0 && bm.k12 * y2 + q1 >= 0.0)) {
+                        // Neither point pushes; q >= 0 then, for K positive
+                        // definite (anything else is rounding: keep a).
+                        y2 = 0.0;
+                        if (!(q1 >= 0.0 && q2 >= 0.0)) {
+                            y1 = a1 / t0.massScale;
+                            y2 = a2 / t0.massScale;
+                        }
+                    }
+                }
+            }
+            const double x1 = t0.massScale * y1, x2 = t0.massScale * y2;
+            const double d1 = x1 - a1, d2 = x2 - a2;
+            p1.normalImpulse = x1;
+            p2.normalImpulse = x2;
+            const double d = d1 + d2;
+            vA -= (mA * d) * n;
+            wA -= iA * (p1.rnA * d1 + p2.rnA * d2);
+            vB += (mB * d) * n;
+            wB += iB * (p1.rnB * d1 + p2.rnB * d2);
+        } else {
+            for (int i = 0; i < c.pointCount; ++i) {
+                ContactPoint& p = c.points[i];
+                const Target& tg = i == 0 ? t0 : t1;
+                const double vn = dot(vB - vA, n) + wB * p.rnB - wA * p.rnA;
+                double impulse = -p.normalMass * tg.massScale * (vn + tg.bias) - tg.impulseScale * p.normalImpulse;
+                const double total = std::max(p.normalImpulse + impulse, 0.0);
+                impulse = total - p.normalImpulse;
+                p.normalImpulse = total;
+                vA -= (mA * impulse) * n;
+                wA -= iA * p.rnA * impulse;
+                vB += (mB * impulse) * n;
+                wB += iB * p.rnB * impulse;
+            }
         }
         // Friction: t = (n.y, -n.x), and cross(r, t) = -dot(r, n).
         const Vec2 t = tangentOf(n);

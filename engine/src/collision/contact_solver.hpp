@@ -48,13 +48,25 @@ struct ContactPoint {
     double normalImpulse = 0.0, tangentImpulse = 0.0;  ///< accumulated, N*s
 };
 
+/// The 2x2 normal system of a two-point manifold, for the block solve.
+/// K maps the two normal impulses (N*s) to the two normal velocity changes
+/// (m/s): K = [k11 k12; k12 k22], 1/kg; inv is its inverse, kg.
+struct BlockMass {
+    double k11 = 0.0, k12 = 0.0, k22 = 0.0;
+    double i11 = 0.0, i12 = 0.0, i22 = 0.0;
+};
+
 struct ContactConstraint {
     std::uint32_t bodyA = 0, bodyB = 0;  ///< SolverBody indices (0 = static)
     Vec2 normal;                         ///< from A to B
     double friction = 0.0;
     std::int32_t pointCount = 0;
     bool touchesStatic = false;
+    /// Two points whose normal impulses are solved together (K well
+    /// conditioned); otherwise the points are solved one after the other.
+    bool block = false;
     ContactPoint points[2];
+    BlockMass blockMass;
 };
 
 /// Everything about a contact that the solver iterations do not touch:
@@ -81,8 +93,8 @@ struct SolverSettings {
     bool warmStart = true;
 };
 
-/// Prepares masses and adjusted separations (once per step, after the
-/// narrow phase).
+/// Prepares masses, the block solve's 2x2 systems and adjusted separations
+/// (once per step, after the narrow phase).
 void prepareContacts(std::span<ContactConstraint> contacts, std::span<const ContactDetail> details,
                      std::span<const SolverBody> bodies);
 

@@ -16,33 +16,39 @@ namespace {
 /// corner i to corner i+1; normal i is its outward normal.
 struct BoxPolygon {
     std::array<Vec2, 4> vertices;
-    std::array<Vec2, 4> normals;
+    std::array<Vec2, 4> normals;  ///< normals 1 and 2 are the box's x and y axes
+    Vec2 centre, half;
 };
 
 BoxPolygon worldBox(Vec2 h, Vec2 p, Rot q) {
-    const std::array<Vec2, 4> local{Vec2{-h.x, -h.y}, Vec2{h.x, -h.y}, Vec2{h.x, h.y}, Vec2{-h.x, h.y}};
-    const std::array<Vec2, 4> normals{Vec2{0, -1}, Vec2{1, 0}, Vec2{0, 1}, Vec2{-1, 0}};
     BoxPolygon out;
-    for (int i = 0; i < 4; ++i) {
-        out.vertices[i] = p + rotate(q, local[i]);
-        out.normals[i] = rotate(q, normals[i]);
-    }
+    const Vec2 ax{q.c, q.s}, ay{-q.s, q.c};  // the box's axes in the world
+    const Vec2 ex = h.x * ax, ey = h.y * ay;
+    out.vertices = {p - ex - ey, p + ex - ey, p + ex + ey, p - ex + ey};
+    out.normals = {-ay, ax, ay, -ax};
+    out.centre = p;
+    out.half = h;
     return out;
 }
 
-/// Largest separation of B from A's face planes, and that face.
+/// Largest separation of B from A's face planes, and that face. B's deepest
+/// corner along -n is its support point, so its depth below face i is
+/// dot(n, centreB - centreA) - |dot(n, xB)| hB.x - |dot(n, yB)| hB.y - hA
+/// (hA: A's half extent along face i): 4 projections instead of 16 corner
+/// tests.
 std::pair<int, double> maxSeparation(const BoxPolygon& a, const BoxPolygon& b) {
+    const Vec2 d = b.centre - a.centre;
+    const Vec2 xA = a.normals[1], yA = a.normals[2], xB = b.normals[1], yB = b.normals[2];
+    const double dx = dot(d, xA), dy = dot(d, yA);
+    const double reachX = std::abs(dot(xA, xB)) * b.half.x + std::abs(dot(xA, yB)) * b.half.y;
+    const double reachY = std::abs(dot(yA, xB)) * b.half.x + std::abs(dot(yA, yB)) * b.half.y;
+    // Faces in edge order: -y, +x, +y, -x.
+    const double s[4] = {-dy - reachY - a.half.y, dx - reachX - a.half.x, dy - reachY - a.half.y,
+                         -dx - reachX - a.half.x};
     int bestEdge = 0;
-    double best = -std::numeric_limits<double>::infinity();
-    for (int i = 0; i < 4; ++i) {
-        double deepest = std::numeric_limits<double>::infinity();
-        for (int j = 0; j < 4; ++j) deepest = std::min(deepest, dot(a.normals[i], b.vertices[j] - a.vertices[i]));
-        if (deepest > best) {
-            best = deepest;
-            bestEdge = i;
-        }
-    }
-    return {bestEdge, best};
+    for (int i = 1; i < 4; ++i)
+        if (s[i] > s[bestEdge]) bestEdge = i;
+    return {bestEdge, s[bestEdge]};
 }
 
 struct ClipVertex {
