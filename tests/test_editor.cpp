@@ -604,6 +604,20 @@ TEST(Files, AutosaveKilledAtRandomPointsLeavesAWholeRecoveryFile) {
     EXPECT_TRUE(g == 2.0 || g == 3.0) << g;
 }
 
+TEST(Tools, NameAllocatorGivesTheFirstFreeNumberLikeUniqueName) {
+    Scene s;
+    for (const char* n : {"ball", "ball_2", "ball_4", "box"}) s.registry.emplace(s.registry.create(), Name{n});
+    EXPECT_EQ(uniqueName(s.registry, "ball"), "ball_3");
+    EXPECT_EQ(uniqueName(s.registry, "ball_4"), "ball_3");  // copies of copies count on from the stem
+    EXPECT_EQ(uniqueName(s.registry, "wall"), "wall");
+    NameAllocator names(s.registry);
+    EXPECT_EQ(names.take("ball"), "ball_3");
+    EXPECT_EQ(names.take("ball"), "ball_5");  // 4 is taken
+    EXPECT_EQ(names.take("ball_2"), "ball_6");
+    EXPECT_EQ(names.take("wall"), "wall");
+    EXPECT_EQ(names.take("wall"), "wall_2");
+}
+
 TEST(Camera, ZoomKeepsThePointUnderTheCursor) {
     ViewCamera v;
     v.width = 640;

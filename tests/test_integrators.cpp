@@ -5,13 +5,17 @@
 
 #include "integrators/integrator.hpp"
 #include "stepwise/integrators.hpp"
+#include "world/world_impl.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace stepwise;
@@ -256,6 +260,135 @@ TEST(Stability, LimitsFromAmplificationMatrices) {
     EXPECT_NEAR(stabilityLimit(IntegratorKind::ExplicitEuler, 0.1), 0.2, 1e-9);
     EXPECT_TRUE(std::isinf(stabilityLimit(IntegratorKind::ImplicitEuler, 0.0)));
     EXPECT_TRUE(std::isinf(stabilityLimit(IntegratorKind::ImplicitMidpoint, 0.0)));
+}
+
+// ---------------------------------------------------------------------------
+// Fused local-force kernels (gravity + drag; explicit_integrators.cpp): one
+// pass per step, compiled for SSE2, AVX2 and AVX-512. Each instruction set
+// the CPU has must give exactly the bits of the unfused formulas
+// (ForceModel::accelerations, then the integrator's update), including the
+// scalar tail (11 bodies: two blocks of four and three left over).
+
+using detail::SimdLevel;
+
+std::vector<SimdLevel> availableSimdLevels() {
+    std::vector<SimdLevel> levels;
+    for (SimdLevel l : {SimdLevel::Baseline, SimdLevel::Avx2, SimdLevel::Avx512})
+        if (detail::setSimdLevel(l) == l) levels.push_back(l);
+    detail::setSimdLevel(SimdLevel::Avx512);  // back to the best there is
+    return levels;
+}
+
+const char* simdName(SimdLevel l) {
+    return l == SimdLevel::Baseline ? "baseline" : l == SimdLevel::Avx2 ? "avx2" : "avx512";
+}
+
+Scene localForceScene(const std::string& integrator, bool gravity, bool drag) {
+    Scene s = emptyScene(integrator, 1.0 / 60.0, gravity ? Vec2{0.3, -9.81} : Vec2{0.0, 0.0});
+    s.world.substeps = 2;
+    for (int i = 0; i < 11; ++i) {
+        Entity e = addBody(s, "p" + std::to_string(i), {0.37 * i - 1.0, 2.0 + 0.11 * i * i},
+                           {1.3 - 0.29 * i, 0.7 * std::sin(double(i))}, 0.5 + 0.17 * i);
+        // Body 4 has no drag (rate 0 in the dense array).
+        if (drag && i != 4) s.registry.emplace<Drag>(e, {0.05 + 0.03 * i});
+    }
+    return s;
+}
+
+// One step of `integrator` the unfused way: the force model writes a, then
+// the update formulas of explicit_integrators.cpp.
+void referenceStep(const detail::ForceModel& f, bool rk4, std::vector<double>& x, std::vector<double>& v, double h) {
+    const std::size_t m = x.size();
+    std::vector<double> a(m), x1(m), v1(m);
+    f.accelerations(x.data(), v.data(), a.data());
+    if (!rk4) {
+        for (std::size_t i = 0; i < m; ++i) {
+            v1[i] = v[i] + h * a[i];
+            x1[i] = x[i] + h * v1[i];
+        }
+    } else {
+        std::vector<double> xs(m), vs(m);
+        const double h2 = 0.5 * h, h3 = h / 3.0, h6 = h / 6.0;
+        for (std::size_t i = 0; i < m; ++i) {
+            x1[i] = x[i] + h6 * v[i];
+            v1[i] = v[i] + h6 * a[i];
+            xs[i] = x[i] + h2 * v[i];
+            vs[i] = v[i] + h2 * a[i];
+        }
+        for (double c : {h2, h}) {
+            f.accelerations(xs.data(), vs.data(), a.data());
+            for (std::size_t i = 0; i < m; ++i) {
+                const double vk = vs[i];
+                x1[i] += h3 * vk;
+                v1[i] += h3 * a[i];
+                xs[i] = x[i] + c * vk;
+                vs[i] = v[i] + c * a[i];
+            }
+        }
+        f.accelerations(xs.data(), vs.data(), a.data());
+        for (std::size_t i = 0; i < m; ++i) {
+            x1[i] += h6 * vs[i];
+            v1[i] += h6 * a[i];
+        }
+    }
+    x = std::move(x1);
+    v = std::move(v1);
+}
+
+TEST(FusedKernels, EveryInstructionSetMatchesTheUnfusedFormulasBitForBit) {
+    for (SimdLevel level : availableSimdLevels()) {
+        detail::setSimdLevel(level);
+        for (const char* integrator : {"semi_implicit_euler", "rk4"})
+            for (bool gravity : {false, true})
+                for (bool drag : {false, true}) {
+                    World w = buildOrDie(localForceScene(integrator, gravity, drag));
+                    const detail::ForceModel& f = w.impl().model;
+                    ASSERT_TRUE(f.localOnly());
+                    std::vector<double> x(w.impl().xs(), w.impl().xs() + 2 * f.n);
+                    std::vector<double> v(w.impl().vs(), w.impl().vs() + 2 * f.n);
+                    const double h = w.settings().dt / 2.0;
+                    for (int step = 0; step < 40; ++step) {
+                        ASSERT_TRUE(w.step().ok());
+                        referenceStep(f, std::string(integrator) == "rk4", x, v, h);
+                        referenceStep(f, std::string(integrator) == "rk4", x, v, h);
+                    }
+                    for (std::size_t i = 0; i < 2 * f.n; ++i) {
+                        // Bit patterns, so that -0 against +0 would fail too.
+                        EXPECT_EQ(std::bit_cast<std::uint64_t>(w.impl().xs()[i]), std::bit_cast<std::uint64_t>(x[i])) << simdName(level) << " " << integrator << " g" << gravity
+                                                          << " drag" << drag << " x[" << i << "]";
+                        EXPECT_EQ(std::bit_cast<std::uint64_t>(w.impl().vs()[i]), std::bit_cast<std::uint64_t>(v[i])) << simdName(level) << " " << integrator << " g" << gravity
+                                                          << " drag" << drag << " v[" << i << "]";
+                    }
+                }
+    }
+    detail::setSimdLevel(SimdLevel::Avx512);
+}
+
+TEST(FusedKernels, DivergenceIsCaughtInTheVectorBlockAndInTheTail) {
+    // x grows by 0.5e308 per step: step 4 pushes it past DBL_MAX. Body 1 is
+    // in the first block of four, body 5 in the scalar tail (6 bodies).
+    for (SimdLevel level : availableSimdLevels()) {
+        detail::setSimdLevel(level);
+        for (const char* integrator : {"semi_implicit_euler", "rk4"})
+            for (int bad : {1, 5}) {
+                Scene s = emptyScene(integrator, 0.5);
+                for (int i = 0; i < 6; ++i) {
+                    Entity e = addBody(s, "b" + std::to_string(i), {double(i), 0.0}, {i == bad ? 1e308 : 0.1, 0.0});
+                    s.registry.emplace<Drag>(e, {i == bad ? 0.0 : 0.2});
+                }
+                World w = buildOrDie(s);
+                for (int i = 0; i < 3; ++i) ASSERT_TRUE(w.step().ok()) << simdName(level) << " " << integrator;
+                const Vec2 before = w.bodyPosition(std::size_t(bad));
+                Result<void> r = w.step();
+                ASSERT_FALSE(r.ok()) << simdName(level) << " " << integrator << " body " << bad;
+                EXPECT_EQ(r.error(), "step 4: entity " + std::to_string(bad) + " (\"b" + std::to_string(bad) +
+                                         "\"): position.x became inf")
+                    << simdName(level) << " " << integrator;
+                EXPECT_EQ(w.bodyPosition(std::size_t(bad)), before);
+                EXPECT_EQ(w.lastStats().step, 3u);
+            }
+    }
+    detail::setSimdLevel(SimdLevel::Avx512);
 }
 
 } // namespace

@@ -137,21 +137,29 @@ Entity findByName(const Registry& registry, std::string_view name) {
     return {};
 }
 
-std::string uniqueName(const Registry& registry, const std::string& base) {
-    std::unordered_set<std::string> used;
+NameAllocator::NameAllocator(const Registry& registry) {
     for (Entity e : registry.entities())
-        if (const Name* n = registry.tryGet<Name>(e)) used.insert(n->value);
-    if (!used.count(base)) return base;
+        if (const Name* n = registry.tryGet<Name>(e)) used_.insert(n->value);
+}
+
+std::string NameAllocator::take(const std::string& base) {
+    if (used_.insert(base).second) return base;
     // "ball_3" -> stem "ball" so copies of copies count on, not "ball_3_2".
     std::string stem = base;
     if (const auto u = stem.rfind('_'); u != std::string::npos && u + 1 < stem.size() &&
                                         std::all_of(stem.begin() + std::ptrdiff_t(u) + 1, stem.end(), ::isdigit))
         stem.resize(u);
-    for (int i = 2;; ++i) {
-        std::string candidate = stem + "_" + std::to_string(i);
-        if (!used.count(candidate)) return candidate;
+    int& next = nextNumber_.try_emplace(stem, 2).first->second;
+    for (;; ++next) {
+        std::string candidate = stem + "_" + std::to_string(next);
+        if (used_.insert(candidate).second) {
+            ++next;
+            return candidate;
+        }
     }
 }
+
+std::string uniqueName(const Registry& registry, const std::string& base) { return NameAllocator(registry).take(base); }
 
 std::string displayName(const Registry& registry, Entity e) {
     if (const Name* n = registry.tryGet<Name>(e); n && !n->value.empty()) return n->value;
@@ -262,14 +270,14 @@ std::size_t destroyWithSprings(Scene& scene, const std::vector<Entity>& entities
 std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>& entities, Scene& dst, Vec2 offset) {
     std::vector<Entity> created;
     std::unordered_map<std::string, std::string> renamed;  // old name -> new name
+    NameAllocator names(dst.registry);  // before the copies exist, so they do not see themselves
     for (Entity e : entities) {
         if (!src.alive(e)) continue;
         const Entity c = dst.registry.create();
         copyEntity(src, e, dst.registry, c);
         if (Name* n = dst.registry.tryGet<Name>(c)) {
             const std::string old = n->value;
-            n->value = "";  // so uniqueName does not see the copy itself
-            n->value = uniqueName(dst.registry, old.empty() ? std::string("entity") : old);
+            n->value = names.take(old.empty() ? std::string("entity") : old);
             if (!old.empty()) renamed[old] = n->value;
         }
         if (Position* p = dst.registry.tryGet<Position>(c)) p->value += offset;

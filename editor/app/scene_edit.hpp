@@ -12,6 +12,8 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <variant>
 #include <vector>
 
@@ -43,7 +45,24 @@ std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, cons
 /// Removes it from each that has it.
 std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities);
 
-/// `base` if no entity is called that, else base_2, base_3, ...
+/// Unique entity names for a burst of creations (paste, generated levels):
+/// the names in use are gathered once, O(n), and each take() is O(1)
+/// amortised because the next free number of each stem is remembered, so
+/// pasting k bodies into an n-body scene costs O(n + k), not O(n k).
+class NameAllocator {
+public:
+    explicit NameAllocator(const Registry& registry);
+    /// `base` if unused, else base_2, base_3, ... (the first free one); the
+    /// name returned counts as used from then on.
+    std::string take(const std::string& base);
+
+private:
+    std::unordered_set<std::string> used_;
+    std::unordered_map<std::string, int> nextNumber_;  ///< stem -> first number not yet known to be used
+};
+
+/// `base` if no entity is called that, else base_2, base_3, ... (one name;
+/// use a NameAllocator for many).
 std::string uniqueName(const Registry& registry, const std::string& base);
 /// Entity called `name`, or a null handle.
 Entity findByName(const Registry& registry, std::string_view name);

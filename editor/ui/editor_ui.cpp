@@ -744,6 +744,15 @@ void statusBar(UiState& ui, Editor& ed) {
         else
             ImGui::TextColored(kDim, "%zu entities | frame %.1f ms (ui %.1f, scene %.1f, physics %.1f)", bodies, ui.frameMs,
                                ui.uiMs, ui.sceneMs, ui.stepMs);
+        // Big scenes (100,000 bodies: ~100 ms a frame here) stay usable but
+        // slow; say so and say where the time goes, so the designer knows
+        // what to switch off. Under 20 frames per second the simulation
+        // also runs behind real time (Simulation::maxStepsPerFrame).
+        if (!ui.deterministic && ui.frameMs > 50.0 && ed.sim.state() == editor::SimState::Playing) {
+            ImGui::SameLine();
+            ImGui::TextColored(kGold, "| slow: %.0f fps (physics %.0f ms, drawing %.0f ms); behind real time", 1000.0 / ui.frameMs,
+                               ui.stepMs, ui.sceneMs);
+        }
         ImGui::SameLine();
         ImGui::TextUnformatted(("| " + ed.status).c_str());
     }

@@ -25,12 +25,33 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <string_view>
 #include <vector>
 
 namespace stepwise::detail {
 
 inline constexpr std::uint32_t kNoBody = 0xFFFFFFFFu;
+
+/// Allocates on 64-byte cache-line boundaries. The streaming kernels load
+/// and store 64 bytes at a time (AVX-512): on malloc's 16-byte alignment
+/// most of those accesses straddle two cache lines.
+template <class T>
+struct CacheLineAllocator {
+    using value_type = T;
+    static constexpr std::align_val_t kAlignment{64};
+    CacheLineAllocator() = default;
+    template <class U>
+    CacheLineAllocator(const CacheLineAllocator<U>&) noexcept {}
+    T* allocate(std::size_t count) { return static_cast<T*>(::operator new(count * sizeof(T), kAlignment)); }
+    void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, kAlignment); }
+    template <class U>
+    bool operator==(const CacheLineAllocator<U>&) const noexcept {
+        return true;
+    }
+};
+/// A state or per-body array the streaming kernels read or write.
+using AlignedDoubles = std::vector<double, CacheLineAllocator<double>>;
 
 /// Force systems, in pipeline order. Index into ForceModel::systemSeconds.
 enum class ForceSystem : int { Gravity = 0, Drag, Springs, Attractors, Boids, Count };
@@ -123,7 +144,7 @@ public:
 
     bool dragOn = false;
     std::vector<double> dragB;      ///< kg/s per body (0 = none)
-    std::vector<double> dragRate;   ///< b/m, 1/s per body
+    AlignedDoubles dragRate;        ///< b/m, 1/s per body
 
     std::vector<SpringData> springs;
     double G = 1.0;

@@ -16,6 +16,9 @@
 //                            the others (as in every impulse-based engine).
 //     rotation               angle += h * angular_velocity
 //   check                    every state value finite, else undo the step
+//                            (x and v: done inside the integrator's pass
+//                            when its kernel is fused and no contact solve
+//                            ran after it)
 //
 // Determinism: nothing is carried between steps except the state and the
 // time, both of which a saved file holds exactly (shortest round-trip
@@ -322,8 +325,8 @@ Result<World> World::build(const Scene& scene) {
     if (!w.spinBody.empty()) w.active.push_back("rotation");
     if (w.collision) w.active.push_back("collisions");
 
-    w.x[0] = std::move(x0);
-    w.v[0] = std::move(v0);
+    w.x[0].assign(x0.begin(), x0.end());
+    w.v[0].assign(v0.begin(), v0.end());
     w.x[1].assign(2 * n, 0.0);
     w.v[1].assign(2 * n, 0.0);
     if (ws.substeps > 1) {
@@ -352,6 +355,7 @@ Result<void> World::step() {
     }
     std::copy(w.angle.begin(), w.angle.end(), w.angleBackup.begin());
     int evaluations = 0;
+    bool verifiedFinite = false;  // the last substep's integrator pass checked x, v
     double rotationSeconds = 0.0, contactSeconds = 0.0;
     collision::CollisionSystem* contacts = w.collision.get();
     if (contacts) {
@@ -366,6 +370,7 @@ Result<void> World::step() {
         // --- forces + integrate
         w.integrator->step(f, w.x[w.current].data(), w.v[w.current].data(), w.x[next].data(), w.v[next].data(), h);
         evaluations += w.integrator->lastEvaluations();
+        verifiedFinite = w.integrator->lastStepVerifiedFinite();
         // --- contact solve on the integrator's end-of-substep state
         if (contacts) {
             contacts->solveSubstep(detail::asVec2(w.x[next].data(), f.n), detail::asVec2(w.v[next].data(), f.n), h);
@@ -381,8 +386,12 @@ Result<void> World::step() {
     }
     if (contacts) contacts->endStep();
     const Clock::time_point t1 = timed ? Clock::now() : Clock::time_point{};
-    // --- check
-    const bool finite = allFinite(w.xs(), m) && allFinite(w.vs(), m) && allFinite(w.angle.data(), w.angle.size()) &&
+    // --- check. The integrator may have checked x and v in its writing
+    // pass (fused kernels): then only if nothing changed them since (no
+    // contact solve) is a second pass over the state skipped.
+    const bool stateChecked = verifiedFinite && !contacts;
+    const bool finite = (stateChecked || (allFinite(w.xs(), m) && allFinite(w.vs(), m))) &&
+                        allFinite(w.angle.data(), w.angle.size()) &&
                         (!contacts || (allFinite(contacts->angles().data(), contacts->angles().size()) &&
                                        allFinite(contacts->angularVelocities().data(),
                                                  contacts->angularVelocities().size())));

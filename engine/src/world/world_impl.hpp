@@ -23,7 +23,7 @@ public:
 
     // Double-buffered state: buffers[current] is the state; a step writes
     // the other one and flips `current` only if it stayed finite.
-    std::vector<double> x[2], v[2];
+    detail::AlignedDoubles x[2], v[2];
     int current = 0;
     // Start-of-step copy, only needed with substeps > 1 (the intermediate
     // substeps overwrite both buffers).
