@@ -425,6 +425,26 @@ TEST(Simulation, TimeScaleSetsStepsPerFrame) {
     EXPECT_EQ(f.ed.sim.steps(), 20u);  // 10 frames * (1/60 * 0.5) / (1/240)
 }
 
+TEST(Simulation, ASlowFrameDropsTimeInsteadOfTakingMoreSteps) {
+    Fixture f("orbit.json");  // dt = 1/240: a 1/60 s frame is due 4 steps
+    f.ed.togglePlay();
+    f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 4u);
+    EXPECT_FALSE(f.ed.sim.behind());
+    // A budget already spent after the first step (as on a frame where one
+    // step takes longer than the budget): one step per frame, the rest of
+    // the frame's time dropped, and the editor says it is behind.
+    f.ed.sim.physicsBudgetMs = -1.0;
+    for (int i = 0; i < 5; ++i) f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 9u);
+    EXPECT_TRUE(f.ed.sim.behind());
+    // The dropped time is not owed later: back on budget, 4 per frame again.
+    f.ed.sim.physicsBudgetMs = 1e9;
+    f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 13u);
+    EXPECT_FALSE(f.ed.sim.behind());
+}
+
 TEST(Files, SaveIsAtomicAndEqualsTheExpectedJson) {
     Fixture f("orbit.json");
     const std::filesystem::path out = f.tmp.path / "out.json";

@@ -207,9 +207,16 @@ void Simulation::advance(Scene& scene, double frameSeconds) {
     int taken = 0;
     // A small tolerance so a 1/60 s frame at dt = 1/60 is exactly one step
     // despite rounding in the accumulator.
+    behind_ = false;
     while (accumulator_ >= dt * (1.0 - 1e-9) && state_ == SimState::Playing) {
-        if (taken == maxStepsPerFrame) {
-            accumulator_ = 0.0;  // behind: drop the time rather than fall further behind
+        const double spentMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        if (taken == maxStepsPerFrame || (taken > 0 && spentMs > physicsBudgetMs)) {
+            // Behind: drop the time rather than fall further behind. A slow
+            // frame must not buy more steps for the next one (each step
+            // would make the frames slower still); the scene runs in slow
+            // motion instead and the UI stays responsive.
+            accumulator_ = 0.0;
+            behind_ = true;
             break;
         }
         accumulator_ -= dt;

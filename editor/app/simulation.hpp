@@ -72,6 +72,11 @@ public:
 
     double timeScale = 1.0;       ///< simulated seconds per real second
     int maxStepsPerFrame = 8;     ///< past this a frame drops time (no spiral of death)
+    /// Wall time, ms, a frame may spend on steps beyond its first: half a
+    /// 60 Hz frame, so drawing keeps the other half.
+    double physicsBudgetMs = 8.0;
+    /// The last frame dropped simulated time (slow motion).
+    bool behind() const { return behind_; }
     /// Pause when this body starts touching something (null: off).
     Entity breakOnContact;
     /// Mouse spring while playing: pulls `dragBody` toward `dragTarget`.
@@ -123,6 +128,7 @@ private:
     std::string message_;
     bool diverged_ = false;
     bool touchingBefore_ = false;
+    bool behind_ = false;
 };
 
 } // namespace stepwise::editor

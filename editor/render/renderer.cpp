@@ -199,11 +199,14 @@ std::string Renderer::describeContext() const {
     return "OpenGL " + str(GL_VERSION) + ", " + str(GL_RENDERER);
 }
 
-void Renderer::draw(const DrawData& data) {
+void Renderer::draw(const DrawData& data, int originX, int originY) {
     Impl& im = *impl_;
     const GlApi& gl = im.gl;
     drawCalls_ = 0;
-    gl.Viewport(0, 0, data.width, data.height);
+    gl.Viewport(originX, originY, data.width, data.height);
+    // The clear (and every draw) stays inside the rectangle.
+    gl.Enable(GL_SCISSOR_TEST);
+    gl.Scissor(originX, originY, data.width, data.height);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_CULL_FACE);
     gl.Enable(GL_BLEND);
@@ -259,11 +262,12 @@ void Renderer::draw(const DrawData& data) {
         ++drawCalls_;
     }
     gl.BindVertexArray(0);
+    gl.Disable(GL_SCISSOR_TEST);
 }
 
-DrawData Renderer::render(const FrameInput& input, int widthPx, int heightPx) {
+DrawData Renderer::render(const FrameInput& input, int widthPx, int heightPx, int originX, int originY) {
     DrawData data = buildDrawData(input, widthPx, heightPx);
-    draw(data);
+    draw(data, originX, originY);
     return data;
 }
 

@@ -24,12 +24,14 @@ public:
     Renderer(const Renderer&) = delete;
     Renderer& operator=(const Renderer&) = delete;
 
-    /// Draws into the currently bound framebuffer, viewport (0,0,w,h) with
-    /// w, h from `data`.
-    void draw(const DrawData& data);
+    /// Draws into the currently bound framebuffer, in the w x h rectangle
+    /// (w, h from `data`) whose bottom-left pixel is (originX, originY) in
+    /// GL's y-up framebuffer coordinates; nothing outside it is touched (the
+    /// editor draws its viewport straight into the window, under ImGui).
+    void draw(const DrawData& data, int originX = 0, int originY = 0);
 
     /// buildDrawData + draw.
-    DrawData render(const FrameInput& input, int widthPx, int heightPx);
+    DrawData render(const FrameInput& input, int widthPx, int heightPx, int originX = 0, int originY = 0);
 
     /// Waits until the GPU (llvmpipe: the rasteriser threads) has finished.
     void finish();

@@ -367,10 +367,21 @@ void viewportPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     ImGui::SetNextWindowPos(r.viewportPos, ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(r.viewportSize, ImGuiCond_FirstUseEver);
     ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+    // The scene is drawn into the window before ImGui (Session::frame), so
+    // this panel has no background of its own, and it stays behind every
+    // other panel: one that went behind it would be drawn over the scene.
     const bool open = ImGui::Begin("Viewport", nullptr, ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse |
-                                                             ImGuiWindowFlags_NoCollapse);
+                                                             ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoBackground |
+                                                             ImGuiWindowFlags_NoBringToFrontOnFocus);
     ImGui::PopStyleVar();
     if (open) {
+        // The toolbar band gets the background the window does not draw:
+        // its size is known after the toolbar, so the fill goes into a
+        // channel drawn under the toolbar's widgets.
+        ImDrawList* dl = ImGui::GetWindowDrawList();
+        dl->ChannelsSplit(2);
+        dl->ChannelsSetCurrent(1);
+        const ImVec2 band = ImGui::GetCursorScreenPos();
         ImGui::SetCursorPos(ImVec2(ImGui::GetCursorPosX() + 6 * ui.scale, ImGui::GetCursorPosY() + 4 * ui.scale));
         simToolbar(ui, ed);
         ImGui::SetCursorPosY(ImGui::GetCursorPosY() + 2 * ui.scale);
@@ -378,6 +389,9 @@ void viewportPanel(UiState& ui, Editor& ed, const PanelRects& r) {
         avail.x = std::max(16.0f, std::floor(avail.x));
         avail.y = std::max(16.0f, std::floor(avail.y));
         const ImVec2 pos = ImGui::GetCursorScreenPos();
+        dl->ChannelsSetCurrent(0);
+        dl->AddRectFilled(band, ImVec2(band.x + ImGui::GetWindowWidth(), std::floor(pos.y)), ImGui::GetColorU32(ImGuiCol_WindowBg));
+        dl->ChannelsMerge();
         ui.viewportPos = ImVec2(std::floor(pos.x), std::floor(pos.y));
         ui.viewportSize = avail;
         // An invisible button owns the mouse over the image, so a drag there
@@ -386,10 +400,6 @@ void viewportPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                                ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight |
                                    ImGuiButtonFlags_MouseButtonMiddle);
         ui.viewportHovered = ImGui::IsItemHovered() || ImGui::IsItemActive();
-        ImDrawList* dl = ImGui::GetWindowDrawList();
-        if (ui.viewportTexture)
-            dl->AddImage(reinterpret_cast<ImTextureID>(ui.viewportTexture), ui.viewportPos,
-                         ImVec2(ui.viewportPos.x + avail.x, ui.viewportPos.y + avail.y), ImVec2(0, 1), ImVec2(1, 0));
         const ImVec2 o = ui.viewportPos;
         // Mode frame: green while playing, gold when paused.
         if (ed.sim.running())
@@ -746,12 +756,12 @@ void statusBar(UiState& ui, Editor& ed) {
                                ui.uiMs, ui.sceneMs, ui.stepMs);
         // Big scenes (100,000 bodies: ~100 ms a frame here) stay usable but
         // slow; say so and say where the time goes, so the designer knows
-        // what to switch off. Under 20 frames per second the simulation
-        // also runs behind real time (Simulation::maxStepsPerFrame).
-        if (!ui.deterministic && ui.frameMs > 50.0 && ed.sim.state() == editor::SimState::Playing) {
+        // what to switch off, and say when the simulation runs slower than
+        // real time (Simulation::physicsBudgetMs).
+        if (!ui.deterministic && ed.sim.state() == editor::SimState::Playing && (ui.frameMs > 50.0 || ed.sim.behind())) {
             ImGui::SameLine();
-            ImGui::TextColored(kGold, "| slow: %.0f fps (physics %.0f ms, drawing %.0f ms); behind real time", 1000.0 / ui.frameMs,
-                               ui.stepMs, ui.sceneMs);
+            ImGui::TextColored(kGold, "| slow: %.0f fps (physics %.0f ms, drawing %.0f ms)%s", 1000.0 / ui.frameMs, ui.stepMs,
+                               ui.sceneMs, ed.sim.behind() ? ", slower than real time" : "");
         }
         ImGui::SameLine();
         ImGui::TextUnformatted(("| " + ed.status).c_str());

@@ -43,7 +43,6 @@ struct UiState {
     // Viewport, filled by drawEditorUi each frame
     ImVec2 viewportPos{0, 0}, viewportSize{1, 1};
     bool viewportHovered = false;
-    std::uintptr_t viewportTexture = 0;
 
     // Dialog buffers
     std::string openPath, saveAsPath, entityFilter;

@@ -42,8 +42,6 @@ struct ImGuiGl::Impl {
     Gl gl;
     GLuint program = 0, vao = 0, vbo = 0, ebo = 0, font = 0;
     GLint projection = -1, texture = -1;
-    GLuint fbo = 0, target = 0;
-    int targetW = 0, targetH = 0;
 
     void uploadFonts() {
         ImGuiIO& io = ImGui::GetIO();
@@ -118,8 +116,6 @@ Result<std::unique_ptr<ImGuiGl>> ImGuiGl::create(render::GetProcAddress getProc)
 ImGuiGl::~ImGuiGl() {
     if (!impl_) return;
     Gl& gl = impl_->gl;
-    if (impl_->fbo) gl.DeleteFramebuffers(1, &impl_->fbo);
-    if (impl_->target) gl.DeleteTextures(1, &impl_->target);
     if (impl_->font) gl.DeleteTextures(1, &impl_->font);
     if (impl_->vbo) gl.DeleteBuffers(1, &impl_->vbo);
     if (impl_->ebo) gl.DeleteBuffers(1, &impl_->ebo);
@@ -129,14 +125,21 @@ ImGuiGl::~ImGuiGl() {
 
 void ImGuiGl::rebuildFonts() { impl_->uploadFonts(); }
 
+void ImGuiGl::clear(int fbWidth, int fbHeight) {
+    Gl& gl = impl_->gl;
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.Disable(GL_SCISSOR_TEST);
+    gl.Viewport(0, 0, fbWidth, fbHeight);
+    // Behind the panels: the theme's window colour, so gaps look intended.
+    gl.ClearColor(0.075f, 0.082f, 0.102f, 1.0f);
+    gl.Clear(GL_COLOR_BUFFER_BIT);
+}
+
 void ImGuiGl::render(const ImDrawData* data, int fbWidth, int fbHeight) {
     Impl& im = *impl_;
     Gl& gl = im.gl;
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.Viewport(0, 0, fbWidth, fbHeight);
-    // Behind the panels: the theme's window colour, so gaps look intended.
-    gl.ClearColor(0.075f, 0.082f, 0.102f, 1.0f);
-    gl.Clear(GL_COLOR_BUFFER_BIT);
     if (!data || data->CmdListsCount == 0) return;
     gl.Enable(GL_BLEND);
     gl.BlendEquation(GL_FUNC_ADD);
@@ -181,27 +184,5 @@ void ImGuiGl::render(const ImDrawData* data, int fbWidth, int fbHeight) {
     gl.Disable(GL_SCISSOR_TEST);
     gl.BindVertexArray(0);
 }
-
-std::uintptr_t ImGuiGl::bindViewportTarget(int width, int height) {
-    Impl& im = *impl_;
-    Gl& gl = im.gl;
-    if (!im.fbo) {
-        gl.GenFramebuffers(1, &im.fbo);
-        gl.GenTextures(1, &im.target);
-    }
-    gl.BindFramebuffer(GL_FRAMEBUFFER, im.fbo);
-    if (width != im.targetW || height != im.targetH) {
-        gl.BindTexture(GL_TEXTURE_2D, im.target);
-        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
-        gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, im.target, 0);
-        im.targetW = width;
-        im.targetH = height;
-    }
-    return im.target;
-}
-
-void ImGuiGl::unbindViewportTarget() { impl_->gl.BindFramebuffer(GL_FRAMEBUFFER, 0); }
 
 } // namespace stepwise::ui

@@ -24,15 +24,14 @@ public:
     static Result<std::unique_ptr<ImGuiGl>> create(render::GetProcAddress getProc);
     ~ImGuiGl();
 
-    /// Draws `data` into the default framebuffer (0) of size fbWidth x fbHeight.
+    /// Clears the default framebuffer (0) of size fbWidth x fbHeight to the
+    /// theme's background. A frame is: clear, the scene renderer draws the
+    /// viewport's rectangle, then render() draws the panels over it. (No
+    /// offscreen target: on llvmpipe sampling one would make the rasteriser
+    /// finish the scene before ImGui's triangles could even be binned.)
+    void clear(int fbWidth, int fbHeight);
+    /// Draws `data` over the default framebuffer of size fbWidth x fbHeight.
     void render(const ImDrawData* data, int fbWidth, int fbHeight);
-
-    /// Binds (creating or resizing) the offscreen colour target of the
-    /// viewport; the scene renderer then draws into it. Returns its texture
-    /// id for ImGui::Image.
-    std::uintptr_t bindViewportTarget(int width, int height);
-    /// Back to the default framebuffer.
-    void unbindViewportTarget();
     /// Rebuilds the font texture (after a font size change).
     void rebuildFonts();
 

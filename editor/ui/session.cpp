@@ -244,9 +244,10 @@ void Session::frame(int width, int height, double frameSeconds) {
         }
     }
     input.caption.clear();
-    ui_.viewportTexture = gl_->bindViewportTarget(vw, vh);
-    renderer_->render(input, vw, vh);
-    gl_->unbindViewportTarget();
+    // Straight into the window at the viewport panel's place (GL counts
+    // rows from the bottom), under the panels ImGui draws next.
+    gl_->clear(width, height);
+    renderer_->render(input, vw, vh, int(ui_.viewportPos.x), height - int(ui_.viewportPos.y) - vh);
     const double sceneMs = msSince(t2);
     // The font rebuild must happen between frames.
     const auto t3 = Clock::now();
@@ -277,7 +278,6 @@ void Session::frame(int width, int height, double frameSeconds) {
 }
 
 render::Image Session::capture(int width, int height) {
-    gl_->unbindViewportTarget();
     return renderer_->readPixels(width, height);
 }
 
