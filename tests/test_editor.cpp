@@ -491,6 +491,26 @@ TEST(Files, UnwritableFolderAndBadLevelGiveMessagesNotCrashes) {
     EXPECT_FALSE(std::filesystem::exists(f.tmp.path / "dup.json"));
 }
 
+TEST(Files, AReadOnlyFolderGivesAMessageForSaveAndAutosave) {
+    // /proc takes no new files, even from root (CI runs as root, where a
+    // chmod'ed folder would still be writable).
+    Fixture f("orbit.json");
+    ASSERT_TRUE(f.ed.applyEdit("G", [](Scene& s) {
+        s.world.G = 4.0;
+        return true;
+    }));
+    const std::string edited = textOf(f.ed.doc.scene);
+    EXPECT_FALSE(f.ed.saveAs("/proc/stepwise-level.json"));
+    EXPECT_NE(f.ed.errorModal.find("Cannot save /proc/stepwise-level.json"), std::string::npos) << f.ed.errorModal;
+    EXPECT_TRUE(f.ed.dirty());  // nothing was saved, and nothing is lost
+    EXPECT_EQ(textOf(f.ed.doc.scene), edited);
+    f.ed.configDir = "/proc/stepwise-config";
+    EXPECT_FALSE(f.ed.tickAutosave(0.0));
+    EXPECT_FALSE(f.ed.tickAutosave(31.0));
+    EXPECT_EQ(f.ed.status.rfind("autosave failed: ", 0), 0u) << f.ed.status;
+    EXPECT_EQ(textOf(f.ed.doc.scene), edited);
+}
+
 TEST(Files, UnsavedChangesAreAskedAbout) {
     Fixture f("orbit.json");
     f.ed.request(PendingAction::New);  // clean: happens at once
