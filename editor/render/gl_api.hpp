@@ -85,4 +85,10 @@ struct GlApi {
     std::string load(GetProcAddress getProc);
 };
 
+/// Compiles a vertex and a fragment shader from full sources and links
+/// them; `label` names them in the error. Returns the program, or 0 with
+/// the compiler's or linker's log in `error`.
+GLuint linkProgram(const GlApi& gl, const std::string& vertexSource, const std::string& fragmentSource,
+                   const std::string& label, std::string& error);
+
 } // namespace stepwise::render

@@ -89,50 +89,25 @@ struct Renderer::Impl {
         }
     }
 
-    Result<GLuint> compile(GLenum stage, std::string_view name) {
+    /// The embedded shader `name` with the #version line, and for vertex
+    /// shaders the shared quad.glsl, in front; empty when not embedded.
+    static std::string source(GLenum stage, std::string_view name) {
         const std::string_view body = findShader(name);
-        if (body.empty()) return Error{"shader " + std::string(name) + " is not embedded"};
-        std::string source = "#version 330 core\n";
-        if (stage == GL_VERTEX_SHADER) source += std::string(findShader("quad.glsl"));
-        source += "#line 1\n";
-        source += body;
-        const GLuint shader = gl.CreateShader(stage);
-        const char* text = source.c_str();
-        gl.ShaderSource(shader, 1, &text, nullptr);
-        gl.CompileShader(shader);
-        GLint ok = 0;
-        gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-        if (!ok) {
-            char log[4096] = {};
-            gl.GetShaderInfoLog(shader, sizeof log, nullptr, log);
-            gl.DeleteShader(shader);
-            return Error{"shader " + std::string(name) + " does not compile:\n" + log};
-        }
-        return shader;
+        if (body.empty()) return {};
+        std::string text = "#version 330 core\n";
+        if (stage == GL_VERTEX_SHADER) text += std::string(findShader("quad.glsl"));
+        text += "#line 1\n";
+        text += body;
+        return text;
     }
 
     Result<GLuint> link(std::string_view vert, std::string_view frag) {
-        Result<GLuint> vs = compile(GL_VERTEX_SHADER, vert);
-        if (!vs) return Error{vs.error()};
-        Result<GLuint> fs = compile(GL_FRAGMENT_SHADER, frag);
-        if (!fs) {
-            gl.DeleteShader(*vs);
-            return Error{fs.error()};
-        }
-        const GLuint program = gl.CreateProgram();
-        gl.AttachShader(program, *vs);
-        gl.AttachShader(program, *fs);
-        gl.LinkProgram(program);
-        gl.DeleteShader(*vs);
-        gl.DeleteShader(*fs);
-        GLint ok = 0;
-        gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char log[4096] = {};
-            gl.GetProgramInfoLog(program, sizeof log, nullptr, log);
-            gl.DeleteProgram(program);
-            return Error{"program " + std::string(vert) + " + " + std::string(frag) + " does not link:\n" + log};
-        }
+        const std::string vs = source(GL_VERTEX_SHADER, vert), fs = source(GL_FRAGMENT_SHADER, frag);
+        if (vs.empty()) return Error{"shader " + std::string(vert) + " is not embedded"};
+        if (fs.empty()) return Error{"shader " + std::string(frag) + " is not embedded"};
+        std::string error;
+        const GLuint program = linkProgram(gl, vs, fs, std::string(vert) + " + " + std::string(frag), error);
+        if (!program) return Error{error};
         return program;
     }
 

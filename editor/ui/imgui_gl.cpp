@@ -65,32 +65,9 @@ Result<std::unique_ptr<ImGuiGl>> ImGuiGl::create(render::GetProcAddress getProc)
     if (std::string missing = im.gl.load(getProc); !missing.empty())
         return Error{"OpenGL entry point " + missing + " is missing"};
     Gl& gl = im.gl;
-    auto compile = [&](GLenum type, const char* src, std::string& log) -> GLuint {
-        const GLuint s = gl.CreateShader(type);
-        gl.ShaderSource(s, 1, &src, nullptr);
-        gl.CompileShader(s);
-        GLint ok = 0;
-        gl.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
-        if (!ok) {
-            char buffer[1024] = {};
-            gl.GetShaderInfoLog(s, sizeof buffer, nullptr, buffer);
-            log = buffer;
-        }
-        return s;
-    };
-    std::string log;
-    const GLuint vs = compile(GL_VERTEX_SHADER, kVertex, log);
-    const GLuint fs = compile(GL_FRAGMENT_SHADER, kFragment, log);
-    if (!log.empty()) return Error{"ImGui shader: " + log};
-    im.program = gl.CreateProgram();
-    gl.AttachShader(im.program, vs);
-    gl.AttachShader(im.program, fs);
-    gl.LinkProgram(im.program);
-    gl.DeleteShader(vs);
-    gl.DeleteShader(fs);
-    GLint linked = 0;
-    gl.GetProgramiv(im.program, GL_LINK_STATUS, &linked);
-    if (!linked) return Error{"ImGui shader program does not link"};
+    std::string error;
+    im.program = render::linkProgram(gl, kVertex, kFragment, "ImGui", error);
+    if (!im.program) return Error{error};
     im.projection = gl.GetUniformLocation(im.program, "uProjection");
     im.texture = gl.GetUniformLocation(im.program, "uTexture");
     gl.GenVertexArrays(1, &im.vao);

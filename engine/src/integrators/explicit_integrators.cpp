@@ -109,7 +109,28 @@ template <bool Drag>
 // accelerations depend on the stage velocity only, so the whole step of a
 // body runs in registers, one pass instead of four force evaluations and
 // four combination passes. Same operations, same order as Rk4::step with
-// ForceModel::accelerations (a = g, then a -= r v).
+// ForceModel::accelerations (a = g, then a -= r v). T is V8 (four bodies)
+// or double (one coordinate of the tail): the same code for both.
+template <bool Drag, class T>
+[[gnu::always_inline]] inline void rk4Stages(T x, T v, T r, T g, double h, T& xn, T& vn) {
+    const double h2 = 0.5 * h, h3 = h / 3.0, h6 = h / 6.0;
+    T a = Drag ? g - r * v : g;  // k1
+    xn = x + h6 * v;
+    vn = v + h6 * a;
+    T vs = v + h2 * a;
+    a = Drag ? g - r * vs : g;  // k2
+    xn += h3 * vs;
+    vn += h3 * a;
+    vs = v + h2 * a;
+    a = Drag ? g - r * vs : g;  // k3
+    xn += h3 * vs;
+    vn += h3 * a;
+    vs = v + h * a;
+    a = Drag ? g - r * vs : g;  // k4
+    xn += h6 * vs;
+    vn += h6 * a;
+}
+
 template <bool Drag>
 [[gnu::always_inline]] inline bool rk4Local(const LocalArgs& k) {
     const double* __restrict x0 = k.x0;
@@ -118,7 +139,6 @@ template <bool Drag>
     double* __restrict v1 = k.v1;
     const double* __restrict rate = k.rate;
     const double h = k.h, gx = k.gx, gy = k.gy;
-    const double h2 = 0.5 * h, h3 = h / 3.0, h6 = h / 6.0;
     const std::size_t n = k.n;  // a local: the stores could alias k
     const V8 g = {gx, gy, gx, gy, gx, gy, gx, gy};
     U8 bad8 = {};
@@ -133,21 +153,8 @@ template <bool Drag>
             std::memcpy(&r4, rate + b, sizeof r4);
             r = __builtin_shufflevector(r4, r4, 0, 0, 1, 1, 2, 2, 3, 3);
         }
-        V8 a = Drag ? g - r * v : g;  // k1
-        V8 xn = x + h6 * v;
-        V8 vn = v + h6 * a;
-        V8 vs = v + h2 * a;
-        a = Drag ? g - r * vs : g;  // k2
-        xn += h3 * vs;
-        vn += h3 * a;
-        vs = v + h2 * a;
-        a = Drag ? g - r * vs : g;  // k3
-        xn += h3 * vs;
-        vn += h3 * a;
-        vs = v + h * a;
-        a = Drag ? g - r * vs : g;  // k4
-        xn += h6 * vs;
-        vn += h6 * a;
+        V8 xn, vn;
+        rk4Stages<Drag>(x, v, r, g, h, xn, vn);
         std::memcpy(v1 + 2 * b, &vn, sizeof vn);
         std::memcpy(x1 + 2 * b, &xn, sizeof xn);
         bad8 |= (U8)(vn - vn) | (U8)(xn - xn);
@@ -157,22 +164,8 @@ template <bool Drag>
     for (std::size_t i = 2 * b; i < 2 * n; ++i) {
         const double r = Drag ? rate[i / 2] : 0.0;
         const double gi = (i & 1) ? gy : gx;
-        const double v = v0[i];
-        double a = Drag ? gi - r * v : gi;  // k1
-        double xn = x0[i] + h6 * v;
-        double vn = v + h6 * a;
-        double vs = v + h2 * a;
-        a = Drag ? gi - r * vs : gi;  // k2
-        xn += h3 * vs;
-        vn += h3 * a;
-        vs = v + h2 * a;
-        a = Drag ? gi - r * vs : gi;  // k3
-        xn += h3 * vs;
-        vn += h3 * a;
-        vs = v + h * a;
-        a = Drag ? gi - r * vs : gi;  // k4
-        xn += h6 * vs;
-        vn += h6 * a;
+        double xn, vn;
+        rk4Stages<Drag>(x0[i], v0[i], r, gi, h, xn, vn);
         v1[i] = vn;
         x1[i] = xn;
         bad |= nonFiniteBits(vn) | nonFiniteBits(xn);
