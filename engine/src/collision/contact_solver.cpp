@@ -17,10 +17,6 @@ inline Vec2 tangentOf(Vec2 n) { return {n.y, -n.x}; }
 inline double normalSpeed(const SolverBody& a, const SolverBody& b, Vec2 n, double rnA, double rnB) {
     return dot(b.v - a.v, n) + b.w * rnB - a.w * rnA;
 }
-/// Same along the tangent, where cross(r, t) = -dot(r, n).
-inline double tangentSpeed(const SolverBody& a, const SolverBody& b, Vec2 t, double dnA, double dnB) {
-    return dot(b.v - a.v, t) - b.w * dnB + a.w * dnA;
-}
 /// Applies impulse magnitude `j` along unit `dir`, whose lever arms are
 /// cross(rA, dir) = armA and cross(rB, dir) = armB.
 inline void applyImpulse(SolverBody& a, SolverBody& b, Vec2 dir, double armA, double armB, double j) {

@@ -112,7 +112,7 @@ template <bool Drag>
 // ForceModel::accelerations (a = g, then a -= r v). T is V8 (four bodies)
 // or double (one coordinate of the tail): the same code for both.
 template <bool Drag, class T>
-[[gnu::always_inline]] inline void rk4Stages(T x, T v, T r, T g, double h, T& xn, T& vn) {
+[[gnu::always_inline]] inline void rk4Stages(const T& x, const T& v, const T& r, const T& g, double h, T& xn, T& vn) {
     const double h2 = 0.5 * h, h3 = h / 3.0, h6 = h / 6.0;
     T a = Drag ? g - r * v : g;  // k1
     xn = x + h6 * v;
