@@ -52,67 +52,28 @@ struct LocalArgs {
 
 inline std::uint64_t nonFiniteBits(double v) { return std::bit_cast<std::uint64_t>(v - v); }
 
+// The per-body updates, for T = V8 (four bodies of the interleaved state)
+// or double (one coordinate of the tail): the same code, so the same
+// operations in the same order, for both.
+//
 // Semi-implicit Euler: v1 = v0 + h (g - r v0), x1 = x0 + h v1 (without drag
-// v1 = v0 + h g). Returns true when all of x1, v1 is finite.
-template <bool Drag>
-[[gnu::always_inline]] inline bool eulerLocal(const LocalArgs& k) {
-    const double* __restrict x0 = k.x0;
-    const double* __restrict v0 = k.v0;
-    double* __restrict x1 = k.x1;
-    double* __restrict v1 = k.v1;
-    const double* __restrict rate = k.rate;
-    const double h = k.h, gx = k.gx, gy = k.gy;
-    const std::size_t n = k.n;  // a local: the stores could alias k
-    const V8 g = {gx, gy, gx, gy, gx, gy, gx, gy};
-    U8 bad8 = {};
-    std::size_t b = 0;
-    for (; b + 4 <= n; b += 4) {
-        V8 v, x;
-        std::memcpy(&v, v0 + 2 * b, sizeof v);
-        std::memcpy(&x, x0 + 2 * b, sizeof x);
-        V8 vn;
-        if constexpr (Drag) {
-            V4 r4;
-            std::memcpy(&r4, rate + b, sizeof r4);
-            const V8 r = __builtin_shufflevector(r4, r4, 0, 0, 1, 1, 2, 2, 3, 3);
-            vn = v + h * (g - r * v);
-        } else {
-            vn = v + h * g;
-        }
-        const V8 xn = x + h * vn;
-        std::memcpy(v1 + 2 * b, &vn, sizeof vn);
-        std::memcpy(x1 + 2 * b, &xn, sizeof xn);
-        bad8 |= (U8)(vn - vn) | (U8)(xn - xn);
-    }
-    std::uint64_t bad = 0;
-    for (int lane = 0; lane < 8; ++lane) bad |= bad8[lane];
-    for (; b < n; ++b) {
-        double vx, vy;
-        if constexpr (Drag) {
-            vx = v0[2 * b] + h * (gx - rate[b] * v0[2 * b]);
-            vy = v0[2 * b + 1] + h * (gy - rate[b] * v0[2 * b + 1]);
-        } else {
-            vx = v0[2 * b] + h * gx;
-            vy = v0[2 * b + 1] + h * gy;
-        }
-        const double px = x0[2 * b] + h * vx, py = x0[2 * b + 1] + h * vy;
-        v1[2 * b] = vx;
-        v1[2 * b + 1] = vy;
-        x1[2 * b] = px;
-        x1[2 * b + 1] = py;
-        bad |= nonFiniteBits(vx) | nonFiniteBits(vy) | nonFiniteBits(px) | nonFiniteBits(py);
-    }
-    return bad == 0;
+// v1 = v0 + h g).
+template <bool Drag, class T>
+[[gnu::always_inline]] inline void eulerBody(const T& x, const T& v, const T& r, const T& g, double h, T& xn, T& vn) {
+    if constexpr (Drag)
+        vn = v + h * (g - r * v);
+    else
+        vn = v + h * g;
+    xn = x + h * vn;
 }
 
 // Classical RK4 (the Rk4 class below) with a = g - r v: the stage
 // accelerations depend on the stage velocity only, so the whole step of a
 // body runs in registers, one pass instead of four force evaluations and
 // four combination passes. Same operations, same order as Rk4::step with
-// ForceModel::accelerations (a = g, then a -= r v). T is V8 (four bodies)
-// or double (one coordinate of the tail): the same code for both.
+// ForceModel::accelerations (a = g, then a -= r v).
 template <bool Drag, class T>
-[[gnu::always_inline]] inline void rk4Stages(const T& x, const T& v, const T& r, const T& g, double h, T& xn, T& vn) {
+[[gnu::always_inline]] inline void rk4Body(const T& x, const T& v, const T& r, const T& g, double h, T& xn, T& vn) {
     const double h2 = 0.5 * h, h3 = h / 3.0, h6 = h / 6.0;
     T a = Drag ? g - r * v : g;  // k1
     xn = x + h6 * v;
@@ -131,8 +92,11 @@ template <bool Drag, class T>
     vn += h6 * a;
 }
 
-template <bool Drag>
-[[gnu::always_inline]] inline bool rk4Local(const LocalArgs& k) {
+// One pass over the state: reads x0, v0 (and the drag rates), writes x1, v1
+// with Euler's or RK4's update, and returns true when every value written
+// is finite.
+template <bool Rk, bool Drag>
+[[gnu::always_inline]] inline bool localPass(const LocalArgs& k) {
     const double* __restrict x0 = k.x0;
     const double* __restrict v0 = k.v0;
     double* __restrict x1 = k.x1;
@@ -151,10 +115,13 @@ template <bool Drag>
         if constexpr (Drag) {
             V4 r4;
             std::memcpy(&r4, rate + b, sizeof r4);
-            r = __builtin_shufflevector(r4, r4, 0, 0, 1, 1, 2, 2, 3, 3);
+            r = __builtin_shufflevector(r4, r4, 0, 0, 1, 1, 2, 2, 3, 3);  // (r0 r0 r1 r1 ...)
         }
         V8 xn, vn;
-        rk4Stages<Drag>(x, v, r, g, h, xn, vn);
+        if constexpr (Rk)
+            rk4Body<Drag>(x, v, r, g, h, xn, vn);
+        else
+            eulerBody<Drag>(x, v, r, g, h, xn, vn);
         std::memcpy(v1 + 2 * b, &vn, sizeof vn);
         std::memcpy(x1 + 2 * b, &xn, sizeof xn);
         bad8 |= (U8)(vn - vn) | (U8)(xn - xn);
@@ -165,7 +132,10 @@ template <bool Drag>
         const double r = Drag ? rate[i / 2] : 0.0;
         const double gi = (i & 1) ? gy : gx;
         double xn, vn;
-        rk4Stages<Drag>(x0[i], v0[i], r, gi, h, xn, vn);
+        if constexpr (Rk)
+            rk4Body<Drag>(x0[i], v0[i], r, gi, h, xn, vn);
+        else
+            eulerBody<Drag>(x0[i], v0[i], r, gi, h, xn, vn);
         v1[i] = vn;
         x1[i] = xn;
         bad |= nonFiniteBits(vn) | nonFiniteBits(xn);
@@ -179,17 +149,17 @@ using LocalKernel = bool (*)(const LocalArgs&);
 // kernel is compiled inside each, with that function's instruction set.
 template <bool Rk, bool Drag>
 bool localBaseline(const LocalArgs& k) {
-    return Rk ? rk4Local<Drag>(k) : eulerLocal<Drag>(k);
+    return localPass<Rk, Drag>(k);
 }
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define STEPWISE_X86_DISPATCH 1
 template <bool Rk, bool Drag>
 __attribute__((target("avx2"))) bool localAvx2(const LocalArgs& k) {
-    return Rk ? rk4Local<Drag>(k) : eulerLocal<Drag>(k);
+    return localPass<Rk, Drag>(k);
 }
 template <bool Rk, bool Drag>
 __attribute__((target("avx512f"))) bool localAvx512(const LocalArgs& k) {
-    return Rk ? rk4Local<Drag>(k) : eulerLocal<Drag>(k);
+    return localPass<Rk, Drag>(k);
 }
 #endif
 
