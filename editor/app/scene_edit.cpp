@@ -333,37 +333,39 @@ Entity addPlane(Scene& scene, Vec2 through, Vec2 normal) {
     return e;
 }
 
-Entity addSpring(Scene& scene, Entity a, Entity b) {
-    Registry& reg = scene.registry;
-    // Springs name their ends: give unnamed bodies a name first.
-    for (Entity end : {a, b})
-        if (const Name* n = reg.tryGet<Name>(end); !n || n->value.empty())
-            reg.emplace(end, Name{uniqueName(reg, "body")});
-    Spring s;
-    s.a = reg.tryGet<Name>(a)->value;
-    s.b = reg.tryGet<Name>(b)->value;
+namespace {
+/// Springs name their ends: gives an unnamed body a name first.
+const std::string& nameForSpring(Registry& reg, Entity body) {
+    if (const Name* n = reg.tryGet<Name>(body); !n || n->value.empty()) reg.emplace(body, Name{uniqueName(reg, "body")});
+    return reg.tryGet<Name>(body)->value;
+}
+
+/// The palette's spring from body `a` to `other` (a body's name or an
+/// anchor point), 50 N/m and 0.5 N s/m, resting at its current length.
+Entity addPaletteSpring(Registry& reg, Entity a, Spring s, Vec2 otherEnd) {
+    s.a = nameForSpring(reg, a);
     s.k = 50.0;
     s.damping = 0.5;
-    s.restLength = length(reg.tryGet<Position>(a)->value - reg.tryGet<Position>(b)->value);
+    s.restLength = length(reg.tryGet<Position>(a)->value - otherEnd);
     const Entity e = reg.create();
     reg.emplace(e, Name{uniqueName(reg, "spring")});
     reg.emplace(e, std::move(s));
     return e;
 }
+} // namespace
+
+Entity addSpring(Scene& scene, Entity a, Entity b) {
+    Registry& reg = scene.registry;
+    nameForSpring(reg, a);  // a before b, so unnamed ends become body, body_2 in that order
+    Spring s;
+    s.b = nameForSpring(reg, b);
+    return addPaletteSpring(reg, a, std::move(s), reg.tryGet<Position>(b)->value);
+}
 
 Entity addAnchoredSpring(Scene& scene, Entity a, Vec2 anchor) {
-    Registry& reg = scene.registry;
-    if (const Name* n = reg.tryGet<Name>(a); !n || n->value.empty()) reg.emplace(a, Name{uniqueName(reg, "body")});
     Spring s;
-    s.a = reg.tryGet<Name>(a)->value;
     s.anchor = anchor;
-    s.k = 50.0;
-    s.damping = 0.5;
-    s.restLength = length(reg.tryGet<Position>(a)->value - anchor);
-    const Entity e = reg.create();
-    reg.emplace(e, Name{uniqueName(reg, "spring")});
-    reg.emplace(e, std::move(s));
-    return e;
+    return addPaletteSpring(scene.registry, a, std::move(s), anchor);
 }
 
 Entity addAttractor(Scene& scene, Vec2 at, double mass) {
