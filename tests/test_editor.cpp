@@ -618,37 +618,17 @@ TEST(Files, AutosaveKilledAtRandomPointsLeavesAWholeRecoveryFile) {
     std::mt19937 rng(20261201u);
     std::uniform_int_distribution<long long> delayMicros(0, 2 * micros);
     for (int kill = 0; kill < kKills; ++kill) {
-        int ready[2];
-        ASSERT_EQ(::pipe(ready), 0);
-        const pid_t child = ::fork();
-        ASSERT_GE(child, 0);
-        if (child == 0) {
-            ::close(ready[0]);
-            // One whole autosave first, then tell the parent to start the
-            // clock, then autosave forever (a new version each time).
-            double now = 100.0 + 31.0 * kill;
-            if (!autosave(kill, now)) _exit(1);
-            if (::write(ready[1], "r", 1) != 1) _exit(1);
-            for (int k = kill + 1;; ++k)
-                if (!autosave(k, now += 31.0)) _exit(1);
-        }
-        ::close(ready[1]);
-        char byte = 0;
-        const bool started = ::read(ready[0], &byte, 1) == 1;
-        ::close(ready[0]);
-        if (!started) {
-            int status = 0;
-            ::waitpid(child, &status, 0);
-            FAIL() << "kill " << kill << ": the autosaving child failed before its loop (status " << status << ")";
-        }
-        std::this_thread::sleep_for(std::chrono::microseconds(delayMicros(rng)));
-        ASSERT_EQ(::kill(child, SIGKILL), 0);
-        int status = 0;
-        ASSERT_EQ(::waitpid(child, &status, 0), child);
-        ASSERT_TRUE(WIFSIGNALED(status)) << "kill " << kill << ": the autosaving child ended by itself";
-        const std::string now = readFile(recovery);
-        ASSERT_TRUE(now == versions[0] || now == versions[1])
-            << "kill " << kill << ": the recovery file is neither version (" << now.size() << " bytes)";
+        // One whole autosave first, then autosave forever (a new version
+        // each time) until killed.
+        double now = 100.0 + 31.0 * kill;
+        int k = kill;
+        const std::string killed = stepwise::test::killWhileWorking(
+            [&] { return autosave(k, now); }, [&] { return autosave(++k, now += 31.0); },
+            std::chrono::microseconds(delayMicros(rng)));
+        ASSERT_EQ(killed, "") << "kill " << kill;
+        const std::string onDisk = readFile(recovery);
+        ASSERT_TRUE(onDisk == versions[0] || onDisk == versions[1])
+            << "kill " << kill << ": the recovery file is neither version (" << onDisk.size() << " bytes)";
     }
     // A fresh editor on the level is offered the recovery copy and gets it whole.
     Editor again;

@@ -121,37 +121,15 @@ TEST(SaveUnderFault, SigkillAtRandomPointsLeavesEitherTheOldOrTheNewFileNeverAPa
     int onDisk = 0;  // which version the file holds
     int changed = 0, killedMidSave = 0;
     for (int kill = 0; kill < kKills; ++kill) {
-        int ready[2];
-        ASSERT_EQ(::pipe(ready), 0);
-        const pid_t child = ::fork();
-        ASSERT_GE(child, 0);
-        if (child == 0) {
-            // A fresh child first pays for copy-on-write faults (under ASan,
-            // tens of milliseconds), so it warms up with a save of the bytes
-            // already on disk and only then tells the parent to start the
-            // clock. Then it alternates versions forever, starting with the
-            // one not on disk, so every completed rename changes the file.
-            ::close(ready[0]);
-            if (!saveSceneFile(scenes[onDisk], level)) _exit(1);
-            if (::write(ready[1], "r", 1) != 1) _exit(1);
-            for (int k = 1;; ++k)
-                if (!saveSceneFile(scenes[(onDisk + k) % 2], level)) _exit(1);
-        }
-        ::close(ready[1]);
-        char byte = 0;
-        const bool started = ::read(ready[0], &byte, 1) == 1;
-        ::close(ready[0]);
-        if (!started) {  // the child failed before its loop: report how
-            int status = 0;
-            ::waitpid(child, &status, 0);
-            FAIL() << "kill " << kill << ": the saving child could not start (status " << status << ")";
-        }
-        std::this_thread::sleep_for(std::chrono::microseconds(delay(kill)));
-        ASSERT_EQ(::kill(child, SIGKILL), 0);
-        int status = 0;
-        ASSERT_EQ(::waitpid(child, &status, 0), child);
-        ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL)
-            << "kill " << kill << ": the saving child ended by itself (a failed save exits 1), status " << status;
+        // The child warms up with a save of the bytes already on disk, then
+        // alternates versions forever, starting with the one not on disk, so
+        // every completed rename changes the file.
+        int k = 0;
+        const std::string killed = stepwise::test::killWhileWorking(
+            [&] { return bool(saveSceneFile(scenes[onDisk], level)); },
+            [&] { return bool(saveSceneFile(scenes[(onDisk + ++k) % 2], level)); },
+            std::chrono::microseconds(delay(kill)));
+        ASSERT_EQ(killed, "") << "kill " << kill;
 
         const std::string now = readFile(level);
         ASSERT_TRUE(now == bytes[0] || now == bytes[1])

@@ -2,10 +2,17 @@
 /// \file test_support.hpp
 /// Small helpers the test files share.
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
+#include <thread>
 
 namespace stepwise::test {
 
@@ -16,6 +23,44 @@ inline std::string readFile(const std::filesystem::path& p) {
     std::ostringstream s;
     s << in.rdbuf();
     return s.str();
+}
+
+/// The saves-under-fault tests' harness: forks a child that runs `warmUp`
+/// once (a fresh child first pays for copy-on-write faults, tens of
+/// milliseconds under ASan, so the clock starts after it), tells the parent
+/// it is ready, then runs `work` until it fails or is killed. The parent
+/// waits `delay` after "ready", kills the child with SIGKILL and reaps it.
+/// Returns "" when the child was killed in its loop, else what happened
+/// (either function returning false ends the child with exit 1).
+inline std::string killWhileWorking(const std::function<bool()>& warmUp, const std::function<bool()>& work,
+                                    std::chrono::microseconds delay) {
+    int ready[2];
+    if (::pipe(ready) != 0) return "pipe failed";
+    const pid_t child = ::fork();
+    if (child < 0) return "fork failed";
+    if (child == 0) {
+        ::close(ready[0]);
+        if (!warmUp()) _exit(1);
+        if (::write(ready[1], "r", 1) != 1) _exit(1);
+        while (work()) {
+        }
+        _exit(1);
+    }
+    ::close(ready[1]);
+    char byte = 0;
+    const bool started = ::read(ready[0], &byte, 1) == 1;
+    ::close(ready[0]);
+    int status = 0;
+    if (!started) {
+        ::waitpid(child, &status, 0);
+        return "the child failed before its loop (status " + std::to_string(status) + ")";
+    }
+    std::this_thread::sleep_for(delay);
+    if (::kill(child, SIGKILL) != 0) return "kill failed";
+    if (::waitpid(child, &status, 0) != child) return "waitpid failed";
+    if (!(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL))
+        return "the child ended by itself (a failed step exits 1), status " + std::to_string(status);
+    return "";
 }
 
 } // namespace stepwise::test
