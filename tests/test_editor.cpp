@@ -390,6 +390,32 @@ TEST(Simulation, SteppingThroughTheEditorMatchesTheWorld) {
     EXPECT_EQ(textOf(f.ed.doc.scene), textOf(expected));
 }
 
+TEST(Simulation, AMouseSpringDragBuildsTheWorldOnceAndPullsTheBody) {
+    Fixture f("spring_chain.json");  // link11, the free end, starts at (6, 0)
+    f.ed.tool = Tool::Select;
+    f.ed.togglePlay();
+    f.ed.update(1.0 / 60.0);
+    const std::uint64_t buildsBefore = f.ed.sim.worldBuilds();
+    const Entity link = findByName(f.ed.doc.scene.registry, "link11");
+    const Vec2 grab = f.ed.doc.scene.registry.tryGet<Position>(link)->value;
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseDown, grab));
+    ASSERT_TRUE(f.ed.sim.mouseSpring);
+    // The cursor moves every frame; the anchor follows without a rebuild.
+    const Vec2 target{6.0, 3.0};
+    for (int i = 1; i <= 60; ++i) {
+        f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseMove, grab + (target - grab) * std::min(1.0, i / 20.0)));
+        f.ed.update(1.0 / 60.0);
+    }
+    EXPECT_EQ(f.ed.sim.worldBuilds(), buildsBefore + 1);  // once, when the drag began
+    // Pulled up against gravity toward the cursor, from below y = 0.
+    const Vec2 held = f.ed.doc.scene.registry.tryGet<Position>(link)->value;
+    EXPECT_GT(held.y, 1.0) << held.x << ", " << held.y;
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseUp, target));
+    EXPECT_FALSE(f.ed.sim.mouseSpring);
+    f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.worldBuilds(), buildsBefore + 2);  // released: rebuilt without it
+}
+
 TEST(Simulation, DisabledSystemIsLeftOutOfTheWorld) {
     Fixture f("spring_chain.json");
     f.ed.sim.disabledSystems.insert("springs");

@@ -19,7 +19,7 @@ bool Simulation::canDisable(std::string_view system) {
            system == "boids" || system == "collisions";
 }
 
-Scene Simulation::simulationScene(const Scene& scene) const {
+Scene Simulation::simulationScene(const Scene& scene, Entity* mouseSpringEntity) const {
     Scene sim = scene;  // deep copy; the same entity handles, so writeBack lands on `scene`
     Registry& reg = sim.registry;
     auto off = [&](std::string_view s) { return disabledSystems.count(s) != 0; };
@@ -57,12 +57,16 @@ Scene Simulation::simulationScene(const Scene& scene) const {
         const Entity e = reg.create();
         reg.emplace(e, Name{uniqueName(reg, "mouse_spring")});
         reg.emplace(e, std::move(s));
+        if (mouseSpringEntity) *mouseSpringEntity = e;
     }
     return sim;
 }
 
 bool Simulation::rebuild(const Scene& scene) {
-    Result<World> built = World::build(simulationScene(scene));
+    builtMouseSpring_ = {};
+    Result<World> built = World::build(simulationScene(scene, &builtMouseSpring_));
+    ++worldBuilds_;
+    builtMouseBody_ = builtMouseSpring_.isNull() ? Entity{} : mouseSpring->first;
     if (!built) {
         world_.reset();
         message_ = "cannot simulate: " + built.error();
@@ -129,8 +133,12 @@ bool Simulation::stepOnce(Scene& scene) {
         return false;
     }
     if (mouseSpring) {
-        // The anchor moves with the cursor: rebuild so the spring sees it.
-        if (!rebuild(scene)) return false;
+        // The anchor follows the cursor. The World built with this drag's
+        // spring only moves the anchor; a new drag (or none built yet)
+        // rebuilds it with the spring.
+        const bool moved = !builtMouseSpring_.isNull() && builtMouseBody_ == mouseSpring->first &&
+                           world_->setSpringAnchor(builtMouseSpring_, mouseSpring->second);
+        if (!moved && !rebuild(scene)) return false;
     }
     history_.push_back(scene);
     while (history_.size() > historyCapacity_) history_.pop_front();

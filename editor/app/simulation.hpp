@@ -87,8 +87,12 @@ public:
     /// Systems whose switch works: the names the editor knows how to remove.
     static bool canDisable(std::string_view system);
     /// The scene the World is built from: switched-off systems removed,
-    /// the mouse spring added.
-    Scene simulationScene(const Scene& scene) const;
+    /// the mouse spring added (its entity in that scene goes to
+    /// `mouseSpringEntity` when given).
+    Scene simulationScene(const Scene& scene, Entity* mouseSpringEntity = nullptr) const;
+    /// Times the World was built since the program started (tests: a mouse
+    /// drag must not rebuild it every step).
+    std::uint64_t worldBuilds() const { return worldBuilds_; }
 
     /// Last message: divergence, break on contact, refusal. Empty when none.
     const std::string& message() const { return message_; }
@@ -129,6 +133,10 @@ private:
     bool diverged_ = false;
     bool touchingBefore_ = false;
     bool behind_ = false;
+    std::uint64_t worldBuilds_ = 0;
+    /// The mouse spring the current World was built with: its body and its
+    /// spring entity there (null when built without one).
+    Entity builtMouseBody_, builtMouseSpring_;
 };
 
 } // namespace stepwise::editor

@@ -100,6 +100,11 @@ public:
     const WorldSettings& settings() const;
     /// Changes the integrator by name (one of integratorNames()).
     Result<void> setIntegrator(std::string_view name);
+    /// Moves the fixed end of a spring whose second end is fixed (an
+    /// `anchor`, or a static body), metres: the editor's mouse spring follows the
+    /// cursor this way without rebuilding the world (which would also drop
+    /// the contacts' warm start). Fails when `spring` is not such a spring.
+    Result<void> setSpringAnchor(Entity spring, Vec2 anchor);
     double time() const;
 
     /// Systems this scene needs, in pipeline order: "gravity", "drag",

@@ -487,6 +487,16 @@ Result<void> World::setIntegrator(std::string_view name) {
     return {};
 }
 
+Result<void> World::setSpringAnchor(Entity spring, Vec2 anchor) {
+    for (detail::SpringData& s : impl_->model.springs)
+        if (s.entity == spring && s.b == detail::kNoBody) {
+            s.fx = anchor.x;
+            s.fy = anchor.y;
+            return {};
+        }
+    return Error{"no anchored spring with that entity in this world"};
+}
+
 double World::time() const { return impl_->settings.time; }
 
 std::vector<std::string_view> World::activeSystems() const { return impl_->active; }
