@@ -4,8 +4,12 @@
 #include "render/frame.hpp"
 
 #include "stepwise/components.hpp"
+#include "stepwise/world.hpp"
 
 #include <gtest/gtest.h>
+
+#include <optional>
+#include <set>
 
 using namespace stepwise;
 using namespace stepwise::render;
@@ -22,6 +26,37 @@ Scene ringOfCircles(int n) {
         scene.registry.emplace<Radius>(e, {0.2});
     }
     return scene;
+}
+
+/// rows x columns circles of radius 0.25 m touching in a square packing on
+/// a floor: about two contacts per body once stepped.
+Scene packedCircles(int rows, int columns) {
+    Scene scene;
+    const Entity floor = scene.registry.create();
+    scene.registry.emplace<Plane>(floor, {{0.0, 1.0}, 0.0});
+    for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < columns; ++c) {
+            Entity e = scene.registry.create();
+            scene.registry.emplace<Name>(e, {"c" + std::to_string(r * columns + c)});
+            scene.registry.emplace<Position>(e, {{0.5 * c, 0.25 + 0.5 * r}});
+            scene.registry.emplace<Velocity>(e, {{0.1 * (c % 5), -0.2}});
+            scene.registry.emplace<Mass>(e, {1.0});
+            scene.registry.emplace<Radius>(e, {0.25});
+        }
+    return scene;
+}
+
+std::size_t countOf(const DrawData& data, BatchKind kind) {
+    std::size_t n = 0;
+    for (const Batch& b : data.batches)
+        if (b.kind == kind) n += b.count();
+    return n;
+}
+
+/// Pixel position of a world point under `input`'s camera (frame.cpp's transform).
+Vec2 pixelOf(const FrameInput& input, Vec2 p, int w, int h) {
+    const double ppm = input.camera.pixelsPerMetre(h);
+    return {(p.x - input.camera.center.x) * ppm + 0.5 * w, (p.y - input.camera.center.y) * ppm + 0.5 * h};
 }
 
 TEST(RenderOverlays, ParsesNamesAllAndNone) {
@@ -113,6 +148,90 @@ TEST(RenderBatching, OffscreenBodiesAreCulled) {
     const DrawData data = buildDrawData(input, 800, 600);
     // Only the grid (Solid geometry) remains: no body is near the camera.
     for (const Batch& b : data.batches) EXPECT_EQ(b.kind, BatchKind::Solid);
+}
+
+TEST(RenderBatching, ContactMarkersAndAnchoredSpringsDoNotSplitBatches) {
+    // A contact is an arrow and a dot, an anchored spring a pin and
+    // segments. Drawn item by item they used to start a new batch (a draw
+    // call) per item: 4,000 draw calls for 2,000 contacts.
+    Scene scene = packedCircles(10, 20);
+    for (int i = 0; i < 20; ++i) {
+        Entity s = scene.registry.create();
+        scene.registry.emplace<Spring>(s, {"c" + std::to_string(180 + i), "", Vec2{0.5 * i, 8.0}, 50.0, 0.5, 2.0});
+    }
+    Result<World> world = World::build(scene);
+    ASSERT_TRUE(world.ok()) << world.error();
+    ASSERT_TRUE(world->step());
+    const std::size_t contacts = world->contacts().size();
+    ASSERT_GT(contacts, 300u);  // past CellThinner's limit, so some are thinned
+    FrameInput input;
+    input.scene = &scene;
+    input.world = &*world;
+    input.camera = fitCamera(scene, 1280, 800);
+    input.overlays.add(Overlay::Contacts);
+    const DrawData data = buildDrawData(input, 1280, 800);
+    // Grid, planes, springs, bodies, contacts, HUD: a handful of batches.
+    EXPECT_LE(data.batches.size(), 14u);
+    // Every kept contact has its arrow and its dot (the legend adds one arrow).
+    std::size_t contactDots = 0;
+    for (const Batch& b : data.batches)
+        if (b.kind == BatchKind::Disc)
+            for (std::size_t i = 0; i < b.count(); ++i) contactDots += b.data[i * 9 + 2] <= 3.0f ? 1 : 0;
+    EXPECT_EQ(countOf(data, BatchKind::Arrow), contactDots + 1);
+    EXPECT_GT(contactDots, 100u);
+    EXPECT_LT(contactDots, contacts);
+}
+
+TEST(RenderLevelOfDetail, FewArrowsAreAllDrawnEvenWhenCrowded) {
+    // 300 bodies (CellThinner's limit) 2 px apart: every arrow is drawn.
+    Scene scene = packedCircles(15, 20);
+    FrameInput input;
+    input.scene = &scene;
+    input.camera = Camera{{5.0, 4.0}, 4.0};
+    input.overlays.add(Overlay::Velocity);
+    input.hud = false;
+    EXPECT_EQ(countOf(buildDrawData(input, 1280, 800), BatchKind::Arrow), 300u);
+}
+
+TEST(RenderLevelOfDetail, CrowdedArrowsKeepOnePerCellAndTheSelection) {
+    Scene scene = packedCircles(40, 50);  // 2,000 bodies
+    FrameInput input;
+    input.scene = &scene;
+    input.camera = fitCamera(scene, 1280, 800);
+    input.overlays.add(Overlay::Velocity);
+    input.hud = false;
+    const int w = 1280, h = 800;
+    // One arrow per cell of max(24 px, half the 0.06 h reference arrow).
+    const double cell = std::max(24.0, 0.5 * 0.06 * h);
+    const double ppm = input.camera.pixelsPerMetre(h);
+    ASSERT_LT(0.5 * ppm, cell);  // bodies are closer than a cell
+    const DrawData thinned = buildDrawData(input, w, h);
+    const std::size_t arrows = countOf(thinned, BatchKind::Arrow);
+    const double bodiesSpanPx = 25.0 * ppm * 20.0 * ppm;  // 25 m x 20 m of bodies
+    EXPECT_LE(double(arrows), bodiesSpanPx / (cell * cell) + 2.0 * (25.0 + 20.0) * ppm / cell + 1.0);
+    EXPECT_GE(double(arrows), 0.5 * bodiesSpanPx / (cell * cell));
+    // Each kept arrow starts in its own cell.
+    std::set<std::pair<int, int>> cells;
+    for (const Batch& b : thinned.batches)
+        if (b.kind == BatchKind::Arrow)
+            for (std::size_t i = 0; i < b.count(); ++i)
+                EXPECT_TRUE(cells.insert({int(b.data[i * 9] / cell), int(b.data[i * 9 + 1] / cell)}).second);
+    // A selected body keeps its arrow even when its cell went to another.
+    auto arrowAt = [&](const DrawData& d, Vec2 at) {
+        for (const Batch& b : d.batches)
+            if (b.kind == BatchKind::Arrow)
+                for (std::size_t i = 0; i < b.count(); ++i)
+                    if (std::abs(b.data[i * 9] - at.x) < 1e-3 && std::abs(b.data[i * 9 + 1] - at.y) < 1e-3) return true;
+        return false;
+    };
+    std::optional<Entity> dropped;
+    scene.registry.each<Position, Velocity>([&](Entity e, const Position& p, const Velocity&) {
+        if (!dropped && !arrowAt(thinned, pixelOf(input, p.value, w, h))) dropped = e;
+    });
+    ASSERT_TRUE(dropped.has_value());
+    input.selection = {*dropped};
+    const Vec2 at = pixelOf(input, scene.registry.tryGet<Position>(*dropped)->value, w, h);
+    EXPECT_TRUE(arrowAt(buildDrawData(input, w, h), at));
 }
 
 TEST(RenderBatching, SameInputSameFloats) {

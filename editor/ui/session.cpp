@@ -229,7 +229,7 @@ void Session::frame(int width, int height, double frameSeconds) {
         for (const StageTime& s : w->lastStats().systems) average(ui_.stageAverage["system:" + std::string(s.name)], s.milliseconds);
     }
 
-    // Viewport: the shared renderer into an offscreen target of the image's size.
+    // Viewport: the shared renderer, straight into the window.
     const auto t2 = Clock::now();
     const int vw = std::max(16, int(ui_.viewportSize.x)), vh = std::max(16, int(ui_.viewportSize.y));
     editor_.setViewportSize(vw, vh);
