@@ -99,6 +99,7 @@ void applyTheme(float scale) {
     ImGuiStyle& style = ImGui::GetStyle();
     style = ImGuiStyle();
     ImGui::StyleColorsDark(&style);
+    style.AntiAliasedLinesUseTex = false;  // the font atlas is sampled nearest (ui/imgui_gl.cpp)
     style.WindowRounding = 0.0f;
     style.FrameRounding = 3.0f;
     style.GrabRounding = 3.0f;

@@ -98,10 +98,19 @@ void Session::loadFonts() {
     size = std::clamp(size, 8.0f, 48.0f);
     ui_.scale = size / 13.0f;
     bool loaded = false;
+    // No baked line textures: the atlas is sampled nearest (ui/imgui_gl.cpp).
+    io.Fonts->Flags |= ImFontAtlasFlags_NoBakedLines;
     if (!options_.builtinFont) {
+        // Glyphs rasterised at their drawn size and placed on whole pixels,
+        // so the atlas maps 1:1 to the screen and needs no filtering.
+        ImFontConfig config;
+        config.OversampleH = 1;
+        config.OversampleV = 1;
+        config.PixelSnapH = true;
         std::error_code ec;
         for (const char* path : kFontPaths)
-            if (std::filesystem::exists(path, ec) && io.Fonts->AddFontFromFileTTF(path, std::round(size * 1.1f))) {
+            if (std::filesystem::exists(path, ec) &&
+                io.Fonts->AddFontFromFileTTF(path, std::round(size * 1.1f), &config)) {
                 loaded = true;
                 break;
             }
