@@ -1,5 +1,7 @@
 // Signed-distance rounded rectangle.
 // Flags: 1 selected, 2 static (hatched), 4 outline only, 16 flat.
+// Compiled twice: with PLAIN defined, for batches of flat or outline boxes
+// that are neither selected nor static (Batch::plain), only those two.
 in vec2 vLocal;
 flat in vec2 vHalf;
 flat in vec4 vColor;
@@ -16,6 +18,10 @@ void main() {
     int flags = int(vStyle.x);
     float r = min(vStyle.y, min(vHalf.x, vHalf.y));
     float d = boxDistance(vLocal, vHalf, r);
+#ifdef PLAIN
+    float cover = (flags & 4) != 0 ? clamp(1.1 - abs(d), 0.0, 1.0) : clamp(0.5 - d, 0.0, 1.0);
+    fragColor = vec4(vColor.rgb, cover * vColor.a);
+#else
     vec3 base = vColor.rgb;
     vec3 c = base;
     float alpha;
@@ -41,4 +47,5 @@ void main() {
         alpha = max(alpha, ring);
     }
     fragColor = vec4(c, alpha);
+#endif
 }

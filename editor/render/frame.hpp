@@ -118,6 +118,12 @@ enum class BatchKind : std::uint8_t { Plane, Disc, Box, Segment, Arrow, Solid };
 
 struct Batch {
     BatchKind kind;
+    /// Discs and boxes: no instance uses the rarely drawn features
+    /// (selection ring, static hatching, attractor glow; for boxes, the
+    /// shading of a body), so the renderer may use a program compiled
+    /// without them. llvmpipe runs every branch of a shader for every pixel,
+    /// so code an instance does not use still costs.
+    bool plain = false;
     std::vector<float> data;  ///< instance (or vertex, for Solid) records, packed
     std::size_t count() const;
 };

@@ -49,6 +49,7 @@ struct Renderer::Impl {
     GlApi gl;
     struct KindState {
         GLuint program = 0;
+        GLuint plainProgram = 0;  ///< the fragment shader with PLAIN defined (Batch::plain); 0: none
         GLuint vao = 0;
         GLuint vbo = 0;
     };
@@ -84,6 +85,7 @@ struct Renderer::Impl {
         gl.DeleteBuffers(1, &quadIndices);
         for (KindState& k : kinds) {
             gl.DeleteProgram(k.program);
+            if (k.plainProgram) gl.DeleteProgram(k.plainProgram);
             gl.DeleteVertexArrays(1, &k.vao);
             gl.DeleteBuffers(1, &k.vbo);
         }
@@ -91,28 +93,25 @@ struct Renderer::Impl {
 
     /// The embedded shader `name` with the #version line, and for vertex
     /// shaders the shared quad.glsl, in front; empty when not embedded.
-    static std::string source(GLenum stage, std::string_view name) {
+    static std::string source(GLenum stage, std::string_view name, bool plain) {
         const std::string_view body = findShader(name);
         if (body.empty()) return {};
         std::string text = "#version 330 core\n";
+        if (plain) text += "#define PLAIN\n";
         if (stage == GL_VERTEX_SHADER) text += std::string(findShader("quad.glsl"));
         text += "#line 1\n";
         text += body;
         return text;
     }
 
-    Result<GLuint> link(std::string_view vert, std::string_view frag) {
-        const std::string vs = source(GL_VERTEX_SHADER, vert), fs = source(GL_FRAGMENT_SHADER, frag);
+    Result<GLuint> link(std::string_view vert, std::string_view frag, bool plain = false) {
+        const std::string vs = source(GL_VERTEX_SHADER, vert, plain), fs = source(GL_FRAGMENT_SHADER, frag, plain);
         if (vs.empty()) return Error{"shader " + std::string(vert) + " is not embedded"};
         if (fs.empty()) return Error{"shader " + std::string(frag) + " is not embedded"};
         std::string error;
         const GLuint program = linkProgram(gl, vs, fs, std::string(vert) + " + " + std::string(frag), error);
         if (!program) return Error{error};
         return program;
-    }
-
-    void uniform3(GLuint program, const char* name, const float* v) {
-        gl.Uniform3f(gl.GetUniformLocation(program, name), v[0], v[1], v[2]);
     }
 };
 
@@ -140,6 +139,11 @@ Result<std::unique_ptr<Renderer>> Renderer::create(GetProcAddress getProc) {
         if (!program) return Error{program.error()};
         Impl::KindState& st = im.kinds[k];
         st.program = *program;
+        if (kind == BatchKind::Disc || kind == BatchKind::Box) {
+            Result<GLuint> plain = im.link(vert, frag, true);
+            if (!plain) return Error{plain.error()};
+            st.plainProgram = *plain;
+        }
         im.gl.GenVertexArrays(1, &st.vao);
         im.gl.GenBuffers(1, &st.vbo);
         im.gl.BindVertexArray(st.vao);
@@ -199,11 +203,12 @@ void Renderer::draw(const DrawData& data, int originX, int originY) {
         if (count == 0) continue;
         const std::size_t k = std::size_t(std::find(kKinds.begin(), kKinds.end(), batch.kind) - kKinds.begin());
         const Impl::KindState& st = im.kinds[k];
-        gl.UseProgram(st.program);
-        gl.Uniform2f(gl.GetUniformLocation(st.program, "uViewport"), w, h);
-        if (GLint loc = gl.GetUniformLocation(st.program, "uArrow"); loc >= 0)
+        const GLuint program = batch.plain && st.plainProgram ? st.plainProgram : st.program;
+        gl.UseProgram(program);
+        gl.Uniform2f(gl.GetUniformLocation(program, "uViewport"), w, h);
+        if (GLint loc = gl.GetUniformLocation(program, "uArrow"); loc >= 0)
             gl.Uniform1i(loc, batch.kind == BatchKind::Arrow ? 1 : 0);
-        if (GLint loc = gl.GetUniformLocation(st.program, "uHighlight"); loc >= 0)
+        if (GLint loc = gl.GetUniformLocation(program, "uHighlight"); loc >= 0)
             gl.Uniform3f(loc, kHighlight[0], kHighlight[1], kHighlight[2]);
         gl.BindVertexArray(st.vao);
         gl.BindBuffer(GL_ARRAY_BUFFER, st.vbo);
