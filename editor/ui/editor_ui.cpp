@@ -6,6 +6,7 @@
 #include "stepwise/integrators.hpp"
 #include "stepwise/scene_io.hpp"
 
+#include <imgui_internal.h>
 #include <imgui_stdlib.h>
 
 #include <algorithm>
@@ -95,6 +96,30 @@ PanelRects defaultLayout(float width, float height, float scale) {
     return r;
 }
 
+bool beginPanel(const char* name, bool* open, ImGuiWindowFlags flags) {
+    const ImGuiContext& g = *GImGui;
+    const ImGuiWindow* self = ImGui::FindWindowByName(name);
+    // A drag that moves or resizes a window can make an overlap this frame.
+    const bool arranging = g.MovingWindow != nullptr ||
+                           (g.ActiveId != 0 && g.ActiveIdWindow != nullptr && g.ActiveIdWindow == g.ActiveIdWindow->RootWindow &&
+                            ImGui::IsMouseDragging(ImGuiMouseButton_Left) && g.ActiveIdWindow->Name != std::string_view("Viewport"));
+    bool alone = self != nullptr && !arranging;
+    if (alone) {
+        const ImRect rect = self->Rect();
+        for (const ImGuiWindow* w : g.Windows) {
+            if (w == self || !w->WasActive || w->Hidden) continue;
+            if ((w->Flags & (ImGuiWindowFlags_ChildWindow | ImGuiWindowFlags_Popup | ImGuiWindowFlags_Tooltip)) != 0)
+                continue;  // inside a window, or drawn over it with its own background
+            if (w->Rect().Overlaps(rect)) {
+                alone = false;
+                break;
+            }
+        }
+    }
+    if (alone) ImGui::SetNextWindowBgAlpha(0.0f);
+    return ImGui::Begin(name, open, flags);
+}
+
 void applyTheme(float scale) {
     ImGuiStyle& style = ImGui::GetStyle();
     style = ImGuiStyle();
@@ -111,8 +136,10 @@ void applyTheme(float scale) {
     style.ScrollbarSize = 12;
     ImVec4* c = style.Colors;
     // Panels a shade lighter than the viewport's #0f1218 so it reads as a canvas.
-    c[ImGuiCol_WindowBg] = {0.075f, 0.082f, 0.102f, 1.0f};
-    c[ImGuiCol_ChildBg] = {0.075f, 0.082f, 0.102f, 1.0f};
+    c[ImGuiCol_WindowBg] = kPanelBackground;
+    // Children (scrolling tables, lists) show their panel's background, or
+    // the cleared window of the same colour: drawing their own is overdraw.
+    c[ImGuiCol_ChildBg] = {kPanelBackground.x, kPanelBackground.y, kPanelBackground.z, 0.0f};
     c[ImGuiCol_PopupBg] = {0.10f, 0.11f, 0.135f, 0.98f};
     c[ImGuiCol_MenuBarBg] = {0.10f, 0.11f, 0.135f, 1.0f};
     c[ImGuiCol_TitleBg] = {0.10f, 0.11f, 0.135f, 1.0f};
@@ -244,7 +271,7 @@ void toolsPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     if (!ui.showTools) return;
     ImGui::SetNextWindowPos(r.toolsPos, ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(r.toolsSize, ImGuiCond_FirstUseEver);
-    if (ImGui::Begin("Tools", &ui.showTools)) {
+    if (beginPanel("Tools", &ui.showTools)) {
         const float bw = (ImGui::GetContentRegionAvail().x - ImGui::GetStyle().ItemSpacing.x) / 2;
         for (int t = 0; t < int(Tool::Count); ++t) {
             const Tool tool = Tool(t);
@@ -284,7 +311,7 @@ void entitiesPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     if (!ui.showEntities) return;
     ImGui::SetNextWindowPos(r.entitiesPos, ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(r.entitiesSize, ImGuiCond_FirstUseEver);
-    if (ImGui::Begin("Entities", &ui.showEntities)) {
+    if (beginPanel("Entities", &ui.showEntities)) {
         const Registry& reg = ed.doc.scene.registry;
         ImGui::SetNextItemWidth(-1);
         ImGui::InputTextWithHint("##filter", "filter by name or type", &ui.entityFilter);
@@ -441,7 +468,7 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     if (!ui.showWorld) return;
     ImGui::SetNextWindowPos(r.worldPos, ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(r.worldSize, ImGuiCond_FirstUseEver);
-    if (ImGui::Begin("World", &ui.showWorld)) {
+    if (beginPanel("World", &ui.showWorld)) {
         WorldSettings ws = ed.doc.scene.world;
         auto edited = [&](const char* label) {
             // One merge key per widget activation: a drag is one undo step.
@@ -717,7 +744,7 @@ void debugPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     if (!ui.showDebug) return;
     ImGui::SetNextWindowPos(r.debugPos, ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(r.debugSize, ImGuiCond_FirstUseEver);
-    if (ImGui::Begin("Debug", &ui.showDebug)) {
+    if (beginPanel("Debug", &ui.showDebug)) {
         if (ImGui::BeginTabBar("debugtabs")) {
             const char* names[] = {"Contacts", "Plots", "Profile", "History"};
             for (int t = 0; t < 4; ++t) {
@@ -776,7 +803,7 @@ void helpWindow(UiState& ui) {
     if (!ui.showHelp) return;
     ImGui::SetNextWindowSize(ImVec2(520 * ui.scale, 520 * ui.scale), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowPos(ImGui::GetMainViewport()->GetCenter(), ImGuiCond_FirstUseEver, ImVec2(0.5f, 0.5f));
-    if (ImGui::Begin("Help: shortcuts", &ui.showHelp)) {
+    if (beginPanel("Help: shortcuts", &ui.showHelp)) {
         if (ImGui::BeginTable("keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
             ImGui::TableSetupColumn("keys", ImGuiTableColumnFlags_WidthFixed, 170 * ui.scale);
             ImGui::TableSetupColumn("does");

@@ -109,13 +109,14 @@ ImGuiGl::~ImGuiGl() {
 
 void ImGuiGl::rebuildFonts() { impl_->uploadFonts(); }
 
-void ImGuiGl::clear(int fbWidth, int fbHeight) {
+void ImGuiGl::clear(int fbWidth, int fbHeight, const ImVec4& colour) {
     Gl& gl = impl_->gl;
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.Disable(GL_SCISSOR_TEST);
     gl.Viewport(0, 0, fbWidth, fbHeight);
-    // Behind the panels: the theme's window colour, so gaps look intended.
-    gl.ClearColor(0.075f, 0.082f, 0.102f, 1.0f);
+    // The panels' colour: gaps between them look intended, and a panel
+    // alone can leave its background out (ui::beginPanel).
+    gl.ClearColor(colour.x, colour.y, colour.z, colour.w);
     gl.Clear(GL_COLOR_BUFFER_BIT);
 }
 

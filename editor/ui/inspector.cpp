@@ -102,7 +102,7 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label) {
 } // namespace
 
 void drawInspector(UiState& ui, Editor& ed) {
-    if (!ImGui::Begin("Inspector", &ui.showInspector)) {
+    if (!beginPanel("Inspector", &ui.showInspector)) {
         ImGui::End();
         return;
     }

@@ -255,7 +255,7 @@ void Session::frame(int width, int height, double frameSeconds) {
     input.caption.clear();
     // Straight into the window at the viewport panel's place (GL counts
     // rows from the bottom), under the panels ImGui draws next.
-    gl_->clear(width, height);
+    gl_->clear(width, height, kPanelBackground);
     renderer_->render(input, vw, vh, int(ui_.viewportPos.x), height - int(ui_.viewportPos.y) - vh);
     const double sceneMs = msSince(t2);
     // The font rebuild must happen between frames.
