@@ -224,20 +224,18 @@ void Renderer::draw(const DrawData& data, int originX, int originY) {
             // instanced draws one instance at a time (~1-6 us each), while a
             // plain indexed draw runs its vertices through SIMD batches.
             const std::size_t stride = floatsPerInstance(batch.kind);
-            const std::size_t quadsPer = batch.kind == BatchKind::Arrow ? 2 : 1;
-            const std::size_t verticesPer = 4 * quadsPer;
-            im.expanded.resize(count * verticesPer * stride);
+            im.expanded.resize(count * 4 * stride);
             float* dst = im.expanded.data();
             for (std::size_t i = 0; i < count; ++i) {
                 const float* src = batch.data.data() + i * stride;
-                for (std::size_t v = 0; v < verticesPer; ++v, dst += stride) std::memcpy(dst, src, stride * sizeof(float));
+                for (int v = 0; v < 4; ++v, dst += stride) std::memcpy(dst, src, stride * sizeof(float));
             }
-            im.ensureQuadIndices(count * quadsPer);
+            im.ensureQuadIndices(count);
             gl.BindVertexArray(st.vao);
             gl.BindBuffer(GL_ARRAY_BUFFER, st.vbo);
             gl.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(im.expanded.size() * sizeof(float)), im.expanded.data(),
                           GL_STREAM_DRAW);
-            gl.DrawElements(GL_TRIANGLES, GLsizei(count * quadsPer * 6), GL_UNSIGNED_INT, nullptr);
+            gl.DrawElements(GL_TRIANGLES, GLsizei(count * 6), GL_UNSIGNED_INT, nullptr);
         }
         ++drawCalls_;
     }
