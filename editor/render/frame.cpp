@@ -509,24 +509,42 @@ void Builder::fields() {
     if (vField) {
         // Gaussian kernel of width h = grid spacing, cut at 2h; bodies are
         // binned into cells of size s so each sample visits 5x5 cells.
+        // Samples sit at the centres of cells i0..i1 x j0..j1, so only
+        // bodies within two cells of those count: a flat grid over that
+        // range, filled by counting sort in scene order (no hashing, no
+        // allocation per cell, and the sums keep their order).
         struct Sample { Vec2 p, v; };
-        std::unordered_map<long long, std::vector<Sample>> cells;
-        auto key = [](long long x, long long y) { return (x << 32) ^ (y & 0xffffffffLL); };
+        const long long gx0 = i0 - 2, gy0 = j0 - 2, nx = i1 - i0 + 5, ny = j1 - j0 + 5;
+        auto cellOf = [&](Vec2 p) -> long long {
+            const long long cx = (long long)std::floor(p.x / s) - gx0, cy = (long long)std::floor(p.y / s) - gy0;
+            return cx < 0 || cy < 0 || cx >= nx || cy >= ny ? -1 : cy * nx + cx;
+        };
+        std::vector<std::size_t> cellStart(std::size_t(nx * ny) + 1, 0);
+        std::vector<std::pair<long long, Sample>> binned;
         scene_.registry.each<Position, Velocity>([&](Entity e, const Position& p, const Velocity& v) {
             if (isStatic(scene_, e)) return;
-            cells[key((long long)std::floor(p.value.x / s), (long long)std::floor(p.value.y / s))].push_back({p.value, v.value});
+            const long long c = cellOf(p.value);
+            if (c < 0) return;
+            binned.push_back({c, {p.value, v.value}});
+            ++cellStart[std::size_t(c) + 1];
         });
+        for (std::size_t c = 1; c < cellStart.size(); ++c) cellStart[c] += cellStart[c - 1];
+        std::vector<Sample> bodies(binned.size());
+        {
+            std::vector<std::size_t> next(cellStart.begin(), cellStart.end() - 1);
+            for (const auto& [c, b] : binned) bodies[next[std::size_t(c)]++] = b;
+        }
         std::vector<std::pair<Vec2, double>> fieldValues;  // mean velocity, confidence
         std::vector<double> mags;
         for (Vec2 p : points) {
-            const long long ci = (long long)std::floor(p.x / s), cj = (long long)std::floor(p.y / s);
+            const long long ci = (long long)std::floor(p.x / s) - gx0, cj = (long long)std::floor(p.y / s) - gy0;
             Vec2 sum;
             double wsum = 0.0;
             for (long long dj = -2; dj <= 2; ++dj)
                 for (long long di = -2; di <= 2; ++di) {
-                    auto it = cells.find(key(ci + di, cj + dj));
-                    if (it == cells.end()) continue;
-                    for (const Sample& b : it->second) {
+                    const std::size_t c = std::size_t((cj + dj) * nx + ci + di);
+                    for (std::size_t k = cellStart[c]; k < cellStart[c + 1]; ++k) {
+                        const Sample& b = bodies[k];
                         const double r2 = lengthSquared(b.p - p) / (s * s);
                         if (r2 > 4.0) continue;
                         const double w = std::exp(-0.5 * r2);
@@ -566,6 +584,8 @@ void Builder::trails() {
     for (const TrailRecorder::Trail& t : in_.trails->trails())
         if (t.points.size() >= 2) heads.push_back(toPx(t.points.back()));
     CellThinner thin(*this, heads);
+    // Crowded: thinner trails in longer segments (8 px instead of 3 px).
+    const bool coarse = dense_ || thin.active();
     for (const TrailRecorder::Trail& t : in_.trails->trails()) {
         if (t.points.size() < 2 || !scene_.registry.alive(t.entity)) continue;
         if (!thin.keep(toPx(t.points.back()), selected_.count(t.entity) != 0)) continue;
@@ -574,13 +594,13 @@ void Builder::trails() {
         Vec2 prev = toPx(t.points[0]);
         for (std::size_t k = 1; k < n; ++k) {
             const Vec2 cur = toPx(t.points[k]);
-            // Merge steps into segments at least 3 px long (the newest one
-            // excepted): a 10,000-body scene draws ~8 segments per trail
-            // instead of 47, and the curve looks the same.
-            if (lengthSquared(cur - prev) < (dense_ ? 64.0 : 9.0) && k + 1 < n) continue;
+            // Merge steps into segments at least 3 px long (8 px when
+            // coarse; the newest one excepted): a 10,000-body scene draws
+            // ~8 segments per trail instead of 47, and the curve looks the same.
+            if (lengthSquared(cur - prev) < (coarse ? 64.0 : 9.0) && k + 1 < n) continue;
             // Older segments fade out: alpha rises linearly to 0.7 at the body.
             const float a = float(0.7 * double(k) / double(n - 1));
-            if (lengthSquared(cur - prev) > 0.01) segment(prev, cur, dense_ ? 1.0 : 1.6, withAlpha(c, a));
+            if (lengthSquared(cur - prev) > 0.01) segment(prev, cur, coarse ? 1.0 : 1.6, withAlpha(c, a));
             prev = cur;
         }
     }
