@@ -111,6 +111,7 @@ void writeDebugState(const std::string& path, ui::Session& session, std::uint64_
 struct FrameTimes {
     std::vector<double> ms;
     ui::UiState::FrameParts sum;  ///< the parts summed over the recorded frames
+    ui::UiState::FrameParts last; ///< the last recorded frame's parts
 
     void add(double frameMs, const ui::UiState::FrameParts& parts) {
         ms.push_back(frameMs);
@@ -119,6 +120,7 @@ struct FrameTimes {
         sum.sceneMs += parts.sceneMs;
         sum.drawUiMs += parts.drawUiMs;
         sum.steps += parts.steps;
+        last = parts;
     }
     void report(const char* what, std::size_t bodies) const {
         if (ms.empty()) return;
@@ -137,6 +139,7 @@ struct FrameTimes {
                     "ui draw %.2f ms, swap and rest %.2f ms\n",
                     sum.uiMs / n, sum.stepMs / n, double(sum.steps) / n, sum.sceneMs / n, sum.drawUiMs / n,
                     std::max(0.0, mean - parts));
+        std::printf("  viewport, last frame: %zu instances in %d draw calls\n", last.instances, last.drawCalls);
     }
 };
 

@@ -256,7 +256,10 @@ void Session::frame(int width, int height, double frameSeconds) {
     // Straight into the window at the viewport panel's place (GL counts
     // rows from the bottom), under the panels ImGui draws next.
     gl_->clear(width, height, kPanelBackground);
-    renderer_->render(input, vw, vh, int(ui_.viewportPos.x), height - int(ui_.viewportPos.y) - vh);
+    const render::DrawData drawn =
+        renderer_->render(input, vw, vh, int(ui_.viewportPos.x), height - int(ui_.viewportPos.y) - vh);
+    ui_.lastFrame.instances = drawn.instanceCount();
+    ui_.lastFrame.drawCalls = renderer_->lastDrawCalls();
     const double sceneMs = msSince(t2);
     // The font rebuild must happen between frames.
     const auto t3 = Clock::now();
