@@ -1,7 +1,14 @@
-// The editor's ImGui panels with no GL context: ImGui builds its draw lists
-// on the CPU, so what a panel draws can be checked directly.
+// The editor's ImGui panels with no GL context (ImGui builds its draw lists
+// on the CPU, so what a panel draws can be checked directly), and a whole
+// editor frame through OSMesa.
 
+#include "render/offscreen.hpp"
 #include "ui/editor_ui.hpp"
+#include "ui/session.hpp"
+
+#include "stepwise/components.hpp"
+
+#include <GL/osmesa.h>
 
 #include <imgui.h>
 #include <imgui_internal.h>
@@ -79,6 +86,50 @@ TEST_F(PanelFrames, OverlappingPanelsDrawTheirBackgrounds) {
     frame({400, 0});
     EXPECT_EQ(backgroundVertices("A"), 0);
     EXPECT_EQ(backgroundVertices("B"), 0);
+}
+
+TEST(SessionFrame, PresentsThePreviousFrameAfterPhysicsAndBeforeDrawing) {
+    // The window's swap of frame N runs inside frame N+1, after its physics
+    // and before its first GL call, so llvmpipe finishes drawing N while
+    // N+1's CPU work runs. The buffer must still hold frame N there.
+    const int w = 640, h = 400;
+    auto context = stepwise::render::OffscreenRenderer::create(w, h);
+    ASSERT_TRUE(context.ok()) << context.error();
+    stepwise::ui::SessionOptions options;
+    options.persist = false;
+    options.deterministic = true;
+    options.builtinFont = true;
+    auto created = stepwise::ui::Session::create(
+        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    ASSERT_TRUE(created.ok()) << created.error();
+    stepwise::ui::Session& session = **created;
+    stepwise::editor::Editor& ed = session.editor();
+    stepwise::Scene scene;
+    const stepwise::Entity ball = scene.registry.create();
+    scene.registry.emplace<stepwise::Position>(ball, {{0.0, 5.0}});
+    scene.registry.emplace<stepwise::Velocity>(ball, {{3.0, 0.0}});
+    scene.registry.emplace<stepwise::Mass>(ball, {1.0});
+    scene.registry.emplace<stepwise::Radius>(ball, {0.5});
+    ed.doc.reset(std::move(scene));
+    session.frame(w, h, 1.0 / 60.0);  // lays out the panels and frames the view
+    ed.togglePlay();
+    session.frame(w, h, 1.0 / 60.0);
+    const stepwise::render::Image shown = session.capture(w, h);
+    const std::uint64_t stepsBefore = ed.sim.steps();
+
+    int presents = 0;
+    std::uint64_t stepsAtPresent = 0;
+    stepwise::render::Image atPresent;
+    session.frame(w, h, 1.0 / 60.0, [&] {
+        ++presents;
+        stepsAtPresent = ed.sim.steps();
+        atPresent = session.capture(w, h);
+    });
+    EXPECT_EQ(presents, 1);
+    EXPECT_GT(stepsAtPresent, stepsBefore);       // this frame's physics ran first
+    EXPECT_EQ(stepsAtPresent, ed.sim.steps());    // and nothing stepped after
+    EXPECT_TRUE(atPresent.rgb == shown.rgb);      // the previous frame, untouched
+    EXPECT_FALSE(session.capture(w, h).rgb == shown.rgb);  // then this frame was drawn
 }
 
 } // namespace

@@ -59,6 +59,7 @@ using GetProcAddress = void* (*)(const char* name);
     X(PFNGLGETERRORPROC, GetError)                                 \
     X(PFNGLGETSTRINGPROC, GetString)                               \
     X(PFNGLFINISHPROC, Finish)                                     \
+    X(PFNGLFLUSHPROC, Flush)                                       \
     /* the editor's ImGui pass and viewport target (ui/imgui_gl.cpp) */ \
     X(PFNGLSCISSORPROC, Scissor)                                   \
     X(PFNGLBLENDEQUATIONPROC, BlendEquation)                       \

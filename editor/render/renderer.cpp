@@ -251,6 +251,8 @@ DrawData Renderer::render(const FrameInput& input, int widthPx, int heightPx, in
 
 void Renderer::finish() { impl_->gl.Finish(); }
 
+void Renderer::flush() { impl_->gl.Flush(); }
+
 Image Renderer::readPixels(int widthPx, int heightPx) {
     const GlApi& gl = impl_->gl;
     Image image{widthPx, heightPx, std::vector<std::uint8_t>(std::size_t(widthPx) * std::size_t(heightPx) * 3)};

@@ -35,6 +35,9 @@ public:
 
     /// Waits until the GPU (llvmpipe: the rasteriser threads) has finished.
     void finish();
+    /// Hands everything drawn so far to the GPU without waiting (llvmpipe:
+    /// its rasteriser threads start on it now instead of at the swap).
+    void flush();
 
     /// Reads the bound framebuffer back as top-down RGB8 (waits for the GPU).
     Image readPixels(int widthPx, int heightPx);

@@ -59,6 +59,7 @@ struct UiState {
     /// and the physics steps it took.
     struct FrameParts {
         double uiMs = 0.0, stepMs = 0.0, sceneMs = 0.0, drawUiMs = 0.0;
+        double presentMs = 0.0;     ///< the previous frame's swap, run inside this one (Session::frame)
         std::size_t instances = 0;  ///< instances the viewport drew
         int drawCalls = 0;          ///< the viewport's draw calls
         int steps = 0;

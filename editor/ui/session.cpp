@@ -200,7 +200,7 @@ void Session::route(const std::vector<InputEvent>& events) {
     }
 }
 
-void Session::frame(int width, int height, double frameSeconds) {
+void Session::frame(int width, int height, double frameSeconds, const std::function<void()>& presentPrevious) {
     const auto t0 = Clock::now();
     // This frame's events: stop before a second mouse-button change.
     std::vector<InputEvent> batch;
@@ -253,20 +253,31 @@ void Session::frame(int width, int height, double frameSeconds) {
         }
     }
     input.caption.clear();
+    const render::DrawData drawn = render::buildDrawData(input, vw, vh);
+    const double buildMs = msSince(t2);
+
+    // The previous frame leaves the back buffer only now: all of the above
+    // ran while llvmpipe's threads were still drawing it.
+    const auto tPresent = Clock::now();
+    if (presentPrevious) presentPrevious();
+    const double presentMs = msSince(tPresent);
+
     // Straight into the window at the viewport panel's place (GL counts
     // rows from the bottom), under the panels ImGui draws next.
+    const auto tDraw = Clock::now();
     gl_->clear(width, height, kPanelBackground);
-    const render::DrawData drawn =
-        renderer_->render(input, vw, vh, int(ui_.viewportPos.x), height - int(ui_.viewportPos.y) - vh);
+    renderer_->draw(drawn, int(ui_.viewportPos.x), height - int(ui_.viewportPos.y) - vh);
     ui_.lastFrame.instances = drawn.instanceCount();
     ui_.lastFrame.drawCalls = renderer_->lastDrawCalls();
-    const double sceneMs = msSince(t2);
-    // The font rebuild must happen between frames.
+    const double sceneMs = buildMs + msSince(tDraw);
     const auto t3 = Clock::now();
+    renderer_->flush();  // llvmpipe starts on the viewport while ImGui's lists are submitted
     gl_->render(ImGui::GetDrawData(), width, height);
+    renderer_->flush();
     ui_.lastFrame.uiMs = uiMs;
     ui_.lastFrame.sceneMs = sceneMs;
     ui_.lastFrame.drawUiMs = msSince(t3);
+    ui_.lastFrame.presentMs = presentMs;
     average(ui_.uiMs, uiMs);
     average(ui_.sceneMs, sceneMs);
     average(ui_.frameMs, msSince(t0));

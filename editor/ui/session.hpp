@@ -13,6 +13,7 @@
 
 #include <deque>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -48,8 +49,12 @@ public:
 
     /// Runs one frame of width x height window pixels: input, panels,
     /// simulation (frameSeconds of time), viewport and UI drawing into the
-    /// default framebuffer.
-    void frame(int width, int height, double frameSeconds);
+    /// default framebuffer, then a flush so rasterising starts at once.
+    /// `presentPrevious` (the window's buffer swap of the last frame) runs
+    /// just before the first GL call: everything up to there (input,
+    /// panels, physics, building the viewport's shapes) is CPU work that
+    /// overlaps llvmpipe's threads finishing the previous frame.
+    void frame(int width, int height, double frameSeconds, const std::function<void()>& presentPrevious = {});
 
     /// Reads the default framebuffer (after frame()).
     render::Image capture(int width, int height);
