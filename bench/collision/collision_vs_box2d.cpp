@@ -23,6 +23,7 @@
 #include <box2d/box2d.h>
 
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -31,6 +32,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 using namespace stepwise;
@@ -213,7 +215,7 @@ Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex) {
     }
     const float dt = float(scene.world.dt);
     const auto start = std::chrono::steady_clock::now();
-    for (int i = 0; i < steps; ++i) world.Step(dt, 8, 3);  // the 8 velocity, 3 position iterations
+    for (int i = 0; i < steps; ++i) world.Step(dt, 8, 3);  // Box2D 2.4.1's recommended 8 velocity, 3 position iterations
     Outcome out;
     out.msPerStep = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / steps;
     std::vector<Pose> poses = poses0;
@@ -270,6 +272,25 @@ BroadPhaseTimes timeBroadPhases(const std::vector<Pose>& poses) {
     return t;
 }
 
+/// The first line of the written table: when, on what, and by which
+/// command it was measured, so a table in docs/ never loses its context.
+std::string measuredOn(int argc, char** argv) {
+    const std::time_t now = std::time(nullptr);
+    char when[32];
+    std::strftime(when, sizeof when, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+    std::string cpu = "unknown CPU";
+    std::ifstream cpuinfo("/proc/cpuinfo");
+    for (std::string line; std::getline(cpuinfo, line);)
+        if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
+            cpu = line.substr(line.find(':') + 2);
+            break;
+        }
+    std::string command = "collision_vs_box2d";
+    for (int i = 1; i < argc; ++i) command.append(" ").append(argv[i]);
+    return "Measured " + std::string(when) + " on " + cpu + " (" + std::to_string(std::thread::hardware_concurrency()) +
+           " hardware threads) by `" + command + "`.";
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -309,6 +330,7 @@ int main(int argc, char** argv) {
         return 0;
     }
     std::ostringstream md;
+    md << measuredOn(argc, argv) << "\n\n";
     md << "| scene | bodies | steps | Stepwise ms/step | Box2D 2.4.1 ms/step | speed ratio (Box2D/Stepwise) | deepest overlap "
           "Stepwise / Box2D (mm) | deepest overlap of the collision shapes Stepwise / Box2D (mm) | top-box drift Stepwise / "
           "Box2D (mm) | kinetic energy after Stepwise / Box2D (J) |\n"
