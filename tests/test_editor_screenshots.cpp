@@ -7,8 +7,8 @@
 // Regenerate after a deliberate change (and look at the images):
 //     STEPWISE_UPDATE_GOLDENS=1 build/tests/test_editor_screenshots
 
-#include "render/image.hpp"
-#include "render/screenshot.hpp"
+#include "image.hpp"
+#include "screenshot.hpp"
 
 #include "stepwise/scene_io.hpp"
 

@@ -1,7 +1,7 @@
 // Renderer unit tests that need no GL context: overlay parsing, camera
 // fitting, batching and arrow scales (editor/render/frame.hpp).
 
-#include "render/frame.hpp"
+#include "frame.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/world.hpp"

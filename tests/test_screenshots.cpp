@@ -7,7 +7,7 @@
 //     cmake --build build --target update-goldens
 // which runs this binary with STEPWISE_UPDATE_GOLDENS=1.
 
-#include "render/screenshot.hpp"
+#include "screenshot.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"

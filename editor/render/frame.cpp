@@ -5,7 +5,7 @@
 // level far from the origin draws as crisply as one near it (float world
 // coordinates in the shaders would lose sub-pixel precision past ~1e4 m).
 
-#include "render/frame.hpp"
+#include "frame.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/world.hpp"
@@ -409,8 +409,9 @@ void Builder::planes() {
 void Builder::aabbCells() {
     // The broad phase's uniform grid as the renderer pictures it: cells of
     // the 1-2-5 size just above twice the median shape extent, shaded where
-    // a bounding box overlaps them. (The engine will expose its own cells
-    // when collisions land; until then this shows the bounding-box density.)
+    // a bounding box overlaps them. The engine's broad phase does not expose
+    // its cells (and below 512 shapes it sweeps and prunes instead of using
+    // a grid), so this is the renderer's own picture of bounding-box density.
     std::vector<std::pair<Vec2, Vec2>> boxes;  // centre, half extents (metres)
     std::vector<double> extents;
     for (Entity e : scene_.registry.entities()) {

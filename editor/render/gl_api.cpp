@@ -1,4 +1,4 @@
-#include "render/gl_api.hpp"
+#include "gl_api.hpp"
 
 namespace stepwise::render {
 

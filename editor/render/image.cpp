@@ -1,4 +1,4 @@
-#include "render/image.hpp"
+#include "image.hpp"
 
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>

@@ -1,4 +1,4 @@
-#include "render/offscreen.hpp"
+#include "offscreen.hpp"
 
 #include <GL/osmesa.h>
 

@@ -4,7 +4,7 @@
 /// no X server) with a Renderer on it. The Renderer is the same class the
 /// editor window uses; only the context differs.
 
-#include "render/renderer.hpp"
+#include "renderer.hpp"
 
 #include <memory>
 

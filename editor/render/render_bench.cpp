@@ -5,7 +5,7 @@
 //
 //   build/render_bench [--bodies N] [--width W] [--height H] [--frames F] [--out FILE.png]
 
-#include "render/offscreen.hpp"
+#include "offscreen.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
@@ -89,16 +89,9 @@ int main(int argc, char** argv) {
         }
     }
     Scene scene = makeScene(bodies);
-    // Forces do not depend on shapes, so the force overlays sample a World
-    // built from a shape-free copy (same entity handles) while the renderer
-    // draws the shapes. (World::build refuses shapes until collisions land.)
-    Scene forcesOnly = scene;
-    for (Entity e : forcesOnly.registry.entities()) {
-        forcesOnly.registry.remove<Radius>(e);
-        forcesOnly.registry.remove<Box>(e);
-        forcesOnly.registry.remove<Plane>(e);
-    }
-    Result<World> built = World::build(forcesOnly);
+    // The World is the whole scene, shapes and collisions included, so the
+    // contacts overlay has the contacts of the last step to draw.
+    Result<World> built = World::build(scene);
     std::optional<World> world;
     if (built) world.emplace(std::move(*built));
     else std::fprintf(stderr, "render_bench: no World (%s); force overlays skipped\n", built.error().c_str());

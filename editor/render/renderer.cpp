@@ -1,6 +1,6 @@
-#include "render/renderer.hpp"
+#include "renderer.hpp"
 
-#include "render/shader_sources.hpp"
+#include "shader_sources.hpp"
 
 #include <algorithm>
 #include <array>

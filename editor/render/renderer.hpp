@@ -5,9 +5,9 @@
 /// The caller owns the context (OsmesaContext headless, SDL2 in the editor)
 /// and makes it current before create(), draw() and readPixels().
 
-#include "render/frame.hpp"
-#include "render/gl_api.hpp"
-#include "render/image.hpp"
+#include "frame.hpp"
+#include "gl_api.hpp"
+#include "image.hpp"
 
 #include "stepwise/result.hpp"
 

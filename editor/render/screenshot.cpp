@@ -1,4 +1,4 @@
-#include "render/screenshot.hpp"
+#include "screenshot.hpp"
 
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"

@@ -4,7 +4,7 @@
 /// (screenshots/<level>.png): one place, so the test and the regeneration
 /// command can never disagree.
 
-#include "render/offscreen.hpp"
+#include "offscreen.hpp"
 
 #include <filesystem>
 #include <string>
