@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Soak (issue 7): every shipped level runs STEPS steps headless through
+# Soak: every shipped level runs STEPS steps headless through
 # `stepwise run`, which checks every state for non-finite values (exit 3
 # names the step, entity and quantity). Memory must stay flat: the script
 # prints the peak resident set (getrusage's ru_maxrss through /usr/bin/time)

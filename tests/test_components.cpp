@@ -65,7 +65,7 @@ TEST(ComponentTable, NamesAreUniqueAndFindable) {
         for (const FieldInfo& f : info.fields) EXPECT_EQ(f.key.empty(), info.inlineValue) << info.name;
     }
     EXPECT_EQ(findComponent("velocty"), nullptr);
-    // The contract's components (shared/SCENE_FORMAT.md) are all present.
+    // The scene format's required components (docs/format.md) are all present.
     for (const char* required : {"name", "type", "position", "velocity", "mass", "static", "radius", "box", "angle",
                                  "angular_velocity", "color", "restitution", "friction", "drag", "plane", "attractor",
                                  "spring", "boid"})

@@ -1,4 +1,4 @@
-// Determinism (issue 7): the final state of one fixed scene after N steps,
+// Determinism: the final state of one fixed scene after N steps,
 // hashed, under every integrator, compared with values recorded from a known
 // good build (the Box2D determinism test's pattern). A scene that is stepped
 // the same way must give the same bits on every machine and build type this
@@ -81,7 +81,7 @@ std::string hex(std::uint64_t v) {
     return buffer;
 }
 
-/// Recorded from the build of issue 7 (gcc 12, RelWithDebInfo + ASan/UBSan,
+/// Recorded from a gcc 12 build (RelWithDebInfo + ASan/UBSan,
 /// and checked equal in Release); see the header for re-recording.
 const std::map<std::string, std::uint64_t> kRecorded = {
     {"explicit_euler", 0x43071363d8925064ull},

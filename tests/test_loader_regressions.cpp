@@ -1,4 +1,4 @@
-// Findings of the loader fuzzer and of the review around it (issue 7), each
+// Findings of the loader fuzzer and of a review of bad input, each
 // kept as an exact-message or exact-bytes test, plus a replay of every file
 // in tests/fuzz/corpus/ through the fuzzer's own property, so the findings stay
 // fixed in the ordinary gcc build too.
@@ -168,7 +168,7 @@ TEST(LoaderRegressions, OnlyEntitiesCountTowardsTheEntityLimit) {
     EXPECT_EQ(r.error(), "t.json: error: more than 1 entities; the limit is 1");
 }
 
-// README: "JSON nested deeper than 16 levels is refused". The callback
+// docs/format.md: "JSON nested deeper than 16 levels is refused". The callback
 // counted enclosing containers, so 17 levels passed. 16 levels now reach
 // the ordinary checks, 17 are refused while parsing.
 TEST(LoaderRegressions, TheDepthLimitIsSixteenLevels) {

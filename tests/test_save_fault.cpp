@@ -1,4 +1,4 @@
-// Saves under fault (issue 7): a process saving a level is killed with
+// Saves under fault: a process saving a level is killed with
 // SIGKILL at random points, hundreds of times. After every kill the level on
 // disk is exactly the old bytes or exactly the new bytes, and it loads.
 // Temporaries a killed save leaves behind are hidden, never loaded, and

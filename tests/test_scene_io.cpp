@@ -38,7 +38,7 @@ fs::path freshDir(const std::string& name) {
     return dir;
 }
 
-// The two entities of the course notes (shared/seed), with straight quotes
+// The two entities of the course notes (levels/course_notes.json), with straight quotes
 // and wrapped in {"entities": [...]}, exactly as printed there.
 const char* kCourseNotes = R"({"entities": [
   {
@@ -90,7 +90,7 @@ TEST(SceneLoad, CourseNotesExampleLoadsWithDefaults) {
     EXPECT_EQ(r.tryGet<Velocity>(land)->value, (Vec2{0.0, 1.0}));
     EXPECT_EQ(r.tryGet<Radius>(land)->value, 0.93000000000000006);
     EXPECT_FALSE(r.has<Radius>(water));
-    // World defaults from the contract.
+    // World defaults from the scene format (docs/format.md).
     EXPECT_EQ(scene->world.gravity, (Vec2{0.0, -9.81}));
     EXPECT_EQ(scene->world.G, 1.0);
     EXPECT_EQ(scene->world.integrator, "semi_implicit_euler");

@@ -2,7 +2,7 @@
 /// \file script.hpp
 /// The scripted mode's input file: one command per line, replayed as
 /// InputEvents through the same handlers a person's input goes through
-/// (README.md, The editor, documents the format). Parsing reports the line
+/// (docs/editor.md, "Scripted, headless", documents the format). Parsing reports the line
 /// and what was expected; a bad script is refused whole before anything runs.
 ///
 ///   # comment                     key Space | key Ctrl+Shift+Z

@@ -6,7 +6,7 @@
 
 namespace stepwise::cli {
 
-/// Process exit codes (README "Exit codes").
+/// Process exit codes (README.md, "Exit codes").
 enum ExitCode : int {
     kExitOk = 0,
     kExitFailure = 1,    ///< an unexpected internal failure

@@ -1,4 +1,4 @@
-// libFuzzer target for the level loader (issue 7): parseScene on any bytes,
+// libFuzzer target for the level loader: parseScene on any bytes,
 // then save -> load -> save on whatever loads (scene_loader_property.hpp).
 // A crash, a sanitizer report, a hang or a broken property is a finding: the
 // target aborts with the reason on stderr so libFuzzer keeps the input.

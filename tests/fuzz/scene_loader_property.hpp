@@ -5,7 +5,7 @@
 // only by clang's fuzz build.
 //
 // Every input is either refused with one well-formed message, or loads; and
-// whatever loads saves, loads again and saves to the same bytes (README:
+// whatever loads saves, loads again and saves to the same bytes (docs/format.md:
 // "load, save, load, save gives identical bytes").
 
 #include "stepwise/scene_io.hpp"

@@ -16,8 +16,9 @@ struct Entity {
     std::uint32_t index = kInvalidIndex;
     std::uint32_t generation = 0;
 
-    /// True for a handle that was ever issued; says nothing about liveness
-    /// (ask the Registry for that).
+    /// True for the default handle, which was never issued by a Registry
+    /// (index == kInvalidIndex). False says only that the handle was issued
+    /// once, not that its entity is still alive: ask the Registry for that.
     constexpr bool isNull() const { return index == kInvalidIndex; }
     friend constexpr bool operator==(Entity, Entity) = default;
 };

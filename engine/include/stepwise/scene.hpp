@@ -12,8 +12,8 @@
 
 namespace stepwise {
 
-/// The `world` object of a level file. Defaults are the contract's
-/// (shared/SCENE_FORMAT.md).
+/// The `world` object of a level file, with the scene format's defaults
+/// (docs/format.md).
 struct WorldSettings {
     Vec2 gravity{0.0, -9.81};                ///< m/s^2, applied to every dynamic body
     double G = 1.0;                          ///< gravitational constant for attractors, N*m^2/kg^2

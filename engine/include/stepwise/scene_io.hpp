@@ -1,6 +1,6 @@
 #pragma once
 /// \file scene_io.hpp
-/// Reading and writing level files (shared/SCENE_FORMAT.md). Everything is
+/// Reading and writing level files (docs/format.md). Everything is
 /// driven by the component table. A bad file is refused whole with one
 /// message; saving is atomic.
 
@@ -15,7 +15,7 @@
 
 namespace stepwise {
 
-/// Documented limits of the loader (README "Limits"). Past them a file is
+/// Documented limits of the loader (docs/format.md, "Limits"). Past them a file is
 /// refused with a message instead of exhausting memory.
 struct LoadLimits {
     std::uintmax_t maxFileBytes = 256ull << 20;  ///< 256 MiB of JSON text

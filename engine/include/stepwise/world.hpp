@@ -118,9 +118,11 @@ public:
     /// Springs past the integrator's stability limit at the current dt.
     std::vector<StiffnessHint> stiffnessHints() const;
 
-    /// Net force a unit-mass probe at `point` moving at `velocity` would feel
-    /// from the scene's force model (gravity, attractors, drag-free). Uses the
-    /// same force code the step uses. Newtons (= m/s^2 for 1 kg).
+    /// Net force a unit-mass probe at `point` would feel from the scene's
+    /// field forces: gravity and attractors, through the same code the step
+    /// runs. Newtons (= m/s^2 for 1 kg). `velocity` is ignored: both field
+    /// forces depend on position only, and the velocity-dependent forces
+    /// (drag, spring damping, boids) act on bodies, not on a probe.
     Vec2 probeForce(Vec2 point, Vec2 velocity = {}) const;
 
     /// Dynamic bodies, in the order of the state vector.

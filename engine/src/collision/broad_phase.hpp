@@ -1,6 +1,6 @@
 #pragma once
 // Broad phase: candidate pairs whose (fattened) AABBs overlap. Two
-// strategies, chosen by measurement (bench/collision_bench.cpp): sweep and
+// strategies, chosen by measurement (bench/collision/collision_vs_box2d.cpp; docs/collisions.md): sweep and
 // prune on x, and a uniform grid. Both return the same pairs in the same
 // order (sorted by (a, b)), so the solver's result does not depend on which
 // one ran.

@@ -142,7 +142,7 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
         boxes_[k] = box;
         movable_[k] = colliders_[i].body >= 0 ? 1 : 0;
     }
-    // Strategy by size (bench/collisions.md): per call, sweep and prune wins
+    // Strategy by size (docs/measured/collisions.md): per call, sweep and prune wins
     // on a few hundred bodies (pyramid: 5 vs 9 us) and the uniform grid on a
     // dense 2,000-circle pile (490 vs 580 us); over whole runs the two are
     // within noise, since pairs cost far less than the contact solve. Both
@@ -200,7 +200,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         unconstrainedV_[i] = v[body];
     }
     // Contact stiffness may not exceed a quarter of the substep rate, or the
-    // soft constraint itself becomes unstable (Box2D v3's rule). Contacts
+    // soft constraint itself becomes unstable (Box2D v3.0's cap; v3.1
+    // lowered it to an eighth). Contacts
     // with static bodies may be twice as stiff, but under the same cap:
     // above it a heavy box on light boxes never comes to rest (measured).
     const double hertz = std::min(settings_.contactHertz, 0.25 / h);

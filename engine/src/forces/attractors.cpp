@@ -2,8 +2,8 @@
 // attractor a,
 //   a_i = G m_a d / (|d|^2 + eps^2)^(3/2),   d = p_a - p_i,
 // the gradient of the potential -G m_i m_a / sqrt(|d|^2 + eps^2). Dynamic
-// attractors pull each other (n-body); only attractors pull (SCENE_FORMAT:
-// "every other dynamic body i feels ... toward this body"), so a plain
+// attractors pull each other (n-body); only attractors pull (the scene
+// format: "every other dynamic body i feels ... toward this body"), so a plain
 // body does not pull an attractor back. Cost O(bodies * attractors).
 
 #include "forces/force_model.hpp"

@@ -5,7 +5,7 @@
 // aliasing question, and the layout the springs want (one cache line holds
 // both coordinates of a body). Measured against split x[]/y[] arrays in
 // bench/stepwise_bench.cpp (Layout/*, 2-core Xeon, see
-// bench/README-physics.md): for the streaming Euler kernel split arrays
+// docs/performance.md): for the streaming Euler kernel split arrays
 // were ~30% faster while the state fits in cache (1e4-1e5 bodies) and
 // ~10% faster at 1e6 (memory-bound); for the spring pass, which gathers
 // both ends, the two were equal up to 1e5 and interleaved ~11% faster at

@@ -6,7 +6,7 @@
 namespace stepwise {
 
 namespace {
-// The contract's names (shared/SCENE_FORMAT.md) plus implicit_midpoint.
+// The scene format's names (docs/format.md) plus implicit_midpoint.
 constexpr std::array<std::string_view, 8> kNames{
     "explicit_euler", "semi_implicit_euler", "midpoint",       "trapezoid",
     "rk4",            "velocity_verlet",     "implicit_euler", "implicit_midpoint",

@@ -5,10 +5,11 @@
 //     forces + integrate     the integrator calls the force systems
 //                            (gravity, drag, springs, attractors, boids) as
 //                            often as its method needs
-//     [broad phase, narrow phase, contact solve]   -- collisions, another
-//                            issue: they go here, after the integrator has
-//                            produced the end-of-substep velocities and
-//                            before positions are final. A contact solver
+//     [impact propagation, contact solve]   only when the scene has shapes:
+//                            after the integrator has produced the
+//                            end-of-substep velocities and before positions
+//                            are final (the broad and narrow phases run once
+//                            per step, before the substeps). A contact solver
 //                            changes velocities by dv; positions then take
 //                            x += h dv, the semi-implicit Euler position
 //                            update applied to the impulse, which is exact
