@@ -5,8 +5,9 @@
 # Stages (each timed; the times are printed at the end):
 #   release  build/ (Release): every test with ctest
 #   asan     build-asan/ (-DSTEPWISE_SANITIZE=ON: AddressSanitizer +
-#            UndefinedBehaviorSanitizer, LeakSanitizer included): every test
-#            again; any report fails the test that caused it
+#            UndefinedBehaviorSanitizer, LeakSanitizer included, and assert()
+#            on): every test again; any report or failed assert fails the
+#            test that caused it
 #   fuzz     build-fuzz/ (clang, libFuzzer): 60 s on the level loader
 #            (tests/fuzz/run.sh), seeded from levels/ and tests/fuzz/corpus/
 # STEPWISE_STAGES="release" (or any subset, space-separated) runs fewer.
@@ -42,10 +43,12 @@ fi
 if has asan; then
   # -O1 -g1: line tables are enough for file:line in sanitizer reports, and
   # against -O2 -g the build is about 40% shorter for a test run about a
-  # minute longer (measured: ASan build 475 -> 313 s on 2 cores). The
-  # benchmarks are not tests; the bench library the CLI needs is still built.
+  # minute longer (measured: ASan build 475 -> 313 s on 2 cores). No
+  # -DNDEBUG: this is the one stage that runs the suite with assert() on,
+  # so a broken invariant aborts here instead of passing silently in Release.
+  # The benchmarks are not tests; the bench library the CLI needs is still built.
   timed asan-configure cmake -S . -B build-asan -DSTEPWISE_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" -DSTEPWISE_BUILD_BENCH=OFF
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DSTEPWISE_BUILD_BENCH=OFF
   timed asan-build cmake --build build-asan -j "$jobs"
   # halt_on_error / abort: a report must fail the test, not scroll past.
   # detect_leaks: LeakSanitizer at exit. The suppressions file lists leaks
