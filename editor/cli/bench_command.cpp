@@ -1,11 +1,11 @@
 // stepwise bench accuracy [--quick] --out DIR: the speed-against-error
-// report (bench/accuracy): accuracy.csv, accuracy.md and the work-precision
+// report (editor/report): accuracy.csv, accuracy.md and the work-precision
 // plot accuracy.png.
 
 #include "cli/cli_common.hpp"
 #include "cli/commands.hpp"
 
-#include "accuracy/accuracy.hpp"
+#include "report/accuracy.hpp"
 
 #include <filesystem>
 #include <iostream>
@@ -26,7 +26,7 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
         else reportError("bench: unknown report \"" + *unknown + "\"; expected one of: accuracy");
         exitCode = kExitBadInput;
     });
-    auto options = std::make_shared<bench::AccuracyOptions>();
+    auto options = std::make_shared<report::AccuracyOptions>();
     auto out = std::make_shared<std::string>();
     CLI::App* accuracy = bench->add_subcommand(
         "accuracy", "Speed against error of every integrator (and Boost.Odeint's) on five problems");
@@ -45,7 +45,7 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
             return;
         }
         try {
-            const std::string problem = bench::runAccuracyReport(*options, std::cerr);
+            const std::string problem = report::runAccuracyReport(*options, std::cerr);
             if (!problem.empty()) {
                 reportError(problem);
                 exitCode = kExitBadInput;

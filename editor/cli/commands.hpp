@@ -16,7 +16,7 @@ enum ExitCode : int {
 
 void addValidateCommand(CLI::App& app, int& exitCode);
 void addRunCommand(CLI::App& app, int& exitCode);
-/// `stepwise bench accuracy`: the speed-against-error report (bench/accuracy).
+/// `stepwise bench accuracy`: the speed-against-error report (editor/report).
 void addBenchCommand(CLI::App& app, int& exitCode);
 void addRenderCommand(CLI::App& app, int& exitCode);
 void addSchemaCommand(CLI::App& app, int& exitCode);

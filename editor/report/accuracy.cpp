@@ -6,8 +6,8 @@
 // model (forces/force_model.hpp), so the comparison is integrator against
 // integrator, not force code against force code.
 
-#include "accuracy/accuracy.hpp"
-#include "accuracy/odeint_implicit.hpp"
+#include "report/accuracy.hpp"
+#include "report/odeint_implicit.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
@@ -34,7 +34,7 @@
 #include <ostream>
 #include <sstream>
 
-namespace stepwise::bench {
+namespace stepwise::report {
 
 namespace odeint = boost::numeric::odeint;
 using Clock = std::chrono::steady_clock;
@@ -570,4 +570,4 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
     return {};
 }
 
-} // namespace stepwise::bench
+} // namespace stepwise::report

@@ -1,6 +1,6 @@
 // Compiled as C++17: see odeint_implicit.hpp.
 
-#include "accuracy/odeint_implicit.hpp"
+#include "report/odeint_implicit.hpp"
 
 #include <boost/numeric/odeint/stepper/implicit_euler.hpp>
 #include <boost/numeric/odeint/util/ublas_wrapper.hpp>
@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-namespace stepwise::bench {
+namespace stepwise::report {
 
 double runOdeintImplicitEulerDense(std::size_t m, const double* x0, const double* v0, double dt, long steps,
                                    const AccelerationFn& accel, const JacobianFn& jacobian, double* xOut) {
@@ -54,4 +54,4 @@ double runOdeintImplicitEulerDense(std::size_t m, const double* x0, const double
     return seconds;
 }
 
-} // namespace stepwise::bench
+} // namespace stepwise::report

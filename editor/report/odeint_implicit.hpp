@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <functional>
 
-namespace stepwise::bench {
+namespace stepwise::report {
 
 /// a(x, v) into `a` (m doubles each).
 using AccelerationFn = std::function<void(const double* x, const double* v, double* a)>;
@@ -19,4 +19,4 @@ using JacobianFn = std::function<void(const double* x, const double* v, double* 
 double runOdeintImplicitEulerDense(std::size_t m, const double* x0, const double* v0, double dt, long steps,
                                    const AccelerationFn& accel, const JacobianFn& jacobian, double* xOut);
 
-} // namespace stepwise::bench
+} // namespace stepwise::report

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace stepwise::bench {
+namespace stepwise::report {
 
 struct AccuracyOptions {
     bool quick = false;              ///< fewer dt and timing repeats: under a minute
@@ -33,4 +33,4 @@ struct AccuracyRow {
 std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
                               std::vector<AccuracyRow>* rowsOut = nullptr);
 
-} // namespace stepwise::bench
+} // namespace stepwise::report
