@@ -5,8 +5,13 @@
 #include "stepwise/world.hpp"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
+#include <tuple>
+
+#include <sys/stat.h>
 
 namespace stepwise::cli {
 
@@ -48,6 +53,75 @@ CLI::Validator wholeNumberAtLeastZero() {
             return {};
         },
         "INT>=0");
+}
+
+CLI::Validator outputFileName() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            if (text.empty()) return "expected a file name, got \"\"";
+            return {};
+        },
+        "FILE");
+}
+
+CLI::Validator secondsPerStep() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double value = std::strtod(text.c_str(), &end);
+            // strtod sets ERANGE for a subnormal result too (1e-320): that
+            // is still a number > 0, so only the value decides.
+            if (text.empty() || *end != '\0' || !std::isfinite(value) || !(value > 0.0) || value > 10.0)
+                return "expected seconds per step, a number in (0, 10], got \"" + text + "\"";
+            return {};
+        },
+        "SECONDS");
+}
+
+namespace {
+
+/// Device and inode of the file `path` names; for a file not there yet,
+/// those of its folder plus its name. False when the folder is missing too.
+bool fileIdentity(const std::string& path, std::tuple<dev_t, ino_t, std::string>& id) {
+    struct stat info {};
+    if (::stat(path.c_str(), &info) == 0) {
+        id = {info.st_dev, info.st_ino, std::string()};
+        return true;
+    }
+    const std::filesystem::path p(path);
+    const std::filesystem::path folder = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+    if (::stat(folder.c_str(), &info) != 0) return false;
+    id = {info.st_dev, info.st_ino, p.filename().string()};
+    return true;
+}
+
+} // namespace
+
+std::string checkOutputs(const std::vector<std::string>& inputs, const std::vector<OutputFile>& outputs) {
+    using Identity = std::tuple<dev_t, ino_t, std::string>;
+    std::vector<std::pair<Identity, std::string>> inputIds;
+    for (const std::string& in : inputs) {
+        Identity id;
+        if (fileIdentity(in, id)) inputIds.emplace_back(id, in);
+    }
+    std::vector<std::pair<Identity, const OutputFile*>> seen;
+    for (const OutputFile& out : outputs) {
+        // The saver's own message, as a failed save prints it.
+        if (std::string problem = checkWritableTarget(out.path); !problem.empty()) return problem;
+        Identity id;
+        if (!fileIdentity(out.path, id)) continue;  // checkWritableTarget said why already
+        for (const auto& [inputId, name] : inputIds)
+            if (inputId == id)
+                return "stepwise: error: " + out.option + ": " + out.path + " is the input " + name +
+                       "; refusing to replace it (give the output another name)";
+        for (const auto& [otherId, other] : seen)
+            if (otherId == id)
+                return "stepwise: error: " + out.option + ": " + out.path + " is the same file as " + other->option + " " +
+                       other->path +
+                       "; give each output its own file";
+        seen.emplace_back(id, &out);
+    }
+    return {};
 }
 
 } // namespace stepwise::cli

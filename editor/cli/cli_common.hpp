@@ -7,6 +7,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace stepwise::cli {
 
@@ -26,5 +27,32 @@ std::string sceneSummary(const Scene& scene);
 /// got -5"); CLI::NonNegativeNumber printed all 309 digits of DBL_MAX as
 /// the range and called "abc" a value out of range.
 CLI::Validator wholeNumberAtLeastZero();
+
+/// CLI11 check for an output file option: a non-empty name ("--out:
+/// expected a file name, got \"\""; an empty name gave ": error: ..." with
+/// no name at all).
+CLI::Validator outputFileName();
+
+/// CLI11 check for --dt: a number of seconds in (0, 10], the documented
+/// range of world.dt; subnormal values (1e-320) included. "nan", "inf" and
+/// "0" are refused naming the option, without CLI::PositiveNumber's 309
+/// digits of DBL_MAX.
+CLI::Validator secondsPerStep();
+
+/// An output named on the command line: the option and the path.
+struct OutputFile {
+    std::string option;  ///< "--out", "--trace", ...
+    std::string path;
+};
+
+/// Everything that can be known about the outputs before any work is done,
+/// so that a bad one costs nothing and nothing is written: each can be
+/// written (checkWritableTarget), none is one of `inputs` and no two are the
+/// same file. Files are compared by identity (device and inode; for a file
+/// not yet there, its folder's identity and its name), not by spelling:
+/// "t.csv", "./t.csv" and a hard link are the same file. Returns "" or the
+/// line to print on stderr ("PATH: error: cannot write: REASON", as a
+/// failed save prints it, or "stepwise: error: --trace: ...").
+std::string checkOutputs(const std::vector<std::string>& inputs, const std::vector<OutputFile>& outputs);
 
 } // namespace stepwise::cli

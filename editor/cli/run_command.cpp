@@ -15,10 +15,16 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <vector>
+
+#include <sys/statvfs.h>
+#include <unistd.h>
 
 namespace stepwise::cli {
 
@@ -74,9 +80,74 @@ void appendContactLine(std::string& jsonl, std::uint64_t step, const World& worl
     jsonl += "]}\n";
 }
 
+/// Ctrl-C (SIGINT) or SIGTERM during the steps: the loop stops, the
+/// temporaries are removed and nothing is written.
+volatile std::sig_atomic_t gInterrupted = 0;
+extern "C" void onInterrupt(int) { gInterrupted = 1; }
+
+/// "45 s", "12 min", "3.2 h", "4.1 days", "2.3e+04 years".
+std::string duration(double seconds) {
+    char buffer[48];
+    if (seconds < 120) std::snprintf(buffer, sizeof buffer, "%.0f s", seconds);
+    else if (seconds < 7200) std::snprintf(buffer, sizeof buffer, "%.0f min", seconds / 60);
+    else if (seconds < 2 * 86400) std::snprintf(buffer, sizeof buffer, "%.1f h", seconds / 3600);
+    else if (seconds < 365.25 * 86400) std::snprintf(buffer, sizeof buffer, "%.1f days", seconds / 86400);
+    else std::snprintf(buffer, sizeof buffer, "%.2g years", seconds / (365.25 * 86400));
+    return buffer;
+}
+
+/// "" when every energy is finite, else what became non-finite: an energy
+/// of -inf or NaN in a report is a non-finite value like any other.
+std::string nonFiniteEnergy(const EnergyReport& e, long long step) {
+    if (std::isfinite(e.total()) && std::isfinite(e.momentum.x) && std::isfinite(e.momentum.y)) return {};
+    return "step " + std::to_string(step) + ": the total energy became " + number(e.total()) + " J (kinetic " +
+           number(e.kinetic) + ", gravity " + number(e.gravity) + ", springs " + number(e.springs) +
+           ", attractors " + number(e.attractors) + " J; momentum " + number(e.momentum.x) + ", " +
+           number(e.momentum.y) + " kg m/s)";
+}
+
+/// Smallest bytes a trace row and a contacts line can take, for the check
+/// that the disk can hold the run's files at all.
+constexpr double kMinTraceRowBytes = 26;     // "1,0.01,0,0,0,0,0,0,0,0,0\n"
+constexpr double kMinContactLineBytes = 39;  // {"step": 1, "time": 0, "contacts": []}
+
+/// Refuses a run whose trace or contacts file cannot fit on its disk even
+/// at the smallest row size: 1e18 steps would otherwise run until killed.
+std::string checkOutputSpace(const std::optional<std::string>& path, const char* option, long long steps,
+                             double bytesPerStep) {
+    if (!path) return {};
+    const std::filesystem::path p(*path);
+    const std::filesystem::path folder = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+    struct statvfs fs {};
+    if (::statvfs(folder.c_str(), &fs) != 0) return {};
+    const double free = double(fs.f_bavail) * double(fs.f_frsize);
+    const double need = (double(steps) + 1.0) * bytesPerStep;
+    if (need <= free) return {};
+    char text[160];
+    std::snprintf(text, sizeof text, "%s: %lld steps need at least %.3g bytes (%.0f a step); the disk holding %s has %.3g free",
+                  option, steps, need, bytesPerStep, path->c_str(), free);
+    return text;
+}
+
 int run(const RunOptions& options) {
     std::optional<Scene> scene = loadLevelOrReport(options.level);
     if (!scene) return kExitBadInput;
+    // Every output is checked before any step, so a bad one costs nothing
+    // and nothing is written.
+    std::vector<OutputFile> outputs;
+    if (options.out) outputs.push_back({"--out", *options.out});
+    if (options.trace) outputs.push_back({"--trace", *options.trace});
+    if (options.contacts) outputs.push_back({"--contacts", *options.contacts});
+    if (std::string problem = checkOutputs({options.level}, outputs); !problem.empty()) {
+        std::cerr << problem << "\n";
+        return kExitBadInput;
+    }
+    for (std::string problem : {checkOutputSpace(options.trace, "--trace", options.steps, kMinTraceRowBytes),
+                                checkOutputSpace(options.contacts, "--contacts", options.steps, kMinContactLineBytes)})
+        if (!problem.empty()) {
+            reportError(problem);
+            return kExitBadInput;
+        }
     if (options.dt) scene->world.dt = *options.dt;
     if (options.integrator) scene->world.integrator = *options.integrator;
 
@@ -87,45 +158,128 @@ int run(const RunOptions& options) {
     }
     World& world = built.value();
 
-    std::string csv;
-    if (options.trace) {
-        csv = "step,time,kinetic,potential_gravity,potential_springs,potential_attractors,potential,total,"
-              "momentum_x,momentum_y,contacts\n";
-        appendTraceRow(csv, 0, world);
+    // The trace and contacts stream into temporaries next to their targets
+    // (memory stays flat however long the run); they are put in place only
+    // when the whole run succeeded.
+    std::optional<StreamedFileWriter> trace, contacts;
+    for (auto [path, writer] : {std::pair{&options.trace, &trace}, std::pair{&options.contacts, &contacts}}) {
+        if (!*path) continue;
+        Result<StreamedFileWriter> opened = StreamedFileWriter::open(**path);
+        if (!opened) {
+            std::cerr << opened.error() << "\n";
+            return kExitBadInput;
+        }
+        writer->emplace(std::move(*opened));
     }
-    std::string jsonl;
-    const auto start = std::chrono::steady_clock::now();
+    std::string row;
+    std::optional<std::string> failure;  // a write error: exit 2
+    auto emit = [&](std::optional<StreamedFileWriter>& writer) {
+        if (Result<void> written = writer->write(row); !written && !failure) failure = written.error();
+        row.clear();
+    };
     std::optional<std::string> divergence;
+    if (trace) {
+        row = "step,time,kinetic,potential_gravity,potential_springs,potential_attractors,potential,total,"
+              "momentum_x,momentum_y,contacts\n";
+        appendTraceRow(row, 0, world);
+        emit(trace);
+        divergence = nonFiniteEnergy(world.energy(), 0);
+        if (divergence->empty()) divergence.reset();
+    }
+
+    gInterrupted = 0;
+    struct sigaction action {}, oldInt {}, oldTerm {};
+    action.sa_handler = onInterrupt;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(SIGINT, &action, &oldInt);
+    ::sigaction(SIGTERM, &action, &oldTerm);
+    const bool terminal = ::isatty(2) != 0;
+    bool progressShown = false, estimateShown = false;
+    const auto start = std::chrono::steady_clock::now();
+    auto lastProgress = start;
     long long taken = 0;
-    for (; taken < options.steps; ++taken) {
+    for (; !divergence && !failure && taken < options.steps; ++taken) {
+        if (gInterrupted) break;
         if (Result<void> stepped = world.step(); !stepped) {
             divergence = stepped.error();
             break;
         }
-        if (options.trace) appendTraceRow(csv, std::uint64_t(taken + 1), world);
-        if (options.contacts) appendContactLine(jsonl, std::uint64_t(taken + 1), world, *scene);
+        if (trace) {
+            const EnergyReport e = world.energy();
+            if (std::string bad = nonFiniteEnergy(e, taken + 1); !bad.empty()) {
+                divergence = bad;
+                ++taken;
+                break;
+            }
+            appendTraceRow(row, std::uint64_t(taken + 1), world);
+            emit(trace);
+        }
+        if (contacts) {
+            appendContactLine(row, std::uint64_t(taken + 1), world, *scene);
+            emit(contacts);
+        }
+        // A clock read every 256 steps: a progress line on a terminal twice
+        // a second, and once, after a second, the estimate of the whole run
+        // when it is long (on any stderr: a log shows it too).
+        if ((taken & 255) != 255) continue;
+        const auto now = std::chrono::steady_clock::now();
+        const double elapsed = std::chrono::duration<double>(now - start).count();
+        const double perStep = elapsed / double(taken + 1);
+        const double left = perStep * double(options.steps - taken - 1);
+        if (!estimateShown && elapsed >= 1.0) {
+            estimateShown = true;
+            if (elapsed + left > 30.0) {
+                if (progressShown) std::fputc('\n', stderr);
+                std::fprintf(stderr,
+                             "stepwise: note: %s: %lld steps at %.3g ms/step take about %s; Ctrl-C stops the run "
+                             "and writes nothing\n",
+                             options.level.c_str(), options.steps, 1e3 * perStep, duration(elapsed + left).c_str());
+                progressShown = false;
+            }
+        }
+        if (terminal && std::chrono::duration<double>(now - lastProgress).count() >= 0.5) {
+            lastProgress = now;
+            std::fprintf(stderr, "\rstep %lld of %lld (%.1f%%), %.3g steps/s, about %s left   ", taken + 1,
+                         options.steps, 100.0 * double(taken + 1) / double(options.steps), 1.0 / perStep,
+                         duration(left).c_str());
+            std::fflush(stderr);
+            progressShown = true;
+        }
     }
+    ::sigaction(SIGINT, &oldInt, nullptr);
+    ::sigaction(SIGTERM, &oldTerm, nullptr);
+    if (progressShown) std::fputc('\n', stderr);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-    // The trace is written even after a divergence: it shows the run-up.
-    if (options.trace) {
-        if (Result<void> written = writeFileAtomically(*options.trace, csv); !written) {
-            std::cerr << written.error() << "\n";
-            return kExitBadInput;
-        }
+    std::string notWritten;
+    for (const OutputFile& o : outputs) notWritten += (notWritten.empty() ? "" : ", ") + o.option;
+    notWritten = notWritten.empty() ? "no output written" : notWritten + " not written";
+    if (failure) {
+        std::cerr << *failure << "\n";
+        return kExitBadInput;
     }
-    if (options.contacts) {
-        if (Result<void> written = writeFileAtomically(*options.contacts, jsonl); !written) {
-            std::cerr << written.error() << "\n";
-            return kExitBadInput;
-        }
+    if (gInterrupted) {
+        reportError(options.level + ": interrupted at step " + std::to_string(taken) + " of " +
+                    std::to_string(options.steps) + "; " + notWritten);
+        return 128 + SIGINT;
+    }
+    const EnergyReport energy = world.energy();
+    if (!divergence) {
+        if (std::string bad = nonFiniteEnergy(energy, taken); !bad.empty()) divergence = bad;
     }
     if (divergence) {
         reportError(options.level + ": simulation diverged at " + *divergence + " (integrator " +
-                    world.settings().integrator + ", dt " + number(world.settings().dt) + "); " +
-                    (options.out ? "--out not written" : "no output written"));
+                    world.settings().integrator + ", dt " + number(world.settings().dt) + "); " + notWritten);
         return kExitDiverged;
     }
+    // Put in place only now: the streams are complete on disk first, then
+    // the scene is saved, then the streams are renamed over their targets.
+    for (std::optional<StreamedFileWriter>* writer : {&trace, &contacts})
+        if (*writer)
+            if (Result<void> done = (*writer)->finish(); !done) {
+                std::cerr << done.error() << "\n";
+                return kExitBadInput;
+            }
     if (options.out) {
         world.writeBack(*scene);
         if (Result<void> saved = saveSceneFile(*scene, *options.out); !saved) {
@@ -133,7 +287,12 @@ int run(const RunOptions& options) {
             return kExitBadInput;
         }
     }
-    const EnergyReport energy = world.energy();
+    for (std::optional<StreamedFileWriter>* writer : {&trace, &contacts})
+        if (*writer)
+            if (Result<void> done = (*writer)->commit(); !done) {
+                std::cerr << done.error() << "\n";
+                return kExitBadInput;
+            }
     std::cout << options.level << ": ran " << taken << " steps of " << number(world.settings().dt) << " s ("
               << world.settings().substeps << " substep" << (world.settings().substeps == 1 ? "" : "s") << ") with "
               << world.settings().integrator << "; t = " << number(world.time()) << " s; " << world.bodyCount()
@@ -152,16 +311,17 @@ void addRunCommand(CLI::App& app, int& exitCode) {
     CLI::App* cmd = app.add_subcommand("run", "Step a level headlessly and write the resulting scene");
     cmd->add_option("LEVEL", options->level, "Level file (JSON)")->required();
     cmd->add_option("--steps", options->steps, "Number of steps to take")->required()->check(wholeNumberAtLeastZero());
-    cmd->add_option("--dt", options->dt, "Seconds per step (overrides world.dt)")
-        ->check(CLI::PositiveNumber & CLI::Range(0.0, 10.0));
+    cmd->add_option("--dt", options->dt, "Seconds per step, in (0, 10] (overrides world.dt)")->check(secondsPerStep());
     cmd->add_option("--integrator", options->integrator, "Integrator (overrides world.integrator)")
         ->check(CLI::IsMember(std::vector<std::string>(integratorNames().begin(), integratorNames().end())));
-    cmd->add_option("--out", options->out, "Write the resulting scene here (atomic)");
+    cmd->add_option("--out", options->out, "Write the resulting scene here (atomic)")->check(outputFileName());
     cmd->add_option("--trace", options->trace,
-                    "Write a CSV row per step (step 0 is the initial state): time, energies, momentum, contacts");
+                    "Write a CSV row per step (step 0 is the initial state): time, energies, momentum, contacts")
+        ->check(outputFileName());
     cmd->add_option("--contacts", options->contacts,
                     "Write one JSON line per step: the step, the time and every contact (entities, point, normal, "
-                    "depth, normal and tangent impulse)");
+                    "depth, normal and tangent impulse)")
+        ->check(outputFileName());
     cmd->callback([options, &exitCode] { exitCode = run(*options); });
 }
 

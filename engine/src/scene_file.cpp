@@ -39,61 +39,151 @@ Result<Scene> loadSceneFile(const fs::path& path, const LoadLimits& limits) {
     return parseScene(text, name, limits);
 }
 
-Result<void> writeFileAtomically(const fs::path& path, std::string_view bytes) {
+std::string checkWritableTarget(const fs::path& path) {
     const std::string name = path.string();
+    const auto cannot = [&](const std::string& why) { return name + ": error: cannot write: " + why; };
+    if (name.empty()) return ": error: cannot write: no file name given";
     const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    struct stat info {};
+    if (::stat(folder.c_str(), &info) != 0) return cannot(std::strerror(errno));
+    if (!S_ISDIR(info.st_mode)) return cannot(std::strerror(ENOTDIR));
+    // The temporary is created in the folder and renamed there.
+    if (::access(folder.c_str(), W_OK | X_OK) != 0) return cannot(std::strerror(errno));
+    if (::stat(name.c_str(), &info) == 0) {
+        if (S_ISDIR(info.st_mode)) return cannot(std::strerror(EISDIR));
+        // A device or pipe (/dev/stdout) would be replaced by the rename,
+        // not written through.
+        if (!S_ISREG(info.st_mode)) return cannot("not a regular file (outputs are replaced by a rename)");
+        // The rename would replace a read-only file too (it needs only the
+        // folder's permission); the file's own mode says the user may not.
+        if (::access(name.c_str(), W_OK) != 0) return cannot(std::strerror(errno));
+    }
+    return {};
+}
+
+Result<StreamedFileWriter> StreamedFileWriter::open(const fs::path& path) {
+    if (std::string problem = checkWritableTarget(path); !problem.empty()) return Error{problem};
+    StreamedFileWriter w;
+    w.name_ = path.string();
+    w.folder_ = path.has_parent_path() ? path.parent_path() : fs::path(".");
     // Hidden temporary next to the target, so rename() stays on one filesystem.
     std::string tmpName = ".";
     tmpName += path.filename().string();
     tmpName += ".tmp-XXXXXX";
-    std::string tmpl = (folder / tmpName).string();
-    const int fd = ::mkstemp(tmpl.data());
-    if (fd < 0) return Error{name + ": error: cannot write: " + std::strerror(errno)};
-    const std::string tmpPath = tmpl;
-    auto fail = [&](const char* what, int err) -> Result<void> {
-        ::close(fd);
-        ::unlink(tmpPath.c_str());
-        return Error{name + ": error: " + what + ": " + std::strerror(err)};
-    };
+    std::string tmpl = (w.folder_ / tmpName).string();
+    w.fd_ = ::mkstemp(tmpl.data());
+    if (w.fd_ < 0) return Error{w.name_ + ": error: cannot write: " + std::strerror(errno)};
+    w.tmpPath_ = tmpl;
     // Keep an existing file's permissions; a new file gets 0666 less umask
     // (mkstemp makes 0600).
     struct stat existing {};
     mode_t mode;
-    if (::stat(name.c_str(), &existing) == 0) {
+    if (::stat(w.name_.c_str(), &existing) == 0) {
         mode = existing.st_mode & 07777;
     } else {
         const mode_t mask = ::umask(0);
         ::umask(mask);
         mode = 0666 & ~mask;
     }
-    if (::fchmod(fd, mode) != 0) return fail("cannot set permissions", errno);
+    if (::fchmod(w.fd_, mode) != 0) return Error{w.fail("cannot set permissions", errno).error()};
+    return w;
+}
+
+StreamedFileWriter::StreamedFileWriter(StreamedFileWriter&& o) noexcept
+    : name_(std::move(o.name_)), tmpPath_(std::move(o.tmpPath_)), folder_(std::move(o.folder_)),
+      buffer_(std::move(o.buffer_)), fd_(o.fd_), finished_(o.finished_) {
+    o.fd_ = -1;
+    o.tmpPath_.clear();
+}
+
+StreamedFileWriter& StreamedFileWriter::operator=(StreamedFileWriter&& o) noexcept {
+    if (this != &o) {
+        discard();
+        name_ = std::move(o.name_);
+        tmpPath_ = std::move(o.tmpPath_);
+        folder_ = std::move(o.folder_);
+        buffer_ = std::move(o.buffer_);
+        fd_ = o.fd_;
+        finished_ = o.finished_;
+        o.fd_ = -1;
+        o.tmpPath_.clear();
+    }
+    return *this;
+}
+
+StreamedFileWriter::~StreamedFileWriter() { discard(); }
+
+void StreamedFileWriter::discard() {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+    if (!tmpPath_.empty()) ::unlink(tmpPath_.c_str());
+    tmpPath_.clear();
+    buffer_.clear();
+}
+
+Result<void> StreamedFileWriter::fail(const char* what, int err) {
+    discard();
+    return Error{name_ + ": error: " + what + ": " + std::strerror(err)};
+}
+
+Result<void> StreamedFileWriter::writeAll(std::string_view bytes) {
     std::size_t written = 0;
     while (written < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+        const ssize_t n = ::write(fd_, bytes.data() + written, bytes.size() - written);
         if (n < 0) {
             if (errno == EINTR) continue;
             return fail("write failed", errno);
         }
         written += std::size_t(n);
     }
-    if (::fsync(fd) != 0) return fail("fsync failed", errno);
-    if (::close(fd) != 0) {
-        const int err = errno;
-        ::unlink(tmpPath.c_str());
-        return Error{name + ": error: close failed: " + std::strerror(err)};
+    return {};
+}
+
+Result<void> StreamedFileWriter::write(std::string_view bytes) {
+    if (fd_ < 0) return Error{name_ + ": error: write failed: the file is closed"};
+    constexpr std::size_t kBlock = 1u << 20;
+    if (buffer_.size() + bytes.size() < kBlock) {
+        buffer_.append(bytes);
+        return {};
     }
-    if (::rename(tmpPath.c_str(), name.c_str()) != 0) {
-        const int err = errno;
-        ::unlink(tmpPath.c_str());
-        return Error{name + ": error: cannot replace the file: " + std::strerror(err)};
-    }
+    // A full block: write what is buffered, then `bytes` without copying
+    // them (a whole level saved at once).
+    if (Result<void> flushed = writeAll(buffer_); !flushed) return flushed;
+    buffer_.clear();
+    return writeAll(bytes);
+}
+
+Result<void> StreamedFileWriter::finish() {
+    if (finished_) return {};
+    if (fd_ < 0) return Error{name_ + ": error: write failed: the file is closed"};
+    if (Result<void> flushed = writeAll(buffer_); !flushed) return flushed;
+    buffer_.clear();
+    if (::fsync(fd_) != 0) return fail("fsync failed", errno);
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) return fail("close failed", errno);
+    finished_ = true;
+    return {};
+}
+
+Result<void> StreamedFileWriter::commit() {
+    if (Result<void> done = finish(); !done) return done;
+    if (::rename(tmpPath_.c_str(), name_.c_str()) != 0) return fail("cannot replace the file", errno);
+    tmpPath_.clear();
     // Make the rename itself durable.
-    const int dirFd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY);
+    const int dirFd = ::open(folder_.c_str(), O_RDONLY | O_DIRECTORY);
     if (dirFd >= 0) {
         ::fsync(dirFd);
         ::close(dirFd);
     }
     return {};
+}
+
+Result<void> writeFileAtomically(const fs::path& path, std::string_view bytes) {
+    Result<StreamedFileWriter> writer = StreamedFileWriter::open(path);
+    if (!writer) return Error{writer.error()};
+    if (Result<void> written = writer->write(bytes); !written) return written;
+    return writer->commit();
 }
 
 namespace {

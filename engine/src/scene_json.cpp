@@ -8,6 +8,8 @@
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
 
+#include "json_reader.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -310,64 +312,6 @@ View readView(const Json& v) {
     return view;
 }
 
-/// 1-based line and column (in bytes) of byte offset `offset`.
-std::pair<std::size_t, std::size_t> lineColumn(std::string_view text, std::size_t offset) {
-    offset = std::min(offset, text.size());
-    std::size_t line = 1, column = 1;
-    for (std::size_t i = 0; i < offset; ++i) {
-        if (text[i] == '\n') {
-            ++line;
-            column = 1;
-        } else {
-            ++column;
-        }
-    }
-    return {line, column};
-}
-
-/// Message for a JSON syntax error at byte `offset` (0-based, at the
-/// offending character), with hints for the two mistakes people make most.
-std::string syntaxMessage(std::string_view text, std::size_t offset, std::string_view sourceName,
-                          std::string detail) {
-    // Typographic quotes (U+2018/2019/201C/201D, UTF-8 E2 80 98..9D) pasted
-    // from slides: point at the first one, wherever the parser gave up.
-    for (std::size_t i = 0; i + 2 < text.size(); ++i) {
-        if (static_cast<unsigned char>(text[i]) == 0xE2 && static_cast<unsigned char>(text[i + 1]) == 0x80) {
-            const unsigned char c = static_cast<unsigned char>(text[i + 2]);
-            if (c == 0x9C || c == 0x9D || c == 0x98 || c == 0x99) {
-                const auto [line, column] = lineColumn(text, i);
-                const bool dbl = c == 0x9C || c == 0x9D;
-                return std::string(sourceName) + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                       ": error: typographic quote " + std::string(text.substr(i, 3)) +
-                       " where JSON needs a straight quote " + (dbl ? "\"" : "\" (JSON strings use double quotes)") +
-                       "; text pasted from slides or a word processor has these. Replace every “ ” ‘ ’ with \"";
-            }
-        }
-    }
-    // Trailing comma: the parser stops at '}' or ']' right after a ','.
-    if (offset < text.size() && (text[offset] == '}' || text[offset] == ']')) {
-        std::size_t j = offset;
-        while (j > 0 && std::isspace(static_cast<unsigned char>(text[j - 1]))) --j;
-        if (j > 0 && text[j - 1] == ',') {
-            const auto [line, column] = lineColumn(text, j - 1);
-            return std::string(sourceName) + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                   ": error: trailing comma before '" + text[offset] +
-                   "'; JSON allows no comma after the last element. Remove this comma";
-        }
-    }
-    const auto [line, column] = lineColumn(text, offset);
-    return std::string(sourceName) + ":" + std::to_string(line) + ":" + std::to_string(column) + ": error: " + detail;
-}
-
-/// The part of nlohmann's parse_error text after its "line L, column C: "
-/// prefix (we compute line and column ourselves, in bytes).
-std::string parserDetail(const std::string& what) {
-    const auto pos = what.find(": ", what.find("parse error"));
-    std::string detail = pos == std::string::npos ? what : what.substr(pos + 2);
-    return detail.empty() ? "not valid JSON" : detail;
-}
-
-
 /// Pretty printer for level files: small all-scalar objects (vectors,
 /// colours, boxes) stay on one line, everything else is indented by two.
 void writeJson(const Json& v, int indent, std::string& out) {
@@ -512,112 +456,18 @@ std::string checkSceneRelations(const Scene& scene) {
 
 namespace {
 
-/// Thrown by LimitedDomParser when a limit is passed; caught in parseScene.
-struct LimitHit {
-    std::string message;
-};
-
-/// nlohmann's DOM builder (the one Json::parse uses) with the loader's
-/// limits checked on the way: nesting depth on every container, and the
-/// entity count on every object that opens inside the top-level
-/// "entities" array. Errors are thrown as by Json::parse.
-class LimitedDomParser {
-public:
-    using Dom = nlohmann::detail::json_sax_dom_parser<Json>;
-
-    LimitedDomParser(Json& root, const LoadLimits& limits) : dom_(root, /*allow_exceptions=*/true), limits_(limits) {}
-
-    bool null() { return dom_.null(); }
-    bool boolean(bool v) { return dom_.boolean(v); }
-    bool number_integer(Json::number_integer_t v) { return dom_.number_integer(v); }
-    bool number_unsigned(Json::number_unsigned_t v) { return dom_.number_unsigned(v); }
-    bool number_float(Json::number_float_t v, const Json::string_t& s) { return dom_.number_float(v, s); }
-    bool string(Json::string_t& v) { return dom_.string(v); }
-    bool binary(Json::binary_t& v) { return dom_.binary(v); }
-    bool key(Json::string_t& k) {
-        if (open_ == 1) rootKey_ = k;
-        return dom_.key(k);
-    }
-    bool start_object(std::size_t n) {
-        enter();
-        if (open_ == 3 && inEntities_ && ++entities_ > limits_.maxEntities)
-            throw LimitHit{"more than " + std::to_string(limits_.maxEntities) + " entities; the limit is " +
-                           std::to_string(limits_.maxEntities)};
-        return dom_.start_object(n);
-    }
-    bool end_object() {
-        --open_;
-        return dom_.end_object();
-    }
-    bool start_array(std::size_t n) {
-        enter();
-        if (open_ == 2 && rootKey_ == "entities") inEntities_ = true;
-        return dom_.start_array(n);
-    }
-    bool end_array() {
-        if (open_ == 2) inEntities_ = false;
-        --open_;
-        return dom_.end_array();
-    }
-    template <class Exception>
-    bool parse_error(std::size_t position, const std::string& token, const Exception& e) {
-        return dom_.parse_error(position, token, e);
-    }
-
-private:
-    void enter() {
-        // open_ counts the containers open including this one: the root
-        // object is level 1, an entity level 3, a vector in it level 4.
-        if (++open_ > limits_.maxDepth)
-            throw LimitHit{"JSON nesting deeper than " + std::to_string(limits_.maxDepth) +
-                           " levels; a level file needs 4"};
-    }
-
-    Dom dom_;
-    const LoadLimits& limits_;
-    int open_ = 0;
-    std::string rootKey_;
-    bool inEntities_ = false;
-    std::size_t entities_ = 0;
-};
-
 Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view sourceName, const LoadLimits& limits) {
     const std::string prefix = std::string(sourceName) + ": error: ";
     if (text.size() > limits.maxFileBytes)
         return Error{prefix + "file is " + std::to_string(text.size()) + " bytes; the limit is " +
                      std::to_string(limits.maxFileBytes) + " bytes"};
 
-    // The depth and entity limits are enforced while parsing, so a hostile
-    // file is refused before its DOM is built. Not with nlohmann's parser
-    // callback: after every value it scans the whole enclosing array for a
-    // discarded element, so 1,000,001 entities took 3 minutes to refuse
-    // (quadratic; 200,000 took 7 s). LimitedDomParser forwards to the plain
-    // DOM builder, which is linear.
+    // The text layer (json_reader.cpp) checks the limits and the rules of
+    // the JSON itself (NUL bytes, duplicate keys) while parsing, so a
+    // hostile file is refused before its DOM is built.
     Json root;
-    try {
-        LimitedDomParser sax(root, limits);
-        Json::sax_parse(text.begin(), text.end(), &sax, nlohmann::detail::input_format_t::json, /*strict=*/true,
-                        /*ignore_comments=*/false);
-    } catch (const LimitHit& hit) {
-        return Error{prefix + hit.message};
-    } catch (const Json::parse_error& e) {
-        // e.byte is 1-based and points just past the offending character.
-        const std::size_t offset = e.byte > 0 ? e.byte - 1 : 0;
-        return Error{syntaxMessage(text, offset, sourceName, parserDetail(e.what()))};
-    } catch (const Json::out_of_range& e) {
-        // A number literal beyond double range (1e999): nlohmann names the
-        // literal but not its position, so find the literal in the text.
-        const std::string what = e.what();
-        const auto open = what.find('\''), close = what.rfind('\'');
-        const std::string literal =
-            open != std::string::npos && close > open ? what.substr(open + 1, close - open - 1) : std::string();
-        const std::size_t at = literal.empty() ? std::string_view::npos : text.find(literal);
-        const auto [line, column] = lineColumn(text, at == std::string_view::npos ? 0 : at);
-        return Error{std::string(sourceName) + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                     ": error: number " + literal + " is out of double range; expected a finite number"};
-    } catch (const Json::exception& e) {
-        return Error{prefix + "not a valid level: " + e.what()};
-    }
+    if (Result<void> parsed = detail::parseLevelJson(text, sourceName, limits, root); !parsed)
+        return Error{parsed.error()};
 
     Scene scene;
     try {
@@ -682,7 +532,7 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
 
 Result<Scene> parseScene(std::string_view text, std::string_view sourceName, const LoadLimits& limits) {
     Result<Scene> scene = parseSceneUnchecked(text, sourceName, limits);
-    if (!scene) return Error{printableMessage(scene.error())};
+    if (!scene) return Error{printableMessage(detail::shortenForMessage(scene.error()))};
     return scene;
 }
 

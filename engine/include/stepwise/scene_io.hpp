@@ -21,6 +21,14 @@ struct LoadLimits {
     std::uintmax_t maxFileBytes = 256ull << 20;  ///< 256 MiB of JSON text
     std::size_t maxEntities = 1'000'000;
     int maxDepth = 16;                            ///< JSON nesting; real levels use 4
+    /// Every JSON value counts (numbers, strings, true/false/null, objects,
+    /// arrays, at any depth): the DOM costs 16 to about 120 bytes per value,
+    /// so this bounds the loader's memory for every shape of file. A level
+    /// uses about 14 per entity (name, position, velocity, mass, radius,
+    /// colour), so the entity limit is reached first by real levels.
+    std::size_t maxValues = 20'000'000;
+    /// Values inside one entity (its components and their fields).
+    std::size_t maxValuesPerEntity = 100'000;
 };
 
 /// Parses level text. `sourceName` prefixes every message ("levels/a.json").
@@ -36,6 +44,48 @@ Result<Scene> loadSceneFile(const std::filesystem::path& path, const LoadLimits&
 /// order, numbers in the shortest form that reads back to the same double.
 /// load -> save -> load -> save gives identical bytes.
 std::string sceneToJsonText(const Scene& scene);
+
+/// Whether `path` can be written by writeFileAtomically: its folder exists,
+/// is a folder and the user may create files in it, and an existing target
+/// is a regular file the user may write (a read-only file is refused even
+/// though the rename would replace it). "" or "PATH: error: cannot write:
+/// REASON". Checked by every save, and by the command line for every output
+/// before any work.
+std::string checkWritableTarget(const std::filesystem::path& path);
+
+/// A file written in pieces and put in place atomically at the end (a long
+/// run's trace: memory stays flat however many steps). The bytes go to a
+/// hidden temporary in the target's folder; commit() does fsync, rename
+/// over the target and fsync of the folder. Destroyed without commit() (an
+/// error, a divergence, Ctrl-C), the temporary is removed and the target is
+/// untouched.
+class StreamedFileWriter {
+public:
+    /// Checks the target (checkWritableTarget) and creates the temporary.
+    static Result<StreamedFileWriter> open(const std::filesystem::path& path);
+    StreamedFileWriter(StreamedFileWriter&& other) noexcept;
+    StreamedFileWriter& operator=(StreamedFileWriter&& other) noexcept;
+    ~StreamedFileWriter();
+
+    /// Appends; written to the temporary in blocks of 1 MiB.
+    Result<void> write(std::string_view bytes);
+    /// Writes the rest, fsyncs and closes the temporary (not yet in place).
+    Result<void> finish();
+    /// finish() if not done, then renames the temporary over the target.
+    Result<void> commit();
+    /// Removes the temporary; the target stays as it was.
+    void discard();
+
+private:
+    StreamedFileWriter() = default;
+    Result<void> writeAll(std::string_view bytes);
+    Result<void> fail(const char* what, int err);
+    std::string name_, tmpPath_;
+    std::filesystem::path folder_;
+    std::string buffer_;
+    int fd_ = -1;
+    bool finished_ = false;
+};
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same folder,
 /// fsync, rename over the target, fsync of the folder. On any failure the old
