@@ -96,15 +96,13 @@ int run(const RunOptions& options) {
     std::string jsonl;
     const auto start = std::chrono::steady_clock::now();
     std::optional<std::string> divergence;
-    long long taken = 0;
-    for (; taken < options.steps; ++taken) {
-        if (Result<void> stepped = world.step(); !stepped) {
-            divergence = stepped.error();
-            break;
-        }
-        if (options.trace) appendTraceRow(csv, std::uint64_t(taken + 1), world);
-        if (options.contacts) appendContactLine(jsonl, std::uint64_t(taken + 1), world, *scene);
-    }
+    const AdvanceResult advanced = advance(world, std::uint64_t(options.steps), {.afterStep = [&](std::uint64_t step) {
+        if (options.trace) appendTraceRow(csv, step, world);
+        if (options.contacts) appendContactLine(jsonl, step, world, *scene);
+        return true;
+    }});
+    const long long taken = (long long)advanced.taken;
+    const std::optional<std::string>& divergence = advanced.divergence;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     // The trace is written even after a divergence: it shows the run-up.
@@ -127,7 +125,11 @@ int run(const RunOptions& options) {
         return kExitDiverged;
     }
     if (options.out) {
+        // The solver's warm start goes with the state, so that running the
+        // written file on gives the same bits as running on here.
         world.writeBack(*scene);
+        SolverState solver = world.solverState();
+        scene->solverState = solver.empty() ? std::nullopt : std::optional<SolverState>(std::move(solver));
         if (Result<void> saved = saveSceneFile(*scene, *options.out); !saved) {
             std::cerr << saved.error() << "\n";
             return kExitBadInput;
