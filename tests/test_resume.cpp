@@ -83,15 +83,16 @@ std::string resumed(const fs::path& level, std::uint64_t steps, bool withSolverS
     return savedText(second, *reloaded);
 }
 
-bool hasContacts(const fs::path& level) {
+/// True when the warm start at step `kSteps` holds a non-zero impulse: then
+/// a cold restart there starts the solve from elsewhere. (Newton's cradle
+/// and the pool break have contacts but no load on them at that step.)
+bool carriesImpulses(const fs::path& level) {
     const Scene scene = load(level);
     World w = build(scene);
-    bool any = false;
-    advance(w, kSteps, {.afterStep = [&](std::uint64_t) {
-                    any = any || !w.contacts().empty();
-                    return !any;
-                }});
-    return any;
+    advance(w, kSteps);
+    for (const ContactImpulse& c : w.solverState().contacts)
+        if (c.normalImpulse != 0.0 || c.tangentImpulse != 0.0) return true;
+    return false;
 }
 
 /// Largest distance between the same entity's positions in two saved texts.
@@ -122,20 +123,21 @@ TEST(Resume, EveryShippedLevelResumesBitForBitFromItsSavedFile) {
 }
 
 // The test above failed before `solver_state` existed: without the warm
-// start the resumed run leaves the straight one on every level with contacts
-// (measured: rain 1.6 m, pile 0.8 m, ramp_friction 0.25 m, default 7 cm).
-// This keeps the check honest: dropping the section must show.
-TEST(Resume, WithoutTheSolverStateLevelsWithContactsDoNotResumeExactly) {
+// start the resumed run leaves the straight one on every level whose
+// contacts carry load at the save (measured: rain 1.7 m, pile 0.87 m,
+// ramp_friction 0.28 m, default 7 cm). This keeps the check honest:
+// dropping the section must show.
+TEST(Resume, WithoutTheSolverStateLoadedContactsDoNotResumeExactly) {
     int withContacts = 0;
     for (const fs::path& level : shippedLevels()) {
-        if (!hasContacts(level)) continue;
+        if (!carriesImpulses(level)) continue;
         ++withContacts;
         const std::string once = straight(level, 2 * kSteps), cold = resumed(level, kSteps, false);
-        EXPECT_NE(once, cold) << level.filename();
+        EXPECT_TRUE(once != cold) << level.filename();
         std::cout << level.filename().string() << ": a resume without solver_state ends up to "
                   << largestPositionGap(once, cold) << " m away after 100 + 100 steps\n";
     }
-    EXPECT_GE(withContacts, 8);
+    EXPECT_GE(withContacts, 6);
 }
 
 TEST(Resume, SnapshotRestoreThenStepGivesTheSameBytesAsTheFirstPass) {
@@ -274,7 +276,7 @@ TEST(Resume, BadSolverStateIsRefusedWithWhereAndWhat) {
          "t.json: error: /solver_state/contacts/0: missing \"tangent_impulse\""},
         {R"({"impulses": []})",
          "t.json: error: /solver_state/impulses: unknown key \"impulses\" in solver_state. Known keys: contacts"},
-        {R"([])", "t.json: error: /solver_state: expected an object {\"contacts\": [...]}, got an array"},
+        {R"([])", "t.json: error: /solver_state: expected an object {\"contacts\": [...]}, got an empty array"},
     };
     for (const Case& c : cases) {
         Result<Scene> r = parseScene(head + c.state + "}", "t.json");

@@ -121,11 +121,17 @@ const World* Simulation::editingWorld(const Scene& scene) {
 std::size_t Simulation::historyBytes() const {
     std::size_t bytes = historyStateBytes_ + history_.size() * sizeof(HistoryEntry);
     const Scene* last = nullptr;
-    for (const HistoryEntry& h : history_)
+    const std::vector<Gained>* lastGained = nullptr;
+    for (const HistoryEntry& h : history_) {
         if (h.scene.get() != last) {
             last = h.scene.get();
             bytes += 256 + 256 * last->registry.size();  // estimate: a scene's components and pools
         }
+        if (h.gained && h.gained.get() != lastGained) {
+            lastGained = h.gained.get();
+            bytes += lastGained->capacity() * sizeof(Gained);
+        }
+    }
     return bytes;
 }
 
@@ -173,19 +179,55 @@ void Simulation::pause() {
     if (state_ == SimState::Playing) state_ = SimState::Paused;
 }
 
+namespace {
+std::array<std::size_t, 3> stateComponentCounts(const Registry& reg) {
+    return {reg.count<Velocity>(), reg.count<Angle>(), reg.count<AngularVelocity>()};
+}
+} // namespace
+
+Scene Simulation::HistoryEntry::restore() const {
+    Scene out = *scene;
+    if (gained) {
+        Registry& reg = out.registry;
+        for (const Gained& g : *gained) {
+            if (!reg.alive(g.entity)) continue;
+            if (g.components & 1) reg.emplace<Velocity>(g.entity);
+            if (g.components & 2) reg.emplace<Angle>(g.entity);
+            if (g.components & 4) reg.emplace<AngularVelocity>(g.entity);
+        }
+    }
+    state.writeBack(out);
+    return out;
+}
+
 void Simulation::pushHistory(const Scene& scene) {
     // The scene copy holds everything but the state. writeBack only ever
     // adds Velocity, Angle and AngularVelocity components (once a body
-    // moves or turns), so while their counts stay the same one copy serves
-    // every state since the last change, and a restored scene has exactly
-    // the components the first pass had.
+    // moves or turns), so one copy serves every state since the last edit,
+    // with the list of bodies that gained one since (kept while it is short;
+    // past an eighth of the entities a new copy is cheaper to keep). A
+    // restored scene then has exactly the components the first pass had.
     const Registry& reg = scene.registry;
-    const std::array<std::size_t, 3> counts{reg.count<Velocity>(), reg.count<Angle>(), reg.count<AngularVelocity>()};
-    if (!sceneAtBuild_ || counts != sceneCounts_) {
-        sceneAtBuild_ = std::make_shared<const Scene>(scene);
+    const std::array<std::size_t, 3> counts = stateComponentCounts(reg);
+    if (sceneAtBuild_ && counts != sceneCounts_) {
+        const Registry& base = sceneAtBuild_->registry;
+        std::vector<Gained> gained;
+        for (const Entity e : reg.entities()) {
+            const std::uint8_t mask = std::uint8_t((reg.has<Velocity>(e) && !base.has<Velocity>(e) ? 1 : 0) |
+                                                   (reg.has<Angle>(e) && !base.has<Angle>(e) ? 2 : 0) |
+                                                   (reg.has<AngularVelocity>(e) && !base.has<AngularVelocity>(e) ? 4 : 0));
+            if (mask) gained.push_back({e, mask});
+        }
+        if (gained.size() * 8 > reg.size()) sceneAtBuild_.reset();
+        else gained_ = std::make_shared<const std::vector<Gained>>(std::move(gained));
         sceneCounts_ = counts;
     }
-    HistoryEntry entry{sceneAtBuild_, world_->saveState()};
+    if (!sceneAtBuild_) {
+        sceneAtBuild_ = std::make_shared<const Scene>(scene);
+        gained_.reset();
+        sceneCounts_ = counts;
+    }
+    HistoryEntry entry{sceneAtBuild_, gained_, world_->saveState()};
     historyStateBytes_ += entry.state.bytes();
     history_.push_back(std::move(entry));
     while (!history_.empty() && (history_.size() > historyCapacity_ ||
@@ -274,8 +316,7 @@ bool Simulation::stepBack(Scene& scene) {
     state_ = SimState::Paused;
     HistoryEntry entry = std::move(history_.back());
     popHistory();
-    scene = *entry.scene;
-    entry.state.writeBack(scene);
+    scene = entry.restore();
     // The live World takes the state in place when it was compiled from
     // that entry's scene; after an edit (or a switched system, or a drag)
     // it is recompiled from the restored scene first, with the entry's warm
@@ -302,8 +343,8 @@ bool Simulation::stepBack(Scene& scene) {
     }
     if (world_) (void)world_->restoreState(entry.state);  // refused only for another layout: then reload set it
     sceneAtBuild_ = world_ ? entry.scene : nullptr;
-    const Registry& reg = scene.registry;
-    sceneCounts_ = {reg.count<Velocity>(), reg.count<Angle>(), reg.count<AngularVelocity>()};
+    gained_ = entry.gained;
+    sceneCounts_ = stateComponentCounts(scene.registry);
     if (!samples_.empty()) samples_.pop_back();
     if (steps_ > 0) --steps_;
     diverged_ = false;

@@ -133,9 +133,20 @@ public:
 private:
     /// One step-back entry: the World's state before a step, and the scene
     /// (as of the last edit) whose other components go with it.
+    /// A body that gained a Velocity (1), Angle (2) or AngularVelocity (4)
+    /// component since the entry's scene was copied (writeBack adds them
+    /// once a body moves or turns, and never removes them).
+    struct Gained {
+        Entity entity;
+        std::uint8_t components = 0;
+    };
     struct HistoryEntry {
         std::shared_ptr<const Scene> scene;
+        std::shared_ptr<const std::vector<Gained>> gained;  ///< null: none
         WorldState state;
+        /// The scene this entry stands for: `scene`, the gained components,
+        /// then the state written back.
+        Scene restore() const;
     };
     bool rebuild(const Scene& scene);
     /// Recompiles a changed scene into the live World (keeps the warm start).
@@ -162,8 +173,9 @@ private:
     /// The scene as of the last build or reload, shared by the history
     /// entries taken since (null: not yet taken since the last change).
     std::shared_ptr<const Scene> sceneAtBuild_;
-    std::array<std::size_t, 3> sceneCounts_{};
-    std::string editingError_;  ///< its Velocity, Angle, AngularVelocity counts
+    std::shared_ptr<const std::vector<Gained>> gained_;  ///< since sceneAtBuild_ was copied
+    std::array<std::size_t, 3> sceneCounts_{};  ///< Velocity, Angle, AngularVelocity counts when gained_ was taken
+    std::string editingError_;
     std::vector<SimSample> samples_;
     double initialEnergy_ = 0.0;
     std::uint64_t steps_ = 0;

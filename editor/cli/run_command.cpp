@@ -95,12 +95,12 @@ int run(const RunOptions& options) {
     }
     std::string jsonl;
     const auto start = std::chrono::steady_clock::now();
-    std::optional<std::string> divergence;
-    const AdvanceResult advanced = advance(world, std::uint64_t(options.steps), {.afterStep = [&](std::uint64_t step) {
-        if (options.trace) appendTraceRow(csv, step, world);
-        if (options.contacts) appendContactLine(jsonl, step, world, *scene);
-        return true;
-    }});
+    const AdvanceResult advanced =
+        advance(world, std::uint64_t(options.steps), {.afterStep = [&](std::uint64_t step) {
+                    if (options.trace) appendTraceRow(csv, step, world);
+                    if (options.contacts) appendContactLine(jsonl, step, world, *scene);
+                    return true;
+                }});
     const long long taken = (long long)advanced.taken;
     const std::optional<std::string>& divergence = advanced.divergence;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
