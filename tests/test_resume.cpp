@@ -329,3 +329,29 @@ TEST(Resume, RunOutThenRunOnEqualsOneLongRun) {
     }
     fs::remove_all(dir);
 }
+
+// The schema (levels/scene.schema.json) describes the section: a running
+// state written by `run --out` validates, and a bad entry does not.
+TEST(Resume, ASavedRunningStateValidatesAgainstTheSchema) {
+    const fs::path dir = fs::temp_directory_path() / ("stepwise_resume_schema_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path state = dir / "pile_state.json";
+    const std::string run = std::string(STEPWISE_BINARY) + " run " +
+                            (fs::path(STEPWISE_SOURCE_DIR) / "levels" / "pile.json").string() +
+                            " --steps 30 --out " + state.string() + " > /dev/null";
+    ASSERT_EQ(std::system(run.c_str()), 0);
+    const std::string text = readFile(state);
+    ASSERT_NE(text.find("\"solver_state\""), std::string::npos);
+    const std::string validator = "/usr/bin/python3 " +
+                                  (fs::path(STEPWISE_SOURCE_DIR) / "tests" / "validate_levels_schema.py").string() +
+                                  " " + (fs::path(STEPWISE_SOURCE_DIR) / "levels").string() + " ";
+    EXPECT_EQ(std::system((validator + state.string() + " > /dev/null").c_str()), 0);
+    std::string bad = text;
+    bad.replace(bad.find("\"feature\": "), 11, "\"feature\": 7000000");  // past 65535
+    {
+        std::ofstream out(dir / "bad_state.json", std::ios::binary);
+        out << bad;
+    }
+    EXPECT_NE(std::system((validator + (dir / "bad_state.json").string() + " > /dev/null").c_str()), 0);
+    fs::remove_all(dir);
+}
