@@ -150,11 +150,9 @@ Outcome runStepwise(const Scene& initial, int steps, std::size_t topIndex) {
         world.impl().collision->setBroadPhase(g_broadPhase == "sap" ? collision::BroadPhaseKind::SweepAndPrune
                                                                     : collision::BroadPhaseKind::UniformGrid);
     const auto start = std::chrono::steady_clock::now();
-    for (int i = 0; i < steps; ++i) {
-        if (Result<void> r = world.step(); !r) {
-            std::cerr << "stepwise diverged: " << r.error() << "\n";
-            std::exit(1);
-        }
+    if (const AdvanceResult r = advance(world, std::uint64_t(steps)); !r.ok()) {
+        std::cerr << "stepwise diverged: " << *r.divergence << "\n";
+        std::exit(1);
     }
     Outcome out;
     out.msPerStep = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / steps;

@@ -1,40 +1,231 @@
 #include "app/command_stack.hpp"
 
+#include "stepwise/component_table.hpp"
+
+#include <algorithm>
+#include <cstring>
+
 namespace stepwise::editor {
+
+namespace {
+
+// An entity's components as bytes, driven by the component table: a marker
+// (so an alive entity with no components is not ""), then per component its
+// table index and its fields in table order. Numbers are copied bit for bit,
+// so decoding gives back the same doubles.
+template <class T>
+void put(std::string& out, const T& v) {
+    out.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+template <class T>
+T take(const std::string& in, std::size_t& at) {
+    T v;
+    std::memcpy(&v, in.data() + at, sizeof v);
+    at += sizeof v;
+    return v;
+}
+
+constexpr char kAlive = 'E';
+
+std::string encodeEntity(const Registry& reg, Entity e) {
+    if (!reg.alive(e)) return {};
+    std::string out(1, kAlive);
+    const std::span<const ComponentInfo> table = componentTable();
+    for (std::size_t c = 0; c < table.size(); ++c) {
+        const void* component = table[c].getConst(reg, e);
+        if (!component) continue;
+        put(out, std::uint8_t(c));
+        for (const FieldInfo& f : table[c].fields) {
+            const void* field = f.address(const_cast<void*>(component));
+            switch (f.kind) {
+            case FieldKind::Number: put(out, *static_cast<const double*>(field)); break;
+            case FieldKind::OptionalNumber: {
+                const auto& o = *static_cast<const std::optional<double>*>(field);
+                put(out, std::uint8_t(o.has_value()));
+                if (o) put(out, *o);
+                break;
+            }
+            case FieldKind::Vector: put(out, *static_cast<const Vec2*>(field)); break;
+            case FieldKind::OptionalVector: {
+                const auto& o = *static_cast<const std::optional<Vec2>*>(field);
+                put(out, std::uint8_t(o.has_value()));
+                if (o) put(out, *o);
+                break;
+            }
+            case FieldKind::Color: put(out, *static_cast<const Rgb*>(field)); break;
+            case FieldKind::Bool: put(out, std::uint8_t(*static_cast<const bool*>(field))); break;
+            case FieldKind::String:
+            case FieldKind::EntityName: {
+                const auto& text = *static_cast<const std::string*>(field);
+                put(out, std::uint32_t(text.size()));
+                out += text;
+                break;
+            }
+            }
+        }
+    }
+    return out;
+}
+
+/// Gives alive entity `e` (with no components) the encoded components.
+void decodeEntity(const std::string& in, Registry& reg, Entity e) {
+    const std::span<const ComponentInfo> table = componentTable();
+    std::size_t at = 1;
+    while (at < in.size()) {
+        const ComponentInfo& info = table[take<std::uint8_t>(in, at)];
+        void* component = info.emplaceDefault(reg, e);
+        for (const FieldInfo& f : info.fields) {
+            void* field = f.address(component);
+            switch (f.kind) {
+            case FieldKind::Number: *static_cast<double*>(field) = take<double>(in, at); break;
+            case FieldKind::OptionalNumber: {
+                auto& o = *static_cast<std::optional<double>*>(field);
+                o.reset();
+                if (take<std::uint8_t>(in, at)) o = take<double>(in, at);
+                break;
+            }
+            case FieldKind::Vector: *static_cast<Vec2*>(field) = take<Vec2>(in, at); break;
+            case FieldKind::OptionalVector: {
+                auto& o = *static_cast<std::optional<Vec2>*>(field);
+                o.reset();
+                if (take<std::uint8_t>(in, at)) o = take<Vec2>(in, at);
+                break;
+            }
+            case FieldKind::Color: *static_cast<Rgb*>(field) = take<Rgb>(in, at); break;
+            case FieldKind::Bool: *static_cast<bool*>(field) = take<std::uint8_t>(in, at) != 0; break;
+            case FieldKind::String:
+            case FieldKind::EntityName: {
+                const std::uint32_t n = take<std::uint32_t>(in, at);
+                *static_cast<std::string*>(field) = in.substr(at, n);
+                at += n;
+                break;
+            }
+            }
+        }
+    }
+}
+
+void removeAllComponents(Registry& reg, Entity e) {
+    if (!reg.alive(e)) return;
+    for (const ComponentInfo& info : componentTable()) info.remove(reg, e);
+}
+
+template <class T>
+void setIfChanged(std::optional<std::pair<T, T>>& slot, const T& before, const T& after) {
+    if (!(before == after)) slot.emplace(before, after);
+}
+
+/// Merging: `later` follows `earlier`; the pair becomes (earlier's before,
+/// later's after).
+template <class T>
+void compose(std::optional<std::pair<T, T>>& earlier, const std::optional<std::pair<T, T>>& later) {
+    if (!later) return;
+    if (earlier) earlier->second = later->second;
+    else earlier = later;
+}
+
+} // namespace
+
+std::size_t CommandStack::Delta::bytes() const {
+    std::size_t n = sizeof(Delta) + entities.capacity() * sizeof(EntityChange);
+    for (const EntityChange& c : entities) {
+        // Short strings live inside the std::string itself (SSO).
+        if (c.before.capacity() > 15) n += c.before.capacity() + 1;
+        if (c.after.capacity() > 15) n += c.after.capacity() + 1;
+    }
+    if (slots) n += slots->first.bytes() + slots->second.bytes();
+    if (solver)
+        for (const std::optional<SolverState>* s : {&solver->first, &solver->second})
+            if (*s) n += (*s)->contacts.capacity() * sizeof(ContactImpulse);
+    return n;
+}
+
+CommandStack::Delta CommandStack::diff(const Scene& before, const Scene& after) {
+    Delta d;
+    const Registry& b = before.registry;
+    const Registry& a = after.registry;
+    Registry::Slots slotsBefore = b.slots(), slotsAfter = a.slots();
+    if (!(slotsBefore == slotsAfter)) d.slots.emplace(std::move(slotsBefore), std::move(slotsAfter));
+    for (const Entity e : b.entities()) {
+        std::string was = encodeEntity(b, e), now = encodeEntity(a, e);
+        if (was != now) d.entities.push_back({e, std::move(was), std::move(now)});
+    }
+    for (const Entity e : a.entities())
+        if (!b.alive(e)) d.entities.push_back({e, std::string(), encodeEntity(a, e)});
+    d.entities.shrink_to_fit();
+    setIfChanged(d.world, before.world, after.world);
+    setIfChanged(d.view, before.view, after.view);
+    setIfChanged(d.solver, before.solverState, after.solverState);
+    setIfChanged(d.version, before.version, after.version);
+    return d;
+}
+
+void CommandStack::apply(Scene& scene, const Delta& d, bool forward) {
+    Registry& reg = scene.registry;
+    for (const Delta::EntityChange& c : d.entities) removeAllComponents(reg, c.entity);
+    if (d.slots) reg.setSlots(forward ? d.slots->second : d.slots->first);
+    for (const Delta::EntityChange& c : d.entities) {
+        const std::string& target = forward ? c.after : c.before;
+        if (!target.empty()) decodeEntity(target, reg, c.entity);
+    }
+    if (d.world) scene.world = forward ? d.world->second : d.world->first;
+    if (d.view) scene.view = forward ? d.view->second : d.view->first;
+    if (d.solver) scene.solverState = forward ? d.solver->second : d.solver->first;
+    if (d.version) scene.version = forward ? d.version->second : d.version->first;
+}
 
 bool CommandStack::apply(Scene& scene, std::string label, const std::function<bool(Scene&)>& edit,
                          std::uint64_t mergeKey) {
     const bool merging = open_ && mergeKey != 0 && cursor_ == commands_.size() && cursor_ > 0 &&
                          commands_[cursor_ - 1].mergeKey == mergeKey;
-    if (merging) {
-        // The command keeps its original "before"; only "after" moves on.
-        if (!edit(scene)) return false;
-        commands_[cursor_ - 1].after = scene;
-        ++revision_;
-        return true;
-    }
     Scene before = scene;
     if (!edit(scene)) {
         scene = std::move(before);  // an edit that gave up must leave no trace
         return false;
     }
-    commands_.resize(cursor_);  // a new edit forgets the redo branch
-    commands_.push_back(Command{std::move(label), std::move(before), scene, mergeKey});
-    if (commands_.size() > capacity_) {
-        commands_.erase(commands_.begin());
-        ++dropped_;
+    Delta change = diff(before, scene);
+    if (merging) {
+        // The command keeps its original "before"; only "after" moves on.
+        Command& top = commands_[cursor_ - 1];
+        bytes_ -= top.bytes();
+        Delta& d = top.delta;
+        for (Delta::EntityChange& c : change.entities) {
+            const auto it = std::find_if(d.entities.begin(), d.entities.end(),
+                                         [&](const Delta::EntityChange& o) { return o.entity == c.entity; });
+            if (it != d.entities.end()) it->after = std::move(c.after);
+            else d.entities.push_back(std::move(c));
+        }
+        compose(d.slots, change.slots);
+        compose(d.world, change.world);
+        compose(d.view, change.view);
+        compose(d.solver, change.solver);
+        compose(d.version, change.version);
+        bytes_ += top.bytes();
+        ++revision_;
+        return true;
     }
+    for (std::size_t i = cursor_; i < commands_.size(); ++i) bytes_ -= commands_[i].bytes();
+    commands_.resize(cursor_);  // a new edit forgets the redo branch
+    commands_.push_back(Command{std::move(label), std::move(change), mergeKey});
+    bytes_ += commands_.back().bytes();
+    while (commands_.size() > capacity_ || (commands_.size() > 1 && bytes_ > budgetBytes_)) dropOldest();
     cursor_ = commands_.size();
     open_ = mergeKey != 0;
     ++revision_;
     return true;
 }
 
+void CommandStack::dropOldest() {
+    bytes_ -= commands_.front().bytes();
+    commands_.erase(commands_.begin());
+    ++dropped_;
+}
+
 std::string CommandStack::undo(Scene& scene) {
     open_ = false;
     if (!canUndo()) return {};
     --cursor_;
-    scene = commands_[cursor_].before;
+    apply(scene, commands_[cursor_].delta, false);
     ++revision_;
     return commands_[cursor_].label;
 }
@@ -42,7 +233,7 @@ std::string CommandStack::undo(Scene& scene) {
 std::string CommandStack::redo(Scene& scene) {
     open_ = false;
     if (!canRedo()) return {};
-    scene = commands_[cursor_].after;
+    apply(scene, commands_[cursor_].delta, true);
     ++cursor_;
     ++revision_;
     return commands_[cursor_ - 1].label;
@@ -56,7 +247,10 @@ std::vector<std::string> CommandStack::labels() const {
 }
 
 void CommandStack::truncate(std::size_t n) {
-    if (n < commands_.size()) commands_.resize(n);
+    if (n < commands_.size()) {
+        for (std::size_t i = n; i < commands_.size(); ++i) bytes_ -= commands_[i].bytes();
+        commands_.resize(n);
+    }
     cursor_ = std::min(cursor_, commands_.size());
     open_ = false;
     ++revision_;
@@ -64,6 +258,7 @@ void CommandStack::truncate(std::size_t n) {
 
 void CommandStack::clear() {
     commands_.clear();
+    bytes_ = 0;
     cursor_ = 0;
     open_ = false;
     ++revision_;

@@ -118,7 +118,13 @@ bool Editor::saveStateAs(const std::filesystem::path& file) {
         errorModal = "Cannot save the state: " + problem;
         return false;
     }
-    if (Result<void> r = saveSceneFile(doc.scene, file); !r) {
+    // The running state with the solver's warm start (`solver_state`), so
+    // that playing the saved file on gives the bits this session would.
+    Scene state = doc.scene;
+    state.solverState.reset();
+    if (sim.running() && sim.ensureWorld(doc.scene))
+        if (SolverState solver = sim.world()->solverState(); !solver.empty()) state.solverState = std::move(solver);
+    if (Result<void> r = saveSceneFile(state, file); !r) {
         errorModal = "Cannot save " + file.string() + ":\n" + r.error();
         return false;
     }

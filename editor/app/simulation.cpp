@@ -5,7 +5,9 @@
 #include "stepwise/components.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <functional>
 #include <cmath>
 
 namespace stepwise::editor {
@@ -67,6 +69,7 @@ bool Simulation::rebuild(const Scene& scene) {
     Result<World> built = World::build(simulationScene(scene, &builtMouseSpring_));
     ++worldBuilds_;
     builtMouseBody_ = builtMouseSpring_.isNull() ? Entity{} : mouseSpring->first;
+    sceneAtBuild_.reset();
     if (!built) {
         world_.reset();
         message_ = "cannot simulate: " + built.error();
@@ -77,10 +80,59 @@ bool Simulation::rebuild(const Scene& scene) {
     return true;
 }
 
+bool Simulation::reload(const Scene& scene) {
+    if (!world_) return rebuild(scene);
+    Entity springEntity;
+    Scene sim = simulationScene(scene, &springEntity);
+    // The live World's own warm start carries over; a solver state the
+    // scene was loaded with has been used once, at Play.
+    sim.solverState.reset();
+    Result<void> reloaded = world_->reload(sim);
+    ++worldBuilds_;
+    sceneAtBuild_.reset();
+    if (!reloaded) {
+        world_.reset();
+        message_ = "cannot simulate: " + reloaded.error();
+        return false;
+    }
+    builtMouseSpring_ = springEntity;
+    builtMouseBody_ = springEntity.isNull() ? Entity{} : mouseSpring->first;
+    stale_ = false;
+    return true;
+}
+
 bool Simulation::ensureWorld(const Scene& scene) {
     if (state_ == SimState::Editing) return false;
     if (!stale_ && world_) return true;
-    return rebuild(scene);
+    return reload(scene);
+}
+
+const World* Simulation::editingWorld(const Scene& scene) {
+    if (state_ != SimState::Editing) return nullptr;
+    if (stale_ || !world_) {
+        const std::string kept = message_;
+        editingError_.clear();
+        if (!reload(scene)) editingError_ = message_.substr(std::string_view("cannot simulate: ").size());
+        message_ = kept;  // a refusal while editing is shown in the panel, not as a run's message
+    }
+    return world_ ? &*world_ : nullptr;
+}
+
+std::size_t Simulation::historyBytes() const {
+    std::size_t bytes = historyStateBytes_ + history_.size() * sizeof(HistoryEntry);
+    const Scene* last = nullptr;
+    const std::vector<Gained>* lastGained = nullptr;
+    for (const HistoryEntry& h : history_) {
+        if (h.scene.get() != last) {
+            last = h.scene.get();
+            bytes += 256 + 256 * last->registry.size();  // estimate: a scene's components and pools
+        }
+        if (h.gained && h.gained.get() != lastGained) {
+            lastGained = h.gained.get();
+            bytes += lastGained->capacity() * sizeof(Gained);
+        }
+    }
+    return bytes;
 }
 
 void Simulation::record() {
@@ -103,17 +155,17 @@ bool Simulation::play(Scene& scene) {
         message_.clear();
         diverged_ = false;
         contactPair.reset();
+        // A fresh World: the one kept for the panels while editing has the
+        // same scene but may carry a step count from an earlier run.
         if (!rebuild(scene)) return false;
         edited_ = scene;
         state_ = SimState::Paused;
         history_.clear();
+        historyStateBytes_ = 0;
         samples_.clear();
         steps_ = 0;
         touchingBefore_ = false;
         initialEnergy_ = world_->energy().total();
-        // Snapshots cost about this much each; stay inside the budget.
-        const std::size_t perSnapshot = 256 + 256 * scene.registry.size();
-        historyCapacity_ = std::clamp<std::size_t>(historyBudgetBytes / perSnapshot, 8, 600);
         record();
     } else if (!ensureWorld(scene)) {
         return false;
@@ -127,7 +179,70 @@ void Simulation::pause() {
     if (state_ == SimState::Playing) state_ = SimState::Paused;
 }
 
-bool Simulation::stepOnce(Scene& scene) {
+namespace {
+std::array<std::size_t, 3> stateComponentCounts(const Registry& reg) {
+    return {reg.count<Velocity>(), reg.count<Angle>(), reg.count<AngularVelocity>()};
+}
+} // namespace
+
+Scene Simulation::HistoryEntry::restore() const {
+    Scene out = *scene;
+    if (gained) {
+        Registry& reg = out.registry;
+        for (const Gained& g : *gained) {
+            if (!reg.alive(g.entity)) continue;
+            if (g.components & 1) reg.emplace<Velocity>(g.entity);
+            if (g.components & 2) reg.emplace<Angle>(g.entity);
+            if (g.components & 4) reg.emplace<AngularVelocity>(g.entity);
+        }
+    }
+    state.writeBack(out);
+    return out;
+}
+
+void Simulation::pushHistory(const Scene& scene) {
+    // The scene copy holds everything but the state. writeBack only ever
+    // adds Velocity, Angle and AngularVelocity components (once a body
+    // moves or turns), so one copy serves every state since the last edit,
+    // with the list of bodies that gained one since (kept while it is short;
+    // past an eighth of the entities a new copy is cheaper to keep). A
+    // restored scene then has exactly the components the first pass had.
+    const Registry& reg = scene.registry;
+    const std::array<std::size_t, 3> counts = stateComponentCounts(reg);
+    if (sceneAtBuild_ && counts != sceneCounts_) {
+        const Registry& base = sceneAtBuild_->registry;
+        std::vector<Gained> gained;
+        for (const Entity e : reg.entities()) {
+            const std::uint8_t mask = std::uint8_t((reg.has<Velocity>(e) && !base.has<Velocity>(e) ? 1 : 0) |
+                                                   (reg.has<Angle>(e) && !base.has<Angle>(e) ? 2 : 0) |
+                                                   (reg.has<AngularVelocity>(e) && !base.has<AngularVelocity>(e) ? 4 : 0));
+            if (mask) gained.push_back({e, mask});
+        }
+        if (gained.size() * 8 > reg.size()) sceneAtBuild_.reset();
+        else gained_ = std::make_shared<const std::vector<Gained>>(std::move(gained));
+        sceneCounts_ = counts;
+    }
+    if (!sceneAtBuild_) {
+        sceneAtBuild_ = std::make_shared<const Scene>(scene);
+        gained_.reset();
+        sceneCounts_ = counts;
+    }
+    HistoryEntry entry{sceneAtBuild_, gained_, world_->saveState()};
+    historyStateBytes_ += entry.state.bytes();
+    history_.push_back(std::move(entry));
+    while (!history_.empty() && (history_.size() > historyCapacity_ ||
+                                 (history_.size() > 8 && historyStateBytes_ > historyBudgetBytes))) {
+        historyStateBytes_ -= history_.front().state.bytes();
+        history_.pop_front();
+    }
+}
+
+void Simulation::popHistory() {
+    historyStateBytes_ -= history_.back().state.bytes();
+    history_.pop_back();
+}
+
+bool Simulation::prepareStep(Scene& scene) {
     if (!ensureWorld(scene)) {
         state_ = SimState::Paused;
         return false;
@@ -135,21 +250,16 @@ bool Simulation::stepOnce(Scene& scene) {
     if (mouseSpring) {
         // The anchor follows the cursor. The World built with this drag's
         // spring only moves the anchor; a new drag (or none built yet)
-        // rebuilds it with the spring.
+        // recompiles it with the spring.
         const bool moved = !builtMouseSpring_.isNull() && builtMouseBody_ == mouseSpring->first &&
                            world_->setSpringAnchor(builtMouseSpring_, mouseSpring->second);
-        if (!moved && !rebuild(scene)) return false;
+        if (!moved && !reload(scene)) return false;
     }
-    history_.push_back(scene);
-    while (history_.size() > historyCapacity_) history_.pop_front();
-    Result<void> r = world_->step();
-    if (!r) {
-        history_.pop_back();  // the world is left as before the step
-        state_ = SimState::Paused;
-        diverged_ = true;
-        message_ = "diverged: " + r.error();
-        return false;
-    }
+    pushHistory(scene);
+    return true;
+}
+
+bool Simulation::finishStep(Scene& scene) {
     world_->writeBack(scene);
     ++steps_;
     record();
@@ -173,6 +283,28 @@ bool Simulation::stepOnce(Scene& scene) {
     return true;
 }
 
+AdvanceResult Simulation::runSteps(Scene& scene, int count, const std::function<bool()>& gate) {
+    if (!ensureWorld(scene)) {
+        state_ = SimState::Paused;
+        return {};
+    }
+    const AdvanceResult r = stepwise::advance(*world_, std::uint64_t(count),
+                                    {.beforeStep = [&](std::uint64_t) { return gate() && prepareStep(scene); },
+                                     .afterStep = [&](std::uint64_t) { return finishStep(scene); }});
+    if (r.divergence) {
+        popHistory();  // the world is left as before the step
+        state_ = SimState::Paused;
+        diverged_ = true;
+        message_ = "diverged: " + *r.divergence;
+    }
+    return r;
+}
+
+bool Simulation::stepOnce(Scene& scene) {
+    const AdvanceResult r = runSteps(scene, 1, [] { return true; });
+    return r.taken == 1 && !r.stopped;
+}
+
 bool Simulation::step(Scene& scene) {
     if (state_ == SimState::Editing && !play(scene)) return false;
     state_ = SimState::Paused;
@@ -182,11 +314,39 @@ bool Simulation::step(Scene& scene) {
 bool Simulation::stepBack(Scene& scene) {
     if (state_ == SimState::Editing || history_.empty()) return false;
     state_ = SimState::Paused;
-    scene = std::move(history_.back());
-    history_.pop_back();
+    HistoryEntry entry = std::move(history_.back());
+    popHistory();
+    scene = entry.restore();
+    // The live World takes the state in place when it was compiled from
+    // that entry's scene; after an edit (or a switched system, or a drag)
+    // it is recompiled from the restored scene first, with the entry's warm
+    // start. Either way the next step is the one the first pass took.
+    const bool sameBuild = world_ && !stale_ && entry.scene == sceneAtBuild_;
+    if (!sameBuild) {
+        Entity springEntity;
+        Scene sim = simulationScene(scene, &springEntity);
+        sim.solverState = entry.state.solverState();
+        Result<void> r = world_ ? world_->reload(sim) : Result<void>(Error{"no world"});
+        if (!r) {
+            Result<World> built = World::build(sim);
+            if (!built) {
+                world_.reset();
+                message_ = "cannot simulate: " + built.error();
+            } else {
+                world_.emplace(std::move(*built));
+            }
+        }
+        ++worldBuilds_;
+        builtMouseSpring_ = springEntity;
+        builtMouseBody_ = springEntity.isNull() ? Entity{} : mouseSpring->first;
+        stale_ = !world_;
+    }
+    if (world_) (void)world_->restoreState(entry.state);  // refused only for another layout: then reload set it
+    sceneAtBuild_ = world_ ? entry.scene : nullptr;
+    gained_ = entry.gained;
+    sceneCounts_ = stateComponentCounts(scene.registry);
     if (!samples_.empty()) samples_.pop_back();
     if (steps_ > 0) --steps_;
-    stale_ = true;
     diverged_ = false;
     touchingBefore_ = false;
     return true;
@@ -198,6 +358,8 @@ bool Simulation::reset(Scene& scene) {
     state_ = SimState::Editing;
     world_.reset();
     history_.clear();
+    historyStateBytes_ = 0;
+    sceneAtBuild_.reset();
     stale_ = true;
     message_.clear();
     diverged_ = false;
@@ -216,7 +378,8 @@ void Simulation::advance(Scene& scene, double frameSeconds) {
     // A small tolerance so a 1/60 s frame at dt = 1/60 is exactly one step
     // despite rounding in the accumulator.
     behind_ = false;
-    while (accumulator_ >= dt * (1.0 - 1e-9) && state_ == SimState::Playing) {
+    runSteps(scene, maxStepsPerFrame + 1, [&] {
+        if (!(accumulator_ >= dt * (1.0 - 1e-9) && state_ == SimState::Playing)) return false;
         const double spentMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         if (taken == maxStepsPerFrame || (taken > 0 && spentMs > physicsBudgetMs)) {
             // Behind: drop the time rather than fall further behind. A slow
@@ -225,12 +388,12 @@ void Simulation::advance(Scene& scene, double frameSeconds) {
             // motion instead and the UI stays responsive.
             accumulator_ = 0.0;
             behind_ = true;
-            break;
+            return false;
         }
         accumulator_ -= dt;
         ++taken;
-        if (!stepOnce(scene)) break;
-    }
+        return true;
+    });
     frameStepMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 

@@ -7,12 +7,15 @@
 /// * While running, the document's scene *is* the current state (World::
 ///   writeBack after every step): the viewport, inspector and overlays show
 ///   it, and an edit while paused edits that state, deliberately.
-/// * Every step first stores the scene it starts from in a bounded history
-///   (full snapshots: exact, and cheap next to a step), so stepping back
-///   returns the same bytes.
-/// * The World is rebuilt lazily when the scene was changed from outside
-///   (an edit, a step back, a switched-off system). Determinism of the engine
-///   (build from a written-back scene == keep stepping) makes this exact.
+/// * One live World. An edit, undo or switched-off system marks it stale and
+///   the next use recompiles the scene into it in place (World::reload),
+///   which keeps the contacts' warm start and the step count: an edit never
+///   resets the solver.
+/// * Every step first stores the World's whole evolving state (positions,
+///   velocities, angles, warm-start impulses: World::saveState) in a bounded
+///   history, with a shared pointer to the scene as of the last edit (its
+///   other components). Stepping back restores both, so step back N then
+///   step N gives the same bytes as the first pass, contacts included.
 /// * System switches: the World is built from a copy of the scene with the
 ///   components of switched-off systems removed (gravity set to zero), so
 ///   the engine itself decides what each remaining system costs.
@@ -20,9 +23,12 @@
 #include "stepwise/scene.hpp"
 #include "stepwise/world.hpp"
 
+#include <array>
 #include <cstddef>
+#include <functional>
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -65,9 +71,16 @@ public:
     /// Builds the World now if it is stale (for overlays while paused).
     bool ensureWorld(const Scene& scene);
 
+    /// While editing, the same one World compiled from the edited scene
+    /// (recompiled in place after each edit) for the panels and force
+    /// overlays; null when the engine refuses the scene (editingWorldError()
+    /// says why) or while running (use world()).
+    const World* editingWorld(const Scene& scene);
+    const std::string& editingWorldError() const { return editingError_; }
+
     /// nullptr when editing or when the World could not be built.
-    const World* world() const { return world_ ? &*world_ : nullptr; }
-    World* world() { return world_ ? &*world_ : nullptr; }
+    const World* world() const { return world_ && running() ? &*world_ : nullptr; }
+    World* world() { return world_ && running() ? &*world_ : nullptr; }
     const Scene& editedScene() const { return edited_; }
 
     double timeScale = 1.0;       ///< simulated seconds per real second
@@ -102,8 +115,12 @@ public:
 
     std::size_t historySize() const { return history_.size(); }
     std::size_t historyCapacity() const { return historyCapacity_; }
-    /// Memory budget of the step-back history, bytes (estimated per snapshot).
+    /// Memory budget of the step-back history, bytes: the oldest states go
+    /// first past it (or past historyCapacity() steps).
     std::size_t historyBudgetBytes = std::size_t(128) << 20;
+    /// Heap bytes the history holds now: its states, plus each distinct scene
+    /// they point to.
+    std::size_t historyBytes() const;
 
     const std::vector<SimSample>& samples() const { return samples_; }
     /// Energy at the start of the run, joules (the drift reference).
@@ -114,8 +131,35 @@ public:
     double lastFrameStepMs() const { return frameStepMs_; }
 
 private:
+    /// One step-back entry: the World's state before a step, and the scene
+    /// (as of the last edit) whose other components go with it.
+    /// A body that gained a Velocity (1), Angle (2) or AngularVelocity (4)
+    /// component since the entry's scene was copied (writeBack adds them
+    /// once a body moves or turns, and never removes them).
+    struct Gained {
+        Entity entity;
+        std::uint8_t components = 0;
+    };
+    struct HistoryEntry {
+        std::shared_ptr<const Scene> scene;
+        std::shared_ptr<const std::vector<Gained>> gained;  ///< null: none
+        WorldState state;
+        /// The scene this entry stands for: `scene`, the gained components,
+        /// then the state written back.
+        Scene restore() const;
+    };
     bool rebuild(const Scene& scene);
+    /// Recompiles a changed scene into the live World (keeps the warm start).
+    bool reload(const Scene& scene);
     bool stepOnce(Scene& scene);
+    /// Up to `count` steps through stepwise::advance; `gate` is asked before
+    /// each (false: stop). Each step stores its history entry first and
+    /// writes the scene back after.
+    AdvanceResult runSteps(Scene& scene, int count, const std::function<bool()>& gate);
+    bool prepareStep(Scene& scene);  ///< world ready, mouse spring, history entry
+    bool finishStep(Scene& scene);   ///< write back, plots, break on contact (false: paused)
+    void pushHistory(const Scene& scene);
+    void popHistory();
     void record();
 
     SimState state_ = SimState::Editing;
@@ -123,8 +167,15 @@ private:
     std::optional<World> world_;
     bool stale_ = true;
     double accumulator_ = 0.0;
-    std::deque<Scene> history_;
+    std::deque<HistoryEntry> history_;
+    std::size_t historyStateBytes_ = 0;  ///< sum of history_[i].state.bytes()
     std::size_t historyCapacity_ = 600;
+    /// The scene as of the last build or reload, shared by the history
+    /// entries taken since (null: not yet taken since the last change).
+    std::shared_ptr<const Scene> sceneAtBuild_;
+    std::shared_ptr<const std::vector<Gained>> gained_;  ///< since sceneAtBuild_ was copied
+    std::array<std::size_t, 3> sceneCounts_{};  ///< Velocity, Angle, AngularVelocity counts when gained_ was taken
+    std::string editingError_;
     std::vector<SimSample> samples_;
     double initialEnergy_ = 0.0;
     std::uint64_t steps_ = 0;

@@ -185,14 +185,19 @@ int render(const RenderOptions& o) {
     std::size_t instances = 0;
     for (int frame = 0; frame < o.frames; ++frame) {
         const long long target = o.steps + (long long)frame * o.every;
-        for (; stepsTaken < target; ++stepsTaken) {
-            if (Result<void> stepped = world->step(); !stepped) {
+        if (stepsTaken < target) {
+            const AdvanceResult run = advance(*world, std::uint64_t(target - stepsTaken),
+                                              {.afterStep = [&](std::uint64_t) {
+                                              trails.record(*world);
+                                              return true;
+                                          }});
+            stepsTaken += (long long)run.taken;
+            if (run.divergence) {
                 if (tty) std::fputc('\n', stderr);
-                reportError(o.level + ": simulation diverged at " + stepped.error() + " (integrator " +
+                reportError(o.level + ": simulation diverged at " + *run.divergence + " (integrator " +
                             world->settings().integrator + "); " + std::to_string(frame) + " frame(s) written");
                 return kExitDiverged;
             }
-            trails.record(*world);
         }
         if (world) world->writeBack(*scene);
         input.caption = levelName + "  |  t = " + number(scene->world.time) + " s  |  step " +

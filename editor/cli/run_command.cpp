@@ -197,55 +197,58 @@ int run(const RunOptions& options) {
     bool progressShown = false, estimateShown = false;
     const auto start = std::chrono::steady_clock::now();
     auto lastProgress = start;
-    long long taken = 0;
-    for (; !divergence && !failure && taken < options.steps; ++taken) {
-        if (gInterrupted) break;
-        if (Result<void> stepped = world.step(); !stepped) {
-            divergence = stepped.error();
-            break;
-        }
-        if (trace) {
-            const EnergyReport e = world.energy();
-            if (std::string bad = nonFiniteEnergy(e, taken + 1); !bad.empty()) {
-                divergence = bad;
-                ++taken;
-                break;
-            }
-            appendTraceRow(row, std::uint64_t(taken + 1), world);
-            emit(trace);
-        }
-        if (contacts) {
-            appendContactLine(row, std::uint64_t(taken + 1), world, *scene);
-            emit(contacts);
-        }
-        // A clock read every 256 steps: a progress line on a terminal twice
-        // a second, and once, after a second, the estimate of the whole run
-        // when it is long (on any stderr: a log shows it too).
-        if ((taken & 255) != 255) continue;
-        const auto now = std::chrono::steady_clock::now();
-        const double elapsed = std::chrono::duration<double>(now - start).count();
-        const double perStep = elapsed / double(taken + 1);
-        const double left = perStep * double(options.steps - taken - 1);
-        if (!estimateShown && elapsed >= 1.0) {
-            estimateShown = true;
-            if (elapsed + left > 30.0) {
-                if (progressShown) std::fputc('\n', stderr);
-                std::fprintf(stderr,
-                             "stepwise: note: %s: %lld steps at %.3g ms/step take about %s; Ctrl-C stops the run "
-                             "and writes nothing\n",
-                             options.level.c_str(), options.steps, 1e3 * perStep, duration(elapsed + left).c_str());
-                progressShown = false;
-            }
-        }
-        if (terminal && std::chrono::duration<double>(now - lastProgress).count() >= 0.5) {
-            lastProgress = now;
-            std::fprintf(stderr, "\rstep %lld of %lld (%.1f%%), %.3g steps/s, about %s left   ", taken + 1,
-                         options.steps, 100.0 * double(taken + 1) / double(options.steps), 1.0 / perStep,
-                         duration(left).c_str());
-            std::fflush(stderr);
-            progressShown = true;
-        }
-    }
+    // One step loop for every front end (advance()); the hooks stop it on an
+    // interrupt or a write failure, stream the rows and show the progress.
+    std::uint64_t stepsWanted = divergence ? 0 : std::uint64_t(options.steps);
+    const AdvanceResult advanced = advance(
+        world, stepsWanted,
+        {.beforeStep = [&](std::uint64_t) { return !gInterrupted && !failure; },
+         .afterStep = [&](std::uint64_t step) {
+             if (trace) {
+                 const EnergyReport e = world.energy();
+                 if (std::string bad = nonFiniteEnergy(e, (long long)step); !bad.empty()) {
+                     divergence = bad;
+                     return false;
+                 }
+                 appendTraceRow(row, step, world);
+                 emit(trace);
+             }
+             if (contacts) {
+                 appendContactLine(row, step, world, *scene);
+                 emit(contacts);
+             }
+             // A clock read every 256 steps: a progress line on a terminal twice
+             // a second, and once, after a second, the estimate of the whole run
+             // when it is long (on any stderr: a log shows it too).
+             if ((step & 255) != 0) return true;
+             const auto now = std::chrono::steady_clock::now();
+             const double elapsed = std::chrono::duration<double>(now - start).count();
+             const double perStep = elapsed / double(step);
+             const double left = perStep * double(std::uint64_t(options.steps) - step);
+             if (!estimateShown && elapsed >= 1.0) {
+                 estimateShown = true;
+                 if (elapsed + left > 30.0) {
+                     if (progressShown) std::fputc('\n', stderr);
+                     std::fprintf(stderr,
+                                  "stepwise: note: %s: %lld steps at %.3g ms/step take about %s; Ctrl-C stops the run "
+                                  "and writes nothing\n",
+                                  options.level.c_str(), options.steps, 1e3 * perStep,
+                                  duration(elapsed + left).c_str());
+                     progressShown = false;
+                 }
+             }
+             if (terminal && std::chrono::duration<double>(now - lastProgress).count() >= 0.5) {
+                 lastProgress = now;
+                 std::fprintf(stderr, "\rstep %llu of %lld (%.1f%%), %.3g steps/s, about %s left   ",
+                              (unsigned long long)step, options.steps, 100.0 * double(step) / double(options.steps),
+                              1.0 / perStep, duration(left).c_str());
+                 std::fflush(stderr);
+                 progressShown = true;
+             }
+             return true;
+         }});
+    const long long taken = (long long)advanced.taken;
+    if (advanced.divergence) divergence = advanced.divergence;
     ::sigaction(SIGINT, &oldInt, nullptr);
     ::sigaction(SIGTERM, &oldTerm, nullptr);
     if (progressShown) std::fputc('\n', stderr);
@@ -281,7 +284,11 @@ int run(const RunOptions& options) {
                 return kExitBadInput;
             }
     if (options.out) {
+        // The solver's warm start goes with the state, so that running the
+        // written file on gives the same bits as running on here.
         world.writeBack(*scene);
+        SolverState solver = world.solverState();
+        scene->solverState = solver.empty() ? std::nullopt : std::optional<SolverState>(std::move(solver));
         if (Result<void> saved = saveSceneFile(*scene, *options.out); !saved) {
             std::cerr << saved.error() << "\n";
             return kExitBadInput;

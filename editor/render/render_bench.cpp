@@ -100,10 +100,10 @@ int main(int argc, char** argv) {
     if (world) {
         // 32 steps of history for the trails overlay.
         trails.record(*world);
-        for (int s = 0; s < 31; ++s) {
-            if (!world->step()) break;
-            trails.record(*world);
-        }
+        advance(*world, 31, {.afterStep = [&](std::uint64_t) {
+                    trails.record(*world);
+                    return true;
+                }});
         world->writeBack(scene);
     }
 

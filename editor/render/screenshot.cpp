@@ -23,10 +23,13 @@ Result<Screenshot> renderSceneScreenshot(OffscreenRenderer& renderer, Scene scen
     if (built) {
         world.emplace(std::move(*built));
         trails.record(*world);
-        for (; shot.stepsTaken < settings.steps; ++shot.stepsTaken) {
-            if (Result<void> stepped = world->step(); !stepped) return Error{"diverged: " + stepped.error()};
-            trails.record(*world);
-        }
+        const AdvanceResult run = advance(*world, std::uint64_t(std::max(0LL, settings.steps)),
+                                          {.afterStep = [&](std::uint64_t) {
+                                              trails.record(*world);
+                                              return true;
+                                          }});
+        shot.stepsTaken = (long long)run.taken;
+        if (run.divergence) return Error{"diverged: " + *run.divergence};
         world->writeBack(scene);
     } else {
         shot.note = built.error();

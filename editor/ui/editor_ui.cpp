@@ -169,17 +169,12 @@ const World* panelWorld(UiState& ui, Editor& ed) {
         ed.sim.ensureWorld(ed.doc.scene);
         return ed.sim.world();
     }
-    if (ui.previewRevision != ed.revision()) {
-        ui.previewRevision = ed.revision();
-        ui.preview.reset();
-        ui.previewError.clear();
-        if (ed.doc.scene.registry.size() <= ui.previewLimit) {
-            Result<World> w = World::build(ed.sim.simulationScene(ed.doc.scene));
-            if (w) ui.preview.emplace(std::move(*w));
-            else ui.previewError = w.error();
-        }
-    }
-    return ui.preview ? &*ui.preview : nullptr;
+    // Editing: the simulation's one World, recompiled in place after edits
+    // (no second World of the UI's own).
+    if (ed.doc.scene.registry.size() > ui.previewLimit) return nullptr;
+    const World* w = ed.sim.editingWorld(ed.doc.scene);
+    ui.previewError = ed.sim.editingWorldError();
+    return w;
 }
 
 namespace {
@@ -564,7 +559,6 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                     if (on) ed.sim.disabledSystems.erase(s);
                     else ed.sim.disabledSystems.insert(s);
                     ed.sim.sceneChanged();
-                    ui.previewRevision = ~0ull;
                 }
                 ImGui::EndDisabled();
                 ImGui::TableNextColumn();

@@ -68,10 +68,8 @@ struct UiState {
 
     // A World built from the edited scene while editing (hints, active
     // systems, force field): rebuilt when the scene's revision changes.
-    std::optional<World> preview;
-    std::string previewError;
-    std::uint64_t previewRevision = ~0ull;
-    /// Entities past which the preview World is not built every edit (cost).
+    std::string previewError;  ///< why the edited scene cannot be simulated
+    /// Entities past which the edit-mode World is not recompiled every edit (cost).
     std::size_t previewLimit = 20000;
 };
 

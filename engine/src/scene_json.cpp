@@ -17,6 +17,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <unordered_map>
 
 namespace stepwise {
 
@@ -300,6 +301,66 @@ void readWorld(const Json& v, WorldSettings& world) {
     }
 }
 
+/// `solver_state` (an addition): the warm start a resumed run needs. Read
+/// after the entities, since its entries name them. An entity is named by
+/// its `name`, or by its index in `entities` when it has none.
+SolverState readSolverState(const Json& v, const Registry& registry) {
+    const std::string pointer = "/solver_state";
+    if (!v.is_object()) refuse(pointer, "expected an object {\"contacts\": [...]}, got " + describeFound(v));
+    const auto& entities = registry.entities();
+    std::map<std::string, Entity, std::less<>> byName;
+    for (const Entity e : entities)
+        if (const Name* n = registry.tryGet<Name>(e)) byName.emplace(n->value, e);
+    auto entityAt = [&](const Json& ref, const std::string& at) -> Entity {
+        Entity e;
+        if (ref.is_string()) {
+            const auto it = byName.find(ref.get<std::string>());
+            if (it == byName.end()) refuse(at, "no entity is named " + ref.dump());
+            e = it->second;
+        } else if (ref.is_number_integer() || ref.is_number_unsigned()) {
+            const long index = readInteger(ref, at, 0, long(entities.size()) - 1);
+            e = entities[std::size_t(index)];
+        } else {
+            refuse(at, "expected an entity name or index, got " + describeFound(ref));
+        }
+        if (!registry.has<Radius>(e) && !registry.has<Box>(e) && !registry.has<Plane>(e))
+            refuse(at, "entity " + ref.dump() + " has no shape (radius, box or plane), so it has no contacts");
+        return e;
+    };
+    SolverState state;
+    for (const auto& [key, value] : v.items()) {
+        const std::string at = child(pointer, key);
+        if (key != "contacts") refuse(at, "unknown key \"" + key + "\" in solver_state. Known keys: contacts");
+        if (!value.is_array()) refuse(at, "expected an array of contacts, got " + describeFound(value));
+        state.contacts.reserve(value.size());
+        for (std::size_t i = 0; i < value.size(); ++i) {
+            const Json& c = value[i];
+            const std::string ci = child(at, i);
+            if (!c.is_object())
+                refuse(ci, "expected {\"a\", \"b\", \"feature\", \"normal_impulse\", \"tangent_impulse\"}, got " +
+                               describeFound(c));
+            ContactImpulse impulse;
+            bool seen[5] = {false, false, false, false, false};
+            for (const auto& [field, fv] : c.items()) {
+                const std::string fa = child(ci, field);
+                if (field == "a") impulse.a = entityAt(fv, fa), seen[0] = true;
+                else if (field == "b") impulse.b = entityAt(fv, fa), seen[1] = true;
+                else if (field == "feature") impulse.feature = std::uint32_t(readInteger(fv, fa, 0, 0xFFFF)), seen[2] = true;
+                else if (field == "normal_impulse") impulse.normalImpulse = readNumber(fv, fa, NumberRange{}), seen[3] = true;
+                else if (field == "tangent_impulse") impulse.tangentImpulse = readNumber(fv, fa, NumberRange{}), seen[4] = true;
+                else
+                    refuse(fa, "unknown key \"" + field +
+                                   "\" in a contact. Known keys: a, b, feature, normal_impulse, tangent_impulse");
+            }
+            static constexpr const char* kRequired[5] = {"a", "b", "feature", "normal_impulse", "tangent_impulse"};
+            for (int k = 0; k < 5; ++k)
+                if (!seen[k]) refuse(ci, std::string("missing \"") + kRequired[k] + "\"");
+            state.contacts.push_back(impulse);
+        }
+    }
+    return state;
+}
+
 View readView(const Json& v) {
     const std::string pointer = "/view";
     if (!v.is_object()) refuse(pointer, "expected an object {\"center\": vector, \"zoom\": number}, got " + describeFound(v));
@@ -473,7 +534,8 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
     try {
         if (!root.is_object())
             refuse("", "expected a level object {\"entities\": [...]}, got " + describeFound(root));
-        static constexpr std::array<std::string_view, 4> kTopKeys{"version", "world", "view", "entities"};
+        static constexpr std::array<std::string_view, 5> kTopKeys{"version", "world", "view", "entities",
+                                                                  "solver_state"};
         for (const auto& [key, value] : root.items()) {
             if (std::find(kTopKeys.begin(), kTopKeys.end(), key) == kTopKeys.end()) {
                 std::string message = "unknown top-level key \"" + key + "\"";
@@ -494,6 +556,8 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
             refuse("/entities", "expected an array of entities, got " + describeFound(*entitiesIt));
         scene.registry.reserve(entitiesIt->size());
         for (std::size_t i = 0; i < entitiesIt->size(); ++i) readEntity((*entitiesIt)[i], i, scene.registry);
+        if (auto it = root.find("solver_state"); it != root.end())
+            scene.solverState = readSolverState(*it, scene.registry);
         // Free the DOM before the relation checks: peak memory is one copy.
         root = Json();
         if (std::string problem = checkSceneRelations(scene); !problem.empty()) {
@@ -536,6 +600,40 @@ Result<Scene> parseScene(std::string_view text, std::string_view sourceName, con
     return scene;
 }
 
+namespace {
+
+/// Appends `"solver_state": {...}` as the last key of the written root
+/// object (`out` ends with its closing brace). One line per contact: a
+/// settled pile has thousands. Numbers read back to the same double, so a
+/// resumed run is bit-identical. Entries naming an entity no longer in the
+/// scene are dropped.
+void appendSolverState(const SolverState& state, const Registry& registry, std::string& out) {
+    std::unordered_map<Entity, std::size_t> indexOf;
+    const auto& entities = registry.entities();
+    for (std::size_t i = 0; i < entities.size(); ++i) indexOf.emplace(entities[i], i);
+    auto ref = [&](Entity e) -> std::optional<std::string> {
+        const auto it = indexOf.find(e);
+        if (it == indexOf.end()) return std::nullopt;
+        if (const Name* n = registry.tryGet<Name>(e); n && !n->value.empty()) return Json(n->value).dump();
+        return std::to_string(it->second);
+    };
+    out.erase(out.size() - 2);  // "\n}"
+    out += ",\n  \"solver_state\": {\n    \"contacts\": [";
+    bool first = true;
+    for (const ContactImpulse& c : state.contacts) {
+        const std::optional<std::string> a = ref(c.a), b = ref(c.b);
+        if (!a || !b) continue;
+        out += first ? "\n      " : ",\n      ";
+        first = false;
+        out += "{\"a\": " + *a + ", \"b\": " + *b + ", \"feature\": " + std::to_string(c.feature) +
+               ", \"normal_impulse\": " + Json(c.normalImpulse).dump() +
+               ", \"tangent_impulse\": " + Json(c.tangentImpulse).dump() + "}";
+    }
+    out += first ? "]\n  }\n}" : "\n    ]\n  }\n}";
+}
+
+} // namespace
+
 std::string sceneToJsonText(const Scene& scene) {
     Json root = Json::object();
     root["version"] = scene.version;
@@ -577,6 +675,7 @@ std::string sceneToJsonText(const Scene& scene) {
     root["entities"] = std::move(entities);
     std::string out;
     writeJson(root, 0, out);
+    if (scene.solverState) appendSolverState(*scene.solverState, registry, out);
     out += "\n";
     return out;
 }

@@ -103,6 +103,26 @@ std::string sceneJsonSchema() {
                      {"properties", Json{{"center", ref("vector")},
                                          {"zoom", Json{{"type", "number"}, {"exclusiveMinimum", 0}}}}}};
 
+    const Json entityRef = Json{
+        {"description", "an entity's name, or its index in entities when it has no name"},
+        {"oneOf", Json::array({Json{{"type", "string"}}, Json{{"type", "integer"}, {"minimum", 0}}})}};
+    Json contact = Json{
+        {"type", "object"},
+        {"description", "accumulated impulses of one contact point at the end of the last step (warm start)"},
+        {"additionalProperties", false},
+        {"required", Json::array({"a", "b", "feature", "normal_impulse", "tangent_impulse"})},
+        {"properties", Json{{"a", entityRef},
+                            {"b", entityRef},
+                            {"feature", Json{{"type", "integer"}, {"minimum", 0}, {"maximum", 65535}}},
+                            {"normal_impulse", Json{{"type", "number"}, {"description", "N*s"}}},
+                            {"tangent_impulse", Json{{"type", "number"}, {"description", "N*s"}}}}}};
+    Json solverState = Json{
+        {"type", "object"},
+        {"description", "what the solver carries between steps, written with a running state (stepwise run --out, the "
+                        "editor's Save simulation state) so that a resumed run is bit-identical; absent: a cold start"},
+        {"additionalProperties", false},
+        {"properties", Json{{"contacts", Json{{"type", "array"}, {"items", contact}}}}}};
+
     Json schema = Json::object();
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema";
     schema["title"] = "Stepwise level";
@@ -113,7 +133,8 @@ std::string sceneJsonSchema() {
     schema["properties"] = Json{{"version", Json{{"const", 1}}},
                                 {"world", world},
                                 {"view", view},
-                                {"entities", Json{{"type", "array"}, {"items", ref("entity")}}}};
+                                {"entities", Json{{"type", "array"}, {"items", ref("entity")}}},
+                                {"solver_state", solverState}};
     schema["$defs"] = defs;
     return schema.dump(2) + "\n";
 }

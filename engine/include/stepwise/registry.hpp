@@ -212,6 +212,31 @@ public:
         eachImpl<const Registry, First, Rest...>(*this, std::forward<Fn>(fn));
     }
 
+    /// The slot table (generations, liveness, free list) and the scene
+    /// order: with the components, all a Registry holds. The editor's undo
+    /// keeps it for edits that create or destroy entities, so that undo and
+    /// redo bring back the very same handles.
+    struct Slots {
+        std::vector<std::uint32_t> generations;
+        std::vector<bool> alive;
+        std::vector<std::uint32_t> freeList;
+        std::vector<Entity> order;
+        friend bool operator==(const Slots&, const Slots&) = default;
+        std::size_t bytes() const {
+            return 4 * (generations.capacity() + freeList.capacity()) + alive.capacity() / 8 +
+                   sizeof(Entity) * order.capacity();
+        }
+    };
+    Slots slots() const { return {generations_, alive_, freeList_, order_}; }
+    /// Replaces the slot table. Remove the components of every entity that
+    /// `s` does not keep alive first: pools are not touched here.
+    void setSlots(Slots s) {
+        generations_ = std::move(s.generations);
+        alive_ = std::move(s.alive);
+        freeList_ = std::move(s.freeList);
+        order_ = std::move(s.order);
+    }
+
     /// Handle currently in slot `index` if alive (used to turn dense pool
     /// owners back into handles).
     Entity handleAt(std::uint32_t index) const { return Entity{index, generations_[index]}; }

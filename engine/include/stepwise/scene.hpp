@@ -7,8 +7,10 @@
 #include "stepwise/registry.hpp"
 #include "stepwise/vec2.hpp"
 
+#include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace stepwise {
 
@@ -36,11 +38,41 @@ struct View {
     friend bool operator==(const View&, const View&) = default;
 };
 
+/// The accumulated impulse of one contact point at the end of a step: the
+/// solver's warm start for the next step. In memory the two colliders are
+/// entity handles; in a file, names (or the entity's index in `entities`
+/// when it has no name).
+struct ContactImpulse {
+    Entity a, b;                 ///< the pair in the solver's order (a's collider index < b's, planes first)
+    std::uint32_t feature = 0;   ///< the manifold point's feature id (which vertex/edge pair touches)
+    double normalImpulse = 0.0;  ///< accumulated along the normal, N*s
+    double tangentImpulse = 0.0; ///< accumulated along the tangent, N*s
+
+    friend bool operator==(const ContactImpulse&, const ContactImpulse&) = default;
+};
+
+/// What the solver carries from one step to the next beyond what the
+/// entities hold (positions, velocities, angles, spins). A World built from
+/// a scene with this state steps exactly as the World that wrote it: the
+/// file's optional `solver_state` section (an addition to the format).
+/// Per-body solver state (sleep timers, ...) goes here next to `contacts`,
+/// keyed by entity the same way.
+struct SolverState {
+    std::vector<ContactImpulse> contacts;  ///< warm start, sorted by the solver's key
+
+    bool empty() const { return contacts.empty(); }
+    friend bool operator==(const SolverState&, const SolverState&) = default;
+};
+
 struct Scene {
     int version = 1;
     WorldSettings world;
     std::optional<View> view;
     Registry registry;
+    /// Present when the scene was saved from a running simulation (`stepwise
+    /// run --out`, the editor's "Save simulation state"): World::build then
+    /// resumes exactly. Absent in hand-written levels: the solver starts cold.
+    std::optional<SolverState> solverState;
 };
 
 } // namespace stepwise

@@ -14,6 +14,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -74,6 +75,54 @@ struct StiffnessHint {
     std::string message() const;
 };
 
+/// One contact point's accumulated impulses in the solver's own indexing,
+/// kept from one step to the next for the warm start (ContactImpulse is the
+/// same entry keyed by entities, as files hold it).
+struct CachedImpulse {
+    std::uint64_t key = 0;  ///< (colliderA << 40) | (colliderB << 16) | feature id
+    double normal = 0.0, tangent = 0.0;  ///< N*s
+    static std::uint64_t makeKey(std::uint32_t a, std::uint32_t b, std::uint32_t feature) {
+        return (std::uint64_t(a) << 40) | (std::uint64_t(b) << 16) | (feature & 0xFFFF);
+    }
+    std::uint32_t colliderA() const { return std::uint32_t(key >> 40); }
+    std::uint32_t colliderB() const { return std::uint32_t((key >> 16) & 0xFFFFFF); }
+    std::uint32_t feature() const { return std::uint32_t(key & 0xFFFF); }
+    friend bool operator<(const CachedImpulse& l, const CachedImpulse& r) { return l.key < r.key; }
+    friend bool operator==(const CachedImpulse&, const CachedImpulse&) = default;
+};
+
+/// Which entity each array of a WorldState belongs to. One per build,
+/// shared by every snapshot taken from that build.
+struct WorldLayout {
+    std::vector<Entity> bodies;      ///< dynamic bodies, in state-vector order
+    std::vector<Entity> spinBodies;  ///< dynamic bodies without a shape that turn
+    std::vector<Entity> colliders;   ///< every shape, in collider order
+    std::vector<std::uint8_t> colliderMoves;  ///< per collider: 1 when it is a dynamic body's
+    friend bool operator==(const WorldLayout&, const WorldLayout&) = default;
+};
+
+/// Everything a step reads that an earlier step wrote: a World restored
+/// from a snapshot steps bit for bit as the World that took it did. The
+/// editor's step-back history is made of these. Add any new state carried
+/// between steps (sleep timers, joint impulses, ...) here and in
+/// saveState/restoreState, and its entity-keyed form to SolverState.
+struct WorldState {
+    std::shared_ptr<const WorldLayout> layout;
+    double time = 0.0;            ///< seconds
+    std::uint64_t steps = 0;      ///< StepStats::step
+    std::vector<double> x, v;     ///< bodies, interleaved (x0, y0, x1, ...): metres, m/s
+    std::vector<double> spinAngle;             ///< spinBodies, rad
+    std::vector<double> colliderAngle, colliderSpin;  ///< colliders, rad and rad/s
+    std::vector<CachedImpulse> contacts;       ///< the warm-start cache
+    /// Heap bytes held (the layout, shared, not counted).
+    std::size_t bytes() const;
+    /// The warm-start cache keyed by entities (as World::solverState()).
+    SolverState solverState() const;
+    /// Writes the bodies' state and the time into `scene`, as
+    /// World::writeBack did when the snapshot was taken.
+    void writeBack(Scene& scene) const;
+};
+
 class WorldImpl;
 
 class World {
@@ -96,6 +145,28 @@ public:
     /// Copies positions, velocities, angles and time into `scene`, whose
     /// entities must be the ones the world was built from.
     void writeBack(Scene& scene) const;
+
+    /// The solver's carried state keyed by entities (what a file's
+    /// `solver_state` holds). writeBack + this = everything a resume needs.
+    SolverState solverState() const;
+    /// Sets the carried solver state. Entries whose entities are not
+    /// colliders of this world are skipped (an edit removed them), so it
+    /// never fails. World::build applies a scene's solverState with this.
+    void setSolverState(const SolverState& state);
+
+    /// Snapshot of the whole evolving state (cheap: a few array copies).
+    WorldState saveState() const;
+    /// Restores a snapshot taken from this World or from one built from a
+    /// scene with the same entities, shapes and systems (the same layout).
+    /// Fails, changing nothing, when the layout differs.
+    Result<void> restoreState(const WorldState& state);
+
+    /// Recompiles `scene` (an edited version of the scene this World runs)
+    /// into this World in place: positions, parameters and components come
+    /// from the scene; the warm start of every contact whose two entities
+    /// still collide, and the step count, are kept. On failure the World is
+    /// unchanged. The editor edits its one live World this way.
+    Result<void> reload(const Scene& scene);
 
     const WorldSettings& settings() const;
     /// Changes the integrator by name (one of integratorNames()).
@@ -144,5 +215,27 @@ private:
     explicit World(std::unique_ptr<WorldImpl> impl);
     std::unique_ptr<WorldImpl> impl_;
 };
+
+/// What advance() did.
+struct AdvanceResult {
+    std::uint64_t taken = 0;        ///< steps completed
+    std::optional<std::string> divergence;  ///< World::step's message when a step failed
+    bool stopped = false;           ///< afterStep asked to stop
+    bool ok() const { return !divergence; }
+};
+
+/// Per-step hooks of advance(). Either may be empty.
+struct AdvanceHooks {
+    /// Before step `next` (counted from 1); false: stop without taking it.
+    std::function<bool(std::uint64_t next)> beforeStep;
+    /// After step `taken` completed (counted from 1); false: stop there.
+    std::function<bool(std::uint64_t taken)> afterStep;
+};
+
+/// The step loop: up to `steps` steps of `world`, with the hooks around
+/// each. A divergence stops the loop with World::step's message and leaves
+/// the world as before the failed step. `stepwise run`, `render`, `bench`,
+/// the editor and the tests all step through this one function.
+AdvanceResult advance(World& world, std::uint64_t steps, const AdvanceHooks& hooks = {});
 
 } // namespace stepwise

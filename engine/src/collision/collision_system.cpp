@@ -54,6 +54,12 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     }
 }
 
+void CollisionSystem::setWarmStartCache(std::vector<CachedImpulse> cache) {
+    if (!std::is_sorted(cache.begin(), cache.end())) std::sort(cache.begin(), cache.end());
+    cache_ = std::move(cache);
+    cacheCursor_ = 0;
+}
+
 void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m,
                                   std::span<const Vec2> centres) {
     if (m.pointCount == 0) return;
@@ -248,8 +254,7 @@ void CollisionSystem::endStep() {
         const ContactDetail& d = details_[k];
         for (int i = 0; i < c.pointCount; ++i) {
             const ContactPoint& p = c.points[i];
-            const std::uint64_t key =
-                (std::uint64_t(d.colliderA) << 40) | (std::uint64_t(d.colliderB) << 16) | (d.id[i] & 0xFFFF);
+            const std::uint64_t key = CachedImpulse::makeKey(d.colliderA, d.colliderB, d.id[i]);
             cache_.push_back({key, p.normalImpulse, p.tangentImpulse});
             // Speculative points that never carried load are not contacts.
             if (d.separation[i] > kLinearSlop && p.normalImpulse == 0.0 && d.restitutionImpulse[i] == 0.0) continue;

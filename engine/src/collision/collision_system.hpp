@@ -33,6 +33,8 @@ struct Collider {
 /// Solid-shape moment of inertia about the centre, kg m^2.
 double momentOfInertia(const Shape& shape, double mass);
 
+using stepwise::CachedImpulse;  // world.hpp: snapshots hold the cache as it is
+
 struct CollisionTimings {
     double broadPhaseMs = 0.0, narrowPhaseMs = 0.0, solveMs = 0.0;
 };
@@ -67,10 +69,12 @@ public:
     void endStep();
 
     std::span<const ContactRecord> contacts() const { return records_; }
+    void clearContactRecords() { records_.clear(); }
     std::size_t contactPointCount() const { return records_.size(); }
     const CollisionTimings& timings() const { return timings_; }
 
-    /// Undoes a step's rotational change (after a divergence).
+    /// Sets the rotational state: undoes a step's change (after a
+    /// divergence), or resumes from a snapshot.
     void restoreRotation(std::span<const double> angles, std::span<const double> angularVelocities) {
         angles_.assign(angles.begin(), angles.end());
         angularVelocities_.assign(angularVelocities.begin(), angularVelocities.end());
@@ -78,12 +82,13 @@ public:
     std::span<const double> angles() const { return angles_; }
     std::span<const double> angularVelocities() const { return angularVelocities_; }
 
+    /// The warm-start cache the next step starts from (sorted by key): with
+    /// the bodies' state, all a step reads that an earlier step wrote.
+    const std::vector<CachedImpulse>& warmStartCache() const { return cache_; }
+    /// Replaces it (resume from a snapshot or a file); sorted here.
+    void setWarmStartCache(std::vector<CachedImpulse> cache);
+
 private:
-    struct CachedImpulse {
-        std::uint64_t key;  // (colliderA << 40) | (colliderB << 16) | point id
-        double normal, tangent;
-        friend bool operator<(const CachedImpulse& l, const CachedImpulse& r) { return l.key < r.key; }
-    };
 
     void addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m, std::span<const Vec2> centres);
 

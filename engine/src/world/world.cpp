@@ -21,11 +21,15 @@
 //                            when its kernel is fused and no contact solve
 //                            ran after it)
 //
-// Determinism: nothing is carried between steps except the state and the
-// time, both of which a saved file holds exactly (shortest round-trip
-// numbers). No cached accelerations (Verlet recomputes a(x0, v0)), the boid
-// grid is rebuilt per evaluation, and no summation depends on addresses or
-// threads. So 200 steps equal 100 steps, save, load, 100 steps, bit for bit.
+// Determinism: a step reads the bodies' state, the time and, with contacts,
+// the warm-start cache (the impulses the previous step ended with). Nothing
+// else is carried: no cached accelerations (Verlet recomputes a(x0, v0)),
+// the boid grid is rebuilt per evaluation, the broad phase returns sorted
+// pairs whatever its kept sweep order, and no summation depends on addresses
+// or threads. The state goes to a file through writeBack (shortest
+// round-trip numbers) and the cache through solverState() (the file's
+// `solver_state`), so 200 steps equal 100 steps, save, load, 100 steps, bit
+// for bit; saveState/restoreState do the same in memory.
 
 #include "world/world_impl.hpp"
 #include "world/world_collisions.hpp"
@@ -337,7 +341,20 @@ Result<World> World::build(const Scene& scene) {
     w.setIntegratorKind(*kind);
     w.stats.stages.reserve(8);
     w.stats.systems.reserve(std::size_t(detail::ForceSystem::Count));
-    return World(std::move(impl));
+
+    auto layout = std::make_shared<WorldLayout>();
+    layout->bodies = w.bodyEntity;
+    for (const std::uint32_t b : w.spinBody) layout->spinBodies.push_back(w.bodyEntity[b]);
+    if (w.collision)
+        for (std::size_t c = 0; c < w.collision->colliderCount(); ++c) {
+            layout->colliders.push_back(w.collision->collider(c).entity);
+            layout->colliderMoves.push_back(w.collision->collider(c).body >= 0 ? 1 : 0);
+        }
+    w.layout = std::move(layout);
+
+    World world(std::move(impl));
+    if (scene.solverState) world.setSolverState(*scene.solverState);
+    return world;
 }
 
 Result<void> World::step() {
@@ -448,35 +465,162 @@ Result<void> World::step() {
     return {};
 }
 
-void World::writeBack(Scene& scene) const {
-    const WorldImpl& w = *impl_;
+namespace {
+
+/// World::writeBack and WorldState::writeBack: the arrays of one layout into
+/// the scene's components. `colliderAngle`/`colliderSpin` may be empty (no
+/// shapes).
+void writeStateBack(const WorldLayout& layout, const double* x, const double* v, std::span<const double> spinAngle,
+                    std::span<const double> colliderAngle, std::span<const double> colliderSpin, double time,
+                    Scene& scene) {
     Registry& reg = scene.registry;
-    const double* x = w.xs();
-    const double* v = w.vs();
-    for (std::size_t b = 0; b < w.bodyEntity.size(); ++b) {
-        const Entity e = w.bodyEntity[b];
+    for (std::size_t b = 0; b < layout.bodies.size(); ++b) {
+        const Entity e = layout.bodies[b];
         if (!reg.alive(e)) continue;  // stale: the scene is not the one built from
         reg.emplace<Position>(e, Position{{x[2 * b], x[2 * b + 1]}});
         const Vec2 vel{v[2 * b], v[2 * b + 1]};
         // A body that had no velocity component gets one only once it moves.
         if (reg.has<Velocity>(e) || vel.x != 0.0 || vel.y != 0.0) reg.emplace<Velocity>(e, Velocity{vel});
     }
-    for (std::size_t s = 0; s < w.spinBody.size(); ++s) {
-        const Entity e = w.bodyEntity[w.spinBody[s]];
-        if (reg.alive(e)) reg.emplace<Angle>(e, Angle{w.angle[s]});
+    for (std::size_t s = 0; s < layout.spinBodies.size(); ++s) {
+        const Entity e = layout.spinBodies[s];
+        if (reg.alive(e)) reg.emplace<Angle>(e, Angle{spinAngle[s]});
     }
-    if (const collision::CollisionSystem* contacts = w.collision.get()) {
-        for (std::size_t c = 0; c < contacts->colliderCount(); ++c) {
-            const Entity e = contacts->collider(c).entity;
-            if (contacts->collider(c).body < 0 || !reg.alive(e)) continue;
-            // Like velocity: written once the body turns, so a resumed run
-            // starts from the same rotation.
-            const double angle = contacts->angle(c), spin = contacts->angularVelocity(c);
-            if (reg.has<Angle>(e) || angle != 0.0) reg.emplace<Angle>(e, Angle{angle});
-            if (reg.has<AngularVelocity>(e) || spin != 0.0) reg.emplace<AngularVelocity>(e, AngularVelocity{spin});
+    for (std::size_t c = 0; c < colliderAngle.size(); ++c) {
+        const Entity e = layout.colliders[c];
+        if (!layout.colliderMoves[c] || !reg.alive(e)) continue;
+        // Like velocity: written once the body turns, so a resumed run
+        // starts from the same rotation.
+        const double angle = colliderAngle[c], spin = colliderSpin[c];
+        if (reg.has<Angle>(e) || angle != 0.0) reg.emplace<Angle>(e, Angle{angle});
+        if (reg.has<AngularVelocity>(e) || spin != 0.0) reg.emplace<AngularVelocity>(e, AngularVelocity{spin});
+    }
+    scene.world.time = time;
+}
+
+} // namespace
+
+void World::writeBack(Scene& scene) const {
+    const WorldImpl& w = *impl_;
+    std::span<const double> angles, spins;
+    if (w.collision) {
+        angles = w.collision->angles();
+        spins = w.collision->angularVelocities();
+    }
+    writeStateBack(*w.layout, w.xs(), w.vs(), w.angle, angles, spins, w.settings.time, scene);
+}
+
+void WorldState::writeBack(Scene& scene) const {
+    writeStateBack(*layout, x.data(), v.data(), spinAngle, colliderAngle, colliderSpin, time, scene);
+}
+
+namespace {
+SolverState entityKeyed(const WorldLayout& layout, std::span<const CachedImpulse> cache) {
+    SolverState state;
+    state.contacts.reserve(cache.size());
+    for (const CachedImpulse& c : cache)
+        state.contacts.push_back(
+            {layout.colliders[c.colliderA()], layout.colliders[c.colliderB()], c.feature(), c.normal, c.tangent});
+    return state;
+}
+} // namespace
+
+SolverState WorldState::solverState() const { return entityKeyed(*layout, contacts); }
+
+SolverState World::solverState() const {
+    const WorldImpl& w = *impl_;
+    if (!w.collision) return {};
+    return entityKeyed(*w.layout, w.collision->warmStartCache());
+}
+
+void World::setSolverState(const SolverState& state) {
+    WorldImpl& w = *impl_;
+    if (!w.collision) return;
+    std::unordered_map<Entity, std::uint32_t> colliderOf;
+    const std::vector<Entity>& colliders = w.layout->colliders;
+    for (std::size_t c = 0; c < colliders.size(); ++c) colliderOf.emplace(colliders[c], std::uint32_t(c));
+    std::vector<CachedImpulse> cache;
+    cache.reserve(state.contacts.size());
+    for (const ContactImpulse& c : state.contacts) {
+        const auto a = colliderOf.find(c.a), b = colliderOf.find(c.b);
+        if (a == colliderOf.end() || b == colliderOf.end()) continue;  // no longer collides: nothing to warm
+        cache.push_back({CachedImpulse::makeKey(a->second, b->second, c.feature), c.normalImpulse, c.tangentImpulse});
+    }
+    // Kept in the given order when it is sorted (always, for a state this
+    // engine wrote): entries with equal keys then stay in the order the
+    // warm start reads them.
+    w.collision->setWarmStartCache(std::move(cache));
+}
+
+std::size_t WorldState::bytes() const {
+    return sizeof(double) * (x.capacity() + v.capacity() + spinAngle.capacity() + colliderAngle.capacity() +
+                             colliderSpin.capacity()) +
+           sizeof(CachedImpulse) * contacts.capacity();
+}
+
+WorldState World::saveState() const {
+    const WorldImpl& w = *impl_;
+    WorldState s;
+    s.layout = w.layout;
+    s.time = w.settings.time;
+    s.steps = w.stats.step;
+    s.x.assign(w.x[w.current].begin(), w.x[w.current].end());
+    s.v.assign(w.v[w.current].begin(), w.v[w.current].end());
+    s.spinAngle = w.angle;
+    if (w.collision) {
+        s.colliderAngle.assign(w.collision->angles().begin(), w.collision->angles().end());
+        s.colliderSpin.assign(w.collision->angularVelocities().begin(), w.collision->angularVelocities().end());
+        s.contacts = w.collision->warmStartCache();
+    }
+    return s;
+}
+
+Result<void> World::restoreState(const WorldState& s) {
+    WorldImpl& w = *impl_;
+    if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout))
+        return Error{"the snapshot was taken from a world with other bodies or shapes"};
+    std::copy(s.x.begin(), s.x.end(), w.x[w.current].begin());
+    std::copy(s.v.begin(), s.v.end(), w.v[w.current].begin());
+    w.angle = s.spinAngle;
+    if (w.collision) {
+        w.collision->restoreRotation(s.colliderAngle, s.colliderSpin);
+        w.collision->setWarmStartCache(s.contacts);
+        w.collision->clearContactRecords();  // they described the step this state replaces
+    }
+    w.stats.contactCount = 0;
+    w.settings.time = s.time;
+    w.stats.step = s.steps;
+    return {};
+}
+
+Result<void> World::reload(const Scene& scene) {
+    Result<World> next = build(scene);
+    if (!next) return Error{next.error()};
+    if (!scene.solverState) next->setSolverState(solverState());
+    next->impl_->stats.step = impl_->stats.step;
+    next->impl_->profiling = impl_->profiling;
+    impl_ = std::move(next->impl_);
+    return {};
+}
+
+AdvanceResult advance(World& world, std::uint64_t steps, const AdvanceHooks& hooks) {
+    AdvanceResult result;
+    while (result.taken < steps) {
+        if (hooks.beforeStep && !hooks.beforeStep(result.taken + 1)) {
+            result.stopped = true;
+            break;
+        }
+        if (Result<void> stepped = world.step(); !stepped) {
+            result.divergence = stepped.error();
+            break;
+        }
+        ++result.taken;
+        if (hooks.afterStep && !hooks.afterStep(result.taken)) {
+            result.stopped = true;
+            break;
         }
     }
-    scene.world.time = w.settings.time;
+    return result;
 }
 
 const WorldSettings& World::settings() const { return impl_->settings; }

@@ -46,6 +46,8 @@ public:
     std::unique_ptr<collision::CollisionSystem> collision;
     std::vector<double> collisionAngleBackup, collisionSpinBackup;  ///< undo after a divergence
     bool profiling = true;
+    /// Entities of the state arrays (saveState/restoreState); set by build.
+    std::shared_ptr<const WorldLayout> layout;
 
     const double* xs() const { return x[current].data(); }
     const double* vs() const { return v[current].data(); }
