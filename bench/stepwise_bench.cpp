@@ -49,14 +49,15 @@ Scene makeScene(Problem p, std::size_t n) {
         if (p == Problem::GravityDrag) s.registry.emplace<Drag>(e, {0.1});
     }
     if (p == Problem::Springs) {
+        const std::vector<Entity> particles = s.registry.entities();  // the n particles, in order
         for (std::size_t i = 0; i < n; ++i) {
             Entity e = s.registry.create();
             Spring sp;
-            sp.a = particleName(i);
+            sp.a = particles[i];
             if (i == 0)
                 sp.anchor = Vec2{0.0, 0.0};
             else
-                sp.b = particleName(i - 1);
+                sp.b = particles[i - 1];
             sp.k = 100.0;
             sp.damping = 0.5;
             sp.restLength = 0.1;

@@ -39,13 +39,21 @@ inline Entity addStatic(Scene& s, const std::string& name, Vec2 p, double mass =
     return e;
 }
 
+/// The entity called `name` (springs hold handles; these builders take names
+/// for readability). A null handle when there is none.
+inline Entity entityNamed(const Scene& s, const std::string& name) {
+    for (Entity e : s.registry.entities())
+        if (const Name* n = s.registry.tryGet<Name>(e); n && n->value == name) return e;
+    return {};
+}
+
 inline Entity addSpring(Scene& s, const std::string& name, const std::string& a, const std::string& b, double k,
                         double damping, double rest) {
     Entity e = s.registry.create();
     s.registry.emplace<Name>(e, {name});
     Spring sp;
-    sp.a = a;
-    sp.b = b;
+    sp.a = entityNamed(s, a);
+    sp.b = entityNamed(s, b);
     sp.k = k;
     sp.damping = damping;
     sp.restLength = rest;
@@ -58,7 +66,7 @@ inline Entity addAnchoredSpring(Scene& s, const std::string& name, const std::st
     Entity e = s.registry.create();
     s.registry.emplace<Name>(e, {name});
     Spring sp;
-    sp.a = a;
+    sp.a = entityNamed(s, a);
     sp.anchor = anchor;
     sp.k = k;
     sp.damping = damping;

@@ -17,7 +17,7 @@ namespace {
 
 /// Writes a distinctive, valid, non-default value into a field; `salt`
 /// varies it per field so swapped fields would be caught.
-void setDistinct(const FieldInfo& field, void* component, int salt) {
+void setDistinct(const FieldInfo& field, void* component, int salt, Entity target) {
     void* m = field.address(component);
     const double v = 0.125 + 0.0625 * salt;  // exact binary fractions, in (0, 1]
     switch (field.kind) {
@@ -28,11 +28,13 @@ void setDistinct(const FieldInfo& field, void* component, int salt) {
     case FieldKind::Color: *static_cast<Rgb*>(m) = {0.453125, 1.0 / 3.0, 0.0}; break;
     case FieldKind::Bool: *static_cast<bool*>(m) = salt % 2 == 0; break;
     case FieldKind::String: *static_cast<std::string*>(m) = "label \"quoted\" ü " + std::to_string(salt); break;
-    case FieldKind::EntityName: *static_cast<std::string*>(m) = "target"; break;
+    case FieldKind::EntityRef: *static_cast<Entity*>(m) = target; break;
     }
 }
 
-bool fieldEquals(const FieldInfo& field, const void* a, const void* b) {
+/// Entity references are compared by the name of the entity they point at
+/// (handles differ between two registries).
+bool fieldEquals(const FieldInfo& field, const void* a, const void* b, const Registry& ra, const Registry& rb) {
     const void* ma = field.address(const_cast<void*>(a));
     const void* mb = field.address(const_cast<void*>(b));
     switch (field.kind) {
@@ -44,9 +46,14 @@ bool fieldEquals(const FieldInfo& field, const void* a, const void* b) {
         return *static_cast<const std::optional<Vec2>*>(ma) == *static_cast<const std::optional<Vec2>*>(mb);
     case FieldKind::Color: return *static_cast<const Rgb*>(ma) == *static_cast<const Rgb*>(mb);
     case FieldKind::Bool: return *static_cast<const bool*>(ma) == *static_cast<const bool*>(mb);
-    case FieldKind::String:
-    case FieldKind::EntityName:
-        return *static_cast<const std::string*>(ma) == *static_cast<const std::string*>(mb);
+    case FieldKind::String: return *static_cast<const std::string*>(ma) == *static_cast<const std::string*>(mb);
+    case FieldKind::EntityRef: {
+        const Entity ea = *static_cast<const Entity*>(ma), eb = *static_cast<const Entity*>(mb);
+        if (ea.isNull() || eb.isNull()) return ea.isNull() && eb.isNull();
+        const Name* na = ra.tryGet<Name>(ea);
+        const Name* nb = rb.tryGet<Name>(eb);
+        return na && nb && na->value == nb->value;
+    }
     }
     return false;
 }
@@ -98,11 +105,11 @@ TEST_P(ComponentRoundTrip, EveryFieldSurvivesSaveAndLoad) {
     for (std::string_view needed : info->requires_) findComponent(needed)->emplaceDefault(r, host);
     void* component = info->emplaceDefault(r, host);
     int salt = 1;
-    for (const FieldInfo& f : info->fields) setDistinct(f, component, salt++);
+    for (const FieldInfo& f : info->fields) setDistinct(f, component, salt++, target);
     if (info->name == "spring") {
         auto* s = static_cast<Spring*>(component);
-        s->a = "target";
-        s->b.clear();  // anchored: b and anchor are exclusive
+        s->a = target;
+        s->b = Entity{};  // anchored: b and anchor are exclusive
     }
     if (info->name == "boid") static_cast<Boid*>(component)->separationRadius = 0.5;
     if (info->name == "plane") static_cast<Plane*>(component)->normal = {0.6, 0.8};  // unit already
@@ -114,7 +121,7 @@ TEST_P(ComponentRoundTrip, EveryFieldSurvivesSaveAndLoad) {
     const void* back = info->getConst(loaded->registry, loadedHost);
     ASSERT_NE(back, nullptr) << info->name << " missing after load\n" << text;
     for (const FieldInfo& f : info->fields)
-        EXPECT_TRUE(fieldEquals(f, component, back)) << info->name << "." << f.key << "\n" << text;
+        EXPECT_TRUE(fieldEquals(f, component, back, r, loaded->registry)) << info->name << "." << f.key << "\n" << text;
     EXPECT_EQ(sceneToJsonText(*loaded), text);
 }
 

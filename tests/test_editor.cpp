@@ -217,15 +217,15 @@ TEST(Tools, SpringBetweenTwoBodiesAndToAnAnchor) {
     const Registry& reg = f.ed.doc.scene.registry;
     const Spring* s = reg.tryGet<Spring>(reg.entities().back());
     ASSERT_NE(s, nullptr);
-    EXPECT_EQ(s->a, "planet");
-    EXPECT_EQ(s->b, "comet");
+    EXPECT_EQ(s->a, f.named("planet"));
+    EXPECT_EQ(s->b, f.named("comet"));
     ASSERT_TRUE(s->restLength);
     EXPECT_NEAR(*s->restLength, 6.5, 1e-9);
     f.click(f.positionOf("dust"));
     f.click({5.0, 5.0});
     const Spring* anchored = reg.tryGet<Spring>(reg.entities().back());
     ASSERT_NE(anchored, nullptr);
-    EXPECT_EQ(anchored->a, "dust");
+    EXPECT_EQ(anchored->a, f.named("dust"));
     ASSERT_TRUE(anchored->anchor);
     EXPECT_NEAR(anchored->anchor->x, 5.0, 1e-9);
     EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), "");
@@ -280,9 +280,10 @@ TEST(Tools, DeleteTakesAttachedSpringsDuplicateAndPasteRenameAndRewire) {
     for (Entity e : f.ed.selection)
         if (reg.has<Spring>(e)) pasted = reg.tryGet<Spring>(e);
     ASSERT_NE(pasted, nullptr);
-    EXPECT_NE(pasted->a, "link1");
-    EXPECT_NE(pasted->b, "link2");
-    EXPECT_TRUE(reg.alive(findByName(reg, pasted->a)));
+    EXPECT_NE(pasted->a, f.named("link1"));
+    EXPECT_NE(pasted->b, f.named("link2"));
+    EXPECT_TRUE(reg.alive(pasted->a));
+    EXPECT_TRUE(std::find(f.ed.selection.begin(), f.ed.selection.end(), pasted->a) != f.ed.selection.end());
     EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), "");
     // Delete link3: the springs to link2 and link4 go with it.
     const std::size_t springs = springsAttachedTo(reg, f.named("link3")).size();

@@ -70,6 +70,7 @@ void Editor::newDocument() {
 void Editor::replaceDocument(Document next) {
     if (sim.running()) sim.reset(doc.scene);
     doc = std::move(next);
+    ++documentSerial_;
     commands.clear();
     savedCursor_ = commands.absoluteCursor();
     savedReachable_ = true;
@@ -232,7 +233,8 @@ bool Editor::duplicateSelection() {
 
 void Editor::copySelection() {
     clipboard_ = Scene{};
-    clipboardEntities_ = cloneEntities(doc.scene.registry, selection, clipboard_, {0.0, 0.0});
+    clipboardEntities_ = cloneEntities(doc.scene.registry, selection, clipboard_, {0.0, 0.0}, OutsideRefs::Carry);
+    clipboardDocument_ = documentSerial_;
     pasteCount_ = 0;
     note("copied " + std::to_string(clipboardEntities_.size()) + " entities");
 }
@@ -243,7 +245,10 @@ bool Editor::paste() {
     std::vector<Entity> created;
     const Vec2 offset{0.5 * pasteCount_, -0.5 * pasteCount_};
     const bool done = applyEdit("paste", [&](Scene& s) {
-        created = cloneEntities(clipboard_.registry, clipboardEntities_, s, offset);
+        // Handles to bodies outside the copy mean something only in the
+        // document they were copied from.
+        created = cloneEntities(clipboard_.registry, clipboardEntities_, s, offset,
+                                clipboardDocument_ == documentSerial_ ? OutsideRefs::Keep : OutsideRefs::Drop);
         return !created.empty();
     });
     if (done) selection = created;

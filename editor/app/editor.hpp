@@ -164,6 +164,8 @@ private:
     Scene clipboard_;
     std::vector<Entity> clipboardEntities_;
     int pasteCount_ = 0;
+    std::uint64_t documentSerial_ = 0;    ///< bumped when another document replaces this one
+    std::uint64_t clipboardDocument_ = 0; ///< documentSerial_ when the clipboard was filled
 
     std::uint64_t savedCursor_ = 0;
     bool savedReachable_ = true;

@@ -24,10 +24,8 @@ void copyField(const FieldInfo& field, const void* src, void* dst) {
         break;
     case FieldKind::Color: *static_cast<Rgb*>(to) = *static_cast<const Rgb*>(from); break;
     case FieldKind::Bool: *static_cast<bool*>(to) = *static_cast<const bool*>(from); break;
-    case FieldKind::String:
-    case FieldKind::EntityName:
-        *static_cast<std::string*>(to) = *static_cast<const std::string*>(from);
-        break;
+    case FieldKind::String: *static_cast<std::string*>(to) = *static_cast<const std::string*>(from); break;
+    case FieldKind::EntityRef: *static_cast<Entity*>(to) = *static_cast<const Entity*>(from); break;
     }
 }
 
@@ -40,8 +38,8 @@ FieldValue readField(const FieldInfo& field, const void* component) {
     case FieldKind::OptionalVector: return *static_cast<const std::optional<Vec2>*>(at);
     case FieldKind::Color: return *static_cast<const Rgb*>(at);
     case FieldKind::Bool: return *static_cast<const bool*>(at);
-    case FieldKind::String:
-    case FieldKind::EntityName: return *static_cast<const std::string*>(at);
+    case FieldKind::String: return *static_cast<const std::string*>(at);
+    case FieldKind::EntityRef: return *static_cast<const Entity*>(at);
     }
     return 0.0;
 }
@@ -60,8 +58,8 @@ void writeField(const FieldInfo& field, void* component, const FieldValue& value
                 (std::is_same_v<V, std::optional<Vec2>> && field.kind == FieldKind::OptionalVector) ||
                 (std::is_same_v<V, Rgb> && field.kind == FieldKind::Color) ||
                 (std::is_same_v<V, bool> && field.kind == FieldKind::Bool) ||
-                (std::is_same_v<V, std::string> &&
-                 (field.kind == FieldKind::String || field.kind == FieldKind::EntityName));
+                (std::is_same_v<V, std::string> && field.kind == FieldKind::String) ||
+                (std::is_same_v<V, Entity> && field.kind == FieldKind::EntityRef);
             if (matches) *static_cast<V*>(at) = v;
         },
         value);
@@ -86,38 +84,123 @@ std::string checkField(const FieldInfo& field, const FieldValue& value) {
     return {};
 }
 
+namespace {
+
+/// "component.field" ("velocity" for an inline component).
+std::string fieldPath(const ComponentInfo& component, std::string_view key) {
+    std::string out(component.name);
+    if (!key.empty()) {
+        out += '.';
+        out += key;
+    }
+    return out;
+}
+
+/// A component finish() message ("FIELD: why" or ": why") as "component.field: why".
+std::string finishMessage(const ComponentInfo& component, const std::string& why) {
+    const auto colon = why.find(':');
+    const std::string key = colon == std::string::npos ? std::string() : why.substr(0, colon);
+    const std::string rest = colon == std::string::npos ? why : why.substr(std::min(why.size(), colon + 2));
+    return fieldPath(component, key) + ": " + rest;
+}
+
+} // namespace
+
+std::string describeRefusal(const Scene& scene, const std::string& problem, const std::string& context) {
+    static constexpr std::string_view kPrefix = "/entities/";
+    if (problem.rfind(kPrefix, 0) != 0) return problem;
+    const std::size_t colon = problem.find(": ");
+    const std::string pointer = problem.substr(0, colon);
+    const std::string message = colon == std::string::npos ? std::string() : problem.substr(colon + 2);
+    const std::size_t indexEnd = pointer.find('/', kPrefix.size());
+    const std::string digits = pointer.substr(kPrefix.size(), indexEnd == std::string::npos ? std::string::npos
+                                                                                            : indexEnd - kPrefix.size());
+    const std::size_t index = digits.empty() ? 0 : std::size_t(std::stoull(digits));
+    std::string where = indexEnd == std::string::npos ? context : pointer.substr(indexEnd + 1);
+    std::replace(where.begin(), where.end(), '/', '.');
+    const auto& entities = scene.registry.entities();
+    const std::string who = index < entities.size() ? displayName(scene.registry, entities[index])
+                                                    : "entity " + std::to_string(index);
+    return "\"" + who + "\"" + (where.empty() ? std::string() : " " + where) + ": " + message;
+}
+
+std::string checkEdited(Scene& scene, const std::vector<Entity>& entities, const std::string& context) {
+    Registry& reg = scene.registry;
+    for (Entity e : entities) {
+        if (!reg.alive(e)) continue;
+        for (const ComponentInfo& info : componentTable()) {
+            void* c = info.get(reg, e);
+            if (!c) continue;
+            for (const FieldInfo& f : info.fields)
+                if (std::string why = checkField(f, readField(f, c)); !why.empty())
+                    return "\"" + displayName(reg, e) + "\" " + fieldPath(info, f.key) + why.substr(f.key.size());
+            if (info.finish)
+                if (std::string why = info.finish(c); !why.empty())
+                    return "\"" + displayName(reg, e) + "\" " + finishMessage(info, why);
+        }
+    }
+    if (std::string problem = checkSceneRelations(scene); !problem.empty()) return describeRefusal(scene, problem, context);
+    return {};
+}
+
 std::size_t setFieldOnAll(Scene& scene, const ComponentInfo& component, const FieldInfo& field,
                           const FieldValue& value, const std::vector<Entity>& entities, std::string* problem) {
-    if (std::string why = checkField(field, value); !why.empty()) {
-        if (problem) *problem = std::string(component.name) + "." + why;
-        return 0;
-    }
-    std::size_t changed = 0;
+    // Write, check the way the loader would, and put the old values back
+    // on a refusal: the scene is never left in a state a file could not hold.
+    std::vector<std::pair<Entity, FieldValue>> old;
     for (Entity e : entities) {
         void* c = component.get(scene.registry, e);
         if (!c) continue;
+        old.emplace_back(e, readField(field, c));
         writeField(field, c, value);
-        if (component.finish) {
-            if (std::string why = component.finish(c); !why.empty() && problem) *problem = std::string(component.name) + ": " + why;
-        }
-        ++changed;
     }
-    return changed;
+    if (old.empty()) return 0;
+    std::vector<Entity> touched;
+    for (const auto& [e, v] : old) touched.push_back(e);
+    // Springs and joints that point at a touched entity are checked too.
+    for (Entity s : attachedTo(scene.registry, touched)) touched.push_back(s);
+    if (std::string why = checkEdited(scene, touched, fieldPath(component, field.key)); !why.empty()) {
+        for (const auto& [e, v] : old) writeField(field, component.get(scene.registry, e), v);
+        if (problem) *problem = why;
+        return 0;
+    }
+    return old.size();
 }
 
-std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities) {
-    std::size_t n = 0;
+std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities,
+                              std::string* problem) {
+    std::vector<Entity> added;
     for (Entity e : entities)
         if (scene.registry.alive(e) && !component.has(scene.registry, e)) {
             component.emplaceDefault(scene.registry, e);
-            ++n;
+            added.push_back(e);
         }
-    return n;
+    if (std::string why = checkEdited(scene, added, std::string(component.name)); !why.empty()) {
+        for (Entity e : added) component.remove(scene.registry, e);
+        if (problem) *problem = why;
+        return 0;
+    }
+    return added.size();
 }
 
-std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities) {
+std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities,
+                                   std::string* problem) {
+    // Removal is checked on a copy of what goes: a body that loses its
+    // position while it keeps a velocity would not load.
+    std::vector<Entity> from;
+    for (Entity e : entities)
+        if (component.has(scene.registry, e)) from.push_back(e);
+    if (from.empty()) return 0;
+    Scene trial = scene;
+    for (Entity e : from) component.remove(trial.registry, e);
+    std::vector<Entity> touched = from;
+    for (Entity s : attachedTo(trial.registry, from)) touched.push_back(s);
+    if (std::string why = checkEdited(trial, touched, std::string(component.name)); !why.empty()) {
+        if (problem) *problem = why;
+        return 0;
+    }
     std::size_t n = 0;
-    for (Entity e : entities) n += component.remove(scene.registry, e) ? 1 : 0;
+    for (Entity e : from) n += component.remove(scene.registry, e) ? 1 : 0;
     return n;
 }
 
@@ -181,15 +264,14 @@ double distanceToSegment(Vec2 p, Vec2 a, Vec2 b) {
 
 /// Spring end points (metres); false when an end cannot be found.
 bool springEnds(const Registry& reg, const Spring& s, Vec2& pa, Vec2& pb) {
-    const Entity a = findByName(reg, s.a);
-    const Position* A = reg.tryGet<Position>(a);
+    const Position* A = reg.tryGet<Position>(s.a);
     if (!A) return false;
     pa = A->value;
     if (s.anchor) {
         pb = *s.anchor;
         return true;
     }
-    const Position* B = reg.tryGet<Position>(findByName(reg, s.b));
+    const Position* B = reg.tryGet<Position>(s.b);
     if (!B) return false;
     pb = B->value;
     return true;
@@ -250,49 +332,79 @@ std::vector<Entity> entitiesInRect(const Scene& scene, Vec2 cornerA, Vec2 corner
 
 std::vector<Entity> springsAttachedTo(const Registry& registry, Entity e) {
     std::vector<Entity> out;
-    const Name* n = registry.tryGet<Name>(e);
-    if (!n || n->value.empty()) return out;
+    if (e.isNull()) return out;
     for (Entity s : registry.entities())
-        if (const Spring* sp = registry.tryGet<Spring>(s); sp && (sp->a == n->value || sp->b == n->value))
-            out.push_back(s);
+        if (const Spring* sp = registry.tryGet<Spring>(s); sp && (sp->a == e || sp->b == e)) out.push_back(s);
+    return out;
+}
+
+std::vector<Entity> attachedTo(const Registry& registry, const std::vector<Entity>& entities) {
+    std::unordered_set<Entity> targets(entities.begin(), entities.end());
+    std::vector<Entity> out;
+    for (Entity s : registry.entities()) {
+        if (targets.count(s)) continue;
+        bool attached = false;
+        forEachEntityRef(registry, s, [&](const ComponentInfo&, const FieldInfo&, Entity ref) {
+            attached = attached || (!ref.isNull() && targets.count(ref) != 0);
+        });
+        if (attached) out.push_back(s);
+    }
     return out;
 }
 
 std::size_t destroyWithSprings(Scene& scene, const std::vector<Entity>& entities) {
     std::vector<Entity> doomed = entities;
-    for (Entity e : entities)
-        for (Entity s : springsAttachedTo(scene.registry, e)) doomed.push_back(s);
+    for (Entity s : attachedTo(scene.registry, entities)) doomed.push_back(s);
     std::size_t count = 0;
     for (Entity e : doomed) count += scene.registry.destroy(e) ? 1 : 0;  // duplicates are stale the second time
     return count;
 }
 
-std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>& entities, Scene& dst, Vec2 offset) {
+std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>& entities, Scene& dst, Vec2 offset,
+                                  OutsideRefs outside) {
     std::vector<Entity> created;
-    std::unordered_map<std::string, std::string> renamed;  // old name -> new name
+    std::unordered_map<Entity, Entity> copyOf;  // source handle -> its copy
     NameAllocator names(dst.registry);  // before the copies exist, so they do not see themselves
     for (Entity e : entities) {
         if (!src.alive(e)) continue;
         const Entity c = dst.registry.create();
         copyEntity(src, e, dst.registry, c);
-        if (Name* n = dst.registry.tryGet<Name>(c)) {
-            const std::string old = n->value;
-            n->value = names.take(old.empty() ? std::string("entity") : old);
-            if (!old.empty()) renamed[old] = n->value;
-        }
+        if (Name* n = dst.registry.tryGet<Name>(c)) n->value = names.take(n->value.empty() ? std::string("entity") : n->value);
         if (Position* p = dst.registry.tryGet<Position>(c)) p->value += offset;
         if (Plane* pl = dst.registry.tryGet<Plane>(c)) pl->offset += dot(pl->normal, offset);
+        if (Spring* s = dst.registry.tryGet<Spring>(c); s && s->anchor) *s->anchor += offset;  // moves with the copy
+        copyOf.emplace(e, c);
         created.push_back(c);
     }
-    // Springs follow their ends when those were copied too; an anchored end
-    // moves with the copy.
+    // References follow their targets when those were copied too; others
+    // keep pointing at the original (or are cut when that cannot be reached
+    // from `dst`), and whatever is left without a valid end goes.
+    std::vector<Entity> kept;
+    for (Entity c : created) {
+        bool valid = true;
+        forEachEntityRefMutable(dst.registry, c, [&](const ComponentInfo&, const FieldInfo&, Entity& ref) {
+            if (ref.isNull()) return;
+            if (auto it = copyOf.find(ref); it != copyOf.end()) ref = it->second;
+            else if (outside == OutsideRefs::Drop) ref = Entity{};
+            valid = valid && !ref.isNull();
+        });
+        kept.push_back(c);
+        if (!valid) kept.pop_back();
+    }
     for (Entity c : created)
-        if (Spring* s = dst.registry.tryGet<Spring>(c)) {
-            if (auto it = renamed.find(s->a); it != renamed.end()) s->a = it->second;
-            if (auto it = renamed.find(s->b); it != renamed.end()) s->b = it->second;
-            if (s->anchor) *s->anchor += offset;
-        }
-    return created;
+        if (std::find(kept.begin(), kept.end(), c) == kept.end()) dst.registry.destroy(c);
+    // A kept reference to an outside entity must still reach a body of dst.
+    if (outside == OutsideRefs::Carry) return kept;
+    std::vector<Entity> out;
+    for (Entity c : kept) {
+        bool valid = true;
+        forEachEntityRef(dst.registry, c, [&](const ComponentInfo&, const FieldInfo&, Entity ref) {
+            valid = valid && (ref.isNull() || (dst.registry.alive(ref) && dst.registry.has<Position>(ref)));
+        });
+        if (valid) out.push_back(c);
+        else dst.registry.destroy(c);
+    }
+    return out;
 }
 
 namespace {
@@ -334,10 +446,10 @@ Entity addPlane(Scene& scene, Vec2 through, Vec2 normal) {
 }
 
 namespace {
-/// Springs name their ends: gives an unnamed body a name first.
-const std::string& nameForSpring(Registry& reg, Entity body) {
+/// A file names a spring's ends: gives an unnamed body a name first.
+Entity nameForSpring(Registry& reg, Entity body) {
     if (const Name* n = reg.tryGet<Name>(body); !n || n->value.empty()) reg.emplace(body, Name{uniqueName(reg, "body")});
-    return reg.tryGet<Name>(body)->value;
+    return body;
 }
 
 /// The palette's spring from body `a` to `other` (a body's name or an

@@ -8,6 +8,7 @@
 #include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/scene.hpp"
+#include "stepwise/scene_io.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -28,22 +29,36 @@ void copyField(const FieldInfo& field, const void* src, void* dst);
 void copyEntity(const Registry& src, Entity from, Registry& dst, Entity to);
 
 /// A field's value, by kind (FieldKind -> alternative).
-using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string>;
+using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string, Entity>;
 FieldValue readField(const FieldInfo& field, const void* component);
 void writeField(const FieldInfo& field, void* component, const FieldValue& value);
 /// "" when `value` is acceptable for `field` (finite, in range), else why not.
 std::string checkField(const FieldInfo& field, const FieldValue& value);
 
+/// The checks the loader makes, on entities edited in memory: every field of
+/// every component (finite, in range), each component's own check
+/// (`finish`, which e.g. normalises a plane's normal) and the relations
+/// between entities (checkSceneRelations). "" when a file could hold the
+/// scene, else the refusal naming the entity and the field:
+/// `"circle" box: an entity has at most one shape (radius, box or plane), got 2`.
+/// `context` ("box") names the field when the loader's message names none.
+std::string checkEdited(Scene& scene, const std::vector<Entity>& entities, const std::string& context);
+/// A checkSceneRelations message ("/entities/20/spring/a: ...") with the
+/// entity's name for the index: `"spring" spring.a: ...`.
+std::string describeRefusal(const Scene& scene, const std::string& problem, const std::string& context = {});
+
 /// Sets one field on every entity of `entities` that has the component, then
-/// runs the component's own check (`finish`, which e.g. normalises a plane's
-/// normal). Returns how many were changed; with `problem` set (and nothing
-/// changed) when the value is refused.
+/// runs checkEdited. Returns how many were changed; on a refusal nothing is
+/// changed, 0 is returned and `problem` says why (entity and field named).
 std::size_t setFieldOnAll(Scene& scene, const ComponentInfo& component, const FieldInfo& field,
                           const FieldValue& value, const std::vector<Entity>& entities, std::string* problem = nullptr);
-/// Adds the component (default value) to each entity that lacks it.
-std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities);
-/// Removes it from each that has it.
-std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities);
+/// Adds the component (default value) to each entity that lacks it; refused
+/// like setFieldOnAll (e.g. a box on a circle: one shape per body).
+std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities,
+                              std::string* problem = nullptr);
+/// Removes it from each that has it; refused like setFieldOnAll.
+std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities,
+                                   std::string* problem = nullptr);
 
 /// Unique entity names for a burst of creations (paste, generated levels):
 /// the names in use are gathered once, O(n), and each take() is O(1)
@@ -81,24 +96,35 @@ Entity pick(const Scene& scene, Vec2 world, double pickRadius);
 /// Entities whose position (bodies) or midpoint (springs) lies in the box.
 std::vector<Entity> entitiesInRect(const Scene& scene, Vec2 cornerA, Vec2 cornerB);
 
-/// Springs that name `e` as one of their ends.
+/// Springs that have `e` as one of their ends.
 std::vector<Entity> springsAttachedTo(const Registry& registry, Entity e);
+/// Entities (springs, joints: any component with an entity reference) not
+/// among `entities` that refer to one of them.
+std::vector<Entity> attachedTo(const Registry& registry, const std::vector<Entity>& entities);
 
-/// Destroys the entities and every spring attached to them (a spring whose
+/// Destroys the entities and everything attached to them (a spring whose
 /// end disappears would make the level invalid). Returns how many went.
 std::size_t destroyWithSprings(Scene& scene, const std::vector<Entity>& entities);
 
 /// Copies `entities` (and their components) into `dst` with fresh unique
-/// names, moved by `offset` metres. Springs among them are rewired to the
-/// copies when both ends are copied too. Returns the new entities.
-std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>& entities, Scene& dst, Vec2 offset);
+/// names, moved by `offset` metres. References among them (spring ends) are
+/// rewired to the copies of their targets. A reference to an entity not
+/// copied: see OutsideRefs. Returns the new entities.
+enum class OutsideRefs : std::uint8_t {
+    Keep,      ///< keeps pointing at it (dst is the same document); a copy whose end is not a body of dst goes
+    Carry,     ///< kept unchecked (dst is the clipboard: the handles are the document's)
+    Drop,      ///< the referring copy goes (dst is another document)
+};
+std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>& entities, Scene& dst, Vec2 offset,
+                                  OutsideRefs outside = OutsideRefs::Keep);
 
 /// Palette builders: each returns the new entity. Names are unique.
 Entity addCircle(Scene& scene, Vec2 at, double radius = 0.5);
 Entity addBox(Scene& scene, Vec2 at, double width = 1.0, double height = 1.0);
 /// A wall through `through` with the given normal (normalised here).
 Entity addPlane(Scene& scene, Vec2 through, Vec2 normal);
-/// A spring between two named bodies, rest length = current distance.
+/// A spring between two bodies (named here if they have no name: files
+/// refer to them by name), rest length = current distance.
 Entity addSpring(Scene& scene, Entity a, Entity b);
 /// A spring from a body to a fixed world point.
 Entity addAnchoredSpring(Scene& scene, Entity a, Vec2 anchor);

@@ -51,7 +51,7 @@ Scene Simulation::simulationScene(const Scene& scene, Entity* mouseSpringEntity)
         if (!reg.has<Name>(body) || reg.tryGet<Name>(body)->value.empty())
             reg.emplace(body, Name{uniqueName(reg, "dragged")});
         Spring s;
-        s.a = reg.tryGet<Name>(body)->value;
+        s.a = body;
         s.anchor = mouseSpring->second;
         s.k = k;
         s.damping = 2.0 * std::sqrt(k * mass);

@@ -146,8 +146,6 @@ public:
         // thinner and trails coarser. Legibility is unchanged (the arrows
         // would overlap anyway) and llvmpipe shades a third of the pixels.
         dense_ = scene_.registry.count<Position>() > 2000;
-        for (Entity e : scene_.registry.entities())
-            if (const Name* n = scene_.registry.tryGet<Name>(e)) byName_.emplace(n->value, e);
     }
 
     void build();
@@ -308,7 +306,6 @@ private:
     std::vector<Batch> layer_;  ///< the current stage's batches, one per kind (see batch())
     bool dense_ = false;        ///< thousands of bodies: thinner per-body lines
     std::unordered_set<Entity> selected_;
-    std::unordered_map<std::string, Entity> byName_;
     struct LegendRow {
         std::string label;
         Rgba colour;
@@ -609,20 +606,18 @@ void Builder::trails() {
 
 void Builder::springs() {
     scene_.registry.each<Spring>([&](Entity e, const Spring& sp) {
-        auto endOf = [&](const std::string& name) -> std::optional<Vec2> {
-            auto it = byName_.find(name);
-            if (it == byName_.end()) return std::nullopt;
-            const Position* p = scene_.registry.tryGet<Position>(it->second);
+        auto endOf = [&](Entity end) -> std::optional<Vec2> {
+            const Position* p = scene_.registry.tryGet<Position>(end);
             return p ? std::optional<Vec2>(p->value) : std::nullopt;
         };
         std::optional<Vec2> a = endOf(sp.a);
-        std::optional<Vec2> b = sp.b.empty() ? sp.anchor : endOf(sp.b);
+        std::optional<Vec2> b = sp.b.isNull() ? sp.anchor : endOf(sp.b);
         if (!a || !b) return;
         const Vec2 pa = toPx(*a), pb = toPx(*b);
         const bool sel = selected_.count(e) != 0;
         const Rgba c = sel ? rgb(0xffd166) : colourOf(scene_, e, kSpringColor);
         const double width = sel ? 2.2 : 1.5;
-        if (sp.b.empty()) {
+        if (sp.b.isNull()) {
             // Anchor: a small hatched pin.
             disc(pb, 4.5, 0.0, kAnchorColor, kStatic);
         }

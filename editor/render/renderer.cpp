@@ -208,6 +208,8 @@ void Renderer::draw(const DrawData& data, int originX, int originY) {
         gl.Uniform2f(gl.GetUniformLocation(program, "uViewport"), w, h);
         if (GLint loc = gl.GetUniformLocation(program, "uArrow"); loc >= 0)
             gl.Uniform1i(loc, batch.kind == BatchKind::Arrow ? 1 : 0);
+        if (GLint loc = gl.GetUniformLocation(program, "uOrigin"); loc >= 0)
+            gl.Uniform2f(loc, float(originX), float(originY));
         if (GLint loc = gl.GetUniformLocation(program, "uHighlight"); loc >= 0)
             gl.Uniform3f(loc, kHighlight[0], kHighlight[1], kHighlight[2]);
         gl.BindVertexArray(st.vao);

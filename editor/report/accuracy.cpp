@@ -64,10 +64,16 @@ Entity body(Scene& s, const std::string& name, Vec2 p, Vec2 v, double m) {
 }
 void spring(Scene& s, const std::string& a, const std::string& b, std::optional<Vec2> anchor, double k, double c,
             double rest) {
-    Entity e = s.registry.create();
+    // Springs hold handles: look the ends up by name ("" = none).
+    const auto named = [&](const std::string& name) {
+        for (Entity x : s.registry.entities())
+            if (const Name* n = s.registry.tryGet<Name>(x); n && !name.empty() && n->value == name) return x;
+        return Entity{};
+    };
     Spring sp;
-    sp.a = a;
-    sp.b = b;
+    sp.a = named(a);
+    sp.b = named(b);
+    Entity e = s.registry.create();
     sp.anchor = anchor;
     sp.k = k;
     sp.damping = c;

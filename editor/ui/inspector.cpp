@@ -32,7 +32,7 @@ float speedFor(double v) { return float(std::max(1e-3, std::abs(v) * 0.005)); }
 
 /// Shows the widget for one field; returns true with `value` updated when
 /// the user changed it.
-bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label) {
+bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const Registry& reg) {
     const double* lo = std::isfinite(f.range.min) ? &f.range.min : nullptr;
     const double* hi = std::isfinite(f.range.max) ? &f.range.max : nullptr;
     switch (f.kind) {
@@ -93,8 +93,31 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label) {
         return true;
     }
     case FieldKind::Bool: return ImGui::Checkbox(label, &std::get<bool>(value));
-    case FieldKind::String:
-    case FieldKind::EntityName: return ImGui::InputText(label, &std::get<std::string>(value));
+    case FieldKind::String: return ImGui::InputText(label, &std::get<std::string>(value));
+    case FieldKind::EntityRef: {
+        // Chosen from the bodies, never typed: the field holds a handle, so
+        // renaming the body later keeps the reference.
+        Entity& ref = std::get<Entity>(value);
+        const std::string current = ref.isNull() ? std::string("(none)") : editor::displayName(reg, ref);
+        bool changed = false;
+        if (ImGui::BeginCombo(label, current.c_str(), ImGuiComboFlags_HeightLarge)) {
+            if (ImGui::Selectable("(none)", ref.isNull())) {
+                ref = {};
+                changed = true;
+            }
+            for (Entity e : reg.entities()) {
+                if (!editor::isBody(reg, e)) continue;
+                ImGui::PushID(int(e.index));
+                if (ImGui::Selectable(editor::displayName(reg, e).c_str(), e == ref)) {
+                    ref = e;
+                    changed = true;
+                }
+                ImGui::PopID();
+            }
+            ImGui::EndCombo();
+        }
+        return changed;
+    }
     }
     return false;
 }
@@ -157,7 +180,7 @@ void drawInspector(UiState& ui, Editor& ed) {
                 if (mixed) label += " (mixed)";
                 ImGui::PushID(f.key.empty() ? "value" : f.key.data());
                 const ImGuiID id = ImGui::GetID(label.c_str());
-                const bool changed = fieldWidget(f, value, label.c_str());
+                const bool changed = fieldWidget(f, value, label.c_str(), reg);
                 if (ImGui::IsItemHovered() && !f.description.empty())
                     ImGui::SetTooltip("%.*s%s%s", int(f.description.size()), f.description.data(),
                                       f.kind == FieldKind::Number ? "\nrange: " : "",
@@ -189,8 +212,11 @@ void drawInspector(UiState& ui, Editor& ed) {
     }
     if (toRemove) {
         const ComponentInfo& info = *toRemove;
-        ed.applyEdit("remove " + std::string(info.name),
-                     [&](Scene& s) { return editor::removeComponentFromAll(s, info, selection) > 0; });
+        std::string problem;
+        if (!ed.applyEdit("remove " + std::string(info.name),
+                          [&](Scene& s) { return editor::removeComponentFromAll(s, info, selection, &problem) > 0; }) &&
+            !problem.empty())
+            ed.status = "refused: " + problem;
     }
 
     ImGui::Separator();
@@ -199,9 +225,13 @@ void drawInspector(UiState& ui, Editor& ed) {
         for (const ComponentInfo& info : componentTable()) {
             const bool all = std::all_of(selection.begin(), selection.end(), [&](Entity e) { return info.has(reg, e); });
             if (all) continue;
-            if (ImGui::Selectable(std::string(info.name).c_str()))
-                ed.applyEdit("add " + std::string(info.name),
-                             [&](Scene& s) { return editor::addComponentToAll(s, info, selection) > 0; });
+            if (ImGui::Selectable(std::string(info.name).c_str())) {
+                std::string problem;
+                if (!ed.applyEdit("add " + std::string(info.name),
+                                  [&](Scene& s) { return editor::addComponentToAll(s, info, selection, &problem) > 0; }) &&
+                    !problem.empty())
+                    ed.status = "refused: " + problem;
+            }
             if (ImGui::IsItemHovered() && !info.description.empty())
                 ImGui::SetTooltip("%.*s", int(info.description.size()), info.description.data());
         }

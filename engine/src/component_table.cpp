@@ -45,6 +45,7 @@ constexpr FieldKind kindOf() {
     else if constexpr (std::is_same_v<M, std::optional<Vec2>>) return FieldKind::OptionalVector;
     else if constexpr (std::is_same_v<M, Rgb>) return FieldKind::Color;
     else if constexpr (std::is_same_v<M, bool>) return FieldKind::Bool;
+    else if constexpr (std::is_same_v<M, Entity>) return FieldKind::EntityRef;
     else {
         static_assert(std::is_same_v<M, std::string>, "unsupported field type");
         return FieldKind::String;
@@ -56,13 +57,6 @@ FieldInfo field(std::string_view key, NumberRange range, std::string_view unit,
                 std::string_view description) {
     using M = typename MemberTraits<decltype(Member)>::Type;
     return FieldInfo{key, kindOf<M>(), range, unit, description, &addressOf<Member>};
-}
-
-template <auto Member>
-FieldInfo entityNameField(std::string_view key, std::string_view description) {
-    FieldInfo f = field<Member>(key, kAny, "", description);
-    f.kind = FieldKind::EntityName;
-    return f;
 }
 
 /// Fills the type-erased registry operations for component struct T.
@@ -114,15 +108,26 @@ std::string finishPlane(void* component) {
     return {};
 }
 
+/// Fastest speed a file (or the inspector) accepts, m/s. Faster, v*v and so
+/// the kinetic energy m*v^2/2 overflow a double; the first step diverges.
+constexpr double kMaxSpeed = 1e150;
+
+std::string finishVelocity(void* component) {
+    const Vec2 v = static_cast<Velocity*>(component)->value;
+    if (std::abs(v.x) > kMaxSpeed || std::abs(v.y) > kMaxSpeed)
+        return ": expected a speed up to 1e150 m/s in each axis (beyond it the kinetic energy m*v^2/2 overflows), "
+               "got {\"x\": " + describeNumber(v.x) + ", \"y\": " + describeNumber(v.y) + "}";
+    return {};
+}
+
 std::string finishSpring(void* component) {
     auto& spring = *static_cast<Spring*>(component);
-    if (spring.a.empty()) return "a: expected the name of an entity, got nothing";
-    if (spring.b.empty() == !spring.anchor.has_value()) {
-        return spring.b.empty() ? ": expected either \"b\" (an entity name) or \"anchor\" (a point), got neither"
-                                : ": expected either \"b\" or \"anchor\", got both";
+    if (spring.a.isNull()) return "a: expected the name of an entity, got nothing";
+    if (spring.b.isNull() == !spring.anchor.has_value()) {
+        return spring.b.isNull() ? ": expected either \"b\" (an entity name) or \"anchor\" (a point), got neither"
+                                 : ": expected either \"b\" or \"anchor\", got both";
     }
-    if (!spring.b.empty() && spring.a == spring.b)
-        return "b: a spring cannot join \"" + spring.a + "\" to itself";
+    // a == b is checked with the names at hand: checkSceneRelations.
     return {};
 }
 
@@ -144,7 +149,7 @@ std::vector<ComponentInfo> buildTable() {
     t.push_back(row<Position>("position", "centre of the body", true, {},
                               {field<&Position::value>("", kAny, "m", "centre of the body")}));
     t.push_back(row<Velocity>("velocity", "linear velocity", true, needsPosition,
-                              {field<&Velocity::value>("", kAny, "m/s", "linear velocity")}));
+                              {field<&Velocity::value>("", kAny, "m/s", "linear velocity")}, &finishVelocity));
     t.push_back(row<Mass>("mass", "mass of a dynamic body", true, needsPosition,
                           {field<&Mass::value>("", kPositive, "kg", "mass of a dynamic body")}));
     t.push_back(row<Static>("static", "immovable: infinite mass, never integrated", true, needsPosition,
@@ -177,8 +182,8 @@ std::vector<ComponentInfo> buildTable() {
                                                              "softening length eps")}));
     t.push_back(row<Spring>(
         "spring", "spring-damper between entities a and b, or a and a fixed anchor", false, {},
-        {entityNameField<&Spring::a>("a", "name of the first entity"),
-         entityNameField<&Spring::b>("b", "name of the second entity (or use anchor)"),
+        {field<&Spring::a>("a", kAny, "", "name of the first entity"),
+         field<&Spring::b>("b", kAny, "", "name of the second entity (or use anchor)"),
          field<&Spring::anchor>("anchor", kAny, "m", "fixed world point instead of b"),
          field<&Spring::k>("k", kNonNegative, "N/m", "stiffness"),
          field<&Spring::damping>("damping", kNonNegative, "N*s/m", "damping along the axis"),

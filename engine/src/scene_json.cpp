@@ -139,7 +139,17 @@ Rgb readColor(const Json& v, const std::string& pointer, const NumberRange& rang
     return {a[0], a[1], a[2]};
 }
 
-void readField(const FieldInfo& field, const Json& v, void* component, const std::string& pointer) {
+/// Entity names of the file being read, to their handles: built before any
+/// component is read, so a reference may name an entity further down.
+struct EntityNames {
+    std::unordered_map<std::string, Entity> byName;
+    /// References to names no entity has: "POINTER: message", refused once
+    /// every entity is read (so a component's own complaint comes first).
+    mutable std::vector<std::string> unresolved;
+};
+
+void readField(const FieldInfo& field, const Json& v, void* component, const std::string& pointer,
+               const EntityNames& names) {
     void* member = field.address(component);
     switch (field.kind) {
     case FieldKind::Number: *static_cast<double*>(member) = readNumber(v, pointer, field.range); break;
@@ -152,12 +162,20 @@ void readField(const FieldInfo& field, const Json& v, void* component, const std
         break;
     case FieldKind::Color: *static_cast<Rgb*>(member) = readColor(v, pointer, field.range); break;
     case FieldKind::Bool: *static_cast<bool*>(member) = readBool(v, pointer); break;
-    case FieldKind::String:
-    case FieldKind::EntityName: {
-        std::string s = readString(v, pointer);
-        if (field.kind == FieldKind::EntityName && s.empty())
-            refuse(pointer, "expected the name of an entity, got \"\"");
-        *static_cast<std::string*>(member) = std::move(s);
+    case FieldKind::String: *static_cast<std::string*>(member) = readString(v, pointer); break;
+    case FieldKind::EntityRef: {
+        // Resolved here, once: in memory the field is a handle.
+        const std::string s = readString(v, pointer);
+        if (s.empty()) refuse(pointer, "expected the name of an entity, got \"\"");
+        const auto it = names.byName.find(s);
+        if (it == names.byName.end()) {
+            // A placeholder that is not null (so finish() sees the field as
+            // given) and never alive; the refusal follows after reading.
+            names.unresolved.push_back(pointer + ": no entity is named \"" + s + "\"");
+            *static_cast<Entity*>(member) = Entity{Entity::kInvalidIndex - 1, 0};
+            break;
+        }
+        *static_cast<Entity*>(member) = it->second;
         break;
     }
     }
@@ -171,7 +189,8 @@ Json vectorJson(Vec2 v) {
 }
 
 /// Field value as JSON, or a discarded value when the field is absent.
-Json fieldJson(const FieldInfo& field, const void* component) {
+/// `registry` names the entities that reference fields point at.
+Json fieldJson(const FieldInfo& field, const void* component, const Registry& registry) {
     const void* member = field.address(const_cast<void*>(component));
     switch (field.kind) {
     case FieldKind::Number: return *static_cast<const double*>(member);
@@ -194,9 +213,12 @@ Json fieldJson(const FieldInfo& field, const void* component) {
     }
     case FieldKind::Bool: return *static_cast<const bool*>(member);
     case FieldKind::String: return *static_cast<const std::string*>(member);
-    case FieldKind::EntityName: {
-        const auto& s = *static_cast<const std::string*>(member);
-        return s.empty() ? Json(Json::value_t::discarded) : Json(s);
+    case FieldKind::EntityRef: {
+        // The end's name now (checkSceneRelations refuses an unnamed or
+        // dead end before a save).
+        const Entity ref = *static_cast<const Entity*>(member);
+        const Name* name = ref.isNull() ? nullptr : registry.tryGet<Name>(ref);
+        return name ? Json(name->value) : Json(Json::value_t::discarded);
     }
     }
     return Json(Json::value_t::discarded);
@@ -212,10 +234,10 @@ std::string entityLabel(std::size_t index, const Json& entity) {
 }
 
 void readComponent(const ComponentInfo& info, const Json& value, Registry& registry, Entity e,
-                   const std::string& pointer) {
+                   const std::string& pointer, const EntityNames& names) {
     void* component = info.emplaceDefault(registry, e);
     if (info.inlineValue) {
-        readField(info.fields.front(), value, component, pointer);
+        readField(info.fields.front(), value, component, pointer, names);
     } else {
         if (!value.is_object())
             refuse(pointer, "expected an object for component \"" + std::string(info.name) + "\", got " +
@@ -233,7 +255,7 @@ void readComponent(const ComponentInfo& info, const Json& value, Registry& regis
                 if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
                 refuse(child(pointer, key), message + " Known fields: " + joinNames(known));
             }
-            readField(*it, fieldValue, component, child(pointer, key));
+            readField(*it, fieldValue, component, child(pointer, key), names);
         }
     }
     if (info.finish) {
@@ -246,11 +268,10 @@ void readComponent(const ComponentInfo& info, const Json& value, Registry& regis
     }
 }
 
-void readEntity(const Json& entityJson, std::size_t index, Registry& registry) {
+void readEntity(const Json& entityJson, std::size_t index, Registry& registry, Entity e, const EntityNames& names) {
     const std::string pointer = child("/entities", index);
     if (!entityJson.is_object())
         refuse(pointer, "expected an entity object {\"component\": value, ...}, got " + describeFound(entityJson));
-    const Entity e = registry.create();
     for (const auto& [key, value] : entityJson.items()) {
         const ComponentInfo* info = findComponent(key);
         if (!info) {
@@ -259,7 +280,7 @@ void readEntity(const Json& entityJson, std::size_t index, Registry& registry) {
             if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
             refuse(child(pointer, key), message + " Known components: " + joinNames(known));
         }
-        readComponent(*info, value, registry, e, child(pointer, key));
+        readComponent(*info, value, registry, e, child(pointer, key), names);
     }
     for (const ComponentInfo& info : componentTable()) {
         if (!info.has(registry, e)) continue;
@@ -499,18 +520,41 @@ std::string checkSceneRelations(const Scene& scene) {
                    std::to_string(shapes);
         if (registry.has<Plane>(e) && registry.has<Position>(e))
             return child("/entities", i) + "/position: a plane is placed by its normal and offset, not a position";
-        const Spring* spring = registry.tryGet<Spring>(e);
-        if (!spring) continue;
-        if (registry.has<Position>(e))
-            return child("/entities", i) + "/position: a spring entity has no body of its own; remove \"position\"";
-        for (const auto& [end, key] : {std::pair{&spring->a, "a"}, std::pair{&spring->b, "b"}}) {
-            if (end->empty()) continue;
-            const auto it = indexByName.find(*end);
-            const std::string at = child("/entities", i) + "/spring/" + key;
-            if (it == indexByName.end()) return at + ": no entity is named \"" + *end + "\"";
-            if (!registry.has<Position>(entities[it->second]))
-                return at + ": entity \"" + *end + "\" has no position, so a spring cannot attach to it";
+        // The loader checks this per entity as it reads (readEntity); a scene
+        // edited in memory gets the same rule here.
+        for (const ComponentInfo& info : componentTable()) {
+            if (!info.has(registry, e)) continue;
+            for (std::string_view needed : info.requires_)
+                if (!findComponent(needed)->has(registry, e))
+                    return child("/entities", i) + ": component \"" + std::string(info.name) + "\" needs \"" +
+                           std::string(needed) + "\", which is missing";
         }
+        const Spring* spring = registry.tryGet<Spring>(e);
+        if (spring && registry.has<Position>(e))
+            return child("/entities", i) + "/position: a spring entity has no body of its own; remove \"position\"";
+        // Every entity reference (spring ends, joint bodies): alive, named
+        // (files refer by name) and a body.
+        std::string problem;
+        forEachEntityRef(registry, e, [&](const ComponentInfo& info, const FieldInfo& field, Entity ref) {
+            if (!problem.empty() || ref.isNull()) return;
+            const std::string at = child(child(child("/entities", i), info.name), field.key);
+            const std::string attached = "a " + std::string(info.name);
+            if (!registry.alive(ref)) {
+                problem = at + ": the entity it named was deleted";
+                return;
+            }
+            const Name* name = registry.tryGet<Name>(ref);
+            if (!name || name->value.empty()) {
+                problem = at + ": the entity it attaches to has no name, and a file refers to it by name";
+                return;
+            }
+            if (!registry.has<Position>(ref))
+                problem = at + ": entity \"" + name->value + "\" has no position, so " + attached + " cannot attach to it";
+        });
+        if (!problem.empty()) return problem;
+        if (spring && !spring->b.isNull() && spring->a == spring->b)
+            return child("/entities", i) + "/spring/b: a spring cannot join \"" + registry.tryGet<Name>(spring->a)->value +
+                   "\" to itself";
     }
     return {};
 }
@@ -555,7 +599,24 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
         if (!entitiesIt->is_array())
             refuse("/entities", "expected an array of entities, got " + describeFound(*entitiesIt));
         scene.registry.reserve(entitiesIt->size());
-        for (std::size_t i = 0; i < entitiesIt->size(); ++i) readEntity((*entitiesIt)[i], i, scene.registry);
+        // Every entity exists, with its name known, before any component is
+        // read: an entity reference may name an entity defined after it.
+        EntityNames names;
+        names.byName.reserve(entitiesIt->size());
+        for (std::size_t i = 0; i < entitiesIt->size(); ++i) {
+            const Entity e = scene.registry.create();
+            const Json& entityJson = (*entitiesIt)[i];
+            if (!entityJson.is_object()) continue;
+            if (const auto it = entityJson.find("name"); it != entityJson.end() && it->is_string())
+                names.byName.emplace(it->get<std::string>(), e);  // a duplicate is refused by checkSceneRelations
+        }
+        for (std::size_t i = 0; i < entitiesIt->size(); ++i)
+            readEntity((*entitiesIt)[i], i, scene.registry, scene.registry.entities()[i], names);
+        if (!names.unresolved.empty()) {
+            const std::string& first = names.unresolved.front();
+            const auto split = first.find(": ");
+            refuse(first.substr(0, split), first.substr(split + 2));
+        }
         if (auto it = root.find("solver_state"); it != root.end())
             scene.solverState = readSolverState(*it, scene.registry);
         // Free the DOM before the relation checks: peak memory is one copy.
@@ -569,16 +630,12 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
     }
 
     // A spring without rest_length rests at its length as loaded.
-    std::map<std::string, Vec2> positionByName;
-    scene.registry.each<Name, Position>([&](Entity, const Name& n, const Position& p) {
-        positionByName.emplace(n.value, p.value);
-    });
     const auto& entities = scene.registry.entities();
     for (std::size_t i = 0; i < entities.size(); ++i) {
         Spring* s = scene.registry.tryGet<Spring>(entities[i]);
         if (!s || s->restLength) continue;
-        const Vec2 a = positionByName.at(s->a);
-        const Vec2 b = s->anchor ? *s->anchor : positionByName.at(s->b);
+        const Vec2 a = scene.registry.tryGet<Position>(s->a)->value;
+        const Vec2 b = s->anchor ? *s->anchor : scene.registry.tryGet<Position>(s->b)->value;
         const double rest = length(b - a);
         // Ends more than about 1e154 m apart: the squared length overflows,
         // and an infinite rest_length would be saved as null, which does not
@@ -660,12 +717,12 @@ std::string sceneToJsonText(const Scene& scene) {
             const void* component = info.getConst(registry, e);
             if (!component) continue;
             if (info.inlineValue) {
-                entity[std::string(info.name)] = fieldJson(info.fields.front(), component);
+                entity[std::string(info.name)] = fieldJson(info.fields.front(), component, registry);
                 continue;
             }
             Json object = Json::object();
             for (const FieldInfo& field : info.fields) {
-                Json value = fieldJson(field, component);
+                Json value = fieldJson(field, component, registry);
                 if (!value.is_discarded()) object[std::string(field.key)] = std::move(value);
             }
             entity[std::string(info.name)] = std::move(object);

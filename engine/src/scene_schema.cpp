@@ -36,7 +36,7 @@ Json fieldSchema(const FieldInfo& f) {
     case FieldKind::Color: j = ref("color"); break;
     case FieldKind::Bool: j = Json{{"type", "boolean"}}; break;
     case FieldKind::String: j = Json{{"type", "string"}}; break;
-    case FieldKind::EntityName: j = Json{{"type", "string"}, {"minLength", 1}}; break;
+    case FieldKind::EntityRef: j = Json{{"type", "string"}, {"minLength", 1}}; break;
     }
     if (!f.description.empty()) j["description"] = f.description;
     return j;

@@ -27,7 +27,11 @@ enum class FieldKind {
     Color,           ///< Rgb, JSON {"x","y","z"}, channels in 0..1
     Bool,            ///< bool
     String,          ///< std::string, free text
-    EntityName,      ///< std::string naming another entity; empty = absent
+    /// Entity handle to another entity (null = absent). In files it is that
+    /// entity's name: the loader resolves names to handles once, after every
+    /// entity exists, and the saver writes the current name, so a rename
+    /// never breaks the reference.
+    EntityRef,
 };
 
 /// Inclusive/exclusive bounds for Number fields. Every number must also be
@@ -88,5 +92,31 @@ std::optional<std::string_view> closestName(std::string_view name,
 
 /// Every component name, in table order.
 std::vector<std::string_view> componentNames();
+
+/// Calls fn(component, field, handle) for every entity-reference field
+/// (FieldKind::EntityRef) of every component on `e`, null ones included:
+/// the loader, the saver's checks and the editor's delete, copy and paste
+/// all find references this way, whatever component holds them.
+template <class Fn>
+void forEachEntityRef(const Registry& registry, Entity e, Fn&& fn) {
+    for (const ComponentInfo& info : componentTable()) {
+        const void* component = info.getConst(registry, e);
+        if (!component) continue;
+        for (const FieldInfo& field : info.fields)
+            if (field.kind == FieldKind::EntityRef)
+                fn(info, field, *static_cast<const Entity*>(field.address(const_cast<void*>(component))));
+    }
+}
+
+/// Same, with the handle writable (to rewire a copy, or clear a reference).
+template <class Fn>
+void forEachEntityRefMutable(Registry& registry, Entity e, Fn&& fn) {
+    for (const ComponentInfo& info : componentTable()) {
+        void* component = info.get(registry, e);
+        if (!component) continue;
+        for (const FieldInfo& field : info.fields)
+            if (field.kind == FieldKind::EntityRef) fn(info, field, *static_cast<Entity*>(field.address(component)));
+    }
+}
 
 } // namespace stepwise

@@ -9,6 +9,7 @@
 /// pass over that body, no `radius`/`box`/`plane` means the body never enters
 /// the collision stages.
 
+#include "stepwise/entity.hpp"
 #include "stepwise/vec2.hpp"
 
 #include <optional>
@@ -60,13 +61,15 @@ struct Attractor {
     double softening = 0.0; ///< eps, metres; removes the singularity at r = 0
 };
 
-/// Spring-damper between entities `a` and `b` (by name), or between `a` and
-/// the fixed world point `anchor` when `b` is empty. Force on a:
+/// Spring-damper between entities `a` and `b`, or between `a` and the fixed
+/// world point `anchor` when `b` is null. Force on a:
 /// -(k*(len-rest_length) + damping*(closing speed)) along the unit axis.
-/// A spring entity has no body of its own.
+/// A spring entity has no body of its own. The ends are handles: files name
+/// them, the loader resolves each name once and the saver writes the end's
+/// current name, so renaming a body keeps its springs.
 struct Spring {
-    std::string a;
-    std::string b;                 ///< empty when anchored
+    Entity a;
+    Entity b;                      ///< null when anchored
     std::optional<Vec2> anchor;    ///< world point, metres
     double k = 100.0;              ///< stiffness, N/m (>= 0)
     double damping = 0.0;          ///< N*s/m along the axis (>= 0)

@@ -159,12 +159,10 @@ Result<World> World::build(const Scene& scene) {
     // Dynamic bodies, in scene order (the state vector's order: stable
     // across save and load).
     std::unordered_map<std::uint32_t, std::uint32_t> bodyOfSlot;  // entity index -> body
-    std::unordered_map<std::string, std::size_t> sceneIndexOfName;
     std::vector<double> x0, v0, mass;
     for (std::size_t i = 0; i < order.size(); ++i) {
         const Entity e = order[i];
         const Name* name = reg.tryGet<Name>(e);
-        if (name && !name->value.empty()) sceneIndexOfName.emplace(name->value, i);
         const Position* p = reg.tryGet<Position>(e);
         if (!p) continue;
         const Static* st = reg.tryGet<Static>(e);
@@ -226,20 +224,20 @@ Result<World> World::build(const Scene& scene) {
             std::uint32_t body = kNoBody;
             Vec2 point;
         };
-        auto resolve = [&](const std::string& endName, const char* key, End& end) -> std::string {
-            const auto it = sceneIndexOfName.find(endName);
-            if (it == sceneIndexOfName.end())
-                return label + ": spring " + key + ": no entity is named \"" + endName + "\"";
-            const Entity other = order[it->second];
+        auto resolve = [&](Entity other, const char* key, End& end) -> std::string {
+            if (!reg.alive(other)) return label + ": spring " + key + ": the entity it named was deleted";
             const Position* p = reg.tryGet<Position>(other);
-            if (!p) return label + ": spring " + key + ": entity \"" + endName + "\" has no position";
+            const Name* endName = reg.tryGet<Name>(other);
+            if (!p)
+                return label + ": spring " + key + ": entity \"" + (endName ? endName->value : std::string()) +
+                       "\" has no position";
             end.body = bodyOf(other);
             end.point = p->value;
             return {};
         };
         End a, b;
         if (std::string problem = resolve(s->a, "a", a); !problem.empty()) return Error{problem};
-        if (!s->b.empty()) {
+        if (!s->b.isNull()) {
             if (std::string problem = resolve(s->b, "b", b); !problem.empty()) return Error{problem};
         } else if (s->anchor) {
             b.point = *s->anchor;
