@@ -28,6 +28,9 @@ void copyField(const FieldInfo& field, const void* src, void* dst) {
     case FieldKind::EntityName:
         *static_cast<std::string*>(to) = *static_cast<const std::string*>(from);
         break;
+    // A handle is copied as it is: right within one registry (duplicate);
+    // across registries the caller maps it (copyEntity).
+    case FieldKind::EntityRef: *static_cast<Entity*>(to) = *static_cast<const Entity*>(from); break;
     }
 }
 
@@ -42,6 +45,7 @@ FieldValue readField(const FieldInfo& field, const void* component) {
     case FieldKind::Bool: return *static_cast<const bool*>(at);
     case FieldKind::String:
     case FieldKind::EntityName: return *static_cast<const std::string*>(at);
+    case FieldKind::EntityRef: return *static_cast<const Entity*>(at);
     }
     return 0.0;
 }
@@ -61,7 +65,8 @@ void writeField(const FieldInfo& field, void* component, const FieldValue& value
                 (std::is_same_v<V, Rgb> && field.kind == FieldKind::Color) ||
                 (std::is_same_v<V, bool> && field.kind == FieldKind::Bool) ||
                 (std::is_same_v<V, std::string> &&
-                 (field.kind == FieldKind::String || field.kind == FieldKind::EntityName));
+                 (field.kind == FieldKind::String || field.kind == FieldKind::EntityName)) ||
+                (std::is_same_v<V, Entity> && field.kind == FieldKind::EntityRef);
             if (matches) *static_cast<V*>(at) = v;
         },
         value);

@@ -28,7 +28,7 @@ void copyField(const FieldInfo& field, const void* src, void* dst);
 void copyEntity(const Registry& src, Entity from, Registry& dst, Entity to);
 
 /// A field's value, by kind (FieldKind -> alternative).
-using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string>;
+using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string, Entity>;
 FieldValue readField(const FieldInfo& field, const void* component);
 void writeField(const FieldInfo& field, void* component, const FieldValue& value);
 /// "" when `value` is acceptable for `field` (finite, in range), else why not.

@@ -32,7 +32,7 @@ float speedFor(double v) { return float(std::max(1e-3, std::abs(v) * 0.005)); }
 
 /// Shows the widget for one field; returns true with `value` updated when
 /// the user changed it.
-bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label) {
+bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const Registry& reg) {
     const double* lo = std::isfinite(f.range.min) ? &f.range.min : nullptr;
     const double* hi = std::isfinite(f.range.max) ? &f.range.max : nullptr;
     switch (f.kind) {
@@ -94,7 +94,44 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label) {
     }
     case FieldKind::Bool: return ImGui::Checkbox(label, &std::get<bool>(value));
     case FieldKind::String:
+        if (!f.choices.empty()) {
+            // A fixed set of names (a joint's type): a combo, never a typo.
+            std::string& current = std::get<std::string>(value);
+            bool changed = false;
+            if (ImGui::BeginCombo(label, current.c_str())) {
+                for (std::string_view choice : f.choices)
+                    if (ImGui::Selectable(std::string(choice).c_str(), current == choice)) {
+                        current = std::string(choice);
+                        changed = true;
+                    }
+                ImGui::EndCombo();
+            }
+            return changed;
+        }
+        return ImGui::InputText(label, &std::get<std::string>(value));
     case FieldKind::EntityName: return ImGui::InputText(label, &std::get<std::string>(value));
+    case FieldKind::EntityRef: {
+        // Another body by handle: shown by name, picked from the named
+        // bodies; "(none)" is the world for a joint's b.
+        Entity& current = std::get<Entity>(value);
+        const Name* name = !current.isNull() && reg.alive(current) ? reg.tryGet<Name>(current) : nullptr;
+        const std::string shown = current.isNull() ? "(none)" : name ? name->value : "(unnamed)";
+        bool changed = false;
+        if (ImGui::BeginCombo(label, shown.c_str())) {
+            if (ImGui::Selectable("(none)", current.isNull())) {
+                current = Entity{};
+                changed = true;
+            }
+            reg.each<Name, Position>([&](Entity e, const Name& n, const Position&) {
+                if (ImGui::Selectable(n.value.c_str(), e == current)) {
+                    current = e;
+                    changed = true;
+                }
+            });
+            ImGui::EndCombo();
+        }
+        return changed;
+    }
     }
     return false;
 }
@@ -157,7 +194,7 @@ void drawInspector(UiState& ui, Editor& ed) {
                 if (mixed) label += " (mixed)";
                 ImGui::PushID(f.key.empty() ? "value" : f.key.data());
                 const ImGuiID id = ImGui::GetID(label.c_str());
-                const bool changed = fieldWidget(f, value, label.c_str());
+                const bool changed = fieldWidget(f, value, label.c_str(), reg);
                 if (ImGui::IsItemHovered() && !f.description.empty())
                     ImGui::SetTooltip("%.*s%s%s", int(f.description.size()), f.description.data(),
                                       f.kind == FieldKind::Number ? "\nrange: " : "",

@@ -15,6 +15,8 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
+#include <unordered_map>
 
 namespace stepwise {
 
@@ -136,7 +138,22 @@ Rgb readColor(const Json& v, const std::string& pointer, const NumberRange& rang
     return {a[0], a[1], a[2]};
 }
 
-void readField(const FieldInfo& field, const Json& v, void* component, const std::string& pointer) {
+/// Entity names of the file being read, resolved before any component is
+/// read, so an EntityRef may name an entity that comes later in the file.
+/// The first of duplicate names wins here; checkSceneRelations refuses the
+/// duplicate afterwards.
+using EntityByName = std::unordered_map<std::string, Entity>;
+
+/// What a field reader needs beyond the value: the names, and who is
+/// reading (for messages).
+struct ReadContext {
+    const EntityByName* entityByName = nullptr;
+    std::string entityLabel;  ///< "entity 7 (\"axle\")"
+    std::string_view component;
+};
+
+void readField(const FieldInfo& field, const Json& v, void* component, const std::string& pointer,
+               const ReadContext& context) {
     void* member = field.address(component);
     switch (field.kind) {
     case FieldKind::Number: *static_cast<double*>(member) = readNumber(v, pointer, field.range); break;
@@ -157,6 +174,16 @@ void readField(const FieldInfo& field, const Json& v, void* component, const std
         *static_cast<std::string*>(member) = std::move(s);
         break;
     }
+    case FieldKind::EntityRef: {
+        const std::string name = readString(v, pointer);
+        if (name.empty()) refuse(pointer, "expected the name of an entity, got \"\"");
+        const auto it = context.entityByName->find(name);
+        if (it == context.entityByName->end())
+            refuse(pointer, "no entity is named \"" + name + "\" (" + std::string(context.component) + " on " +
+                                context.entityLabel + ")");
+        *static_cast<Entity*>(member) = it->second;
+        break;
+    }
     }
 }
 
@@ -168,7 +195,9 @@ Json vectorJson(Vec2 v) {
 }
 
 /// Field value as JSON, or a discarded value when the field is absent.
-Json fieldJson(const FieldInfo& field, const void* component) {
+/// EntityRef fields are written as the entity's name (names exist only in
+/// files); a null, dead or unnamed entity is written as absent.
+Json fieldJson(const FieldInfo& field, const void* component, const Registry& registry) {
     const void* member = field.address(const_cast<void*>(component));
     switch (field.kind) {
     case FieldKind::Number: return *static_cast<const double*>(member);
@@ -195,6 +224,11 @@ Json fieldJson(const FieldInfo& field, const void* component) {
         const auto& s = *static_cast<const std::string*>(member);
         return s.empty() ? Json(Json::value_t::discarded) : Json(s);
     }
+    case FieldKind::EntityRef: {
+        const Entity e = *static_cast<const Entity*>(member);
+        const Name* name = !e.isNull() && registry.alive(e) ? registry.tryGet<Name>(e) : nullptr;
+        return name && !name->value.empty() ? Json(name->value) : Json(Json::value_t::discarded);
+    }
     }
     return Json(Json::value_t::discarded);
 }
@@ -209,10 +243,11 @@ std::string entityLabel(std::size_t index, const Json& entity) {
 }
 
 void readComponent(const ComponentInfo& info, const Json& value, Registry& registry, Entity e,
-                   const std::string& pointer) {
+                   const std::string& pointer, ReadContext context) {
     void* component = info.emplaceDefault(registry, e);
+    context.component = info.name;
     if (info.inlineValue) {
-        readField(info.fields.front(), value, component, pointer);
+        readField(info.fields.front(), value, component, pointer, context);
     } else {
         if (!value.is_object())
             refuse(pointer, "expected an object for component \"" + std::string(info.name) + "\", got " +
@@ -230,7 +265,7 @@ void readComponent(const ComponentInfo& info, const Json& value, Registry& regis
                 if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
                 refuse(child(pointer, key), message + " Known fields: " + joinNames(known));
             }
-            readField(*it, fieldValue, component, child(pointer, key));
+            readField(*it, fieldValue, component, child(pointer, key), context);
         }
     }
     if (info.finish) {
@@ -243,11 +278,12 @@ void readComponent(const ComponentInfo& info, const Json& value, Registry& regis
     }
 }
 
-void readEntity(const Json& entityJson, std::size_t index, Registry& registry) {
+void readEntity(const Json& entityJson, std::size_t index, Registry& registry, Entity e,
+                const EntityByName& entityByName) {
     const std::string pointer = child("/entities", index);
     if (!entityJson.is_object())
         refuse(pointer, "expected an entity object {\"component\": value, ...}, got " + describeFound(entityJson));
-    const Entity e = registry.create();
+    const ReadContext context{&entityByName, entityLabel(index, entityJson), {}};
     for (const auto& [key, value] : entityJson.items()) {
         const ComponentInfo* info = findComponent(key);
         if (!info) {
@@ -256,7 +292,7 @@ void readEntity(const Json& entityJson, std::size_t index, Registry& registry) {
             if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
             refuse(child(pointer, key), message + " Known components: " + joinNames(known));
         }
-        readComponent(*info, value, registry, e, child(pointer, key));
+        readComponent(*info, value, registry, e, child(pointer, key), context);
     }
     for (const ComponentInfo& info : componentTable()) {
         if (!info.has(registry, e)) continue;
@@ -471,6 +507,54 @@ std::string printableMessage(std::string_view message) {
     return out;
 }
 
+/// "entity 7 (\"axle\")" for entity `index` of `registry`.
+std::string entityLabelOf(const Registry& registry, std::size_t index) {
+    std::string label = "entity " + std::to_string(index);
+    const Name* name = registry.tryGet<Name>(registry.entities()[index]);
+    if (name && !name->value.empty()) label += " (\"" + name->value + "\")";
+    return label;
+}
+
+/// What a joint end is called in messages: its name, or "entity N".
+std::string endLabel(const Registry& registry, Entity end) {
+    if (end.isNull()) return "the world";
+    const Name* name = registry.tryGet<Name>(end);
+    if (name && !name->value.empty()) return "\"" + name->value + "\"";
+    const auto& order = registry.entities();
+    const auto it = std::find(order.begin(), order.end(), end);
+    return "entity " + std::to_string(std::size_t(it - order.begin()));
+}
+
+/// The joint rules that need the whole scene: ends that exist and have a
+/// position, not the same body twice, not two static ends, a usable slider
+/// axis. "" when fine, else "POINTER: message" naming the joint's entity.
+std::string checkJoint(const Registry& registry, std::size_t index, const Joint& joint) {
+    const std::string at = child("/entities", index) + "/joint";
+    const std::string who = "joint on " + entityLabelOf(registry, index);
+    if (registry.has<Position>(registry.entities()[index]))
+        return child("/entities", index) + "/position: " + who +
+               ": a joint entity has no body of its own; remove \"position\"";
+    if (joint.a.isNull()) return at + "/a: " + who + ": expected the name of a body, got nothing";
+    bool isStatic[2] = {true, true};
+    for (const auto& [end, key, slot] : {std::tuple{joint.a, "a", 0}, std::tuple{joint.b, "b", 1}}) {
+        if (end.isNull()) continue;  // b: the world
+        if (!registry.alive(end)) return at + "/" + key + ": " + who + ": the body it names no longer exists";
+        if (!registry.has<Position>(end))
+            return at + "/" + key + ": " + who + ": entity " + endLabel(registry, end) +
+                   " has no position, so a joint cannot attach to it";
+        const Static* st = registry.tryGet<Static>(end);
+        isStatic[slot] = st && st->value;
+    }
+    if (joint.a == joint.b) return at + "/b: " + who + ": a joint cannot join " + endLabel(registry, joint.a) + " to itself";
+    if (isStatic[0] && isStatic[1])
+        return at + ": " + who + ": joins two static bodies (" + endLabel(registry, joint.a) + " and " +
+               endLabel(registry, joint.b) + "); at least one end must be dynamic";
+    if (joint.type == "slider" && joint.axis && !(std::hypot(joint.axis->x, joint.axis->y) > 1e-12))
+        return at + "/axis: " + who + ": a slider axis needs a non-zero length, got {\"x\": " +
+               describeFound(Json(joint.axis->x)) + ", \"y\": " + describeFound(Json(joint.axis->y)) + "}";
+    return {};
+}
+
 } // namespace
 
 std::string checkSceneRelations(const Scene& scene) {
@@ -494,6 +578,9 @@ std::string checkSceneRelations(const Scene& scene) {
                    std::to_string(shapes);
         if (registry.has<Plane>(e) && registry.has<Position>(e))
             return child("/entities", i) + "/position: a plane is placed by its normal and offset, not a position";
+        if (const Joint* joint = registry.tryGet<Joint>(e)) {
+            if (std::string problem = checkJoint(registry, i, *joint); !problem.empty()) return problem;
+        }
         const Spring* spring = registry.tryGet<Spring>(e);
         if (!spring) continue;
         if (registry.has<Position>(e))
@@ -643,7 +730,19 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
         if (!entitiesIt->is_array())
             refuse("/entities", "expected an array of entities, got " + describeFound(*entitiesIt));
         scene.registry.reserve(entitiesIt->size());
-        for (std::size_t i = 0; i < entitiesIt->size(); ++i) readEntity((*entitiesIt)[i], i, scene.registry);
+        // Every entity exists (with its name known) before any component is
+        // read, so references resolve to handles in one pass.
+        std::vector<Entity> created(entitiesIt->size());
+        EntityByName entityByName;
+        for (std::size_t i = 0; i < entitiesIt->size(); ++i) {
+            created[i] = scene.registry.create();
+            const Json& entity = (*entitiesIt)[i];
+            if (!entity.is_object()) continue;
+            const auto name = entity.find("name");
+            if (name != entity.end() && name->is_string()) entityByName.emplace(name->get<std::string>(), created[i]);
+        }
+        for (std::size_t i = 0; i < entitiesIt->size(); ++i)
+            readEntity((*entitiesIt)[i], i, scene.registry, created[i], entityByName);
         // Free the DOM before the relation checks: peak memory is one copy.
         root = Json();
         if (std::string problem = checkSceneRelations(scene); !problem.empty()) {
@@ -675,10 +774,71 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
                          "\"rest_length\""};
         s->restLength = rest;
     }
+    for (std::size_t i = 0; i < entities.size(); ++i) {
+        Joint* joint = scene.registry.tryGet<Joint>(entities[i]);
+        if (!joint) continue;
+        if (std::string problem = completeJoint(scene.registry, *joint); !problem.empty()) {
+            const auto colon = problem.find(':');
+            return Error{prefix + child("/entities", i) + "/joint/" + problem.substr(0, colon) + ": joint on " +
+                         entityLabelOf(scene.registry, i) + ": " + problem.substr(colon + 2)};
+        }
+    }
     return scene;
 }
 
 } // namespace
+
+std::string completeJoint(const Registry& registry, Joint& joint) {
+    // Pose of an end: position and angle of a body, the identity for the world.
+    struct Pose {
+        Vec2 position;
+        double angle = 0.0;
+    };
+    const auto poseOf = [&](Entity e) {
+        Pose pose;
+        if (e.isNull() || !registry.alive(e)) return pose;
+        if (const Position* p = registry.tryGet<Position>(e)) pose.position = p->value;
+        if (const Angle* an = registry.tryGet<Angle>(e)) pose.angle = an->value;
+        return pose;
+    };
+    // World point of a local point, and back (rotation by the body's angle).
+    const auto toWorld = [](const Pose& pose, Vec2 local) {
+        const double c = std::cos(pose.angle), s = std::sin(pose.angle);
+        return pose.position + Vec2{c * local.x - s * local.y, s * local.x + c * local.y};
+    };
+    const auto toLocal = [](const Pose& pose, Vec2 world) {
+        const double c = std::cos(pose.angle), s = std::sin(pose.angle);
+        const Vec2 d = world - pose.position;
+        return Vec2{c * d.x + s * d.y, -s * d.x + c * d.y};
+    };
+    const Pose a = poseOf(joint.a), b = poseOf(joint.b);
+    if (joint.anchor) {
+        const Vec2 localA = toLocal(a, *joint.anchor), localB = toLocal(b, *joint.anchor);
+        // Past about 1e308 m apart the difference overflows; an infinite
+        // local would be saved as null, which does not load.
+        if (!isFinite(localA) || !isFinite(localB))
+            return "anchor: too far from the bodies to express in their frames (over 1e308 m)";
+        joint.localA = localA;
+        joint.localB = localB;
+        joint.anchor.reset();
+    }
+    const bool angular = joint.type == "hinge" || joint.type == "slider" || joint.type == "weld";
+    if (angular && !joint.referenceAngle) {
+        const double reference = b.angle - a.angle;
+        if (!std::isfinite(reference))
+            return "reference_angle: the bodies' angles are too far apart to subtract; give \"reference_angle\"";
+        joint.referenceAngle = reference;
+    }
+    const bool hasLength = joint.type == "distance" || joint.type == "rope";
+    if (hasLength && !joint.length) {
+        const double d = length(toWorld(b, joint.localB) - toWorld(a, joint.localA));
+        // Same overflow as a spring's rest length: an infinite length would
+        // be saved as null, which does not load.
+        if (!std::isfinite(d)) return "length: the anchors are too far apart to compute it (over 1e154 m); give \"length\"";
+        joint.length = d;
+    }
+    return {};
+}
 
 Result<Scene> parseScene(std::string_view text, std::string_view sourceName, const LoadLimits& limits) {
     Result<Scene> scene = parseSceneUnchecked(text, sourceName, limits);
@@ -712,12 +872,12 @@ std::string sceneToJsonText(const Scene& scene) {
             const void* component = info.getConst(registry, e);
             if (!component) continue;
             if (info.inlineValue) {
-                entity[std::string(info.name)] = fieldJson(info.fields.front(), component);
+                entity[std::string(info.name)] = fieldJson(info.fields.front(), component, registry);
                 continue;
             }
             Json object = Json::object();
             for (const FieldInfo& field : info.fields) {
-                Json value = fieldJson(field, component);
+                Json value = fieldJson(field, component, registry);
                 if (!value.is_discarded()) object[std::string(field.key)] = std::move(value);
             }
             entity[std::string(info.name)] = std::move(object);

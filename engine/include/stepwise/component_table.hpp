@@ -28,6 +28,10 @@ enum class FieldKind {
     Bool,            ///< bool
     String,          ///< std::string, free text
     EntityName,      ///< std::string naming another entity; empty = absent
+    /// Entity handle to another entity; null = absent. Files hold the
+    /// entity's name; the loader resolves it once every entity exists, the
+    /// saver writes the name back (scene_json.cpp, resolveEntityName).
+    EntityRef,
 };
 
 /// Inclusive/exclusive bounds for Number fields. Every number must also be
@@ -51,6 +55,9 @@ struct FieldInfo {
     std::string_view unit;         ///< "m", "kg", "m/s", "" ...
     std::string_view description;  ///< one line, for tooltips and the schema
     void* (*address)(void* component); ///< points at the member inside the struct
+    /// String fields only: the values allowed (empty = any string). The
+    /// schema lists them as an enum and the inspector offers them in a combo.
+    std::span<const std::string_view> choices = {};
 };
 
 /// One row of the table.
