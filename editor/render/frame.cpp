@@ -732,8 +732,9 @@ void Builder::joints() {
         const Rgba c = sel ? rgb(0xffd166) : colourOf(scene_, e, kJointColor);
         const double width = sel ? 2.2 : 1.4;
         const Vec2 pa = toPx(anchorA), pb = toPx(anchorB);
-        segment(toPx(a.centre), pa, width, withAlpha(c, 0.8f));
-        if (b.body) segment(toPx(b.centre), pb, width, withAlpha(c, 0.8f));
+        // Centre-to-anchor lines stay faint: on a ragdoll they cross the bodies.
+        segment(toPx(a.centre), pa, 0.7 * width, withAlpha(c, 0.45f));
+        if (b.body) segment(toPx(b.centre), pb, 0.7 * width, withAlpha(c, 0.45f));
         if (j->type == "distance" || j->type == "rope") segment(pa, pb, j->type == "rope" ? 1.2 : 2.4, c);
         if (j->type == "slider") {
             const Vec2 axis = j->axis ? *j->axis : Vec2{1.0, 0.0};
