@@ -54,8 +54,10 @@ std::string encodeEntity(const Registry& reg, Entity e) {
             }
             case FieldKind::Color: put(out, *static_cast<const Rgb*>(field)); break;
             case FieldKind::Bool: put(out, std::uint8_t(*static_cast<const bool*>(field))); break;
-            case FieldKind::String:
-            case FieldKind::EntityName: {
+            // A handle is stored as it is: undo and redo act on the same
+            // registry, where it stays valid (or is detected as stale).
+            case FieldKind::EntityRef: put(out, *static_cast<const Entity*>(field)); break;
+            case FieldKind::String: {
                 const auto& text = *static_cast<const std::string*>(field);
                 put(out, std::uint32_t(text.size()));
                 out += text;
@@ -93,8 +95,8 @@ void decodeEntity(const std::string& in, Registry& reg, Entity e) {
             }
             case FieldKind::Color: *static_cast<Rgb*>(field) = take<Rgb>(in, at); break;
             case FieldKind::Bool: *static_cast<bool*>(field) = take<std::uint8_t>(in, at) != 0; break;
-            case FieldKind::String:
-            case FieldKind::EntityName: {
+            case FieldKind::EntityRef: *static_cast<Entity*>(field) = take<Entity>(in, at); break;
+            case FieldKind::String: {
                 const std::uint32_t n = take<std::uint32_t>(in, at);
                 *static_cast<std::string*>(field) = in.substr(at, n);
                 at += n;

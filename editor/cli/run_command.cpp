@@ -77,7 +77,29 @@ void appendContactLine(std::string& jsonl, std::uint64_t step, const World& worl
                  "}, \"depth\": " + number(c.depth) + ", \"normal_impulse\": " + number(c.normalImpulse) +
                  ", \"tangent_impulse\": " + number(c.tangentImpulse) + "}";
     }
-    jsonl += "]}\n";
+    jsonl += "]";
+    // Joint lines only for a level with joints, so other levels' output is
+    // unchanged: reaction force and torque on b (a feels the opposite),
+    // world anchors and their separation, relative angle.
+    if (!world.joints().empty()) {
+        jsonl += ", \"joints\": [";
+        first = true;
+        for (const JointRecord& j : world.joints()) {
+            if (!first) jsonl += ", ";
+            first = false;
+            const auto vector = [](Vec2 v) {
+                return "{\"x\": " + number(v.x + 0.0) + ", \"y\": " + number(v.y + 0.0) + "}";
+            };
+            jsonl += "{\"joint\": " + jsonString(entityRef(scene, j.joint)) + ", \"a\": " +
+                     jsonString(entityRef(scene, j.a)) +
+                     ", \"b\": " + (j.b.isNull() ? std::string("null") : jsonString(entityRef(scene, j.b))) +
+                     ", \"anchor_a\": " + vector(j.anchorA) + ", \"anchor_b\": " + vector(j.anchorB) +
+                     ", \"separation\": " + number(j.separation) + ", \"force\": " + vector(j.force) +
+                     ", \"torque\": " + number(j.torque + 0.0) + ", \"angle\": " + number(j.angle + 0.0) + "}";
+        }
+        jsonl += "]";
+    }
+    jsonl += "}\n";
 }
 
 /// Ctrl-C (SIGINT) or SIGTERM during the steps: the loop stops, the
@@ -327,7 +349,8 @@ void addRunCommand(CLI::App& app, int& exitCode) {
         ->check(outputFileName());
     cmd->add_option("--contacts", options->contacts,
                     "Write one JSON line per step: the step, the time and every contact (entities, point, normal, "
-                    "depth, normal and tangent impulse)")
+                    "depth, normal and tangent impulse); with joints, every joint too (anchors, separation, "
+                    "reaction force and torque on b, angle)")
         ->check(outputFileName());
     cmd->callback([options, &exitCode] { exitCode = run(*options); });
 }

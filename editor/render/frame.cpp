@@ -44,6 +44,11 @@ constexpr Rgba kForce = rgb(0xf6ad55);
 constexpr Rgba kForceField = rgb(0xa78bfa, 0.5f);
 constexpr Rgba kContactPoint = rgb(0xff6b6b);
 constexpr Rgba kContactNormal = rgb(0xffa8a8);
+constexpr Rgba kJointColor = rgb(0x90cdf4);
+constexpr Rgba kJointCentre = rgb(0x2d3748);
+constexpr Rgba kJointTick = rgb(0xfbd38d);
+constexpr Rgba kJointForce = rgb(0x9ae6b4);
+constexpr double kPiD = 3.14159265358979323846;
 constexpr Rgba kAabb = rgb(0x68d391, 0.75f);
 constexpr Rgba kAabbCell = rgb(0x68d391, 0.06f);
 constexpr Rgba kText = rgb(0xd5dde8);
@@ -244,6 +249,8 @@ private:
     void trails();
     void springs();
     void bodies();
+    void joints();
+    void jointForces();
     void aabbOutlines();
     void bodyArrows();
     void contacts();
@@ -349,6 +356,8 @@ void Builder::build() {
     if (in_.overlays.has(Overlay::Trails)) layer(&Builder::trails);
     layer(&Builder::springs);
     layer(&Builder::bodies);
+    layer(&Builder::joints);
+    if (in_.overlays.has(Overlay::Joints)) layer(&Builder::jointForces);
     if (in_.overlays.has(Overlay::Aabb)) layer(&Builder::aabbOutlines);
     layer(&Builder::bodyArrows);
     if (in_.overlays.has(Overlay::Contacts)) layer(&Builder::contacts);
@@ -683,6 +692,102 @@ void Builder::bodies() {
     }
 }
 
+void Builder::joints() {
+    // Each joint: a thin line from each body's centre to its anchor, a ring
+    // at the anchor (a filled pin for the world), the line between the two
+    // anchors for distance and rope, the axis for a slider, and a hinge's
+    // angle limits as an arc with a tick at b's current direction.
+    for (Entity e : scene_.registry.entities()) {
+        const Joint* j = scene_.registry.tryGet<Joint>(e);
+        if (!j) continue;
+        struct End {
+            Vec2 centre;
+            double angle = 0.0;
+            bool body = false;
+        };
+        const auto endOf = [&](Entity b) {
+            End end;
+            if (b.isNull() || !scene_.registry.alive(b)) return end;
+            const Position* p = scene_.registry.tryGet<Position>(b);
+            if (!p) return end;
+            end.centre = p->value;
+            const Angle* a = scene_.registry.tryGet<Angle>(b);
+            end.angle = a ? a->value : 0.0;
+            end.body = true;
+            return end;
+        };
+        const End a = endOf(j->a), b = endOf(j->b);
+        if (!a.body) continue;
+        const auto world = [](const End& end, Vec2 local) {
+            const double c = std::cos(end.angle), s = std::sin(end.angle);
+            return end.centre + Vec2{c * local.x - s * local.y, s * local.x + c * local.y};
+        };
+        const Vec2 anchorA = j->anchor ? *j->anchor : world(a, j->localA);
+        const Vec2 anchorB = j->anchor ? *j->anchor : world(b, j->localB);
+        const bool sel = selected_.count(e) != 0;
+        const Rgba c = sel ? rgb(0xffd166) : colourOf(scene_, e, kJointColor);
+        const double width = sel ? 2.2 : 1.4;
+        const Vec2 pa = toPx(anchorA), pb = toPx(anchorB);
+        // Centre-to-anchor lines stay faint: on a ragdoll they cross the bodies.
+        segment(toPx(a.centre), pa, 0.7 * width, withAlpha(c, 0.45f));
+        if (b.body) segment(toPx(b.centre), pb, 0.7 * width, withAlpha(c, 0.45f));
+        if (j->type == "distance" || j->type == "rope") segment(pa, pb, j->type == "rope" ? 1.2 : 2.4, c);
+        if (j->type == "slider") {
+            const Vec2 axis = j->axis ? *j->axis : Vec2{1.0, 0.0};
+            const double len = length(axis);
+            if (len > 0.0) {
+                const double ca = std::cos(a.angle), sa = std::sin(a.angle);
+                const Vec2 u = Vec2{ca * axis.x - sa * axis.y, sa * axis.x + ca * axis.y} / len;
+                const double lo = j->lower ? *j->lower : -1.0, hi = j->upper ? *j->upper : 1.0;
+                segment(toPx(anchorA + u * lo), toPx(anchorA + u * hi), 1.2, c);
+            }
+        }
+        if (j->type == "hinge" && (j->lower || j->upper)) {
+            // The arc spans the allowed directions of b's x axis: a's angle
+            // plus the reference angle plus [lower, upper].
+            const double base = a.angle + j->referenceAngle.value_or(0.0);
+            const double lo = base + j->lower.value_or(-kPiD), hi = base + j->upper.value_or(kPiD);
+            const double radius = 16.0;
+            const int pieces = std::clamp(int((hi - lo) / 0.2) + 1, 2, 64);
+            Vec2 prev = pb + radius * Vec2{std::cos(lo), std::sin(lo)};
+            segment(pb, prev, 1.0, withAlpha(c, 0.6f));
+            for (int k = 1; k <= pieces; ++k) {
+                const double t = lo + (hi - lo) * double(k) / pieces;
+                const Vec2 p = pb + radius * Vec2{std::cos(t), std::sin(t)};
+                segment(prev, p, 1.6, c);
+                prev = p;
+            }
+            segment(pb, prev, 1.0, withAlpha(c, 0.6f));
+            segment(pb, pb + (radius + 4.0) * Vec2{std::cos(b.angle), std::sin(b.angle)}, 1.6, kJointTick);
+        }
+        if (b.body) disc(pb, 4.0, 0.0, c, kFlat);
+        else disc(pb, 4.5, 0.0, kAnchorColor, kStatic);
+        disc(pa, 2.5, 0.0, kJointCentre, kFlat);
+    }
+}
+
+void Builder::jointForces() {
+    if (!in_.world) {
+        out_.notes.push_back("joints: needs a World (not built)");
+        return;
+    }
+    const auto records = in_.world->joints();
+    if (records.empty()) return;
+    std::vector<double> mags;
+    for (const JointRecord& r : records) mags.push_back(length(r.force));
+    const double ref = in_.scales.jointForce > 0 ? in_.scales.jointForce : autoReference(mags);
+    out_.scales.jointForce = ref;
+    for (const JointRecord& r : records) {
+        // The force on a (what holds body a), drawn from a's anchor.
+        const double m = length(r.force);
+        if (!(m > 0.0)) continue;
+        const Vec2 p = toPx(r.anchorA);
+        const double len = std::max(8.0, arrowLength(m, ref, arrowRef_, 3.2 * arrowRef_));
+        arrow(p, p - r.force / m * len, 1.6, kJointForce);
+    }
+    legend_.push_back({"joint force on a", kJointForce, ref, "N"});
+}
+
 void Builder::aabbOutlines() {
     for (Entity e : scene_.registry.entities()) {
         const Position* p = scene_.registry.tryGet<Position>(e);
@@ -862,7 +967,7 @@ const std::vector<std::pair<std::string_view, Overlay>>& overlayNames() {
         {"velocity", Overlay::Velocity}, {"velocity-field", Overlay::VelocityField},
         {"force-field", Overlay::ForceField}, {"force", Overlay::Force},
         {"contacts", Overlay::Contacts}, {"aabb", Overlay::Aabb},
-        {"trails", Overlay::Trails},
+        {"trails", Overlay::Trails}, {"joints", Overlay::Joints},
     };
     return names;
 }

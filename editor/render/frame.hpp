@@ -32,17 +32,20 @@ enum class Overlay : std::uint32_t {
     Contacts = 1u << 4,       ///< World::contacts(): points, normals, impulses
     Aabb = 1u << 5,           ///< bounding boxes and the occupied cells of a uniform grid
     Trails = 1u << 6,         ///< positions over the last N recorded steps
+    Joints = 1u << 7,         ///< World::joints(): reaction force at each joint's anchor
 };
 
 struct OverlaySet {
     std::uint32_t bits = 0;
     bool has(Overlay o) const { return (bits & std::uint32_t(o)) != 0; }
     void add(Overlay o) { bits |= std::uint32_t(o); }
-    bool needsWorld() const { return has(Overlay::ForceField) || has(Overlay::Force) || has(Overlay::Contacts); }
+    bool needsWorld() const {
+        return has(Overlay::ForceField) || has(Overlay::Force) || has(Overlay::Contacts) || has(Overlay::Joints);
+    }
 };
 
 /// Command-line names, in drawing-legend order: "velocity", "velocity-field",
-/// "force-field", "force", "contacts", "aabb", "trails".
+/// "force-field", "force", "contacts", "aabb", "trails", "joints".
 const std::vector<std::pair<std::string_view, Overlay>>& overlayNames();
 
 /// Parses "velocity,force-field" (or "all", or "" for none). The error names
@@ -98,6 +101,7 @@ struct ArrowScales {
     double force = 0.0;          ///< N
     double forceField = 0.0;     ///< N per kg (= m/s^2)
     double impulse = 0.0;        ///< N*s
+    double jointForce = 0.0;     ///< N (joints overlay)
 };
 
 struct FrameInput {

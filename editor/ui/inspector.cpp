@@ -93,7 +93,22 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
         return true;
     }
     case FieldKind::Bool: return ImGui::Checkbox(label, &std::get<bool>(value));
-    case FieldKind::String: return ImGui::InputText(label, &std::get<std::string>(value));
+    case FieldKind::String:
+        if (!f.choices.empty()) {
+            // A fixed set of names (a joint's type): a combo, never a typo.
+            std::string& current = std::get<std::string>(value);
+            bool changed = false;
+            if (ImGui::BeginCombo(label, current.c_str())) {
+                for (std::string_view choice : f.choices)
+                    if (ImGui::Selectable(std::string(choice).c_str(), current == choice)) {
+                        current = std::string(choice);
+                        changed = true;
+                    }
+                ImGui::EndCombo();
+            }
+            return changed;
+        }
+        return ImGui::InputText(label, &std::get<std::string>(value));
     case FieldKind::EntityRef: {
         // Chosen from the bodies, never typed: the field holds a handle, so
         // renaming the body later keeps the reference.

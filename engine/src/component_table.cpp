@@ -131,6 +131,23 @@ std::string finishSpring(void* component) {
     return {};
 }
 
+constexpr std::string_view kJointTypes[] = {"hinge", "slider", "weld", "distance", "rope"};
+
+std::string finishJoint(void* component) {
+    auto& joint = *static_cast<Joint*>(component);
+    if (joint.type.empty())
+        return "type: expected one of hinge, slider, weld, distance, rope, got nothing";
+    if (std::find(std::begin(kJointTypes), std::end(kJointTypes), joint.type) == std::end(kJointTypes)) {
+        std::string message = "type: expected one of hinge, slider, weld, distance, rope, got \"" + joint.type + "\"";
+        if (auto guess = closestName(joint.type, kJointTypes)) message += "; did you mean \"" + std::string(*guess) + "\"?";
+        return message;
+    }
+    if (joint.a.isNull()) return "a: expected the name of a body, got nothing";
+    if (joint.lower && joint.upper && *joint.lower > *joint.upper)
+        return "lower: expected at most upper (" + describeNumber(*joint.upper) + "), got " + describeNumber(*joint.lower);
+    return {};
+}
+
 std::string finishBoid(void* component) {
     auto& boid = *static_cast<Boid*>(component);
     if (boid.separationRadius > boid.neighborRadius)
@@ -201,6 +218,31 @@ std::vector<ComponentInfo> buildTable() {
          field<&Boid::goalWeight>("goal_weight", kNonNegative, "m/s^2", "weight of seeking the goal"),
          field<&Boid::maxSpeed>("max_speed", kPositive, "m/s", "speed limit of steering")},
         &finishBoid));
+    {
+        FieldInfo type = field<&Joint::type>("type", kAny, "", "hinge, slider, weld, distance or rope");
+        type.choices = kJointTypes;
+        t.push_back(row<Joint>(
+            "joint", "constraint between bodies a and b (b absent: the world); on its own entity", false, {},
+            {type,
+             field<&Joint::a>("a", kAny, "", "name of the first body"),
+             field<&Joint::b>("b", kAny, "", "name of the second body; absent: the world"),
+             field<&Joint::localA>("local_a", kAny, "m", "anchor in a's frame"),
+             field<&Joint::localB>("local_b", kAny, "m", "anchor in b's frame (a world point for the world)"),
+             field<&Joint::anchor>("anchor", kAny, "m", "one world point that sets local_a and local_b on load"),
+             field<&Joint::axis>("axis", kAny, "", "slider: direction of travel in a's frame; absent {1, 0}"),
+             field<&Joint::referenceAngle>("reference_angle", kAny, "rad",
+                                           "angle of b relative to a that counts as zero; absent: as loaded"),
+             field<&Joint::lower>("lower", kAny, "rad or m", "hinge: lowest angle; slider: lowest travel"),
+             field<&Joint::upper>("upper", kAny, "rad or m", "hinge: highest angle; slider: highest travel"),
+             field<&Joint::motorSpeed>("motor_speed", kAny, "rad/s or m/s", "motor target speed; absent 0"),
+             field<&Joint::maxMotorTorque>("max_motor_torque", kNonNegative, "N*m", "hinge motor: largest torque"),
+             field<&Joint::maxMotorForce>("max_motor_force", kNonNegative, "N", "slider motor: largest force"),
+             field<&Joint::length>("length", kNonNegative, "m", "distance, rope: length; absent: as loaded"),
+             field<&Joint::stiffnessHz>("stiffness_hz", kNonNegative, "Hz", "weld, distance: softness; 0 rigid"),
+             field<&Joint::dampingRatio>("damping_ratio", kNonNegative, "", "weld, distance: damping; absent 1"),
+             field<&Joint::collideConnected>("collide_connected", kAny, "", "a and b still collide")},
+            &finishJoint));
+    }
     return t;
 }
 
@@ -219,6 +261,8 @@ std::size_t editDistance(std::string_view a, std::string_view b) {
 }
 
 } // namespace
+
+std::span<const std::string_view> jointTypeNames() { return kJointTypes; }
 
 std::string NumberRange::describe() const {
     std::ostringstream out;

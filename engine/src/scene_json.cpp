@@ -17,6 +17,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 
 namespace stepwise {
@@ -497,6 +498,54 @@ std::string printableMessage(std::string_view message) {
     return out;
 }
 
+/// "entity 7 (\"axle\")" for entity `index` of `registry`.
+std::string entityLabelOf(const Registry& registry, std::size_t index) {
+    std::string label = "entity " + std::to_string(index);
+    const Name* name = registry.tryGet<Name>(registry.entities()[index]);
+    if (name && !name->value.empty()) label += " (\"" + name->value + "\")";
+    return label;
+}
+
+/// What a joint end is called in messages: its name, or "entity N".
+std::string endLabel(const Registry& registry, Entity end) {
+    if (end.isNull()) return "the world";
+    const Name* name = registry.tryGet<Name>(end);
+    if (name && !name->value.empty()) return "\"" + name->value + "\"";
+    const auto& order = registry.entities();
+    const auto it = std::find(order.begin(), order.end(), end);
+    return "entity " + std::to_string(std::size_t(it - order.begin()));
+}
+
+/// The joint rules that need the whole scene: ends that exist and have a
+/// position, not the same body twice, not two static ends, a usable slider
+/// axis. "" when fine, else "POINTER: message" naming the joint's entity.
+std::string checkJoint(const Registry& registry, std::size_t index, const Joint& joint) {
+    const std::string at = child("/entities", index) + "/joint";
+    const std::string who = "joint on " + entityLabelOf(registry, index);
+    if (registry.has<Position>(registry.entities()[index]))
+        return child("/entities", index) + "/position: " + who +
+               ": a joint entity has no body of its own; remove \"position\"";
+    if (joint.a.isNull()) return at + "/a: " + who + ": expected the name of a body, got nothing";
+    bool isStatic[2] = {true, true};
+    for (const auto& [end, key, slot] : {std::tuple{joint.a, "a", 0}, std::tuple{joint.b, "b", 1}}) {
+        if (end.isNull()) continue;  // b: the world
+        if (!registry.alive(end)) return at + "/" + key + ": " + who + ": the body it names no longer exists";
+        if (!registry.has<Position>(end))
+            return at + "/" + key + ": " + who + ": entity " + endLabel(registry, end) +
+                   " has no position, so a joint cannot attach to it";
+        const Static* st = registry.tryGet<Static>(end);
+        isStatic[slot] = st && st->value;
+    }
+    if (joint.a == joint.b) return at + "/b: " + who + ": a joint cannot join " + endLabel(registry, joint.a) + " to itself";
+    if (isStatic[0] && isStatic[1])
+        return at + ": " + who + ": joins two static bodies (" + endLabel(registry, joint.a) + " and " +
+               endLabel(registry, joint.b) + "); at least one end must be dynamic";
+    if (joint.type == "slider" && joint.axis && !(std::hypot(joint.axis->x, joint.axis->y) > 1e-12))
+        return at + "/axis: " + who + ": a slider axis needs a non-zero length, got {\"x\": " +
+               describeFound(Json(joint.axis->x)) + ", \"y\": " + describeFound(Json(joint.axis->y)) + "}";
+    return {};
+}
+
 } // namespace
 
 std::string checkSceneRelations(const Scene& scene) {
@@ -528,6 +577,9 @@ std::string checkSceneRelations(const Scene& scene) {
                 if (!findComponent(needed)->has(registry, e))
                     return child("/entities", i) + ": component \"" + std::string(info.name) + "\" needs \"" +
                            std::string(needed) + "\", which is missing";
+        }
+        if (const Joint* joint = registry.tryGet<Joint>(e)) {
+            if (std::string problem = checkJoint(registry, i, *joint); !problem.empty()) return problem;
         }
         const Spring* spring = registry.tryGet<Spring>(e);
         if (spring && registry.has<Position>(e))
@@ -646,10 +698,71 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
                          "\"rest_length\""};
         s->restLength = rest;
     }
+    for (std::size_t i = 0; i < entities.size(); ++i) {
+        Joint* joint = scene.registry.tryGet<Joint>(entities[i]);
+        if (!joint) continue;
+        if (std::string problem = completeJoint(scene.registry, *joint); !problem.empty()) {
+            const auto colon = problem.find(':');
+            return Error{prefix + child("/entities", i) + "/joint/" + problem.substr(0, colon) + ": joint on " +
+                         entityLabelOf(scene.registry, i) + ": " + problem.substr(colon + 2)};
+        }
+    }
     return scene;
 }
 
 } // namespace
+
+std::string completeJoint(const Registry& registry, Joint& joint) {
+    // Pose of an end: position and angle of a body, the identity for the world.
+    struct Pose {
+        Vec2 position;
+        double angle = 0.0;
+    };
+    const auto poseOf = [&](Entity e) {
+        Pose pose;
+        if (e.isNull() || !registry.alive(e)) return pose;
+        if (const Position* p = registry.tryGet<Position>(e)) pose.position = p->value;
+        if (const Angle* an = registry.tryGet<Angle>(e)) pose.angle = an->value;
+        return pose;
+    };
+    // World point of a local point, and back (rotation by the body's angle).
+    const auto toWorld = [](const Pose& pose, Vec2 local) {
+        const double c = std::cos(pose.angle), s = std::sin(pose.angle);
+        return pose.position + Vec2{c * local.x - s * local.y, s * local.x + c * local.y};
+    };
+    const auto toLocal = [](const Pose& pose, Vec2 world) {
+        const double c = std::cos(pose.angle), s = std::sin(pose.angle);
+        const Vec2 d = world - pose.position;
+        return Vec2{c * d.x + s * d.y, -s * d.x + c * d.y};
+    };
+    const Pose a = poseOf(joint.a), b = poseOf(joint.b);
+    if (joint.anchor) {
+        const Vec2 localA = toLocal(a, *joint.anchor), localB = toLocal(b, *joint.anchor);
+        // Past about 1e308 m apart the difference overflows; an infinite
+        // local would be saved as null, which does not load.
+        if (!isFinite(localA) || !isFinite(localB))
+            return "anchor: too far from the bodies to express in their frames (over 1e308 m)";
+        joint.localA = localA;
+        joint.localB = localB;
+        joint.anchor.reset();
+    }
+    const bool angular = joint.type == "hinge" || joint.type == "slider" || joint.type == "weld";
+    if (angular && !joint.referenceAngle) {
+        const double reference = b.angle - a.angle;
+        if (!std::isfinite(reference))
+            return "reference_angle: the bodies' angles are too far apart to subtract; give \"reference_angle\"";
+        joint.referenceAngle = reference;
+    }
+    const bool hasLength = joint.type == "distance" || joint.type == "rope";
+    if (hasLength && !joint.length) {
+        const double d = length(toWorld(b, joint.localB) - toWorld(a, joint.localA));
+        // Same overflow as a spring's rest length: an infinite length would
+        // be saved as null, which does not load.
+        if (!std::isfinite(d)) return "length: the anchors are too far apart to compute it (over 1e154 m); give \"length\"";
+        joint.length = d;
+    }
+    return {};
+}
 
 Result<Scene> parseScene(std::string_view text, std::string_view sourceName, const LoadLimits& limits) {
     Result<Scene> scene = parseSceneUnchecked(text, sourceName, limits);

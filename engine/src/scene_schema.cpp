@@ -35,7 +35,14 @@ Json fieldSchema(const FieldInfo& f) {
     case FieldKind::OptionalVector: j = ref("vector"); break;
     case FieldKind::Color: j = ref("color"); break;
     case FieldKind::Bool: j = Json{{"type", "boolean"}}; break;
-    case FieldKind::String: j = Json{{"type", "string"}}; break;
+    case FieldKind::String:
+        j = Json{{"type", "string"}};
+        if (!f.choices.empty()) {
+            Json names = Json::array();
+            for (std::string_view c : f.choices) names.push_back(std::string(c));
+            j["enum"] = names;
+        }
+        break;
     case FieldKind::EntityRef: j = Json{{"type", "string"}, {"minLength", 1}}; break;
     }
     if (!f.description.empty()) j["description"] = f.description;
@@ -72,6 +79,7 @@ std::string sceneJsonSchema() {
                      {"description", info.description},
                      {"properties", properties},
                      {"additionalProperties", false}};
+            if (info.name == "joint") c["required"] = Json::array({"type", "a"});
             if (info.name == "spring") {
                 c["required"] = Json::array({"a"});
                 c["oneOf"] = Json::array({Json{{"required", Json::array({"b"})}},

@@ -55,6 +55,9 @@ struct FieldInfo {
     std::string_view unit;         ///< "m", "kg", "m/s", "" ...
     std::string_view description;  ///< one line, for tooltips and the schema
     void* (*address)(void* component); ///< points at the member inside the struct
+    /// String fields only: the values allowed (empty = any string). The
+    /// schema lists them as an enum and the inspector offers them in a combo.
+    std::span<const std::string_view> choices = {};
 };
 
 /// One row of the table.

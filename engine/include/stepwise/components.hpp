@@ -13,6 +13,8 @@
 #include "stepwise/vec2.hpp"
 
 #include <optional>
+#include <span>
+#include <string_view>
 #include <string>
 
 namespace stepwise {
@@ -90,5 +92,39 @@ struct Boid {
     double goalWeight = 1.0;        ///< weight of seeking the goal
     double maxSpeed = 4.0;          ///< m/s; steering never exceeds it
 };
+
+/// A constraint between two bodies, or a body and the world
+/// (SCENE_FORMAT.md, "Joints"). A joint entity has no body of its own. The
+/// ends are entity handles, resolved from names when a file is loaded
+/// (names are used only in files), so renaming a body keeps its joints.
+/// After loading, `anchor` is consumed (turned into the locals) and
+/// `reference_angle` / `length` hold their defaults, so a save writes what
+/// the simulation uses.
+struct Joint {
+    /// "hinge", "slider", "weld", "distance" or "rope" (jointTypeNames()).
+    std::string type;
+    Entity a;                       ///< first body; required
+    Entity b;                       ///< second body; null = the world
+    Vec2 localA;                    ///< anchor in a's frame (relative to its position), metres
+    Vec2 localB;                    ///< anchor in b's frame; a world point when b is the world
+    std::optional<Vec2> anchor;     ///< input only: one world point that sets both locals
+    std::optional<Vec2> axis;       ///< slider: direction of travel in a's frame; absent = {1, 0}
+    /// Angle of b relative to a that counts as zero (hinge limits, slider,
+    /// weld), radians. Absent in a file: the relative angle at first load.
+    std::optional<double> referenceAngle;
+    std::optional<double> lower;    ///< hinge: rad; slider: m. Absent: no lower limit
+    std::optional<double> upper;    ///< hinge: rad; slider: m. Absent: no upper limit
+    std::optional<double> motorSpeed;     ///< hinge rad/s, slider m/s; absent = 0 (a brake)
+    std::optional<double> maxMotorTorque; ///< hinge motor, N*m; absent: no motor
+    std::optional<double> maxMotorForce;  ///< slider motor, N; absent: no motor
+    /// distance and rope: metres. Absent in a file: the anchors' distance at first load.
+    std::optional<double> length;
+    std::optional<double> stiffnessHz;    ///< weld, distance: spring frequency, Hz; absent or 0 = rigid
+    std::optional<double> dampingRatio;   ///< weld, distance: with stiffness_hz; absent = 1 (critical)
+    bool collideConnected = false;        ///< whether a and b still collide with each other
+};
+
+/// Joint type names in file order: hinge, slider, weld, distance, rope.
+std::span<const std::string_view> jointTypeNames();
 
 } // namespace stepwise

@@ -105,6 +105,15 @@ Result<void> saveSceneFile(const Scene& scene, const std::filesystem::path& path
 /// runs it before saving.
 std::string checkSceneRelations(const Scene& scene);
 
+struct Joint;
+/// Fills what a joint takes from the bodies' poses as they are now (the
+/// loader runs it on every joint; the editor's Joint tool too): an `anchor`
+/// becomes `local_a` / `local_b` (and is cleared), a missing
+/// `reference_angle` becomes b's angle minus a's (hinge, slider, weld), a
+/// missing `length` the anchors' distance (distance, rope). The ends must
+/// pass checkSceneRelations. Returns "" or "FIELD: message".
+std::string completeJoint(const Registry& registry, Joint& joint);
+
 } // namespace stepwise
 
 namespace stepwise {

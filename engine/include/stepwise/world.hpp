@@ -63,6 +63,17 @@ struct ContactRecord {
     double tangentImpulse = 0.0;  ///< N*s
 };
 
+/// One joint at the end of the last step, for the debugging views.
+struct JointRecord {
+    Entity joint;              ///< the joint's entity
+    Entity a, b;               ///< its ends; b null = the world
+    Vec2 anchorA, anchorB;     ///< world anchor points, metres
+    double separation = 0.0;   ///< |anchorB - anchorA|, metres (the error of a hinge or weld)
+    Vec2 force;                ///< reaction force on b, newtons (a feels -force), over the last substep
+    double torque = 0.0;       ///< reaction torque on b, N*m (motor and limits included)
+    double angle = 0.0;        ///< b's angle relative to a minus the reference angle, rad
+};
+
 /// A stiffness warning: a spring whose dt*sqrt(k/m) is past the chosen
 /// integrator's stability limit.
 struct StiffnessHint {
@@ -185,6 +196,9 @@ public:
     EnergyReport energy() const;
     /// Contacts of the last step (empty when the scene has no shapes).
     std::span<const ContactRecord> contacts() const;
+    /// Joints of the last step, in scene order: anchors, separation and
+    /// reaction force and torque (empty when the scene has no joints).
+    std::span<const JointRecord> joints() const;
 
     /// Springs past the integrator's stability limit at the current dt.
     std::vector<StiffnessHint> stiffnessHints() const;

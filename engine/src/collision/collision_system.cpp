@@ -36,11 +36,19 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     angles_.push_back(angle);
     angularVelocities_.push_back(dynamic ? angularVelocity : 0.0);
     invMass_.push_back(dynamic ? 1.0 / c.mass : 0.0);
-    const double inertia = dynamic ? momentOfInertia(c.shape, c.mass) : 0.0;
+    const double inertia = !dynamic ? 0.0 : c.solverOnly ? c.inertia : momentOfInertia(c.shape, c.mass);
+    colliders_.back().inertia = inertia;
     invInertia_.push_back(inertia > 0.0 ? 1.0 / inertia : 0.0);
-    maxExtent_.push_back(c.shape.kind == ShapeKind::Circle ? c.shape.radius : length(c.shape.halfExtents));
-    if (c.shape.kind == ShapeKind::Plane) planes_.push_back(index);
-    else finite_.push_back(index);
+    maxExtent_.push_back(c.solverOnly ? 0.0
+                         : c.shape.kind == ShapeKind::Circle ? c.shape.radius
+                                                             : length(c.shape.halfExtents));
+    if (c.solverOnly) {
+        // in the solver only: no broad phase, no narrow phase
+    } else if (c.shape.kind == ShapeKind::Plane) {
+        planes_.push_back(index);
+    } else {
+        finite_.push_back(index);
+    }
     // SolverBody 0 is the shared static body.
     if (bodies_.empty()) bodies_.push_back(SolverBody{});
     if (dynamic) {
@@ -58,6 +66,17 @@ void CollisionSystem::setWarmStartCache(std::vector<CachedImpulse> cache) {
     if (!std::is_sorted(cache.begin(), cache.end())) std::sort(cache.begin(), cache.end());
     cache_ = std::move(cache);
     cacheCursor_ = 0;
+}
+
+void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_t filterA, std::int32_t filterB,
+                               bool collideConnected) {
+    if (bodies_.empty()) bodies_.push_back(SolverBody{});
+    joints_.push_back(joint);
+    if (!collideConnected && filterA >= 0 && filterB >= 0) {
+        const auto lo = std::uint64_t(std::min(filterA, filterB)), hi = std::uint64_t(std::max(filterA, filterB));
+        const std::uint64_t key = (lo << 32) | hi;
+        noCollide_.insert(std::lower_bound(noCollide_.begin(), noCollide_.end(), key), key);
+    }
 }
 
 void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m,
@@ -164,6 +183,11 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
     cacheCursor_ = 0;
     for (const ProxyPair& pair : pairs_) {
         const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
+        if (!noCollide_.empty()) {
+            // Bodies joined with collide_connected false do not collide.
+            const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+            if (std::binary_search(noCollide_.begin(), noCollide_.end(), key)) continue;
+        }
         const Manifold m = collide(colliders_[a].shape, centres_[a], rots[a], colliders_[b].shape, centres_[b],
                                    rots[b], margins_[a] + margins_[b]);
         addManifold(a, b, m, centres_);
@@ -189,6 +213,7 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
         bodies_[s].dq = {};
     }
     prepareContacts(constraints_, details_, bodies_);
+    if (!joints_.empty()) joints::prepareJoints(joints_, bodies_, centres_, angles_);
     timings_.narrowPhaseMs = msSince(narrowStart);
     timings_.solveMs = 0.0;
 }
@@ -215,11 +240,23 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     const Softness staticSoft = Softness::make(std::min(2.0 * hertz, 0.25 / h), settings_.dampingRatio, h);
 
     // A row of n touching bodies needs up to n passes; 64 bounds the cost.
+    // Joints: rigid ones are corrected at up to half the substep rate
+    // (twice the contacts' cap, as Box2D v3), solved before the contacts.
+    const bool jointed = !joints_.empty();
+    const Softness jointSoft =
+        Softness::make(std::min(jointSettings_.hertz, 0.5 / h), jointSettings_.dampingRatio, h);
+    lastH_ = h;
+
     propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, 64);
-    if (settings_.warmStart) warmStart(constraints_, bodies_);
+    if (settings_.warmStart) {
+        if (jointed) joints::warmStartJoints(joints_, bodies_);
+        warmStart(constraints_, bodies_);
+    }
     bool reverse = false;
-    for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse)
+    for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse) {
+        if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, true);
         solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
+    }
 
     // Positions: the integrator moved x with the unconstrained velocity; add
     // the contact velocity change over the substep. Angles integrate here
@@ -234,8 +271,10 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         b.dp = x[body] - stepStart_[i];
         b.dq = Rot::fromAngle(angles_[i] - stepStartAngle_[i]);
     }
-    for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse)
+    for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse) {
+        if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, false);
         solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
+    }
 
     for (std::size_t i = 0; i < n; ++i) {
         const std::uint32_t s = solverIndex_[i];
@@ -274,6 +313,21 @@ void CollisionSystem::endStep() {
             r.tangentImpulse = p.tangentImpulse;
             records_.push_back(r);
         }
+    }
+    jointRecords_.clear();
+    for (const joints::JointConstraint& j : joints_) {
+        JointRecord r;
+        r.joint = j.entity;
+        r.a = j.entityA;
+        r.b = j.entityB;
+        const joints::JointAnchors anchors = joints::jointAnchors(j, bodies_);
+        r.anchorA = anchors.a;
+        r.anchorB = anchors.b;
+        r.separation = anchors.separation;
+        r.force = joints::jointForce(j, lastH_);
+        r.torque = joints::jointTorque(j, lastH_);
+        r.angle = joints::jointAngle(j, bodies_);
+        jointRecords_.push_back(r);
     }
     // Usually already in order (constraints follow the sorted pairs); the
     // check is cheaper than sorting sorted data.

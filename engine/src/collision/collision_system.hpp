@@ -9,6 +9,7 @@
 #include "collision/broad_phase.hpp"
 #include "collision/contact_solver.hpp"
 #include "collision/narrow_phase.hpp"
+#include "joints/joint_solver.hpp"
 
 #include "stepwise/entity.hpp"
 #include "stepwise/world.hpp"
@@ -28,6 +29,12 @@ struct Collider {
     double restitution = 0.0;
     double friction = 0.2;
     Entity entity;
+    /// A body with no shape that is in the solver only because a joint
+    /// holds it: it turns and takes impulses but never collides.
+    bool solverOnly = false;
+    /// Moment of inertia about the centre, kg m^2: given for solverOnly
+    /// bodies, set by add() from the shape for the others.
+    double inertia = 0.0;
 };
 
 /// Solid-shape moment of inertia about the centre, kg m^2.
@@ -50,6 +57,20 @@ public:
     double angularVelocity(std::size_t i) const { return angularVelocities_[i]; }
 
     SolverSettings& settings() { return settings_; }
+
+    /// Adds a joint (ends already mapped to solver bodies and colliders).
+    /// `filterA`/`filterB`: the colliders of its two ends (-1 for none); unless
+    /// `collideConnected`, contacts between them are dropped.
+    void addJoint(const joints::JointConstraint& joint, std::int32_t filterA, std::int32_t filterB,
+                  bool collideConnected);
+    /// Solver body of a collider (0 = static), for mapping joint ends.
+    std::uint32_t solverBodyOf(std::size_t collider) const { return solverIndex_[collider]; }
+    bool hasJoints() const { return !joints_.empty(); }
+    /// Whether any collider has a shape (a system may hold only joints).
+    bool hasShapes() const { return !finite_.empty() || !planes_.empty(); }
+    joints::JointSettings& jointSettings() { return jointSettings_; }
+    /// Joints of the last step, for the debugging views.
+    std::span<const JointRecord> jointRecords() const { return jointRecords_; }
     /// Fixes the broad-phase strategy (tests, benchmarks); by default it is
     /// chosen per step from the number of shapes.
     void setBroadPhase(BroadPhaseKind kind) {
@@ -115,6 +136,11 @@ private:
     std::vector<Vec2> unconstrainedV_;
     std::vector<ContactRecord> records_;
     std::vector<Rot> rotScratch_;
+    std::vector<joints::JointConstraint> joints_;
+    joints::JointSettings jointSettings_;
+    std::vector<std::uint64_t> noCollide_;  // sorted (min collider << 32 | max collider)
+    std::vector<JointRecord> jointRecords_;
+    double lastH_ = 0.0;
     CollisionTimings timings_;
     double dt_ = 0.0;
     int substeps_ = 1;

@@ -304,13 +304,18 @@ Result<World> World::build(const Scene& scene) {
     if (f.boidsOn) f.boids.prepare();
 
     // Shapes: the collision stages, only when some entity has one.
-    w.collision = detail::buildCollisions(scene, bodyOf, kNoBody);
+    std::string jointProblem;
+    w.collision = detail::buildCollisions(scene, bodyOf, kNoBody, &jointProblem);
+    if (!jointProblem.empty()) return Error{jointProblem};
 
     // Spin: angle += h * angular velocity for dynamic bodies with both
-    // (bodies with shapes turn in the contact solver instead).
+    // (bodies with shapes or joints turn in the contact solver instead).
+    std::vector<bool> turnedBySolver(n, false);
+    if (w.collision)
+        for (std::size_t c = 0; c < w.collision->colliderCount(); ++c)
+            if (w.collision->collider(c).body >= 0) turnedBySolver[std::size_t(w.collision->collider(c).body)] = true;
     for (std::size_t b = 0; b < n; ++b) {
-        const Entity be = w.bodyEntity[b];
-        if (reg.has<Radius>(be) || reg.has<Box>(be)) continue;
+        if (turnedBySolver[b]) continue;
         const Angle* an = reg.tryGet<Angle>(w.bodyEntity[b]);
         const AngularVelocity* av = reg.tryGet<AngularVelocity>(w.bodyEntity[b]);
         if (!an || !av) continue;
@@ -326,7 +331,8 @@ Result<World> World::build(const Scene& scene) {
     if (f.attractorsOn()) w.active.push_back("attractors");
     if (f.boidsOn) w.active.push_back("boids");
     if (!w.spinBody.empty()) w.active.push_back("rotation");
-    if (w.collision) w.active.push_back("collisions");
+    if (w.collision && w.collision->hasShapes()) w.active.push_back("collisions");
+    if (w.collision && w.collision->hasJoints()) w.active.push_back("joints");
 
     w.x[0].assign(x0.begin(), x0.end());
     w.v[0].assign(v0.begin(), v0.end());
@@ -667,7 +673,7 @@ EnergyReport World::energy() const {
             const collision::Collider& col = contacts->collider(c);
             if (col.body < 0) continue;
             const double spin = contacts->angularVelocity(c);
-            e.kinetic += 0.5 * collision::momentOfInertia(col.shape, col.mass) * spin * spin;
+            e.kinetic += 0.5 * col.inertia * spin * spin;
         }
     }
     e.springs = f.springEnergy(x);
@@ -677,6 +683,10 @@ EnergyReport World::energy() const {
 
 std::span<const ContactRecord> World::contacts() const {
     return impl_->collision ? impl_->collision->contacts() : std::span<const ContactRecord>{};
+}
+
+std::span<const JointRecord> World::joints() const {
+    return impl_->collision ? impl_->collision->jointRecords() : std::span<const JointRecord>{};
 }
 
 std::vector<StiffnessHint> World::stiffnessHints() const {

@@ -17,8 +17,21 @@ namespace stepwise::detail {
 /// plane), or returns nullptr when the scene has none: then the step runs no
 /// collision stage at all. `bodyOf` maps an entity to its index in the
 /// state vector, or kNoBody when it is static.
+///
+/// Joints are solved with the contacts, so a scene with a joint has a
+/// collision system even without shapes; a jointed dynamic body without a
+/// shape joins the solver as a shapeless body (kShapelessRadius). A joint
+/// the engine cannot simulate (an end that no longer exists, two fixed
+/// ends) sets `problem` ("entity N (\"name\"): joint ...") and returns null.
 std::unique_ptr<collision::CollisionSystem> buildCollisions(
-    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody);
+    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody,
+    std::string* problem = nullptr);
+
+/// A dynamic body held by a joint but without a shape turns like a solid
+/// disc of this radius (I = m r^2 / 2), metres: a point mass (I = 0) could
+/// not be welded or driven by a motor, and a small disc changes nothing for
+/// a hinge at its centre.
+inline constexpr double kShapelessRadius = 0.1;
 
 /// Views an interleaved (x0, y0, x1, y1, ...) state array as Vec2s. Vec2 is
 /// exactly two doubles (asserted), the layout the integrators use.

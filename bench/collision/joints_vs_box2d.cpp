@@ -1,0 +1,185 @@
+// Joints: Stepwise against Box2D 2.4.1 (Debian libbox2d-dev) on the same
+// level files, in the same run: ms per step and the largest joint
+// separation (the distance between a hinge's two anchor points, which a
+// rigid hinge keeps at zero) over the whole run.
+//
+//   joints_vs_box2d [--quick] [LEVEL ...]      (default: levels/chain.json levels/bridge.json)
+//
+// Both engines are built from the parsed level: bodies with circle and box
+// shapes, hinge joints (b2RevoluteJoint with the same anchors, limits and
+// motor). Box2D runs 8 velocity and 3 position iterations with sleeping off;
+// Stepwise runs the level's substeps and iterations. Each engine runs three
+// times, alternating, and its fastest run counts (--quick: once, a fifth of
+// the steps).
+
+#include "stepwise/components.hpp"
+#include "stepwise/scene_io.hpp"
+#include "stepwise/world.hpp"
+
+#include <box2d/box2d.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+using namespace stepwise;
+
+namespace {
+
+struct Outcome {
+    double msPerStep = 0.0;
+    double largestSeparation = 0.0;  ///< metres, over every joint and step
+    double finalSeparation = 0.0;    ///< metres, largest at the last step
+};
+
+bool isStatic(const Registry& r, Entity e) { return r.has<Static>(e) && r.tryGet<Static>(e)->value; }
+
+Outcome runStepwise(const Scene& scene, int steps) {
+    Result<World> built = World::build(scene);
+    if (!built) {
+        std::cerr << "stepwise cannot build the level: " << built.error() << "\n";
+        std::exit(1);
+    }
+    World& world = *built;
+    world.setProfiling(false);
+    Outcome out;
+    double seconds = 0.0;
+    for (int i = 0; i < steps; ++i) {
+        const auto start = std::chrono::steady_clock::now();
+        if (Result<void> r = world.step(); !r) {
+            std::cerr << "stepwise diverged: " << r.error() << "\n";
+            std::exit(1);
+        }
+        seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        double worst = 0.0;
+        for (const JointRecord& j : world.joints()) worst = std::max(worst, j.separation);
+        out.largestSeparation = std::max(out.largestSeparation, worst);
+        out.finalSeparation = worst;
+    }
+    out.msPerStep = 1e3 * seconds / steps;
+    return out;
+}
+
+Outcome runBox2d(const Scene& scene, int steps) {
+    const Registry& r = scene.registry;
+    b2World world(b2Vec2(float(scene.world.gravity.x), float(scene.world.gravity.y)));
+    world.SetAllowSleeping(false);
+    std::unordered_map<std::uint32_t, b2Body*> bodyOf;
+    b2BodyDef groundDef;
+    b2Body* worldBody = world.CreateBody(&groundDef);
+    for (Entity e : r.entities()) {
+        const Position* p = r.tryGet<Position>(e);
+        if (!p) continue;
+        b2BodyDef def;
+        def.type = isStatic(r, e) ? b2_staticBody : b2_dynamicBody;
+        def.position.Set(float(p->value.x), float(p->value.y));
+        if (const Velocity* v = r.tryGet<Velocity>(e)) def.linearVelocity.Set(float(v->value.x), float(v->value.y));
+        if (const Angle* a = r.tryGet<Angle>(e)) def.angle = float(a->value);
+        if (const AngularVelocity* w = r.tryGet<AngularVelocity>(e)) def.angularVelocity = float(w->value);
+        b2Body* body = world.CreateBody(&def);
+        const double mass = r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
+        b2FixtureDef fd;
+        fd.friction = float(r.has<Friction>(e) ? r.tryGet<Friction>(e)->value : 0.2);
+        fd.restitution = float(r.has<Restitution>(e) ? r.tryGet<Restitution>(e)->value : 0.0);
+        b2CircleShape circle;
+        b2PolygonShape polygon;
+        if (const Radius* c = r.tryGet<Radius>(e)) {
+            circle.m_radius = float(c->value);
+            fd.shape = &circle;
+            fd.density = float(mass / (M_PI * c->value * c->value));
+        } else if (const Box* b = r.tryGet<Box>(e)) {
+            polygon.SetAsBox(float(b->width / 2), float(b->height / 2));
+            fd.shape = &polygon;
+            fd.density = float(mass / (b->width * b->height));
+        }
+        if (fd.shape) body->CreateFixture(&fd);
+        bodyOf.emplace(e.index, body);
+    }
+    std::vector<b2Joint*> joints;
+    for (Entity e : r.entities()) {
+        const Joint* j = r.tryGet<Joint>(e);
+        if (!j) continue;
+        if (j->type != "hinge") {
+            std::cerr << "joints_vs_box2d compares hinges only; skipping a " << j->type << "\n";
+            continue;
+        }
+        b2RevoluteJointDef def;
+        def.bodyA = bodyOf.at(j->a.index);
+        def.bodyB = j->b.isNull() ? worldBody : bodyOf.at(j->b.index);
+        def.localAnchorA.Set(float(j->localA.x), float(j->localA.y));
+        def.localAnchorB.Set(float(j->localB.x), float(j->localB.y));
+        def.referenceAngle = float(j->referenceAngle.value_or(0.0));
+        def.collideConnected = j->collideConnected;
+        if (j->lower || j->upper) {
+            def.enableLimit = true;
+            def.lowerAngle = float(j->lower.value_or(-1e9));
+            def.upperAngle = float(j->upper.value_or(1e9));
+        }
+        if (j->maxMotorTorque) {
+            def.enableMotor = true;
+            def.motorSpeed = float(j->motorSpeed.value_or(0.0));
+            def.maxMotorTorque = float(*j->maxMotorTorque);
+        }
+        joints.push_back(world.CreateJoint(&def));
+    }
+    const float dt = float(scene.world.dt);
+    Outcome out;
+    double seconds = 0.0;
+    for (int i = 0; i < steps; ++i) {
+        const auto start = std::chrono::steady_clock::now();
+        world.Step(dt, 8, 3);
+        seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        double worst = 0.0;
+        for (b2Joint* joint : joints) {
+            const b2Vec2 d = joint->GetAnchorB() - joint->GetAnchorA();
+            worst = std::max(worst, double(d.Length()));
+        }
+        out.largestSeparation = std::max(out.largestSeparation, worst);
+        out.finalSeparation = worst;
+    }
+    out.msPerStep = 1e3 * seconds / steps;
+    return out;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    bool quick = false;
+    std::vector<std::string> levels;
+    for (int i = 1; i < argc; ++i) {
+        if (std::strcmp(argv[i], "--quick") == 0) quick = true;
+        else levels.push_back(argv[i]);
+    }
+    if (levels.empty()) levels = {STEPWISE_SOURCE_DIR "/levels/chain.json", STEPWISE_SOURCE_DIR "/levels/bridge.json"};
+    const int runs = quick ? 1 : 3;
+    std::printf("| level | joints | speed (Box2D ms / Stepwise ms) | largest joint separation, mm (Stepwise / Box2D) | "
+                "at the end, mm (Stepwise / Box2D) |\n|---|---|---|---|---|\n");
+    for (const std::string& path : levels) {
+        Result<Scene> scene = loadSceneFile(path);
+        if (!scene) {
+            std::cerr << scene.error() << "\n";
+            return 2;
+        }
+        const int steps = quick ? 120 : 600;  // 10 s at 60 Hz
+        Outcome best[2];
+        for (int run = 0; run < runs; ++run) {
+            const Outcome s = runStepwise(*scene, steps);
+            const Outcome b = runBox2d(*scene, steps);
+            if (run == 0 || s.msPerStep < best[0].msPerStep) best[0] = s;
+            if (run == 0 || b.msPerStep < best[1].msPerStep) best[1] = b;
+        }
+        std::size_t jointCount = 0;
+        for (Entity e : scene->registry.entities()) jointCount += scene->registry.has<Joint>(e);
+        std::printf("| %s | %zu | %.2fx (%.3f vs %.3f ms) | %.3f / %.3f | %.3f / %.3f |\n",
+                    path.substr(path.find_last_of('/') + 1).c_str(), jointCount, best[1].msPerStep / best[0].msPerStep,
+                    best[1].msPerStep, best[0].msPerStep, 1e3 * best[0].largestSeparation,
+                    1e3 * best[1].largestSeparation, 1e3 * best[0].finalSeparation, 1e3 * best[1].finalSeparation);
+    }
+    return 0;
+}

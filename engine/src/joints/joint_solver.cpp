@@ -1,0 +1,359 @@
+// Joint constraints in the soft-step solver. See joint_solver.hpp; the
+// formulas are the ones of Catto's "Solver2D" notes and Box2D v3's joint
+// solvers (soft constraints with a bias rate, mass scale and impulse scale
+// from the stiffness and the substep), written for this engine's bodies.
+
+#include "joints/joint_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stepwise::joints {
+
+using collision::Rot;
+using collision::Softness;
+using collision::SolverBody;
+using collision::crossSV;
+using collision::rotate;
+
+namespace {
+
+/// Angle of a rotation, rad. Rotations within one step stay well inside
+/// (-pi, pi), so this recovers the turn since step start exactly enough.
+inline double angleOf(Rot q) { return std::atan2(q.s, q.c); }
+inline Vec2 leftPerp(Vec2 v) { return {-v.y, v.x}; }
+
+/// Solves [k11 k12; k12 k22] x = b; a singular K gives 0 (no impulse).
+inline Vec2 solve22(double k11, double k12, double k22, Vec2 b) {
+    double det = k11 * k22 - k12 * k12;
+    if (det != 0.0) det = 1.0 / det;
+    return {det * (k22 * b.x - k12 * b.y), det * (k11 * b.y - k12 * b.x)};
+}
+
+/// Velocities of the two bodies, worked on locally and stored once (A and B
+/// never alias except when both are the static body 0, whose masses are 0).
+struct Pair {
+    Vec2 vA, vB;
+    double wA, wB;
+    double mA, mB, iA, iB;
+    explicit Pair(const SolverBody& a, const SolverBody& b)
+        : vA(a.v), vB(b.v), wA(a.w), wB(b.w), mA(a.invMass), mB(b.invMass), iA(a.invInertia), iB(b.invInertia) {}
+    void store(SolverBody& a, SolverBody& b) const {
+        a.v = vA;
+        a.w = wA;
+        b.v = vB;
+        b.w = wB;
+    }
+    /// Impulse p at anchors rA, rB: -p on A, +p on B.
+    void applyLinear(Vec2 p, Vec2 rA, Vec2 rB) {
+        vA -= mA * p;
+        wA -= iA * cross(rA, p);
+        vB += mB * p;
+        wB += iB * cross(rB, p);
+    }
+    void applyAngular(double impulse) {
+        wA -= iA * impulse;
+        wB += iB * impulse;
+    }
+};
+
+/// Bias, mass scale and impulse scale of one row: a speculative row (C > 0
+/// for a one-sided limit) may close its gap within the substep; otherwise
+/// the soft correction applies in biased passes only.
+struct Row {
+    double bias = 0.0, massScale = 1.0, impulseScale = 0.0;
+};
+inline Row limitRow(double C, double invH, const Softness& soft, bool useBias) {
+    Row r;
+    if (C > 0.0) r.bias = C * invH;
+    else if (useBias) r = {soft.biasRate * C, soft.massScale, soft.impulseScale};
+    return r;
+}
+inline Row equalityRow(double C, const Softness& soft, bool apply) {
+    return apply ? Row{soft.biasRate * C, soft.massScale, soft.impulseScale} : Row{};
+}
+
+/// Hinge or weld point constraint: the anchors coincide (2x2 solve).
+void solvePoint(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, const Softness& soft,
+                bool apply) {
+    const Vec2 rA = rotate(a.dq, j.anchorA), rB = rotate(b.dq, j.anchorB);
+    const Vec2 cdot = p.vB + crossSV(p.wB, rB) - p.vA - crossSV(p.wA, rA);
+    const Vec2 separation = (b.dp - a.dp) + (rB - rA) + j.deltaCenter;
+    const Row row = equalityRow(0.0, soft, apply);
+    const Vec2 bias = apply ? soft.biasRate * separation : Vec2{};
+    const double mSum = p.mA + p.mB;
+    const double k11 = mSum + rA.y * rA.y * p.iA + rB.y * rB.y * p.iB;
+    const double k12 = -rA.y * rA.x * p.iA - rB.y * rB.x * p.iB;
+    const double k22 = mSum + rA.x * rA.x * p.iA + rB.x * rB.x * p.iB;
+    const Vec2 x = solve22(k11, k12, k22, cdot + bias);
+    const Vec2 impulse = -row.massScale * x - row.impulseScale * j.linearImpulse;
+    j.linearImpulse += impulse;
+    p.applyLinear(impulse, rA, rB);
+}
+
+/// One-sided angular limits and the motor of a hinge (axial rows).
+void solveHingeAxial(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
+                     const Softness& soft, bool useBias) {
+    if (j.motor) {
+        const double cdot = p.wB - p.wA - j.motorSpeed;
+        const double maxImpulse = j.maxMotor * h;
+        const double old = j.motorImpulse;
+        j.motorImpulse = std::clamp(old - j.axialMass * cdot, -maxImpulse, maxImpulse);
+        p.applyAngular(j.motorImpulse - old);
+    }
+    if (!j.hasLower && !j.hasUpper) return;
+    const double angle = j.deltaAngle + angleOf(b.dq) - angleOf(a.dq);
+    const double invH = 1.0 / h;
+    if (j.hasLower) {
+        const Row r = limitRow(angle - j.lower, invH, soft, useBias);
+        const double cdot = p.wB - p.wA;
+        const double impulse = -j.axialMass * r.massScale * (cdot + r.bias) - r.impulseScale * j.lowerImpulse;
+        const double total = std::max(j.lowerImpulse + impulse, 0.0);
+        p.applyAngular(total - j.lowerImpulse);
+        j.lowerImpulse = total;
+    }
+    if (j.hasUpper) {
+        const Row r = limitRow(j.upper - angle, invH, soft, useBias);
+        const double cdot = p.wA - p.wB;
+        const double impulse = -j.axialMass * r.massScale * (cdot + r.bias) - r.impulseScale * j.upperImpulse;
+        const double total = std::max(j.upperImpulse + impulse, 0.0);
+        p.applyAngular(-(total - j.upperImpulse));
+        j.upperImpulse = total;
+    }
+}
+
+void solveWeld(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
+               const Softness& soft, bool useBias) {
+    // A weld with stiffness is a spring in both passes; a rigid one is
+    // corrected softly in the biased passes only.
+    const bool spring = j.stiffnessHz > 0.0;
+    const Softness s = spring ? Softness::make(j.stiffnessHz, j.dampingRatio, h) : soft;
+    const bool apply = spring || useBias;
+    const double angle = j.deltaAngle + angleOf(b.dq) - angleOf(a.dq);
+    const Row r = equalityRow(angle, s, apply);
+    const double cdot = p.wB - p.wA;
+    const double impulse = -j.axialMass * r.massScale * (cdot + r.bias) - r.impulseScale * j.angularImpulse;
+    j.angularImpulse += impulse;
+    p.applyAngular(impulse);
+    solvePoint(j, a, b, p, s, apply);
+}
+
+/// Distance (two-sided, rigid or spring) and rope (at most `length`).
+void solveDistance(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
+                   const Softness& soft, bool useBias) {
+    const Vec2 rA = rotate(a.dq, j.anchorA), rB = rotate(b.dq, j.anchorB);
+    const Vec2 d = (b.dp - a.dp) + j.deltaCenter + (rB - rA);
+    const double len = length(d);
+    if (!(len > 1e-12)) return;  // coincident anchors: no direction to push along
+    const Vec2 axis = (1.0 / len) * d;
+    const double crA = cross(rA, axis), crB = cross(rB, axis);
+    const double k = p.mA + p.mB + p.iA * crA * crA + p.iB * crB * crB;
+    const double mass = k > 0.0 ? 1.0 / k : 0.0;
+    const Vec2 vr = p.vB + crossSV(p.wB, rB) - p.vA - crossSV(p.wA, rA);
+    const double cdot = dot(axis, vr);
+    if (j.kind == JointKind::Distance) {
+        const bool spring = j.stiffnessHz > 0.0;
+        const Row r = spring ? equalityRow(len - j.length, Softness::make(j.stiffnessHz, j.dampingRatio, h), true)
+                             : equalityRow(len - j.length, soft, useBias);
+        const double impulse = -mass * r.massScale * (cdot + r.bias) - r.impulseScale * j.axialImpulse;
+        j.axialImpulse += impulse;
+        p.applyLinear(impulse * axis, rA, rB);
+        return;
+    }
+    // Rope: only pulls, when the anchors are `length` apart or more.
+    const Row r = limitRow(j.length - len, 1.0 / h, soft, useBias);
+    const double impulse = -mass * r.massScale * (-cdot + r.bias) - r.impulseScale * j.upperImpulse;
+    const double total = std::max(j.upperImpulse + impulse, 0.0);
+    p.applyLinear(-(total - j.upperImpulse) * axis, rA, rB);
+    j.upperImpulse = total;
+}
+
+void solveSlider(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
+                 const Softness& soft, bool useBias) {
+    const Vec2 rA = rotate(a.dq, j.anchorA), rB = rotate(b.dq, j.anchorB);
+    const Vec2 d = (b.dp - a.dp) + j.deltaCenter + (rB - rA);
+    const Vec2 axis = rotate(a.dq, j.axisA);
+    const double translation = dot(axis, d);
+    const double a1 = cross(d + rA, axis), a2 = cross(rB, axis);
+    const double k = p.mA + p.mB + p.iA * a1 * a1 + p.iB * a2 * a2;
+    const double axialMass = k > 0.0 ? 1.0 / k : 0.0;
+    // Impulse `impulse` along the axis: -on A, +on B.
+    const auto applyAxial = [&](double impulse) {
+        p.vA -= (p.mA * impulse) * axis;
+        p.wA -= p.iA * impulse * a1;
+        p.vB += (p.mB * impulse) * axis;
+        p.wB += p.iB * impulse * a2;
+    };
+    const auto axialSpeed = [&] { return dot(axis, p.vB - p.vA) + a2 * p.wB - a1 * p.wA; };
+    if (j.motor) {
+        const double maxImpulse = j.maxMotor * h;
+        const double old = j.motorImpulse;
+        j.motorImpulse = std::clamp(old + axialMass * (j.motorSpeed - axialSpeed()), -maxImpulse, maxImpulse);
+        applyAxial(j.motorImpulse - old);
+    }
+    const double invH = 1.0 / h;
+    if (j.hasLower) {
+        const Row r = limitRow(translation - j.lower, invH, soft, useBias);
+        const double impulse = -axialMass * r.massScale * (axialSpeed() + r.bias) - r.impulseScale * j.lowerImpulse;
+        const double total = std::max(j.lowerImpulse + impulse, 0.0);
+        applyAxial(total - j.lowerImpulse);
+        j.lowerImpulse = total;
+    }
+    if (j.hasUpper) {
+        const Row r = limitRow(j.upper - translation, invH, soft, useBias);
+        const double impulse = -axialMass * r.massScale * (-axialSpeed() + r.bias) - r.impulseScale * j.upperImpulse;
+        const double total = std::max(j.upperImpulse + impulse, 0.0);
+        applyAxial(-(total - j.upperImpulse));
+        j.upperImpulse = total;
+    }
+    // No sideways travel and no relative rotation, solved together.
+    const Vec2 perp = leftPerp(axis);
+    const double s1 = cross(d + rA, perp), s2 = cross(rB, perp);
+    const Vec2 cdot{dot(perp, p.vB - p.vA) + s2 * p.wB - s1 * p.wA, p.wB - p.wA};
+    Vec2 bias;
+    Row r;
+    if (useBias) {
+        const Vec2 C{dot(perp, d), j.deltaAngle + angleOf(b.dq) - angleOf(a.dq)};
+        bias = soft.biasRate * C;
+        r = {0.0, soft.massScale, soft.impulseScale};
+    }
+    const double k11 = p.mA + p.mB + p.iA * s1 * s1 + p.iB * s2 * s2;
+    const double k12 = p.iA * s1 + p.iB * s2;
+    double k22 = p.iA + p.iB;
+    if (k22 == 0.0) k22 = 1.0;  // two bodies that cannot turn: the angle row is inert
+    const Vec2 x = solve22(k11, k12, k22, cdot + bias);
+    const Vec2 impulse = -r.massScale * x - r.impulseScale * j.linearImpulse;
+    j.linearImpulse += impulse;
+    const Vec2 P = impulse.x * perp;
+    p.vA -= p.mA * P;
+    p.wA -= p.iA * (impulse.x * s1 + impulse.y);
+    p.vB += p.mB * P;
+    p.wB += p.iB * (impulse.x * s2 + impulse.y);
+}
+
+} // namespace
+
+void prepareJoints(std::span<JointConstraint> joints, std::span<const SolverBody> bodies,
+                   std::span<const Vec2> centres, std::span<const double> angles) {
+    for (JointConstraint& j : joints) {
+        const auto pose = [&](const JointEnd& e, Vec2& centre, double& angle) {
+            centre = e.collider >= 0 ? centres[std::size_t(e.collider)] : e.fixedCentre;
+            angle = e.collider >= 0 ? angles[std::size_t(e.collider)] : e.fixedAngle;
+        };
+        double angleA = 0.0, angleB = 0.0;
+        pose(j.a, j.centreA, angleA);
+        pose(j.b, j.centreB, angleB);
+        const Rot qA = Rot::fromAngle(angleA), qB = Rot::fromAngle(angleB);
+        j.anchorA = rotate(qA, j.a.local);
+        j.anchorB = rotate(qB, j.b.local);
+        j.deltaCenter = j.centreB - j.centreA;
+        j.deltaAngle = angleB - angleA - j.referenceAngle;
+        j.axisA = rotate(qA, j.localAxis);
+        const double k = bodies[j.a.solverBody].invInertia + bodies[j.b.solverBody].invInertia;
+        j.axialMass = k > 0.0 ? 1.0 / k : 0.0;
+    }
+}
+
+void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies) {
+    for (JointConstraint& j : joints) {
+        SolverBody& a = bodies[j.a.solverBody];
+        SolverBody& b = bodies[j.b.solverBody];
+        Pair p(a, b);
+        const Vec2 rA = rotate(a.dq, j.anchorA), rB = rotate(b.dq, j.anchorB);
+        switch (j.kind) {
+        case JointKind::Hinge:
+        case JointKind::Weld: {
+            const double axial = j.kind == JointKind::Weld ? j.angularImpulse
+                                                           : j.motorImpulse + j.lowerImpulse - j.upperImpulse;
+            p.applyLinear(j.linearImpulse, rA, rB);
+            p.applyAngular(axial);
+            break;
+        }
+        case JointKind::Slider: {
+            const Vec2 d = (b.dp - a.dp) + j.deltaCenter + (rB - rA);
+            const Vec2 axis = rotate(a.dq, j.axisA), perp = leftPerp(axis);
+            const double axial = j.motorImpulse + j.lowerImpulse - j.upperImpulse;
+            const Vec2 P = axial * axis + j.linearImpulse.x * perp;
+            p.vA -= p.mA * P;
+            p.wA -= p.iA * (axial * cross(d + rA, axis) + j.linearImpulse.x * cross(d + rA, perp) + j.linearImpulse.y);
+            p.vB += p.mB * P;
+            p.wB += p.iB * (axial * cross(rB, axis) + j.linearImpulse.x * cross(rB, perp) + j.linearImpulse.y);
+            break;
+        }
+        case JointKind::Distance:
+        case JointKind::Rope: {
+            const Vec2 d = (b.dp - a.dp) + j.deltaCenter + (rB - rA);
+            const double len = length(d);
+            if (!(len > 1e-12)) break;
+            p.applyLinear((j.axialImpulse - j.upperImpulse) / len * d, rA, rB);
+            break;
+        }
+        }
+        p.store(a, b);
+    }
+}
+
+void solveJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies, double h, const Softness& soft,
+                 bool useBias) {
+    for (JointConstraint& j : joints) {
+        SolverBody& a = bodies[j.a.solverBody];
+        SolverBody& b = bodies[j.b.solverBody];
+        Pair p(a, b);
+        switch (j.kind) {
+        case JointKind::Hinge:
+            solveHingeAxial(j, a, b, p, h, soft, useBias);
+            solvePoint(j, a, b, p, soft, useBias);
+            break;
+        case JointKind::Weld: solveWeld(j, a, b, p, h, soft, useBias); break;
+        case JointKind::Slider: solveSlider(j, a, b, p, h, soft, useBias); break;
+        case JointKind::Distance:
+        case JointKind::Rope: solveDistance(j, a, b, p, h, soft, useBias); break;
+        }
+        p.store(a, b);
+    }
+}
+
+double jointAngle(const JointConstraint& j, std::span<const SolverBody> bodies) {
+    return j.deltaAngle + angleOf(bodies[j.b.solverBody].dq) - angleOf(bodies[j.a.solverBody].dq);
+}
+
+JointAnchors jointAnchors(const JointConstraint& j, std::span<const SolverBody> bodies) {
+    const SolverBody& a = bodies[j.a.solverBody];
+    const SolverBody& b = bodies[j.b.solverBody];
+    JointAnchors out;
+    out.a = j.centreA + a.dp + rotate(a.dq, j.anchorA);
+    out.b = j.centreB + b.dp + rotate(b.dq, j.anchorB);
+    out.separation = length(out.b - out.a);
+    return out;
+}
+
+Vec2 jointForce(const JointConstraint& j, double h) {
+    const double invH = h > 0.0 ? 1.0 / h : 0.0;
+    switch (j.kind) {
+    case JointKind::Hinge:
+    case JointKind::Weld: return invH * j.linearImpulse;
+    case JointKind::Slider: {
+        const double axial = j.motorImpulse + j.lowerImpulse - j.upperImpulse;
+        return invH * (axial * j.axisA + j.linearImpulse.x * leftPerp(j.axisA));
+    }
+    case JointKind::Distance:
+    case JointKind::Rope: {
+        const Vec2 d = j.deltaCenter + (j.anchorB - j.anchorA);
+        const double len = length(d);
+        return len > 1e-12 ? (invH * (j.axialImpulse - j.upperImpulse) / len) * d : Vec2{};
+    }
+    }
+    return {};
+}
+
+double jointTorque(const JointConstraint& j, double h) {
+    const double invH = h > 0.0 ? 1.0 / h : 0.0;
+    switch (j.kind) {
+    case JointKind::Hinge: return invH * (j.motorImpulse + j.lowerImpulse - j.upperImpulse);
+    case JointKind::Weld: return invH * j.angularImpulse;
+    case JointKind::Slider: return invH * j.linearImpulse.y;
+    default: return 0.0;
+    }
+}
+
+} // namespace stepwise::joints

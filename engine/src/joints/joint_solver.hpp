@@ -1,0 +1,110 @@
+#pragma once
+// Joints in the soft-step solver (Catto's Solver2D / Box2D v3 design): each
+// joint is a velocity constraint solved with the contacts, in the same
+// substeps, warm started from the previous substep and step, with a soft
+// position bias in the biased iterations and none in the relax pass.
+//
+//   hinge     point constraint (2x2 solve) + angle limits + motor
+//   slider    perpendicular and angular rows (2x2 solve) + travel limits + motor
+//   weld      point (2x2) + angle; rigid, or a spring of stiffness_hz
+//   distance  anchors `length` apart along their line; rigid or a spring
+//   rope      anchors at most `length` apart (one-sided)
+//
+// Anchors are taken at step start (rotated by each body's orientation then)
+// and turned by each body's rotation since, as the contact solver does, so
+// the position error is measured on the current pose in every substep.
+
+#include "collision/contact_solver.hpp"
+
+#include "stepwise/entity.hpp"
+#include "stepwise/vec2.hpp"
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+namespace stepwise::joints {
+
+enum class JointKind : std::uint8_t { Hinge, Slider, Weld, Distance, Rope };
+
+/// A fixed end (a static body or the world) or a body in the solver.
+struct JointEnd {
+    std::uint32_t solverBody = 0;  ///< SolverBody index; 0 = fixed
+    std::int32_t collider = -1;    ///< collider index of a dynamic end (its centre and angle); -1 = fixed
+    Vec2 fixedCentre;              ///< fixed end: position, metres (the world: origin)
+    double fixedAngle = 0.0;       ///< fixed end: orientation, rad
+    Vec2 local;                    ///< anchor in the end's frame, metres
+};
+
+/// One joint: its definition (from the scene) and its solver state.
+struct JointConstraint {
+    JointKind kind = JointKind::Hinge;
+    JointEnd a, b;
+    Vec2 localAxis{1.0, 0.0};      ///< slider: unit axis in a's frame
+    double referenceAngle = 0.0;   ///< rad
+    bool hasLower = false, hasUpper = false;
+    double lower = 0.0, upper = 0.0;  ///< rad (hinge) or m (slider)
+    bool motor = false;
+    double motorSpeed = 0.0;       ///< rad/s or m/s
+    double maxMotor = 0.0;         ///< N*m or N
+    double length = 0.0;           ///< distance, rope: metres
+    double stiffnessHz = 0.0;      ///< weld, distance: 0 = rigid
+    double dampingRatio = 1.0;
+    Entity entity;                 ///< the joint's own entity
+    Entity entityA, entityB;       ///< its ends (entityB null: the world)
+
+    // Prepared at step start.
+    Vec2 anchorA, anchorB;         ///< anchors rotated to world orientation, relative to the centres, m
+    Vec2 centreA, centreB;         ///< centres at step start, m
+    Vec2 deltaCenter;              ///< centre B - centre A, m
+    double deltaAngle = 0.0;       ///< angle B - angle A - reference, rad
+    Vec2 axisA;                    ///< slider axis in world orientation at step start
+    double axialMass = 0.0;        ///< 1 / (iA + iB), kg m^2 (hinge motor/limits, weld angle)
+
+    // Accumulated impulses (warm started), N*s and N*m*s.
+    Vec2 linearImpulse;            ///< hinge/weld point; slider: (perpendicular, angular)
+    double angularImpulse = 0.0;   ///< weld angle
+    double axialImpulse = 0.0;     ///< distance / rope along the line; slider: unused
+    double motorImpulse = 0.0;
+    double lowerImpulse = 0.0, upperImpulse = 0.0;
+};
+
+struct JointSettings {
+    /// Stiffness of rigid joints' position correction, Hz, always capped at
+    /// half the substep rate (the soft step's stability limit, twice the
+    /// contacts' cap as in Box2D v3). The default is the cap itself: a
+    /// 20-link chain released horizontally stretched 4.1 mm at the cap and
+    /// 14.6 mm at 60 Hz (8 substeps, 4 iterations, links 0.5 m;
+    /// tests/test_joints.cpp, JointSweep).
+    double hertz = std::numeric_limits<double>::infinity();
+    /// Damping ratio of that correction. 1 (critical) measured 4.1 mm on the
+    /// chain above, 2 measured 5.3 mm and 5 measured 9.4 mm.
+    double dampingRatio = 1.0;
+};
+
+/// Computes the step-start anchors, centres and angles. `centres` and
+/// `angles` are per collider (step start).
+void prepareJoints(std::span<JointConstraint> joints, std::span<const collision::SolverBody> bodies,
+                   std::span<const Vec2> centres, std::span<const double> angles);
+void warmStartJoints(std::span<JointConstraint> joints, std::span<collision::SolverBody> bodies);
+/// One Gauss-Seidel pass over the joints; `soft` is the rigid joints'
+/// softness (used in biased passes only).
+void solveJoints(std::span<JointConstraint> joints, std::span<collision::SolverBody> bodies, double h,
+                 const collision::Softness& soft, bool useBias);
+
+/// The joint's pull on b (newtons) and torque on b (N*m) over the last
+/// substep of length h, from the accumulated impulses; a gets the opposite.
+Vec2 jointForce(const JointConstraint& joint, double h);
+double jointTorque(const JointConstraint& joint, double h);
+/// World anchor points now and the distance between them (metres): the
+/// error a rigid hinge or weld should keep near zero.
+struct JointAnchors {
+    Vec2 a, b;
+    double separation = 0.0;
+};
+/// Angle of b relative to a minus the reference angle, now (rad).
+double jointAngle(const JointConstraint& joint, std::span<const collision::SolverBody> bodies);
+JointAnchors jointAnchors(const JointConstraint& joint, std::span<const collision::SolverBody> bodies);
+
+} // namespace stepwise::joints
