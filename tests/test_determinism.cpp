@@ -111,11 +111,9 @@ Outcome simulate(const std::string& integrator) {
     EXPECT_TRUE(world) << world.error();
     if (!world) return {};
     world->setProfiling(false);  // no clock reads: nothing outside the state enters a step
-    for (int i = 0; i < kSteps; ++i) {
-        Result<void> stepped = world->step();
-        EXPECT_TRUE(stepped) << integrator << ": " << stepped.error();
-        if (!stepped) return {};
-    }
+    const AdvanceResult run = advance(*world, kSteps);
+    EXPECT_TRUE(run.ok()) << integrator << ": " << run.divergence.value_or("");
+    if (!run.ok()) return {};
     world->writeBack(*scene);
     return {sceneToJsonText(*scene), world->contacts().size(), world->activeSystems()};
 }

@@ -383,8 +383,8 @@ TEST(Simulation, SteppingThroughTheEditorMatchesTheWorld) {
     for (int i = 0; i < 30; ++i) ASSERT_TRUE(w->step());
     Scene expected = f.ed.doc.scene;
     w->writeBack(expected);
-    // The editor rebuilds its World after a step back; the engine's
-    // determinism makes the result the same bits.
+    // A step back restores the World's saved state in place, so stepping
+    // on gives the same bits (with contacts too: test_editor_state).
     for (int i = 0; i < 20; ++i) f.ed.stepForward();
     for (int i = 0; i < 5; ++i) f.ed.stepBack();
     for (int i = 0; i < 15; ++i) f.ed.stepForward();

@@ -66,7 +66,7 @@ TEST(LoaderRegressions, BytesThatAreNotUtf8AreEscapedInTheMessage) {
 TEST(LoaderRegressions, ControlCharactersInKeysAreEscapedInTheMessage) {
     EXPECT_EQ(refusal(R"({"a\nb\u0007": 1, "entities": []})"),
               "t.json: error: /a\\x0Ab\\x07: unknown top-level key \"a\\x0Ab\\x07\" Known keys: version, world, "
-              "view, entities");
+              "view, entities, solver_state");
 }
 
 // A long found value is cut to 57 bytes; the cut must not split a UTF-8

@@ -223,7 +223,7 @@ TEST(SceneErrors, UnknownComponentNamesEntityAndSuggests) {
               "Known fields: width, height");
     EXPECT_EQ(refusal(R"({"wrld": {}, "entities": []})"),
               "t.json: error: /wrld: unknown top-level key \"wrld\"; did you mean \"world\"? Known keys: version, "
-              "world, view, entities");
+              "world, view, entities, solver_state");
     EXPECT_EQ(refusal(R"({"world": {"integrator": "rk5"}, "entities": []})"),
               "t.json: error: /world/integrator: unknown integrator \"rk5\"; did you mean \"rk4\"? Known integrators: "
               "explicit_euler, semi_implicit_euler, midpoint, trapezoid, rk4, velocity_verlet, implicit_euler, "

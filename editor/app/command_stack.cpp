@@ -27,6 +27,19 @@ T take(const std::string& in, std::size_t& at) {
 
 constexpr char kAlive = 'E';
 
+template <class T>
+void putOptional(std::string& out, const void* field) {
+    const auto& o = *static_cast<const std::optional<T>*>(field);
+    put(out, std::uint8_t(o.has_value()));
+    if (o) put(out, *o);
+}
+template <class T>
+void takeOptional(const std::string& in, std::size_t& at, void* field) {
+    auto& o = *static_cast<std::optional<T>*>(field);
+    o.reset();
+    if (take<std::uint8_t>(in, at)) o = take<T>(in, at);
+}
+
 std::string encodeEntity(const Registry& reg, Entity e) {
     if (!reg.alive(e)) return {};
     std::string out(1, kAlive);
@@ -39,19 +52,9 @@ std::string encodeEntity(const Registry& reg, Entity e) {
             const void* field = f.address(const_cast<void*>(component));
             switch (f.kind) {
             case FieldKind::Number: put(out, *static_cast<const double*>(field)); break;
-            case FieldKind::OptionalNumber: {
-                const auto& o = *static_cast<const std::optional<double>*>(field);
-                put(out, std::uint8_t(o.has_value()));
-                if (o) put(out, *o);
-                break;
-            }
+            case FieldKind::OptionalNumber: putOptional<double>(out, field); break;
             case FieldKind::Vector: put(out, *static_cast<const Vec2*>(field)); break;
-            case FieldKind::OptionalVector: {
-                const auto& o = *static_cast<const std::optional<Vec2>*>(field);
-                put(out, std::uint8_t(o.has_value()));
-                if (o) put(out, *o);
-                break;
-            }
+            case FieldKind::OptionalVector: putOptional<Vec2>(out, field); break;
             case FieldKind::Color: put(out, *static_cast<const Rgb*>(field)); break;
             case FieldKind::Bool: put(out, std::uint8_t(*static_cast<const bool*>(field))); break;
             // A handle is stored as it is: undo and redo act on the same
@@ -80,19 +83,9 @@ void decodeEntity(const std::string& in, Registry& reg, Entity e) {
             void* field = f.address(component);
             switch (f.kind) {
             case FieldKind::Number: *static_cast<double*>(field) = take<double>(in, at); break;
-            case FieldKind::OptionalNumber: {
-                auto& o = *static_cast<std::optional<double>*>(field);
-                o.reset();
-                if (take<std::uint8_t>(in, at)) o = take<double>(in, at);
-                break;
-            }
+            case FieldKind::OptionalNumber: takeOptional<double>(in, at, field); break;
             case FieldKind::Vector: *static_cast<Vec2*>(field) = take<Vec2>(in, at); break;
-            case FieldKind::OptionalVector: {
-                auto& o = *static_cast<std::optional<Vec2>*>(field);
-                o.reset();
-                if (take<std::uint8_t>(in, at)) o = take<Vec2>(in, at);
-                break;
-            }
+            case FieldKind::OptionalVector: takeOptional<Vec2>(in, at, field); break;
             case FieldKind::Color: *static_cast<Rgb*>(field) = take<Rgb>(in, at); break;
             case FieldKind::Bool: *static_cast<bool*>(field) = take<std::uint8_t>(in, at) != 0; break;
             case FieldKind::EntityRef: *static_cast<Entity*>(field) = take<Entity>(in, at); break;

@@ -776,14 +776,17 @@ namespace {
 /// object (`out` ends with its closing brace). One line per contact: a
 /// settled pile has thousands. Numbers read back to the same double, so a
 /// resumed run is bit-identical. Entries naming an entity no longer in the
-/// scene are dropped.
+/// scene, or no longer a shape, are dropped.
 void appendSolverState(const SolverState& state, const Registry& registry, std::string& out) {
     std::unordered_map<Entity, std::size_t> indexOf;
     const auto& entities = registry.entities();
     for (std::size_t i = 0; i < entities.size(); ++i) indexOf.emplace(entities[i], i);
     auto ref = [&](Entity e) -> std::optional<std::string> {
         const auto it = indexOf.find(e);
-        if (it == indexOf.end()) return std::nullopt;
+        // Gone, or no longer a shape (edited since): the loader would
+        // refuse the entry, and no contact of it can be warmed anyway.
+        if (it == indexOf.end() || !(registry.has<Radius>(e) || registry.has<Box>(e) || registry.has<Plane>(e)))
+            return std::nullopt;
         if (const Name* n = registry.tryGet<Name>(e); n && !n->value.empty()) return Json(n->value).dump();
         return std::to_string(it->second);
     };
