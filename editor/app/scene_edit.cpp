@@ -1,5 +1,7 @@
 #include "app/scene_edit.hpp"
 
+#include "stepwise/scene_io.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
@@ -267,6 +269,11 @@ std::size_t destroyWithSprings(Scene& scene, const std::vector<Entity>& entities
     std::vector<Entity> doomed = entities;
     for (Entity e : entities)
         for (Entity s : springsAttachedTo(scene.registry, e)) doomed.push_back(s);
+    // Joints hold handles: a joint goes with either of its bodies.
+    for (Entity j : scene.registry.entities())
+        if (const Joint* joint = scene.registry.tryGet<Joint>(j))
+            for (Entity e : entities)
+                if (joint->a == e || joint->b == e) doomed.push_back(j);
     std::size_t count = 0;
     for (Entity e : doomed) count += scene.registry.destroy(e) ? 1 : 0;  // duplicates are stale the second time
     return count;
@@ -297,6 +304,32 @@ std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>
             if (auto it = renamed.find(s->b); it != renamed.end()) s->b = it->second;
             if (s->anchor) *s->anchor += offset;
         }
+    // Joints hold handles into `src`: an end that was copied too follows
+    // its copy; one that was not stays on the original when that is the
+    // same entity in `dst` (duplicate), else the joint is not copied.
+    std::unordered_map<std::uint32_t, Entity> copyOf;
+    for (std::size_t k = 0, c = 0; k < entities.size(); ++k)
+        if (src.alive(entities[k])) copyOf.emplace(entities[k].index, created[c++]);
+    const auto sameInDst = [&](Entity end) {
+        if (end.isNull() || !dst.registry.alive(end)) return false;
+        const Name* a = src.tryGet<Name>(end);
+        const Name* b = dst.registry.tryGet<Name>(end);
+        return a && b && a->value == b->value;
+    };
+    std::vector<Entity> orphans;
+    for (Entity c : created)
+        if (Joint* j = dst.registry.tryGet<Joint>(c)) {
+            for (Entity* end : {&j->a, &j->b}) {
+                if (end->isNull()) continue;
+                if (auto it = copyOf.find(end->index); it != copyOf.end()) *end = it->second;
+                else if (!sameInDst(*end)) orphans.push_back(c);
+            }
+            if (j->b.isNull()) j->localB += offset;  // a world anchor moves with the copy
+        }
+    for (Entity o : orphans) {
+        dst.registry.destroy(o);
+        std::erase(created, o);
+    }
     return created;
 }
 
@@ -371,6 +404,47 @@ Entity addAnchoredSpring(Scene& scene, Entity a, Vec2 anchor) {
     Spring s;
     s.anchor = anchor;
     return addPaletteSpring(scene.registry, a, std::move(s), anchor);
+}
+
+Entity addJoint(Scene& scene, const std::string& type, Entity a, Entity b, Vec2 anchor, std::string* problem) {
+    Registry& reg = scene.registry;
+    const auto isFixed = [&](Entity e) {
+        if (e.isNull()) return true;
+        const Static* st = reg.tryGet<Static>(e);
+        return st && st->value;
+    };
+    if (isFixed(a) && isFixed(b)) {
+        if (problem) *problem = "a joint needs at least one dynamic body";
+        return {};
+    }
+    nameForSpring(reg, a);
+    if (!b.isNull()) nameForSpring(reg, b);
+    Joint j;
+    j.type = type;
+    j.a = a;
+    j.b = b;
+    if (type == "distance" || type == "rope") {
+        // a's end at its centre, b's at the click (a world point for the world).
+        j.localA = {};
+        if (b.isNull()) {
+            j.localB = anchor;
+        } else {
+            const Vec2 d = anchor - reg.tryGet<Position>(b)->value;
+            const Angle* an = reg.tryGet<Angle>(b);
+            const double t = an ? an->value : 0.0;
+            j.localB = {std::cos(t) * d.x + std::sin(t) * d.y, -std::sin(t) * d.x + std::cos(t) * d.y};
+        }
+    } else {
+        j.anchor = anchor;
+    }
+    if (std::string why = completeJoint(reg, j); !why.empty()) {
+        if (problem) *problem = why;
+        return {};
+    }
+    const Entity e = reg.create();
+    reg.emplace(e, Name{uniqueName(reg, "joint")});
+    reg.emplace(e, std::move(j));
+    return e;
 }
 
 Entity addAttractor(Scene& scene, Vec2 at, double mass) {
