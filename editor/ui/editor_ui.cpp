@@ -56,7 +56,7 @@ const Shortcut kShortcuts[] = {
     {"Ctrl+S / Ctrl+Shift+S", "Save / save as"},
     {"Ctrl+O / Ctrl+N", "Open / new level"},
     {"Ctrl+Q", "Quit (asks about unsaved changes)"},
-    {"1 .. 8", "Tools: select, rotate, circle, box, wall, spring, attractor, boid brush"},
+    {"1 .. 9", "Tools: select, rotate, circle, box, wall, spring, attractor, boid brush, joint"},
     {"G", "Snap to grid on / off"},
     {"F", "Frame the whole level"},
     {"F1", "This help"},
