@@ -27,7 +27,12 @@ void setDistinct(const FieldInfo& field, void* component, int salt, Entity targe
     case FieldKind::OptionalVector: *static_cast<std::optional<Vec2>*>(m) = Vec2{1e-300, -1e300}; break;
     case FieldKind::Color: *static_cast<Rgb*>(m) = {0.453125, 1.0 / 3.0, 0.0}; break;
     case FieldKind::Bool: *static_cast<bool*>(m) = salt % 2 == 0; break;
-    case FieldKind::String: *static_cast<std::string*>(m) = "label \"quoted\" ü " + std::to_string(salt); break;
+    case FieldKind::String:
+        // A field with a fixed set of values (a joint's type) gets one of them.
+        *static_cast<std::string*>(m) = field.choices.empty()
+                                            ? "label \"quoted\" ü " + std::to_string(salt)
+                                            : std::string(field.choices[std::size_t(salt) % field.choices.size()]);
+        break;
     case FieldKind::EntityRef: *static_cast<Entity*>(m) = target; break;
     }
 }
@@ -110,6 +115,12 @@ TEST_P(ComponentRoundTrip, EveryFieldSurvivesSaveAndLoad) {
         auto* s = static_cast<Spring*>(component);
         s->a = target;
         s->b = Entity{};  // anchored: b and anchor are exclusive
+    }
+    if (info->name == "joint") {
+        auto* j = static_cast<Joint*>(component);
+        j->a = target;
+        j->b = Entity{};   // the world
+        j->anchor.reset(); // input only: the loader turns it into the locals
     }
     if (info->name == "boid") static_cast<Boid*>(component)->separationRadius = 0.5;
     if (info->name == "plane") static_cast<Plane*>(component)->normal = {0.6, 0.8};  // unit already

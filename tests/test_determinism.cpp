@@ -102,8 +102,8 @@ struct Outcome {
     std::vector<std::string_view> systems;
 };
 
-Outcome simulate(const std::string& integrator) {
-    Result<Scene> scene = parseScene(kScene, "determinism.json");
+Outcome simulate(const std::string& integrator, std::string_view sceneText = kScene) {
+    Result<Scene> scene = parseScene(sceneText, "determinism.json");
     EXPECT_TRUE(scene) << scene.error();
     if (!scene) return {};
     scene->world.integrator = integrator;
@@ -166,23 +166,9 @@ std::string simulateJoints(const std::string& integrator) {
     std::ifstream in(std::string(STEPWISE_SOURCE_DIR) + "/tests/data/joints_every_type.json");
     std::stringstream text;
     text << in.rdbuf();
-    Result<Scene> scene = parseScene(text.str(), "joints_every_type.json");
-    EXPECT_TRUE(scene) << scene.error();
-    if (!scene) return {};
-    scene->world.integrator = integrator;
-    Result<World> world = World::build(*scene);
-    EXPECT_TRUE(world) << world.error();
-    if (!world) return {};
-    world->setProfiling(false);
-    for (int i = 0; i < kSteps; ++i) {
-        Result<void> stepped = world->step();
-        EXPECT_TRUE(stepped) << stepped.error();
-        if (!stepped) return {};
-    }
-    const auto systems = world->activeSystems();
-    EXPECT_NE(std::find(systems.begin(), systems.end(), "joints"), systems.end());
-    world->writeBack(*scene);
-    return sceneToJsonText(*scene);
+    const Outcome o = simulate(integrator, text.str());
+    EXPECT_NE(std::find(o.systems.begin(), o.systems.end(), "joints"), o.systems.end());
+    return o.text;
 }
 
 } // namespace

@@ -8,6 +8,7 @@
 
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
+#include "stepwise/world.hpp"
 
 #include "test_support.hpp"
 
@@ -228,6 +229,44 @@ TEST(Tools, SpringBetweenTwoBodiesAndToAnAnchor) {
     EXPECT_EQ(anchored->a, f.named("dust"));
     ASSERT_TRUE(anchored->anchor);
     EXPECT_NEAR(anchored->anchor->x, 5.0, 1e-9);
+    EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), "");
+}
+
+TEST(Tools, JointBetweenTwoBodiesAndToTheWorldSavesAndSimulates) {
+    Fixture f("orbit.json");
+    f.ed.tool = Tool::Joint;
+    f.ed.jointType = "hinge";
+    f.click(f.positionOf("planet"));
+    f.click(f.positionOf("comet"));
+    const Registry& reg = f.ed.doc.scene.registry;
+    const Joint* j = reg.tryGet<Joint>(reg.entities().back());
+    ASSERT_NE(j, nullptr);
+    EXPECT_EQ(j->type, "hinge");
+    EXPECT_EQ(reg.tryGet<Name>(j->a)->value, "planet");
+    EXPECT_EQ(reg.tryGet<Name>(j->b)->value, "comet");
+    EXPECT_FALSE(j->anchor) << "the click point became the locals";
+    ASSERT_TRUE(j->referenceAngle);
+    // A rope to the world from "dust" to the point clicked in empty space.
+    f.ed.jointType = "rope";
+    f.click(f.positionOf("dust"));
+    f.click({5.0, 5.0});
+    const Joint* rope = reg.tryGet<Joint>(reg.entities().back());
+    ASSERT_NE(rope, nullptr);
+    EXPECT_TRUE(rope->b.isNull());
+    EXPECT_NEAR(rope->localB.x, 5.0, 1e-9);  // a world point for the world end
+    EXPECT_NEAR(rope->localB.y, 5.0, 1e-9);
+    ASSERT_TRUE(rope->length);
+    EXPECT_NEAR(*rope->length, length(rope->localB - f.positionOf("dust")), 1e-12);
+    EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), "");
+    const std::string text = sceneToJsonText(f.ed.doc.scene);
+    Result<Scene> again = parseScene(text, "joined.json");
+    ASSERT_TRUE(again) << again.error();
+    EXPECT_EQ(sceneToJsonText(*again), text);
+    EXPECT_TRUE(World::build(f.ed.doc.scene));
+    // Deleting a body takes its joints with it (they would name nothing).
+    f.ed.selection = {reg.tryGet<Joint>(reg.entities().back())->a};
+    ASSERT_TRUE(f.ed.deleteSelection());
+    for (Entity e : reg.entities()) EXPECT_FALSE(reg.has<Joint>(e) && reg.tryGet<Joint>(e)->type == "rope");
     EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), "");
 }
 

@@ -21,6 +21,7 @@ std::string_view toolName(Tool t) {
     case Tool::Spring: return "Spring";
     case Tool::Attractor: return "Attractor";
     case Tool::Boids: return "Boids";
+    case Tool::Joint: return "Joint";
     case Tool::Count: break;
     }
     return "?";
@@ -491,6 +492,33 @@ void Editor::handleViewportEvent(const InputEvent& e) {
                 selection = {created};
             return;
         }
+        case Tool::Joint: {
+            // First click: body a. Second click: body b, or empty space for
+            // the world; the second click's point is the anchor (for
+            // distance and rope, b's end: a's end is its centre).
+            if (springStart_.isNull()) {
+                if (!hit.isNull() && isBody(reg, hit)) {
+                    springStart_ = hit;
+                    note("joint: click a second body, or empty space to join to the world (Esc cancels)");
+                } else {
+                    note("joint: click a body first");
+                }
+                return;
+            }
+            const Entity a = springStart_;
+            springStart_ = {};
+            const Entity b = !hit.isNull() && hit != a && isBody(reg, hit) ? hit : Entity{};
+            Entity created;
+            std::string problem;
+            if (applyEdit("place " + jointType + " joint", [&](Scene& s) {
+                    created = addJoint(s, jointType, a, b, snapped(world), &problem);
+                    return !created.isNull();
+                }))
+                selection = {created};
+            else if (!problem.empty())
+                note("joint refused: " + problem);
+            return;
+        }
         case Tool::Boids: {
             drag_ = Drag::Boids;
             dragKey_ = newMergeKey();
@@ -655,7 +683,7 @@ render::FrameInput Editor::frameInput() const {
     in.world = sim.world();
     in.overlays = overlays;
     if (!in.world) in.overlays.bits &= ~(std::uint32_t(render::Overlay::Force) | std::uint32_t(render::Overlay::ForceField) |
-                                         std::uint32_t(render::Overlay::Contacts));
+                                         std::uint32_t(render::Overlay::Contacts) | std::uint32_t(render::Overlay::Joints));
     in.camera = view.camera;
     in.selection = selection;
     if (!springStart_.isNull()) in.selection.push_back(springStart_);

@@ -21,7 +21,7 @@
 
 namespace stepwise::editor {
 
-enum class Tool : std::uint8_t { Select, Rotate, Circle, Box, Plane, Spring, Attractor, Boids, Count };
+enum class Tool : std::uint8_t { Select, Rotate, Circle, Box, Plane, Spring, Attractor, Boids, Joint, Count };
 std::string_view toolName(Tool t);
 /// Shortcut key of each tool ("1" .. "8").
 Key toolKey(Tool t);
@@ -107,8 +107,10 @@ public:
     Vec2 mouseViewport() const { return mouse_; }
     /// Box-select rectangle in viewport pixels while dragging one.
     std::optional<std::pair<Vec2, Vec2>> selectionRect() const;
-    /// First end of a spring being placed.
+    /// First end of a spring or joint being placed.
     Entity springStart() const { return springStart_; }
+    /// Joint tool: the type the next joint gets (one of jointTypeNames()).
+    std::string jointType = "hinge";
     /// Sets the viewport size; the first call (or fitView) frames the scene.
     void setViewportSize(int width, int height);
     void fitView();

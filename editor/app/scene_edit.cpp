@@ -1,5 +1,7 @@
 #include "app/scene_edit.hpp"
 
+#include "stepwise/scene_io.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
@@ -373,6 +375,7 @@ std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>
         if (Position* p = dst.registry.tryGet<Position>(c)) p->value += offset;
         if (Plane* pl = dst.registry.tryGet<Plane>(c)) pl->offset += dot(pl->normal, offset);
         if (Spring* s = dst.registry.tryGet<Spring>(c); s && s->anchor) *s->anchor += offset;  // moves with the copy
+        if (Joint* j = dst.registry.tryGet<Joint>(c); j && j->b.isNull()) j->localB += offset;  // a world anchor too
         copyOf.emplace(e, c);
         created.push_back(c);
     }
@@ -478,6 +481,47 @@ Entity addAnchoredSpring(Scene& scene, Entity a, Vec2 anchor) {
     Spring s;
     s.anchor = anchor;
     return addPaletteSpring(scene.registry, a, std::move(s), anchor);
+}
+
+Entity addJoint(Scene& scene, const std::string& type, Entity a, Entity b, Vec2 anchor, std::string* problem) {
+    Registry& reg = scene.registry;
+    const auto isFixed = [&](Entity e) {
+        if (e.isNull()) return true;
+        const Static* st = reg.tryGet<Static>(e);
+        return st && st->value;
+    };
+    if (isFixed(a) && isFixed(b)) {
+        if (problem) *problem = "a joint needs at least one dynamic body";
+        return {};
+    }
+    nameForSpring(reg, a);
+    if (!b.isNull()) nameForSpring(reg, b);
+    Joint j;
+    j.type = type;
+    j.a = a;
+    j.b = b;
+    if (type == "distance" || type == "rope") {
+        // a's end at its centre, b's at the click (a world point for the world).
+        j.localA = {};
+        if (b.isNull()) {
+            j.localB = anchor;
+        } else {
+            const Vec2 d = anchor - reg.tryGet<Position>(b)->value;
+            const Angle* an = reg.tryGet<Angle>(b);
+            const double t = an ? an->value : 0.0;
+            j.localB = {std::cos(t) * d.x + std::sin(t) * d.y, -std::sin(t) * d.x + std::cos(t) * d.y};
+        }
+    } else {
+        j.anchor = anchor;
+    }
+    if (std::string why = completeJoint(reg, j); !why.empty()) {
+        if (problem) *problem = why;
+        return {};
+    }
+    const Entity e = reg.create();
+    reg.emplace(e, Name{uniqueName(reg, "joint")});
+    reg.emplace(e, std::move(j));
+    return e;
 }
 
 Entity addAttractor(Scene& scene, Vec2 at, double mass) {

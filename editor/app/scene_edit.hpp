@@ -128,6 +128,12 @@ Entity addPlane(Scene& scene, Vec2 through, Vec2 normal);
 Entity addSpring(Scene& scene, Entity a, Entity b);
 /// A spring from a body to a fixed world point.
 Entity addAnchoredSpring(Scene& scene, Entity a, Vec2 anchor);
+/// A joint of `type` from body `a` to body `b` (null: the world) at world
+/// point `anchor` (for distance and rope: from a's centre to `anchor`).
+/// Unnamed ends get names (files name them). Returns the null entity, with
+/// `problem` set, when the joint would be refused (two static ends).
+Entity addJoint(Scene& scene, const std::string& type, Entity a, Entity b, Vec2 anchor,
+                std::string* problem = nullptr);
 /// A static attractor of `mass` kg.
 Entity addAttractor(Scene& scene, Vec2 at, double mass = 100.0);
 /// A boid at `at` with velocity `velocity`.

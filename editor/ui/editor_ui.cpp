@@ -56,7 +56,7 @@ const Shortcut kShortcuts[] = {
     {"Ctrl+S / Ctrl+Shift+S", "Save / save as"},
     {"Ctrl+O / Ctrl+N", "Open / new level"},
     {"Ctrl+Q", "Quit (asks about unsaved changes)"},
-    {"1 .. 8", "Tools: select, rotate, circle, box, wall, spring, attractor, boid brush"},
+    {"1 .. 9", "Tools: select, rotate, circle, box, wall, spring, attractor, boid brush, joint"},
     {"G", "Snap to grid on / off"},
     {"F", "Frame the whole level"},
     {"F1", "This help"},
@@ -292,6 +292,17 @@ void toolsPanel(UiState& ui, Editor& ed, const PanelRects& r) {
             if (ImGui::Checkbox(std::string(name).c_str(), &on))
                 ed.overlays.bits = on ? ed.overlays.bits | std::uint32_t(overlay) : ed.overlays.bits & ~std::uint32_t(overlay);
             if (++i % 2 == 1) ImGui::SameLine(bw + ImGui::GetStyle().ItemSpacing.x + ImGui::GetStyle().WindowPadding.x);
+        }
+        if (ed.tool == Tool::Joint) {
+            ImGui::SetNextItemWidth(-1);
+            if (ImGui::BeginCombo("##jointtype", ed.jointType.c_str())) {
+                for (std::string_view type : jointTypeNames())
+                    if (ImGui::Selectable(std::string(type).c_str(), ed.jointType == type)) ed.jointType = std::string(type);
+                ImGui::EndCombo();
+            }
+            ImGui::TextWrapped("%s", ed.springStart().isNull()
+                                         ? "Click a body, then a second body or empty space (the world) at the anchor."
+                                         : "Now click the other body or empty space, at the anchor (Esc cancels).");
         }
         if (ed.tool == Tool::Spring)
             ImGui::TextWrapped("%s", ed.springStart().isNull() ? "Click a body, then a second body or empty space."
