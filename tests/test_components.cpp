@@ -27,6 +27,9 @@ void setDistinct(const FieldInfo& field, void* component, int salt) {
     case FieldKind::OptionalVector: *static_cast<std::optional<Vec2>*>(m) = Vec2{1e-300, -1e300}; break;
     case FieldKind::Color: *static_cast<Rgb*>(m) = {0.453125, 1.0 / 3.0, 0.0}; break;
     case FieldKind::Bool: *static_cast<bool*>(m) = salt % 2 == 0; break;
+    case FieldKind::VectorList:  // a convex, counter-clockwise quadrilateral off its origin
+        *static_cast<std::vector<Vec2>*>(m) = {{0.1 * salt + 1.0 / 3.0, -2.0 / 7.0}, {2.0, -0.5}, {2.5, 1e-3}, {0.2, 1.0}};
+        break;
     case FieldKind::String: *static_cast<std::string*>(m) = "label \"quoted\" ü " + std::to_string(salt); break;
     case FieldKind::EntityName: *static_cast<std::string*>(m) = "target"; break;
     }
@@ -44,6 +47,8 @@ bool fieldEquals(const FieldInfo& field, const void* a, const void* b) {
         return *static_cast<const std::optional<Vec2>*>(ma) == *static_cast<const std::optional<Vec2>*>(mb);
     case FieldKind::Color: return *static_cast<const Rgb*>(ma) == *static_cast<const Rgb*>(mb);
     case FieldKind::Bool: return *static_cast<const bool*>(ma) == *static_cast<const bool*>(mb);
+    case FieldKind::VectorList:
+        return *static_cast<const std::vector<Vec2>*>(ma) == *static_cast<const std::vector<Vec2>*>(mb);
     case FieldKind::String:
     case FieldKind::EntityName:
         return *static_cast<const std::string*>(ma) == *static_cast<const std::string*>(mb);
@@ -68,7 +73,7 @@ TEST(ComponentTable, NamesAreUniqueAndFindable) {
     // The contract's components (shared/SCENE_FORMAT.md) are all present.
     for (const char* required : {"name", "type", "position", "velocity", "mass", "static", "radius", "box", "angle",
                                  "angular_velocity", "color", "restitution", "friction", "drag", "plane", "attractor",
-                                 "spring", "boid"})
+                                 "spring", "boid", "polygon"})
         EXPECT_NE(findComponent(required), nullptr) << required;
 }
 

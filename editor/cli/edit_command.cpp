@@ -350,7 +350,7 @@ int runScripted(const EditOptions& o, int width, int height) {
             else if (a == "savestate") ed.saveStateAs(args[0]);
             else if (a == "tool") {
                 bool found = false;
-                static const char* names[] = {"select", "rotate", "circle", "box", "plane", "spring", "attractor", "boids"};
+                static const char* names[] = {"select", "rotate", "circle", "box", "plane", "spring", "attractor", "boids", "polygon"};
                 for (int t = 0; t < int(editor::Tool::Count); ++t)
                     if (args[0] == names[t]) {
                         ed.tool = editor::Tool(t);

@@ -14,6 +14,7 @@
 #include "stepwise/world.hpp"
 
 #include <cstdint>
+#include <deque>
 #include <span>
 #include <vector>
 
@@ -28,6 +29,12 @@ struct Collider {
     double restitution = 0.0;
     double friction = 0.2;
     Entity entity;
+    /// Centre of mass relative to the body's position, in the body frame,
+    /// metres: non-zero for a polygon whose centroid is not its position.
+    /// The state vector then holds the position (the file's value, so saves
+    /// round-trip exactly) and the velocity of the centre of mass; contacts
+    /// work about the centre of mass and turning the body moves its position.
+    Vec2 centreOfMass;
 };
 
 /// Solid-shape moment of inertia about the centre, kg m^2.
@@ -70,6 +77,10 @@ public:
     std::size_t contactPointCount() const { return records_.size(); }
     const CollisionTimings& timings() const { return timings_; }
 
+    /// Centre of mass of collider i in the world (its position plus the
+    /// rotated offset), metres, at the given body positions.
+    Vec2 centreOfMass(std::size_t i, std::span<const Vec2> x) const;
+
     /// Undoes a step's rotational change (after a divergence).
     void restoreRotation(std::span<const double> angles, std::span<const double> angularVelocities) {
         angles_.assign(angles.begin(), angles.end());
@@ -88,6 +99,9 @@ private:
     void addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m, std::span<const Vec2> centres);
 
     std::vector<Collider> colliders_;
+    std::deque<ConvexPolygon> polygons_;  // the polygon shapes' outlines (addresses stay fixed)
+    std::vector<std::uint32_t> offsetBodies_;  // dynamic colliders whose centre of mass is off their position
+    std::vector<double> offsetAngleBefore_;    // their angles at the start of the substep, rad
     std::vector<double> angles_, angularVelocities_;
     std::vector<double> invMass_, invInertia_, maxExtent_;
     std::vector<std::uint32_t> finite_;  // colliders that are not planes (broad-phase proxies)
