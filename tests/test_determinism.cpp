@@ -183,6 +183,14 @@ TEST(Determinism, TheSameRunTwiceInOneProcessGivesTheSameBytes) {
 
 /// Recorded when polygons were added (issue 15), Release build, gcc 12.
 const std::map<std::string, std::uint64_t> kRecordedPolygons = {
+    {"explicit_euler", 0x028ef72cf1b14162ull},
+    {"semi_implicit_euler", 0xc61c378a2427b41eull},
+    {"midpoint", 0x5ec4851647711937ull},
+    {"trapezoid", 0x92d4883184393ae7ull},
+    {"rk4", 0x9a23ec6c677e1730ull},
+    {"velocity_verlet", 0xcc2bf9e5200e8771ull},
+    {"implicit_euler", 0x12ec6e236f298309ull},
+    {"implicit_midpoint", 0x58ed14abccfeb4deull},
 };
 
 TEST(Determinism, PolygonSceneHashUnderEveryIntegratorMatchesTheRecordedValue) {

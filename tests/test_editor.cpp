@@ -819,9 +819,10 @@ TEST(PolygonTool, TheInspectorRefusesADentAndKeepsTheOldOutline) {
     const ComponentInfo* info = findComponent("polygon");
     const std::vector<Vec2> before = f.ed.doc.scene.registry.tryGet<Polygon>(e)->vertices;
     std::string problem;
-    const std::vector<Vec2> dent{{-1, -1}, {1, -1}, {0, 0}, {-1, 1}};
+    const std::vector<Vec2> dent{{-1, -1}, {1, -1}, {-0.25, -0.25}, {-1, 1}};
     EXPECT_EQ(setFieldOnAll(f.ed.doc.scene, *info, info->fields[0], dent, {e}, &problem), 0u);
-    EXPECT_EQ(problem, "polygon: vertices/2: not convex: the outline turns clockwise at vertex 2 {\"x\": 0, \"y\": 0}; "
+    EXPECT_EQ(problem, "polygon: vertices/2: not convex: the outline turns clockwise at vertex 2 {\"x\": -0.25, \"y\": "
+                       "-0.25}; "
                        "a polygon shape must be convex (split the shape into convex pieces)");
     EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Polygon>(e)->vertices, before);
     const std::vector<Vec2> kite{{-1, -1}, {1, -1}, {1.5, 0.5}, {-1, 1}};

@@ -606,7 +606,7 @@ void Editor::handleViewportEvent(const InputEvent& e) {
                 selection = std::move(inside);
             }
         } else if (finished == Drag::RegularPolygon) {
-            const std::vector<Vec2> outline = polygonPreview();
+            const std::vector<Vec2> outline = regularOutline();
             if (outline.empty()) {
                 note("polygon: drag out its size from the centre");
                 return;
@@ -692,15 +692,7 @@ void Editor::discardRecovery() {
 std::vector<Vec2> Editor::polygonPreview() const {
     if (tool != Tool::Polygon) return {};
     const Vec2 cursor = snapped(view.toWorld(mouse_));
-    if (polygonSides >= 3) {
-        if (drag_ != Drag::RegularPolygon) return {};
-        const Vec2 arm = cursor - dragStartWorld_;
-        const double radius = length(arm);
-        if (!(radius > 1e-3)) return {};
-        std::vector<Vec2> outline = regularPolygon(polygonSides, radius, std::atan2(arm.y, arm.x));
-        for (Vec2& v : outline) v += dragStartWorld_;
-        return outline;
-    }
+    if (polygonSides >= 3) return drag_ == Drag::RegularPolygon ? regularOutline() : std::vector<Vec2>{};
     if (polygonClicks_.empty()) return {};
     // The hull with the cursor as the next vertex, unless that breaks the limit.
     std::vector<Vec2> points = polygonClicks_;
@@ -708,6 +700,15 @@ std::vector<Vec2> Editor::polygonPreview() const {
     std::vector<Vec2> hull = convexHull(points);
     if (hull.size() > 8 || hull.size() < 3) hull = convexHull(polygonClicks_);
     return hull;
+}
+
+std::vector<Vec2> Editor::regularOutline() const {
+    const Vec2 arm = snapped(view.toWorld(mouse_)) - dragStartWorld_;
+    const double radius = length(arm);
+    if (!(radius > 1e-3) || polygonSides < 3) return {};  // a click, not a drag
+    std::vector<Vec2> outline = regularPolygon(polygonSides, radius, std::atan2(arm.y, arm.x));
+    for (Vec2& v : outline) v += dragStartWorld_;
+    return outline;
 }
 
 bool Editor::finishPolygon() {

@@ -163,6 +163,9 @@ private:
     Vec2 snapped(Vec2 world) const;
     double pickRadius() const;
     void placeAt(Vec2 world);
+    /// The regular polygon the current drag describes (world metres), or
+    /// empty for a drag shorter than a millimetre.
+    std::vector<Vec2> regularOutline() const;
 
     enum class Drag : std::uint8_t { None, Pan, Move, Rotate, BoxSelect, Plane, Boids, MouseSpring, RegularPolygon };
     Drag drag_ = Drag::None;
