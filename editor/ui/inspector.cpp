@@ -129,7 +129,7 @@ void drawInspector(UiState& ui, Editor& ed) {
     if (ed.selection.empty()) {
         ImGui::TextColored(kDim, "Nothing selected.");
         ImGui::TextWrapped("Click a body in the viewport or the entity list; shift-click or drag a box for several. "
-                           "Place new ones with the tools (1-8).");
+                           "Place new ones with the tools (1-9).");
         ImGui::End();
         return;
     }
