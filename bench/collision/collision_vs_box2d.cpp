@@ -277,7 +277,10 @@ BroadPhaseTimes timeBroadPhases(const std::vector<Pose>& poses) {
 /// built from the same Scene. Sleeping off in Box2D, as above.
 Scene polygonPileScene(int count) {
     Scene s;
+    // The other scenes' settings (collision_scenes.cpp): 4 substeps, 2 iterations.
+    s.world.gravity = {0.0, -10.0};
     s.world.substeps = 4;
+    s.world.solverIterations = 2;
     Registry& r = s.registry;
     const auto wall = [&](Vec2 p, double w, double h) {
         const Entity e = r.create();

@@ -119,25 +119,15 @@ std::pair<int, double> maxSeparation(const WorldPolygon& a, const WorldPolygon& 
     return {bestEdge, best};
 }
 
-/// Separating axis test over both polygons' face normals, then the
-/// incident edge clipped against the reference face's side planes: up to
-/// two points. Feature ids: (reference edge << 8) | (incident vertex, or 16
-/// + reference edge / 24 + reference edge for a point cut by a side plane),
-/// plus bit 16 when B's face is the reference.
-Manifold collideWorldPolygons(const WorldPolygon& a, const WorldPolygon& b, double margin) {
+/// The manifold from reference face `refEdge` of `ref` and the edge of
+/// `inc` most facing it: the incident edge clipped against the reference
+/// face's side planes. Side-plane points get ids sideId + refEdge and
+/// sideId + sideStride + refEdge (boxes and polygons keep their own ranges,
+/// so box ids are what they always were).
+Manifold clipIncidentEdge(const WorldPolygon& ref, int refEdge, const WorldPolygon& inc, bool flip, double margin,
+                          std::uint32_t sideId, std::uint32_t sideStride) {
     Manifold m;
-    const auto [edgeA, separationA] = maxSeparation(a, b);
-    if (separationA > margin) return m;
-    const auto [edgeB, separationB] = maxSeparation(b, a);
-    if (separationB > margin) return m;
-    // The boxes' rule: A's face unless B's is clearly better, so the
-    // reference face does not flicker between steps.
-    const bool flip = separationB > 0.98 * separationA + 0.0005;
-    const WorldPolygon& ref = flip ? b : a;
-    const WorldPolygon& inc = flip ? a : b;
-    const int refEdge = flip ? edgeB : edgeA;
     const Vec2 n = ref.normals[refEdge];
-
     int incEdge = 0;
     double minDot = std::numeric_limits<double>::infinity();
     for (int i = 0; i < inc.count; ++i) {
@@ -153,8 +143,8 @@ Manifold collideWorldPolygons(const WorldPolygon& a, const WorldPolygon& b, doub
     const Vec2 v1 = ref.vertices[refEdge], v2 = ref.vertices[(refEdge + 1) % ref.count];
     const Vec2 t = (v2 - v1) / length(v2 - v1);
     ClipVertex clipped1[2], clipped2[2];
-    if (clipSegment(incident, clipped1, -t, -dot(t, v1), 16 + std::uint32_t(refEdge)) < 2) return m;
-    if (clipSegment(clipped1, clipped2, t, dot(t, v2), 24 + std::uint32_t(refEdge)) < 2) return m;
+    if (clipSegment(incident, clipped1, -t, -dot(t, v1), sideId + std::uint32_t(refEdge)) < 2) return m;
+    if (clipSegment(clipped1, clipped2, t, dot(t, v2), sideId + sideStride + std::uint32_t(refEdge)) < 2) return m;
 
     m.normal = flip ? -n : n;
     for (const ClipVertex& cv : clipped2) {
@@ -166,6 +156,22 @@ Manifold collideWorldPolygons(const WorldPolygon& a, const WorldPolygon& b, doub
         p.id = (std::uint32_t(flip) << 16) | (std::uint32_t(refEdge) << 8) | cv.id;
     }
     return m;
+}
+
+/// Separating axis test over both polygons' face normals, then the
+/// incident edge clipped (clipIncidentEdge): up to two points. Feature ids:
+/// (reference edge << 8) | (incident vertex, or 16 + reference edge / 24 +
+/// reference edge for a point cut by a side plane), plus bit 16 when B's
+/// face is the reference.
+Manifold collideWorldPolygons(const WorldPolygon& a, const WorldPolygon& b, double margin) {
+    const auto [edgeA, separationA] = maxSeparation(a, b);
+    if (separationA > margin) return Manifold{};
+    const auto [edgeB, separationB] = maxSeparation(b, a);
+    if (separationB > margin) return Manifold{};
+    // The boxes' rule: A's face unless B's is clearly better, so the
+    // reference face does not flicker between steps.
+    const bool flip = separationB > 0.98 * separationA + 0.0005;
+    return clipIncidentEdge(flip ? b : a, flip ? edgeB : edgeA, flip ? a : b, flip, margin, 16, kMaxPolygonVertices);
 }
 
 /// Polygon A (in the world) against circle B: the exact closest point of
@@ -310,50 +316,17 @@ Manifold collideBoxCircle(Vec2 h, Vec2 pA, Rot qA, double r, Vec2 pB, double mar
 }
 
 Manifold collideBoxes(Vec2 hA, Vec2 pA, Rot qA, Vec2 hB, Vec2 pB, Rot qB, double margin) {
-    Manifold m;
     const BoxPolygon a = worldBox(hA, pA, qA), b = worldBox(hB, pB, qB);
     const auto [edgeA, separationA] = maxSeparation(a, b);
-    if (separationA > margin) return m;
+    if (separationA > margin) return Manifold{};
     const auto [edgeB, separationB] = maxSeparation(b, a);
-    if (separationB > margin) return m;
+    if (separationB > margin) return Manifold{};
 
     // Prefer A's face unless B's is clearly better: keeps the reference face
     // from flickering between steps when the two are nearly equal.
     const bool flip = separationB > 0.98 * separationA + 0.0005;
-    const BoxPolygon& ref = flip ? b : a;
-    const BoxPolygon& inc = flip ? a : b;
-    const int refEdge = flip ? edgeB : edgeA;
-    const Vec2 n = ref.normals[refEdge];
-
-    int incEdge = 0;
-    double minDot = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < 4; ++i) {
-        const double d = dot(n, inc.normals[i]);
-        if (d < minDot) {
-            minDot = d;
-            incEdge = i;
-        }
-    }
-    const ClipVertex incident[2] = {
-        {inc.vertices[incEdge], std::uint32_t(incEdge)},
-        {inc.vertices[(incEdge + 1) % 4], std::uint32_t((incEdge + 1) % 4)},
-    };
-    const Vec2 v1 = ref.vertices[refEdge], v2 = ref.vertices[(refEdge + 1) % 4];
-    const Vec2 t = (v2 - v1) / length(v2 - v1);
-    ClipVertex clipped1[2], clipped2[2];
-    if (clipSegment(incident, clipped1, -t, -dot(t, v1), 8 + std::uint32_t(refEdge)) < 2) return m;
-    if (clipSegment(clipped1, clipped2, t, dot(t, v2), 12 + std::uint32_t(refEdge)) < 2) return m;
-
-    m.normal = flip ? -n : n;
-    for (const ClipVertex& cv : clipped2) {
-        const double separation = dot(n, cv.v - v1);
-        if (separation > margin) continue;
-        ManifoldPoint& p = m.points[m.pointCount++];
-        p.separation = separation;
-        p.point = cv.v - 0.5 * separation * n;
-        p.id = (std::uint32_t(flip) << 16) | (std::uint32_t(refEdge) << 8) | cv.id;
-    }
-    return m;
+    return clipIncidentEdge(worldPolygon(flip ? b : a), flip ? edgeB : edgeA, worldPolygon(flip ? a : b), flip, margin,
+                            8, 4);
 }
 
 Manifold collidePlaneCircle(Vec2 n, double offset, double r, Vec2 pB, double margin) {
@@ -368,32 +341,7 @@ Manifold collidePlaneCircle(Vec2 n, double offset, double r, Vec2 pB, double mar
 }
 
 Manifold collidePlaneBox(Vec2 n, double offset, Vec2 h, Vec2 pB, Rot qB, double margin) {
-    Manifold m;
-    const BoxPolygon box = worldBox(h, pB, qB);
-    // The two deepest corners within the margin.
-    int first = -1, second = -1;
-    double s[4];
-    for (int i = 0; i < 4; ++i) {
-        s[i] = dot(n, box.vertices[i]) - offset;
-        if (s[i] > margin) continue;
-        if (first < 0 || s[i] < s[first]) {
-            second = first;
-            first = i;
-        } else if (second < 0 || s[i] < s[second]) {
-            second = i;
-        }
-    }
-    m.normal = n;
-    for (int i : {first, second}) {
-        if (i < 0) continue;
-        ManifoldPoint& p = m.points[m.pointCount++];
-        p.separation = s[i];
-        p.point = box.vertices[i] - 0.5 * s[i] * n;
-        p.id = std::uint32_t(i);
-    }
-    // Keep a stable order (by corner id) so warm starting matches points.
-    if (m.pointCount == 2 && m.points[0].id > m.points[1].id) std::swap(m.points[0], m.points[1]);
-    return m;
+    return collidePlaneWorldPolygon(n, offset, worldPolygon(worldBox(h, pB, qB)), margin);
 }
 
 Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot qB, double margin) {
