@@ -440,3 +440,16 @@ TEST_F(Cli, EditScriptNamesTheBadLineForAnUnknownSystemOrEntity) {
     EXPECT_EQ(o.exitCode, 2);
     EXPECT_NE(o.err.find(breakon.string() + ":3: breakon: no entity named \"plnet\""), std::string::npos) << o.err;
 }
+
+TEST_F(Cli, ClockwisePolygonExitsTwoNamingTheEntityAndLeavesTheOutputAlone) {
+    const fs::path bad = write("cw.json", R"({"entities": [{"name": "wedge", "position": {"x": 0, "y": 0},
+      "polygon": {"vertices": [{"x": 0, "y": 0}, {"x": 0, "y": 1}, {"x": 1, "y": 0}]}}]})");
+    const fs::path out = write("out.json", "untouched");
+    const Outcome o = stepwise("run " + bad.string() + " --steps 10 --out " + out.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, bad.string() + ": error: /entities/0/polygon/vertices: entity 0 (\"wedge\"): the vertices run "
+                                    "clockwise; list them counter-clockwise (reverse the list)\n");
+    EXPECT_EQ(readFile(out), "untouched");
+    // The shipped polygon level runs.
+    EXPECT_EQ(stepwise("run " + level("polygons.json") + " --steps 30").exitCode, 0);
+}

@@ -27,6 +27,9 @@ void setDistinct(const FieldInfo& field, void* component, int salt, Entity targe
     case FieldKind::OptionalVector: *static_cast<std::optional<Vec2>*>(m) = Vec2{1e-300, -1e300}; break;
     case FieldKind::Color: *static_cast<Rgb*>(m) = {0.453125, 1.0 / 3.0, 0.0}; break;
     case FieldKind::Bool: *static_cast<bool*>(m) = salt % 2 == 0; break;
+    case FieldKind::VectorList:  // a convex, counter-clockwise quadrilateral off its origin
+        *static_cast<std::vector<Vec2>*>(m) = {{0.1 * salt + 1.0 / 3.0, -2.0 / 7.0}, {2.0, -0.5}, {2.5, 1e-3}, {0.2, 1.0}};
+        break;
     case FieldKind::String:
         // A field with a fixed set of values (a joint's type) gets one of them.
         *static_cast<std::string*>(m) = field.choices.empty()
@@ -51,6 +54,8 @@ bool fieldEquals(const FieldInfo& field, const void* a, const void* b, const Reg
         return *static_cast<const std::optional<Vec2>*>(ma) == *static_cast<const std::optional<Vec2>*>(mb);
     case FieldKind::Color: return *static_cast<const Rgb*>(ma) == *static_cast<const Rgb*>(mb);
     case FieldKind::Bool: return *static_cast<const bool*>(ma) == *static_cast<const bool*>(mb);
+    case FieldKind::VectorList:
+        return *static_cast<const std::vector<Vec2>*>(ma) == *static_cast<const std::vector<Vec2>*>(mb);
     case FieldKind::String: return *static_cast<const std::string*>(ma) == *static_cast<const std::string*>(mb);
     case FieldKind::EntityRef: {
         const Entity ea = *static_cast<const Entity*>(ma), eb = *static_cast<const Entity*>(mb);
@@ -80,7 +85,7 @@ TEST(ComponentTable, NamesAreUniqueAndFindable) {
     // The scene format's required components (docs/format.md) are all present.
     for (const char* required : {"name", "type", "position", "velocity", "mass", "static", "radius", "box", "angle",
                                  "angular_velocity", "color", "restitution", "friction", "drag", "plane", "attractor",
-                                 "spring", "boid"})
+                                 "spring", "boid", "polygon"})
         EXPECT_NE(findComponent(required), nullptr) << required;
 }
 

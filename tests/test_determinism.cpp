@@ -65,6 +65,36 @@ const char* kScene = R"({
   ]
 })";
 
+/// Polygons (issue 15), in their own scene so the scene above keeps its
+/// recorded values (which shows polygons changed nothing for the other
+/// shapes): a static polygon ramp, triangles, n-gons, an off-centre body
+/// (its centroid 2 m from its position), against planes, a box, a circle
+/// and each other.
+const char* kPolygonScene = R"({
+  "world": {"gravity": {"x": 0, "y": -9.81}, "dt": 0.016666666666666666, "substeps": 2},
+  "entities": [
+    {"name": "floor", "plane": {"normal": {"x": 0, "y": 1}, "offset": 0}, "friction": 0.5},
+    {"name": "left", "plane": {"normal": {"x": 1, "y": 0}, "offset": -4}},
+    {"name": "right", "plane": {"normal": {"x": -1, "y": 0}, "offset": -4}},
+    {"name": "ramp", "position": {"x": -4, "y": 0}, "static": true,
+     "polygon": {"vertices": [{"x": 0, "y": 0}, {"x": 3, "y": 0}, {"x": 0, "y": 1.2}]}},
+    {"name": "tri", "position": {"x": -3.2, "y": 1.6}, "angle": -0.38, "friction": 0.3,
+     "polygon": {"vertices": [{"x": -0.3, "y": 0}, {"x": 0.3, "y": 0}, {"x": 0, "y": 0.5}]}},
+    {"name": "hex", "position": {"x": 0, "y": 0.6}, "mass": 2, "angular_velocity": 1,
+     "polygon": {"vertices": [{"x": 0.5, "y": 0}, {"x": 0.25, "y": 0.433}, {"x": -0.25, "y": 0.433},
+                              {"x": -0.5, "y": 0}, {"x": -0.25, "y": -0.433}, {"x": 0.25, "y": -0.433}]}},
+    {"name": "quad", "position": {"x": 0.1, "y": 1.8}, "angle": 0.2, "restitution": 0.4,
+     "polygon": {"vertices": [{"x": -0.4, "y": -0.2}, {"x": 0.4, "y": -0.25}, {"x": 0.3, "y": 0.3}, {"x": -0.35, "y": 0.2}]}},
+    {"name": "flag", "position": {"x": -1, "y": 3}, "velocity": {"x": 1, "y": 0}, "angular_velocity": 2,
+     "polygon": {"vertices": [{"x": 1.6, "y": -0.3}, {"x": 2.4, "y": -0.3}, {"x": 2.4, "y": 0.3}, {"x": 1.6, "y": 0.3}]}},
+    {"name": "crate", "position": {"x": 2, "y": 0.5}, "box": {"width": 0.8, "height": 0.8}},
+    {"name": "ball", "position": {"x": 2.1, "y": 2.5}, "radius": 0.3, "restitution": 0.5},
+    {"name": "oct", "position": {"x": 1.2, "y": 4}, "angle": 0.1,
+     "polygon": {"vertices": [{"x": 0.4, "y": 0}, {"x": 0.283, "y": 0.283}, {"x": 0, "y": 0.4}, {"x": -0.283, "y": 0.283},
+                              {"x": -0.4, "y": 0}, {"x": -0.283, "y": -0.283}, {"x": 0, "y": -0.4}, {"x": 0.283, "y": -0.283}]}}
+  ]
+})";
+
 constexpr int kSteps = 240;  // 4 s: the pile settles, the chain swings into it
 
 /// FNV-1a, 64 bit: tiny, stable, and every byte matters.
@@ -179,4 +209,37 @@ TEST(Determinism, JointSceneHashMatchesTheRecordedValue) {
         EXPECT_EQ(hex(fnv1a(text)), hex(recorded)) << "actual {\"" << integrator << "\", " << hex(fnv1a(text)) << "ull},";
         EXPECT_EQ(simulateJoints(integrator), text) << "the same run twice gives the same bytes";
     }
+}
+
+/// Recorded when polygons were added (issue 15), Release build, gcc 12.
+const std::map<std::string, std::uint64_t> kRecordedPolygons = {
+    {"explicit_euler", 0x028ef72cf1b14162ull},
+    {"semi_implicit_euler", 0xc61c378a2427b41eull},
+    {"midpoint", 0x5ec4851647711937ull},
+    {"trapezoid", 0x92d4883184393ae7ull},
+    {"rk4", 0x9a23ec6c677e1730ull},
+    {"velocity_verlet", 0xcc2bf9e5200e8771ull},
+    {"implicit_euler", 0x12ec6e236f298309ull},
+    {"implicit_midpoint", 0x58ed14abccfeb4deull},
+};
+
+TEST(Determinism, PolygonSceneHashUnderEveryIntegratorMatchesTheRecordedValue) {
+    EXPECT_EQ(integratorNames().size(), kRecordedPolygons.size()) << "a new integrator needs a recorded hash";
+    std::set<std::uint64_t> distinct;
+    for (std::string_view name : integratorNames()) {
+        const std::string integrator(name);
+        const Outcome o = simulate(integrator, kPolygonScene);
+        EXPECT_GT(o.contacts, 8u) << integrator << ": the polygons should be resting on the floor and each other";
+        const std::uint64_t actual = fnv1a(o.text);
+        const auto recorded = kRecordedPolygons.find(integrator);
+        if (recorded == kRecordedPolygons.end()) {
+            ADD_FAILURE() << integrator << ": actual {\"" << integrator << "\", " << hex(actual) << "ull},";
+            continue;
+        }
+        EXPECT_EQ(hex(actual), hex(recorded->second))
+            << "integrator " << integrator << ": actual {\"" << integrator << "\", " << hex(actual) << "ull},";
+        distinct.insert(actual);
+    }
+    EXPECT_EQ(distinct.size(), kRecordedPolygons.size());
+    EXPECT_EQ(simulate("rk4", kPolygonScene).text, simulate("rk4", kPolygonScene).text);
 }

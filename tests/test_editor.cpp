@@ -755,3 +755,124 @@ saveas /tmp/x.json
     ASSERT_FALSE(badKey);
     EXPECT_NE(badKey.error().find("Hyper"), std::string::npos);
 }
+
+// ---- polygon tool (issue 15) ------------------------------------------------
+
+TEST(PolygonTool, ClickedVerticesMakeTheirConvexHullAsOneUndoStep) {
+    Fixture f("orbit.json");
+    const std::string before = textOf(f.ed.doc.scene);
+    const std::size_t n = f.ed.doc.scene.registry.size(), undoDepth = f.ed.commands.size();
+    f.ed.tool = Tool::Polygon;
+    // A square's corners with a point inside it: the hull drops the inner one.
+    for (Vec2 p : {Vec2{4, -3}, Vec2{6, -3}, Vec2{5, -2.5}, Vec2{6, -1}, Vec2{4, -1}}) f.click(p);
+    EXPECT_EQ(f.ed.polygonClicks().size(), 5u);
+    EXPECT_EQ(f.ed.doc.scene.registry.size(), n) << "nothing is made before the outline is finished";
+    // The preview is the hull, counter-clockwise, with the cursor (inside) adding nothing.
+    const std::vector<Vec2> preview = f.ed.polygonPreview();
+    ASSERT_EQ(preview.size(), 4u);
+    EXPECT_EQ(polygonProblem(preview), "");
+    ASSERT_TRUE(f.ed.handleShortcut(Key::Enter, 0));
+    ASSERT_EQ(f.ed.doc.scene.registry.size(), n + 1);
+    const Entity e = f.ed.doc.scene.registry.entities().back();
+    const Polygon* poly = f.ed.doc.scene.registry.tryGet<Polygon>(e);
+    ASSERT_NE(poly, nullptr);
+    EXPECT_EQ(poly->vertices.size(), 4u);
+    // Positioned at the centroid, vertices about it: the centre of mass is the position.
+    const Vec2 p = f.ed.doc.scene.registry.tryGet<Position>(e)->value;
+    EXPECT_NEAR(p.x, 5.0, 1e-9);
+    EXPECT_NEAR(p.y, -2.0, 1e-9);
+    const PolygonMassProperties props = polygonMassProperties(poly->vertices);
+    EXPECT_NEAR(props.centroid.x, 0.0, 1e-12);
+    EXPECT_NEAR(props.area, 4.0, 1e-9);
+    EXPECT_EQ(f.ed.selection, std::vector<Entity>{e});
+    EXPECT_TRUE(f.ed.polygonClicks().empty());
+    EXPECT_EQ(f.ed.commands.size(), undoDepth + 1);
+    ASSERT_TRUE(f.ed.undo());
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+    // It saves and loads: the level stays valid.
+    ASSERT_TRUE(f.ed.redo());
+    Result<Scene> again = parseScene(textOf(f.ed.doc.scene), "edited.json");
+    EXPECT_TRUE(again) << again.error();
+}
+
+TEST(PolygonTool, CollinearClicksAreRefusedAndEscapeCancels) {
+    Fixture f("orbit.json");
+    const std::string before = textOf(f.ed.doc.scene);
+    f.ed.tool = Tool::Polygon;
+    for (Vec2 p : {Vec2{4, -3}, Vec2{5, -3}, Vec2{6, -3}}) f.click(p);
+    EXPECT_FALSE(f.ed.finishPolygon());
+    EXPECT_EQ(f.ed.status, "polygon: needs 3 vertices that are not on one line");
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+    f.click({4, -3});
+    f.click({5, -2});
+    ASSERT_TRUE(f.ed.handleShortcut(Key::Escape, 0));
+    EXPECT_TRUE(f.ed.polygonClicks().empty());
+    EXPECT_TRUE(f.ed.polygonPreview().empty());
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+}
+
+TEST(PolygonTool, ANinthHullVertexIsRefused) {
+    Fixture f("orbit.json");
+    f.ed.tool = Tool::Polygon;
+    for (const Vec2 v : regularPolygon(9, 2.0, 0.0)) f.click(v + Vec2{4.0, -3.0});
+    EXPECT_EQ(f.ed.polygonClicks().size(), 8u);
+    EXPECT_EQ(f.ed.status, "polygon: at most 8 vertices; press Enter to make it");
+    ASSERT_TRUE(f.ed.finishPolygon());
+    const Entity e = f.ed.doc.scene.registry.entities().back();
+    EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Polygon>(e)->vertices.size(), 8u);
+}
+
+TEST(PolygonTool, RegularPolygonDraggedFromItsCentre) {
+    Fixture f("orbit.json");
+    const std::size_t n = f.ed.doc.scene.registry.size(), undoDepth = f.ed.commands.size();
+    f.ed.tool = Tool::Polygon;
+    f.ed.polygonSides = 6;
+    const Vec2 centre{4.0, -3.0}, rim{5.5, -3.0};
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseDown, centre));
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseMove, rim));
+    const std::vector<Vec2> preview = f.ed.polygonPreview();
+    ASSERT_EQ(preview.size(), 6u) << "previewed while dragging";
+    EXPECT_NEAR(preview[0].x, rim.x, 1e-6);
+    EXPECT_NEAR(preview[0].y, rim.y, 1e-6);
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseUp, rim));
+    ASSERT_EQ(f.ed.doc.scene.registry.size(), n + 1);
+    const Entity e = f.ed.doc.scene.registry.entities().back();
+    const Polygon* poly = f.ed.doc.scene.registry.tryGet<Polygon>(e);
+    ASSERT_NE(poly, nullptr);
+    ASSERT_EQ(poly->vertices.size(), 6u);
+    EXPECT_NEAR(f.ed.doc.scene.registry.tryGet<Position>(e)->value.x, centre.x, 1e-6);
+    // Circumradius 1.5: area 3 sqrt(3)/2 r^2.
+    EXPECT_NEAR(polygonMassProperties(poly->vertices).area, 1.5 * std::sqrt(3.0) * 1.5 * 1.5, 1e-4);
+    EXPECT_EQ(f.ed.commands.size(), undoDepth + 1);
+    // A click without a drag makes nothing.
+    f.click({0.0, 5.0});
+    EXPECT_EQ(f.ed.doc.scene.registry.size(), n + 1);
+}
+
+TEST(PolygonTool, TheInspectorRefusesADentAndKeepsTheOldOutline) {
+    Fixture f("orbit.json");
+    Entity e;
+    ASSERT_TRUE(f.ed.applyEdit("add", [&](Scene& s) {
+        e = addPolygon(s, {{0, 0}, {2, 0}, {2, 2}, {0, 2}});
+        return !e.isNull();
+    }));
+    const ComponentInfo* info = findComponent("polygon");
+    const std::vector<Vec2> before = f.ed.doc.scene.registry.tryGet<Polygon>(e)->vertices;
+    std::string problem;
+    const std::vector<Vec2> dent{{-1, -1}, {1, -1}, {-0.25, -0.25}, {-1, 1}};
+    EXPECT_EQ(setFieldOnAll(f.ed.doc.scene, *info, info->fields[0], dent, {e}, &problem), 0u);
+    EXPECT_EQ(problem, "polygon: vertices/2: not convex: the outline turns clockwise at vertex 2 {\"x\": -0.25, \"y\": "
+                       "-0.25}; "
+                       "a polygon shape must be convex (split the shape into convex pieces)");
+    EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Polygon>(e)->vertices, before);
+    const std::vector<Vec2> kite{{-1, -1}, {1, -1}, {1.5, 0.5}, {-1, 1}};
+    EXPECT_EQ(setFieldOnAll(f.ed.doc.scene, *info, info->fields[0], kite, {e}, &problem), 1u);
+    EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Polygon>(e)->vertices, kite);
+}
+
+TEST(PolygonTool, ConvexHullIsCounterClockwiseWithoutCollinearPoints) {
+    const std::vector<Vec2> hull = convexHull({{0, 0}, {1, 0}, {2, 0}, {2, 2}, {1, 1}, {0, 2}, {0, 0}, {1, 2}});
+    ASSERT_EQ(hull.size(), 4u);
+    EXPECT_EQ(polygonProblem(hull), "");
+    EXPECT_EQ(convexHull({{0, 0}, {1, 1}, {2, 2}}).size(), 2u);
+}

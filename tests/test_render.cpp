@@ -279,3 +279,53 @@ TEST(RenderBatching, SameInputSameFloats) {
 }
 
 } // namespace
+
+TEST(RenderPolygons, FanOutlineAndRingFollowTheTurnedOutline) {
+    // An off-centre triangle turned 90 degrees: vertex (2, 0) about position
+    // (1, 1) lands at (1, 3). The fill is one fan triangle per edge, the
+    // outline one segment per edge (plus two per corner of the selection
+    // ring when selected), and no point-mass dot.
+    Scene scene;
+    const Entity e = scene.registry.create();
+    scene.registry.emplace<Position>(e, {{1.0, 1.0}});
+    scene.registry.emplace<Angle>(e, {1.5707963267948966});
+    scene.registry.emplace<Polygon>(e, {{{1.0, -0.5}, {2.0, 0.0}, {1.0, 0.5}}});
+    FrameInput input;
+    input.scene = &scene;
+    input.camera = Camera{{1.0, 2.0}, 100.0};
+    input.hud = false;
+    const DrawData plain = buildDrawData(input, 800, 600);
+    Scene empty;
+    FrameInput gridOnly = input;
+    gridOnly.scene = &empty;
+    const std::size_t grid = countOf(buildDrawData(gridOnly, 800, 600), BatchKind::Solid);  // the grid is Solid too
+    EXPECT_EQ(countOf(plain, BatchKind::Solid) - grid, 3u * 3u) << "three fan triangles, three vertices each";
+    EXPECT_EQ(countOf(plain, BatchKind::Segment), 3u);
+    EXPECT_EQ(countOf(plain, BatchKind::Disc), 0u);
+    const Vec2 apex = pixelOf(input, {1.0, 3.0}, 800, 600);
+    bool found = false;
+    for (const Batch& b : plain.batches)
+        if (b.kind == BatchKind::Segment)
+            for (std::size_t i = 0; i < b.count(); ++i) {
+                const float* s = b.data.data() + i * floatsPerInstance(BatchKind::Segment);
+                found = found || (std::abs(s[0] - apex.x) < 1e-3 && std::abs(s[1] - apex.y) < 1e-3);
+            }
+    EXPECT_TRUE(found) << "an outline segment starts at the turned vertex";
+    input.selection = {e};
+    EXPECT_EQ(countOf(buildDrawData(input, 800, 600), BatchKind::Segment), 3u + 6u);
+    // The camera fit and the AABB overlay use the turned outline: y from 2 to 3 here, x from 0.5 to 1.5.
+    input.selection.clear();
+    input.overlays.add(Overlay::Aabb);
+    const DrawData boxes = buildDrawData(input, 800, 600);
+    bool aabbFound = false;
+    const double ppm = input.camera.pixelsPerMetre(600);
+    const Vec2 centrePx = pixelOf(input, {1.0, 2.5}, 800, 600);
+    for (const Batch& b : boxes.batches)
+        if (b.kind == BatchKind::Box)
+            for (std::size_t i = 0; i < b.count(); ++i) {
+                const float* r = b.data.data() + i * floatsPerInstance(BatchKind::Box);
+                aabbFound = aabbFound || (std::abs(r[0] - centrePx.x) < 1e-3 && std::abs(r[1] - centrePx.y) < 1e-3 &&
+                                          std::abs(r[2] - 0.5 * ppm) < 1e-3 && std::abs(r[3] - 0.5 * ppm) < 1e-3);
+            }
+    EXPECT_TRUE(aabbFound) << "a 1 m x 1 m box centred on (1, 2.5)";
+}

@@ -8,7 +8,9 @@
 //
 // --quick runs a fifth of the simulated time, once; otherwise each engine
 // runs three times, alternating, and the fastest run counts. --scene runs
-// only that scene (pile, pyramid or rain), e.g. while tuning the solver.
+// only that scene (pile, pyramid or rain), e.g. while tuning the solver;
+// --scene polygons runs the polygon pile (issue 15), which is not in the
+// default set and prints one line.
 
 #include "collision/collision_scenes.hpp"
 
@@ -289,6 +291,109 @@ std::string measuredOn(int argc, char** argv) {
            " hardware threads) by `" + command + "`.";
 }
 
+/// A pile of regular 3- to 8-gons (issue 15) dropped between static box
+/// walls: the polygon narrow phase and manifolds under load, both engines
+/// built from the same Scene. Sleeping off in Box2D, as above.
+Scene polygonPileScene(int count) {
+    Scene s;
+    // The other scenes' settings (collision_scenes.cpp): 4 substeps, 2 iterations.
+    s.world.gravity = {0.0, -10.0};
+    s.world.substeps = 4;
+    s.world.solverIterations = 2;
+    Registry& r = s.registry;
+    const auto wall = [&](Vec2 p, double w, double h) {
+        const Entity e = r.create();
+        r.emplace<Position>(e, {p});
+        r.emplace<Static>(e, {true});
+        r.emplace<Box>(e, {w, h});
+    };
+    wall({0.0, -0.5}, 40.0, 1.0);
+    wall({-10.5, 10.0}, 1.0, 20.0);
+    wall({10.5, 10.0}, 1.0, 20.0);
+    for (int i = 0; i < count; ++i) {
+        const int sides = 3 + i % 6;
+        const Entity e = r.create();
+        r.emplace<Position>(e, {{-9.3 + 0.75 * (i % 25) + 0.1 * ((i / 25) % 2), 0.5 + 0.75 * (i / 25)}});
+        r.emplace<Angle>(e, {0.37 * i});
+        r.emplace<Friction>(e, {0.5});
+        Polygon poly;
+        poly.vertices.clear();
+        for (int k = 0; k < sides; ++k) {
+            const double a = 2.0 * M_PI * k / sides;
+            poly.vertices.push_back({0.33 * std::cos(a), 0.33 * std::sin(a)});
+        }
+        r.emplace<Polygon>(e, poly);
+    }
+    return s;
+}
+
+struct PileOutcome {
+    double msPerStep = 0.0;
+    double deepest = 0.0;  ///< metres, deepest contact overlap at the end (each engine's collision shapes)
+};
+
+PileOutcome runPolygonPileStepwise(const Scene& scene, int steps) {
+    Result<World> built = World::build(scene);
+    if (!built) {
+        std::cerr << "stepwise cannot build the polygon pile: " << built.error() << "\n";
+        std::exit(1);
+    }
+    World& world = built.value();
+    world.setProfiling(false);
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < steps; ++i)
+        if (Result<void> r = world.step(); !r) {
+            std::cerr << "stepwise diverged: " << r.error() << "\n";
+            std::exit(1);
+        }
+    PileOutcome out;
+    out.msPerStep = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / steps;
+    for (const ContactRecord& c : world.contacts()) out.deepest = std::max(out.deepest, c.depth);
+    return out;
+}
+
+PileOutcome runPolygonPileBox2d(const Scene& scene, int steps) {
+    b2World world(b2Vec2(float(scene.world.gravity.x), float(scene.world.gravity.y)));
+    world.SetAllowSleeping(false);
+    const Registry& r = scene.registry;
+    for (Entity e : r.entities()) {
+        const bool isStatic = r.has<Static>(e) && r.tryGet<Static>(e)->value;
+        b2BodyDef def;
+        def.type = isStatic ? b2_staticBody : b2_dynamicBody;
+        const Vec2 p = r.tryGet<Position>(e)->value;
+        def.position.Set(float(p.x), float(p.y));
+        if (const Angle* a = r.tryGet<Angle>(e)) def.angle = float(a->value);
+        b2Body* body = world.CreateBody(&def);
+        b2FixtureDef fd;
+        fd.friction = float(r.has<Friction>(e) ? r.tryGet<Friction>(e)->value : 0.2);
+        b2PolygonShape shape;
+        if (const Box* b = r.tryGet<Box>(e)) {
+            shape.SetAsBox(float(b->width / 2), float(b->height / 2));
+            fd.density = 1.0f;
+        } else {
+            const Polygon& poly = *r.tryGet<Polygon>(e);
+            b2Vec2 v[b2_maxPolygonVertices];
+            for (std::size_t k = 0; k < poly.vertices.size(); ++k) v[k].Set(float(poly.vertices[k].x), float(poly.vertices[k].y));
+            shape.Set(v, int(poly.vertices.size()));
+            fd.density = float(1.0 / polygonMassProperties(poly.vertices).area);  // 1 kg, as Stepwise's default
+        }
+        fd.shape = &shape;
+        body->CreateFixture(&fd);
+    }
+    const float dt = float(scene.world.dt);
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < steps; ++i) world.Step(dt, 8, 3);
+    PileOutcome out;
+    out.msPerStep = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / steps;
+    for (b2Contact* c = world.GetContactList(); c; c = c->GetNext()) {
+        if (!c->IsTouching()) continue;
+        b2WorldManifold m;
+        c->GetWorldManifold(&m);
+        for (int i = 0; i < c->GetManifold()->pointCount; ++i) out.deepest = std::max(out.deepest, double(-m.separations[i]));
+    }
+    return out;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -304,15 +409,28 @@ int main(int argc, char** argv) {
             g_broadPhase = argv[++i];
         else {
             std::cerr << "collision_vs_box2d: error: unknown argument \"" << arg
-                      << "\"; usage: collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain]\n";
+                      << "\"; usage: collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain|polygons]\n";
             return 2;
         }
+    }
+    if (only == "polygons") {
+        // The polygon pile: ms per step, alternating engines, fastest of three.
+        const Scene pile = polygonPileScene(400);
+        const int steps = quick ? 60 : 300;
+        PileOutcome mine = runPolygonPileStepwise(pile, steps), peer = runPolygonPileBox2d(pile, steps);
+        for (int repeat = 1; repeat < (quick ? 1 : 3); ++repeat) {
+            mine.msPerStep = std::min(mine.msPerStep, runPolygonPileStepwise(pile, steps).msPerStep);
+            peer.msPerStep = std::min(peer.msPerStep, runPolygonPileBox2d(pile, steps).msPerStep);
+        }
+        std::printf("| polygons | 400 regular 3..8-gons | %d | %.3f | %.3f | %.2fx | deepest overlap %.2f / %.2f mm |\n", steps,
+                    mine.msPerStep, peer.msPerStep, peer.msPerStep / mine.msPerStep, 1e3 * mine.deepest, 1e3 * peer.deepest);
+        return 0;
     }
     std::vector<bench::NamedScene> scenes = bench::benchmarkScenes();
     if (!only.empty()) {
         std::erase_if(scenes, [&](const bench::NamedScene& s) { return s.name != only; });
         if (scenes.empty()) {
-            std::cerr << "collision_vs_box2d: error: no scene named \"" << only << "\" (pile, pyramid, rain)\n";
+            std::cerr << "collision_vs_box2d: error: no scene named \"" << only << "\" (pile, pyramid, rain, polygons)\n";
             return 2;
         }
     }

@@ -22,12 +22,16 @@ std::string_view toolName(Tool t) {
     case Tool::Attractor: return "Attractor";
     case Tool::Boids: return "Boids";
     case Tool::Joint: return "Joint";
+    case Tool::Polygon: return "Polygon";
     case Tool::Count: break;
     }
     return "?";
 }
 
-Key toolKey(Tool t) { return Key(std::uint16_t(Key::Num1) + std::uint16_t(t)); }
+// Keys 1..9 pick the first nine tools and 0 the tenth, as on a keyboard's row.
+Key toolKey(Tool t) {
+    return std::uint16_t(t) < 9 ? Key(std::uint16_t(Key::Num1) + std::uint16_t(t)) : Key::Num0;
+}
 
 Editor::Editor() : configDir(configDirectory()) {
     doc.reset(makeNewScene());
@@ -349,8 +353,15 @@ bool Editor::handleShortcut(Key key, std::uint8_t mods) {
     case Key::R: resetSimulation(); return true;
     case Key::Delete:
     case Key::Backspace: return deleteSelection();
+    case Key::Enter:
+        if (tool == Tool::Polygon && !polygonClicks_.empty()) {
+            finishPolygon();
+            return true;
+        }
+        break;
     case Key::Escape:
         springStart_ = {};
+        polygonClicks_.clear();
         if (drag_ == Drag::None) selection.clear();
         return true;
     case Key::F1: uiRequest = UiRequest::Help; return true;
@@ -358,9 +369,12 @@ bool Editor::handleShortcut(Key key, std::uint8_t mods) {
     case Key::G: snap = !snap; note(snap ? "snap on" : "snap off"); return true;
     default: break;
     }
-    if (key >= Key::Num1 && key < Key(std::uint16_t(Key::Num1) + std::uint16_t(Tool::Count))) {
-        tool = Tool(std::uint16_t(key) - std::uint16_t(Key::Num1));
+    if (key >= Key::Num0 && key <= Key::Num9 &&
+        (key == Key::Num0 ? std::uint16_t(Tool::Count) > 9
+                          : std::uint16_t(key) - std::uint16_t(Key::Num1) < std::uint16_t(Tool::Count))) {
+        tool = key == Key::Num0 ? Tool(9) : Tool(std::uint16_t(key) - std::uint16_t(Key::Num1));
         springStart_ = {};
+        polygonClicks_.clear();
         note(std::string("tool: ") + std::string(toolName(tool)));
         return true;
     }
@@ -420,6 +434,10 @@ void Editor::handleViewportEvent(const InputEvent& e) {
         dragButton_ = e.button;
         const Vec2 world = view.toWorld(px);
         dragStartWorld_ = world;
+        if (e.button == MouseButton::Right && tool == Tool::Polygon && polygonSides == 0 && !polygonClicks_.empty()) {
+            finishPolygon();  // right click ends the outline
+            return;
+        }
         if (e.button != MouseButton::Left) {
             drag_ = Drag::Pan;
             return;
@@ -458,7 +476,7 @@ void Editor::handleViewportEvent(const InputEvent& e) {
             for (Entity s : selection) {
                 if (const Position* p = reg.tryGet<Position>(s)) dragStart_.push_back({s, p->value});
                 if (const Plane* pl = reg.tryGet<Plane>(s)) planeStart_.push_back({s, pl->offset});
-                if (reg.has<Box>(s) || reg.has<Angle>(s)) {
+                if (reg.has<Box>(s) || reg.has<Polygon>(s) || reg.has<Angle>(s)) {
                     const Angle* a = reg.tryGet<Angle>(s);
                     angleStart_.push_back({s, a ? a->value : 0.0});
                 }
@@ -528,6 +546,29 @@ void Editor::handleViewportEvent(const InputEvent& e) {
                 created = addBoid(s, lastBoid_, {1.0, 0.0});
                 return true;
             }, dragKey_);
+            return;
+        }
+        case Tool::Polygon: {
+            const Vec2 at = snapped(world);
+            if (polygonSides >= 3) {
+                drag_ = Drag::RegularPolygon;
+                dragStartWorld_ = at;
+                return;
+            }
+            // A click on the first vertex closes the outline.
+            if (polygonClicks_.size() >= 3 && length(px - view.toPixels(polygonClicks_.front())) <= 8.0) {
+                finishPolygon();
+                return;
+            }
+            std::vector<Vec2> next = polygonClicks_;
+            next.push_back(at);
+            if (convexHull(next).size() > 8) {
+                note("polygon: at most 8 vertices; press Enter to make it");
+                return;
+            }
+            polygonClicks_ = std::move(next);
+            note("polygon: " + std::to_string(polygonClicks_.size()) +
+                 " clicked; click more, then Enter, a right click or the first vertex (Esc cancels)");
             return;
         }
         case Tool::Count: return;
@@ -608,6 +649,21 @@ void Editor::handleViewportEvent(const InputEvent& e) {
             } else {
                 selection = std::move(inside);
             }
+        } else if (finished == Drag::RegularPolygon) {
+            const std::vector<Vec2> outline = regularOutline();
+            if (outline.empty()) {
+                note("polygon: drag out its size from the centre");
+                return;
+            }
+            Entity created;
+            std::string problem;
+            if (applyEdit("place polygon", [&](Scene& s) {
+                    created = addPolygon(s, outline, &problem);
+                    return !created.isNull();
+                }))
+                selection = {created};
+            else if (!problem.empty())
+                note("refused: " + problem);
         } else if (finished == Drag::Plane) {
             const Vec2 world = view.toWorld(px);
             const Vec2 through = snapped(dragStartWorld_);
@@ -677,6 +733,48 @@ void Editor::discardRecovery() {
     std::filesystem::remove(doc.recoveryPath(configDir), ec);
 }
 
+std::vector<Vec2> Editor::polygonPreview() const {
+    if (tool != Tool::Polygon) return {};
+    const Vec2 cursor = snapped(view.toWorld(mouse_));
+    if (polygonSides >= 3) return drag_ == Drag::RegularPolygon ? regularOutline() : std::vector<Vec2>{};
+    if (polygonClicks_.empty()) return {};
+    // The hull with the cursor as the next vertex, unless that breaks the limit.
+    std::vector<Vec2> points = polygonClicks_;
+    points.push_back(cursor);
+    std::vector<Vec2> hull = convexHull(points);
+    if (hull.size() > 8 || hull.size() < 3) hull = convexHull(polygonClicks_);
+    return hull;
+}
+
+std::vector<Vec2> Editor::regularOutline() const {
+    const Vec2 arm = snapped(view.toWorld(mouse_)) - dragStartWorld_;
+    const double radius = length(arm);
+    if (!(radius > 1e-3) || polygonSides < 3) return {};  // a click, not a drag
+    std::vector<Vec2> outline = regularPolygon(polygonSides, radius, std::atan2(arm.y, arm.x));
+    for (Vec2& v : outline) v += dragStartWorld_;
+    return outline;
+}
+
+bool Editor::finishPolygon() {
+    const std::vector<Vec2> hull = convexHull(polygonClicks_);
+    polygonClicks_.clear();
+    std::string problem;
+    Entity created;
+    if (hull.size() < 3) {
+        note("polygon: needs 3 vertices that are not on one line");
+        return false;
+    }
+    if (!applyEdit("place polygon", [&](Scene& s) {
+            created = addPolygon(s, hull, &problem);
+            return !created.isNull();
+        })) {
+        note("refused: " + problem);
+        return false;
+    }
+    selection = {created};
+    return true;
+}
+
 render::FrameInput Editor::frameInput() const {
     render::FrameInput in;
     in.scene = &doc.scene;
@@ -687,6 +785,8 @@ render::FrameInput Editor::frameInput() const {
     in.camera = view.camera;
     in.selection = selection;
     if (!springStart_.isNull()) in.selection.push_back(springStart_);
+    in.polygonPreview = polygonPreview();
+    in.polygonClicks = polygonClicks_;
     in.trails = sim.running() ? &trails : nullptr;
     if (!in.trails) in.overlays.bits &= ~std::uint32_t(render::Overlay::Trails);
     in.hud = true;

@@ -21,7 +21,7 @@
 
 namespace stepwise::editor {
 
-enum class Tool : std::uint8_t { Select, Rotate, Circle, Box, Plane, Spring, Attractor, Boids, Joint, Count };
+enum class Tool : std::uint8_t { Select, Rotate, Circle, Box, Plane, Spring, Attractor, Boids, Joint, Polygon, Count };
 std::string_view toolName(Tool t);
 /// Shortcut key of each tool ("1" .. "8").
 Key toolKey(Tool t);
@@ -111,6 +111,22 @@ public:
     Entity springStart() const { return springStart_; }
     /// Joint tool: the type the next joint gets (one of jointTypeNames()).
     std::string jointType = "hinge";
+
+    // ---- polygon tool ---------------------------------------------------
+    /// 0: click the vertices (their convex hull is the shape; Enter, a
+    /// click on the first vertex or a right click finishes, Esc cancels).
+    /// 3..8: press at the centre of a regular polygon of that many sides and
+    /// drag out its size and turn (vertex 0 follows the mouse).
+    int polygonSides = 0;
+    /// The shape the polygon tool would make now (world metres,
+    /// counter-clockwise), for the viewport's preview; empty when none.
+    std::vector<Vec2> polygonPreview() const;
+    /// The vertices clicked so far (world metres).
+    const std::vector<Vec2>& polygonClicks() const { return polygonClicks_; }
+    /// Makes the body from the clicks (one undo step); false when they do
+    /// not make a valid polygon (the status line says why).
+    bool finishPolygon();
+    void cancelPolygon() { polygonClicks_.clear(); }
     /// Sets the viewport size; the first call (or fitView) frames the scene.
     void setViewportSize(int width, int height);
     void fitView();
@@ -149,8 +165,11 @@ private:
     Vec2 snapped(Vec2 world) const;
     double pickRadius() const;
     void placeAt(Vec2 world);
+    /// The regular polygon the current drag describes (world metres), or
+    /// empty for a drag shorter than a millimetre.
+    std::vector<Vec2> regularOutline() const;
 
-    enum class Drag : std::uint8_t { None, Pan, Move, Rotate, BoxSelect, Plane, Boids, MouseSpring };
+    enum class Drag : std::uint8_t { None, Pan, Move, Rotate, BoxSelect, Plane, Boids, MouseSpring, RegularPolygon };
     Drag drag_ = Drag::None;
     MouseButton dragButton_ = MouseButton::Left;
     Vec2 mouse_, dragStartPx_, dragStartWorld_, lastBoid_;
@@ -161,6 +180,7 @@ private:
     Entity dragPrimary_;
     bool additive_ = false;
     Entity springStart_;
+    std::vector<Vec2> polygonClicks_;  // polygon tool: vertices clicked so far, world metres
     std::uint32_t boidSeed_ = 12345u;
 
     Scene clipboard_;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <type_traits>
 #include <unordered_map>
 #include <unordered_set>
@@ -26,6 +27,9 @@ void copyField(const FieldInfo& field, const void* src, void* dst) {
         break;
     case FieldKind::Color: *static_cast<Rgb*>(to) = *static_cast<const Rgb*>(from); break;
     case FieldKind::Bool: *static_cast<bool*>(to) = *static_cast<const bool*>(from); break;
+    case FieldKind::VectorList:
+        *static_cast<std::vector<Vec2>*>(to) = *static_cast<const std::vector<Vec2>*>(from);
+        break;
     case FieldKind::String: *static_cast<std::string*>(to) = *static_cast<const std::string*>(from); break;
     case FieldKind::EntityRef: *static_cast<Entity*>(to) = *static_cast<const Entity*>(from); break;
     }
@@ -40,6 +44,7 @@ FieldValue readField(const FieldInfo& field, const void* component) {
     case FieldKind::OptionalVector: return *static_cast<const std::optional<Vec2>*>(at);
     case FieldKind::Color: return *static_cast<const Rgb*>(at);
     case FieldKind::Bool: return *static_cast<const bool*>(at);
+    case FieldKind::VectorList: return *static_cast<const std::vector<Vec2>*>(at);
     case FieldKind::String: return *static_cast<const std::string*>(at);
     case FieldKind::EntityRef: return *static_cast<const Entity*>(at);
     }
@@ -60,6 +65,7 @@ void writeField(const FieldInfo& field, void* component, const FieldValue& value
                 (std::is_same_v<V, std::optional<Vec2>> && field.kind == FieldKind::OptionalVector) ||
                 (std::is_same_v<V, Rgb> && field.kind == FieldKind::Color) ||
                 (std::is_same_v<V, bool> && field.kind == FieldKind::Bool) ||
+                (std::is_same_v<V, std::vector<Vec2>> && field.kind == FieldKind::VectorList) ||
                 (std::is_same_v<V, std::string> && field.kind == FieldKind::String) ||
                 (std::is_same_v<V, Entity> && field.kind == FieldKind::EntityRef);
             if (matches) *static_cast<V*>(at) = v;
@@ -79,6 +85,11 @@ std::string checkField(const FieldInfo& field, const FieldValue& value) {
         return isFinite(*v) ? std::string() : std::string(field.key) + ": expected finite numbers";
     if (const auto* ov = std::get_if<std::optional<Vec2>>(&value))
         return !*ov || isFinite(**ov) ? std::string() : std::string(field.key) + ": expected finite numbers";
+    if (const auto* list = std::get_if<std::vector<Vec2>>(&value)) {
+        for (const Vec2& p : *list)
+            if (!isFinite(p)) return std::string(field.key) + ": expected finite numbers";
+        return {};
+    }
     if (const Rgb* c = std::get_if<Rgb>(&value))
         return c->r >= 0 && c->r <= 1 && c->g >= 0 && c->g <= 1 && c->b >= 0 && c->b <= 1
                    ? std::string()
@@ -300,6 +311,17 @@ Entity pick(const Scene& scene, Vec2 world, double pickRadius) {
             const double lx = std::cos(th) * d.x + std::sin(th) * d.y;
             const double ly = -std::sin(th) * d.x + std::cos(th) * d.y;
             if (std::abs(lx) <= 0.5 * b->width && std::abs(ly) <= 0.5 * b->height) return e;
+        } else if (const Polygon* poly = reg.tryGet<Polygon>(e)) {
+            const Angle* a = reg.tryGet<Angle>(e);
+            const double th = a ? a->value : 0.0;
+            const Vec2 local{std::cos(th) * d.x + std::sin(th) * d.y, -std::sin(th) * d.x + std::cos(th) * d.y};
+            // Inside a counter-clockwise convex outline: left of every edge.
+            bool inside = poly->vertices.size() >= 3;
+            for (std::size_t i = 0; inside && i < poly->vertices.size(); ++i) {
+                const Vec2 v0 = poly->vertices[i], v1 = poly->vertices[(i + 1) % poly->vertices.size()];
+                inside = cross(v1 - v0, local - v0) >= 0.0;
+            }
+            if (inside) return e;
         } else if (length(d) <= pickRadius) {
             return e;
         }
@@ -430,6 +452,58 @@ Entity addCircle(Scene& scene, Vec2 at, double radius) {
     return e;
 }
 
+std::vector<Vec2> convexHull(std::vector<Vec2> points) {
+    // Andrew's monotone chain: sort by x then y, build the lower and upper
+    // chains, dropping points that do not turn left (so collinear and
+    // repeated points vanish). Counter-clockwise from the leftmost point.
+    std::sort(points.begin(), points.end(), [](Vec2 a, Vec2 b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
+    points.erase(std::unique(points.begin(), points.end()), points.end());
+    if (points.size() < 3) return points;
+    std::vector<Vec2> hull(2 * points.size());
+    std::size_t k = 0;
+    for (const Vec2 p : points) {
+        while (k >= 2 && cross(hull[k - 1] - hull[k - 2], p - hull[k - 2]) <= 0.0) --k;
+        hull[k++] = p;
+    }
+    for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
+        const Vec2 p = points[i];
+        while (k >= lower && cross(hull[k - 1] - hull[k - 2], p - hull[k - 2]) <= 0.0) --k;
+        hull[k++] = p;
+    }
+    hull.resize(k - 1);  // the last point repeats the first
+    return hull;
+}
+
+std::vector<Vec2> regularPolygon(int sides, double radius, double angle) {
+    std::vector<Vec2> v;
+    for (int i = 0; i < sides; ++i) {
+        const double a = angle + 2.0 * std::numbers::pi * double(i) / double(sides);
+        v.push_back({radius * std::cos(a), radius * std::sin(a)});
+    }
+    return v;
+}
+
+Entity addPolygon(Scene& scene, const std::vector<Vec2>& worldVertices, std::string* problem) {
+    // The position is the centroid, so the centre of mass is the position
+    // and the outline is stored about it.
+    if (std::string why = polygonProblem(worldVertices); !why.empty()) {
+        if (problem) *problem = "polygon" + why.substr(why.find(':'));
+        return {};
+    }
+    const Vec2 centroid = polygonMassProperties(worldVertices).centroid;
+    Polygon poly;
+    poly.vertices.clear();
+    for (const Vec2 v : worldVertices) poly.vertices.push_back(v - centroid);
+    if (std::string why = polygonProblem(poly.vertices); !why.empty()) {  // rounding can merge tiny edges
+        if (problem) *problem = "polygon" + why.substr(why.find(':'));
+        return {};
+    }
+    const Entity e = newBody(scene, "polygon", centroid, Rgb{0.62, 0.55, 0.95});
+    scene.registry.emplace(e, std::move(poly));
+    scene.registry.emplace(e, Angle{0.0});
+    return e;
+}
+
 Entity addBox(Scene& scene, Vec2 at, double width, double height) {
     const Entity e = newBody(scene, "box", at, Rgb{0.95, 0.6, 0.3});
     scene.registry.emplace(e, Box{width, height});
@@ -552,6 +626,8 @@ bool entityBounds(const Registry& registry, Entity e, Vec2& lo, Vec2& hi) {
         // Circumscribed: enough for box select and framing.
         rx = ry = 0.5 * std::hypot(b->width, b->height);
     }
+    if (const Polygon* poly = registry.tryGet<Polygon>(e))
+        for (const Vec2 v : poly->vertices) rx = ry = std::max(rx, length(v));  // any angle
     lo = {p->value.x - rx, p->value.y - ry};
     hi = {p->value.x + rx, p->value.y + ry};
     return true;

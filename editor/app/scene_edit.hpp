@@ -29,7 +29,8 @@ void copyField(const FieldInfo& field, const void* src, void* dst);
 void copyEntity(const Registry& src, Entity from, Registry& dst, Entity to);
 
 /// A field's value, by kind (FieldKind -> alternative).
-using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string, Entity>;
+using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string, Entity,
+                                std::vector<Vec2>>;
 FieldValue readField(const FieldInfo& field, const void* component);
 void writeField(const FieldInfo& field, void* component, const FieldValue& value);
 /// "" when `value` is acceptable for `field` (finite, in range), else why not.
@@ -120,6 +121,16 @@ std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>
 
 /// Palette builders: each returns the new entity. Names are unique.
 Entity addCircle(Scene& scene, Vec2 at, double radius = 0.5);
+/// Convex hull of `points`, counter-clockwise, without repeated or
+/// collinear points (fewer than 3 when they all lie on one line).
+std::vector<Vec2> convexHull(std::vector<Vec2> points);
+/// Vertices of a regular polygon about the origin: vertex 0 at `angle` rad,
+/// `radius` metres from the centre.
+std::vector<Vec2> regularPolygon(int sides, double radius, double angle);
+/// A dynamic polygon body from world-space vertices (convex,
+/// counter-clockwise), positioned at their centroid. Null, with `problem`
+/// set, when polygonProblem() refuses them.
+Entity addPolygon(Scene& scene, const std::vector<Vec2>& worldVertices, std::string* problem = nullptr);
 Entity addBox(Scene& scene, Vec2 at, double width = 1.0, double height = 1.0);
 /// A wall through `through` with the given normal (normalised here).
 Entity addPlane(Scene& scene, Vec2 through, Vec2 normal);

@@ -350,7 +350,7 @@ int runScripted(const EditOptions& o, int width, int height) {
             else if (a == "savestate") ed.saveStateAs(args[0]);
             else if (a == "tool") {
                 bool found = false;
-                static const char* names[] = {"select", "rotate", "circle", "box", "plane", "spring", "attractor", "boids", "joint"};
+                static const char* names[] = {"select", "rotate", "circle", "box", "plane", "spring", "attractor", "boids", "joint", "polygon"};
                 static_assert(std::size(names) == std::size_t(editor::Tool::Count), "a name per tool");
                 for (int t = 0; t < int(editor::Tool::Count); ++t)
                     if (args[0] == names[t]) {

@@ -50,6 +50,7 @@ constexpr Rgba kJointTick = rgb(0xfbd38d);
 constexpr Rgba kJointForce = rgb(0x9ae6b4);
 constexpr double kPiD = 3.14159265358979323846;
 constexpr Rgba kAabb = rgb(0x68d391, 0.75f);
+constexpr Rgba kSelectionRing = rgb(0xffd166);  // the shaders' uHighlight (renderer.cpp)
 constexpr Rgba kAabbCell = rgb(0x68d391, 0.06f);
 constexpr Rgba kText = rgb(0xd5dde8);
 constexpr Rgba kTextDim = rgb(0x8190a5);
@@ -123,13 +124,27 @@ struct Bounds {
     }
 };
 
-/// Half extents of the axis-aligned box around a shape, metres.
-std::optional<Vec2> shapeHalfExtents(const Scene& scene, Entity e) {
-    if (const Radius* r = scene.registry.tryGet<Radius>(e)) return Vec2{r->value, r->value};
+/// The axis-aligned box around an entity's shape, metres: its centre and
+/// half extents (the centre is the position except for a polygon, whose
+/// outline need not be centred on it).
+struct ShapeBox {
+    Vec2 centre, half;
+};
+std::optional<ShapeBox> shapeBox(const Scene& scene, Entity e) {
+    const Position* p = scene.registry.tryGet<Position>(e);
+    if (!p) return std::nullopt;
+    if (const Radius* r = scene.registry.tryGet<Radius>(e)) return ShapeBox{p->value, Vec2{r->value, r->value}};
+    const Angle* a = scene.registry.tryGet<Angle>(e);
+    const double angle = a ? a->value : 0.0;
     if (const Box* b = scene.registry.tryGet<Box>(e)) {
-        const Angle* a = scene.registry.tryGet<Angle>(e);
-        const double c = std::abs(std::cos(a ? a->value : 0.0)), s = std::abs(std::sin(a ? a->value : 0.0));
-        return Vec2{0.5 * (c * b->width + s * b->height), 0.5 * (s * b->width + c * b->height)};
+        const double c = std::abs(std::cos(angle)), s = std::abs(std::sin(angle));
+        return ShapeBox{p->value, Vec2{0.5 * (c * b->width + s * b->height), 0.5 * (s * b->width + c * b->height)}};
+    }
+    if (const Polygon* poly = scene.registry.tryGet<Polygon>(e); poly && !poly->vertices.empty()) {
+        const double c = std::cos(angle), s = std::sin(angle);
+        Bounds bounds;
+        for (const Vec2 v : poly->vertices) bounds.add(p->value + Vec2{c * v.x - s * v.y, s * v.x + c * v.y});
+        return ShapeBox{0.5 * (bounds.lo + bounds.hi), 0.5 * (bounds.hi - bounds.lo)};
     }
     return std::nullopt;
 }
@@ -212,6 +227,52 @@ private:
         const bool plain = (int(flags) & int(kSelected + kStatic)) == 0 && (int(flags) & int(kFlat + kOutline)) != 0;
         push(batch(BatchKind::Box, plain), {c.x, c.y, half.x, half.y, angle, col.r, col.g, col.b, col.a, flags, rounding});
     }
+    /// A polygon body: the fill as a triangle fan, shaded like box.frag
+    /// shades boxes (a light from the upper left, darker when static), with
+    /// a lighter rim, and the selection ring 3.5 px outside the outline.
+    void polygon(const Polygon& poly, Vec2 position, double angle, Rgba col, bool selected, bool isStatic) {
+        const double c = std::cos(angle), s = std::sin(angle);
+        std::vector<Vec2> px;
+        Bounds box;
+        for (const Vec2 v : poly.vertices) {
+            px.push_back(toPx(position + Vec2{c * v.x - s * v.y, s * v.x + c * v.y}));
+            box.add(px.back());
+        }
+        if (!segmentVisible(box.lo, box.hi, 8)) return;
+        Vec2 centre;
+        for (const Vec2 q : px) centre += q;
+        centre = centre / double(px.size());
+        const double shade = isStatic ? 0.72 : 0.9;  // static bodies darker (boxes hatch them)
+        const Rgba fill{float(col.r * shade), float(col.g * shade), float(col.b * shade), col.a};
+        auto& tri = batch(BatchKind::Solid);
+        for (std::size_t i = 0; i < px.size(); ++i) {
+            const Vec2 q0 = px[i], q1 = px[(i + 1) % px.size()];
+            // Each fan triangle's colour leans with its edge's facing, so
+            // the body reads as a solid lit from the upper left.
+            const Vec2 mid = 0.5 * (q0 + q1) - centre;
+            const double len = std::max(length(mid), 1e-9);
+            const double lit = 1.0 + 0.08 * dot(mid / len, Vec2{-0.45, 0.6});
+            const Rgba f{float(fill.r * lit), float(fill.g * lit), float(fill.b * lit), fill.a};
+            for (const Vec2 q : {centre, q0, q1}) push(tri, {q.x, q.y, f.r, f.g, f.b, f.a});
+        }
+        const Rgba rim{float(col.r + (1.0 - col.r) * 0.4), float(col.g + (1.0 - col.g) * 0.4),
+                       float(col.b + (1.0 - col.b) * 0.4), col.a};
+        for (std::size_t i = 0; i < px.size(); ++i) segment(px[i], px[(i + 1) % px.size()], 1.6, rim);
+        if (selected) {
+            // The ring: each edge pushed out 3.5 px along its normal, the
+            // corners joined by their own short segments.
+            for (std::size_t i = 0; i < px.size(); ++i) {
+                const Vec2 q0 = px[i], q1 = px[(i + 1) % px.size()], edge = q1 - q0;
+                const double len = length(edge);
+                if (!(len > 0.0)) continue;
+                const Vec2 out = Vec2{edge.y, -edge.x} / len * 3.5;
+                segment(q0 + out, q1 + out, 2.0, kSelectionRing);
+                const Vec2 q2 = px[(i + 2) % px.size()], next = q2 - q1;
+                const double nextLen = length(next);
+                if (nextLen > 0.0) segment(q1 + out, q1 + Vec2{next.y, -next.x} / nextLen * 3.5, 2.0, kSelectionRing);
+            }
+        }
+    }
     void segment(Vec2 a, Vec2 b, double width, Rgba col) {
         if (!segmentVisible(a, b, width + 2)) return;
         push(batch(BatchKind::Segment), {a.x, a.y, b.x, b.y, width, col.r, col.g, col.b, col.a});
@@ -251,6 +312,7 @@ private:
     void bodies();
     void joints();
     void jointForces();
+    void polygonPreview();
     void aabbOutlines();
     void bodyArrows();
     void contacts();
@@ -358,6 +420,7 @@ void Builder::build() {
     layer(&Builder::bodies);
     layer(&Builder::joints);
     if (in_.overlays.has(Overlay::Joints)) layer(&Builder::jointForces);
+    if (!in_.polygonPreview.empty() || !in_.polygonClicks.empty()) layer(&Builder::polygonPreview);
     if (in_.overlays.has(Overlay::Aabb)) layer(&Builder::aabbOutlines);
     layer(&Builder::bodyArrows);
     if (in_.overlays.has(Overlay::Contacts)) layer(&Builder::contacts);
@@ -421,11 +484,10 @@ void Builder::aabbCells() {
     std::vector<std::pair<Vec2, Vec2>> boxes;  // centre, half extents (metres)
     std::vector<double> extents;
     for (Entity e : scene_.registry.entities()) {
-        const Position* p = scene_.registry.tryGet<Position>(e);
-        auto half = shapeHalfExtents(scene_, e);
-        if (!p || !half) continue;
-        boxes.emplace_back(p->value, *half);
-        extents.push_back(2.0 * std::max(half->x, half->y));
+        const auto shape = shapeBox(scene_, e);
+        if (!shape) continue;
+        boxes.emplace_back(shape->centre, shape->half);
+        extents.push_back(2.0 * std::max(shape->half.x, shape->half.y));
     }
     if (boxes.empty()) return;
     const double cell = niceCeil(2.0 * autoReference(extents));
@@ -660,7 +722,16 @@ void Builder::springs() {
 }
 
 void Builder::bodies() {
-    // Boxes first, then discs: each kind is one instanced batch.
+    // Polygons first (filled triangles, then their outlines), then boxes,
+    // then discs: each kind is one batch.
+    for (Entity e : scene_.registry.entities()) {
+        const Polygon* poly = scene_.registry.tryGet<Polygon>(e);
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!poly || !p || poly->vertices.size() < 3) continue;
+        const Angle* a = scene_.registry.tryGet<Angle>(e);
+        polygon(*poly, p->value, a ? a->value : 0.0, colourOf(scene_, e, kDefaultBody), selected_.count(e) != 0,
+                isStatic(scene_, e));
+    }
     for (Entity e : scene_.registry.entities()) {
         const Box* b = scene_.registry.tryGet<Box>(e);
         const Position* p = scene_.registry.tryGet<Position>(e);
@@ -675,7 +746,8 @@ void Builder::bodies() {
     }
     for (Entity e : scene_.registry.entities()) {
         const Position* p = scene_.registry.tryGet<Position>(e);
-        if (!p || scene_.registry.has<Box>(e) || scene_.registry.has<Spring>(e)) continue;
+        if (!p || scene_.registry.has<Box>(e) || scene_.registry.has<Polygon>(e) || scene_.registry.has<Spring>(e))
+            continue;
         const Radius* r = scene_.registry.tryGet<Radius>(e);
         const Angle* a = scene_.registry.tryGet<Angle>(e);
         float flags = 0;
@@ -788,12 +860,32 @@ void Builder::jointForces() {
     legend_.push_back({"joint force on a", kJointForce, ref, "N"});
 }
 
+void Builder::polygonPreview() {
+    // The polygon tool's shape-to-be: a translucent fill, the outline in the
+    // selection colour, and a dot on each clicked vertex.
+    const std::vector<Vec2>& outline = in_.polygonPreview;
+    if (outline.size() >= 3) {
+        std::vector<Vec2> px;
+        Vec2 centre;
+        for (const Vec2 v : outline) {
+            px.push_back(toPx(v));
+            centre += px.back();
+        }
+        centre = centre / double(px.size());
+        auto& tri = batch(BatchKind::Solid);
+        const Rgba fill{kSelectionRing.r, kSelectionRing.g, kSelectionRing.b, 0.18f};
+        for (std::size_t i = 0; i < px.size(); ++i)
+            for (const Vec2 q : {centre, px[i], px[(i + 1) % px.size()]}) push(tri, {q.x, q.y, fill.r, fill.g, fill.b, fill.a});
+        for (std::size_t i = 0; i < px.size(); ++i) segment(px[i], px[(i + 1) % px.size()], 1.5, kSelectionRing);
+    }
+    for (const Vec2 v : in_.polygonClicks) disc(toPx(v), 3.5, 0.0, kSelectionRing, kFlat);
+}
+
 void Builder::aabbOutlines() {
     for (Entity e : scene_.registry.entities()) {
-        const Position* p = scene_.registry.tryGet<Position>(e);
-        auto half = shapeHalfExtents(scene_, e);
-        if (!p || !half) continue;
-        box(toPx(p->value), *half * ppm_, 0.0, kAabb, kOutline);
+        const auto shape = shapeBox(scene_, e);
+        if (!shape) continue;
+        box(toPx(shape->centre), shape->half * ppm_, 0.0, kAabb, kOutline);
     }
 }
 
@@ -1005,9 +1097,9 @@ Camera fitCamera(const Scene& scene, int widthPx, int heightPx) {
     for (Entity e : reg.entities()) {
         if (const Position* p = reg.tryGet<Position>(e)) {
             if (reg.has<Spring>(e)) continue;
-            if (auto half = shapeHalfExtents(scene, e)) {
-                b.add(p->value - *half);
-                b.add(p->value + *half);
+            if (const auto shape = shapeBox(scene, e)) {
+                b.add(shape->centre - shape->half);
+                b.add(shape->centre + shape->half);
             } else {
                 b.add(p->value, 0.25);
             }

@@ -114,6 +114,9 @@ struct FrameInput {
     ArrowScales scales;                    ///< 0 entries are chosen per frame
     std::string caption;                   ///< top-left text ("" for none)
     bool hud = true;                       ///< scale bar, legend, caption
+    /// The editor's polygon tool: the outline it would make (world metres,
+    /// counter-clockwise) and the vertices clicked so far. Empty: none.
+    std::vector<Vec2> polygonPreview, polygonClicks;
 };
 
 /// Instance batches, each drawn with one call. Floats, pixel coordinates

@@ -52,11 +52,12 @@ const Shortcut kShortcuts[] = {
     {"Ctrl+D", "Duplicate the selection"},
     {"Ctrl+C / Ctrl+V", "Copy / paste"},
     {"Ctrl+A", "Select all"},
-    {"Esc", "Clear the selection, cancel a spring"},
+    {"Esc", "Clear the selection, cancel a spring or a polygon"},
+    {"Enter", "Polygon tool: make the clicked outline (or right click)"},
     {"Ctrl+S / Ctrl+Shift+S", "Save / save as"},
     {"Ctrl+O / Ctrl+N", "Open / new level"},
     {"Ctrl+Q", "Quit (asks about unsaved changes)"},
-    {"1 .. 9", "Tools: select, rotate, circle, box, wall, spring, attractor, boid brush, joint"},
+    {"1 .. 9, 0", "Tools: select, rotate, circle, box, wall, spring, attractor, boid brush, joint, polygon"},
     {"G", "Snap to grid on / off"},
     {"F", "Frame the whole level"},
     {"F1", "This help"},
@@ -277,7 +278,23 @@ void toolsPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                 ed.tool = tool;
             }
             if (active) ImGui::PopStyleColor();
-            if (t % 2 == 0) ImGui::SameLine();
+            if (t % 2 == 0 && t + 1 < int(Tool::Count)) ImGui::SameLine();
+        }
+        if (ed.tool == Tool::Polygon) {
+            // Click the vertices (their convex hull), or drag a regular n-gon.
+            static const char* kShapes[] = {"click vertices", "", "", "triangle", "square", "pentagon",
+                                            "hexagon", "heptagon", "octagon"};
+            ImGui::SetNextItemWidth(-1);
+            if (ImGui::BeginCombo("##polygon", kShapes[ed.polygonSides])) {
+                for (int n : {0, 3, 4, 5, 6, 7, 8})
+                    if (ImGui::Selectable(kShapes[n], ed.polygonSides == n)) {
+                        ed.polygonSides = n;
+                        ed.cancelPolygon();
+                    }
+                ImGui::EndCombo();
+            }
+            ImGui::TextColored(kDim, ed.polygonSides == 0 ? "Click vertices; Enter or right click ends"
+                                                          : "Drag from the centre out to a vertex");
         }
         ImGui::Separator();
         ImGui::Checkbox("Snap (G)", &ed.snap);

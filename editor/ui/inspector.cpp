@@ -93,6 +93,25 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
         return true;
     }
     case FieldKind::Bool: return ImGui::Checkbox(label, &std::get<bool>(value));
+    case FieldKind::VectorList: {
+        // One row per vertex, grouped so the whole list is one item (one
+        // undo step per drag). The component's check refuses an edit that
+        // would make the list invalid (a dent in a polygon).
+        auto& list = std::get<std::vector<Vec2>>(value);
+        bool changed = false;
+        ImGui::BeginGroup();
+        ImGui::TextUnformatted(label);
+        for (std::size_t i = 0; i < list.size(); ++i) {
+            double xy[2] = {list[i].x, list[i].y};
+            const std::string row = std::to_string(i);
+            if (ImGui::DragScalarN(row.c_str(), ImGuiDataType_Double, xy, 2, 0.01f, nullptr, nullptr, "%.5g")) {
+                list[i] = {xy[0], xy[1]};
+                changed = true;
+            }
+        }
+        ImGui::EndGroup();
+        return changed;
+    }
     case FieldKind::String:
         if (!f.choices.empty()) {
             // A fixed set of names (a joint's type): a combo, never a typo.
@@ -148,7 +167,7 @@ void drawInspector(UiState& ui, Editor& ed) {
     if (ed.selection.empty()) {
         ImGui::TextColored(kDim, "Nothing selected.");
         ImGui::TextWrapped("Click a body in the viewport or the entity list; shift-click or drag a box for several. "
-                           "Place new ones with the tools (1-9).");
+                           "Place new ones with the tools (1-9, 0).");
         ImGui::End();
         return;
     }

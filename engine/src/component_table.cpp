@@ -46,6 +46,7 @@ constexpr FieldKind kindOf() {
     else if constexpr (std::is_same_v<M, Rgb>) return FieldKind::Color;
     else if constexpr (std::is_same_v<M, bool>) return FieldKind::Bool;
     else if constexpr (std::is_same_v<M, Entity>) return FieldKind::EntityRef;
+    else if constexpr (std::is_same_v<M, std::vector<Vec2>>) return FieldKind::VectorList;
     else {
         static_assert(std::is_same_v<M, std::string>, "unsupported field type");
         return FieldKind::String;
@@ -120,6 +121,13 @@ std::string finishVelocity(void* component) {
     return {};
 }
 
+std::string finishPolygon(void* component) {
+    const std::string problem = polygonProblem(static_cast<Polygon*>(component)->vertices);
+    if (problem.empty()) return {};
+    // polygonProblem says "INDEX: why" or ": why"; the field is "vertices".
+    return problem[0] == ':' ? "vertices" + problem : "vertices/" + problem;
+}
+
 std::string finishSpring(void* component) {
     auto& spring = *static_cast<Spring*>(component);
     if (spring.a.isNull()) return "a: expected the name of an entity, got nothing";
@@ -176,6 +184,16 @@ std::vector<ComponentInfo> buildTable() {
     t.push_back(row<Box>("box", "box shape, rotated by angle; the body collides", false, needsPosition,
                          {field<&Box::width>("width", kPositive, "m", "full width"),
                           field<&Box::height>("height", kPositive, "m", "full height")}));
+    {
+        ComponentInfo polygon = row<Polygon>(
+            "polygon", "convex polygon shape, rotated by angle about position; the body collides", false,
+            needsPosition,
+            {field<&Polygon::vertices>("vertices", NumberRange{3.0, 8.0}, "m",
+                                       "3 to 8 vertices relative to position, counter-clockwise, convex")},
+            &finishPolygon);
+        polygon.finishNamesEntity = true;
+        t.push_back(std::move(polygon));
+    }
     t.push_back(row<Angle>("angle", "orientation, counter-clockwise", true, needsPosition,
                            {field<&Angle::value>("", kAny, "rad", "orientation")}));
     t.push_back(row<AngularVelocity>("angular_velocity", "spin, counter-clockwise", true, needsPosition,

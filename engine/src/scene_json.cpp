@@ -163,6 +163,15 @@ void readField(const FieldInfo& field, const Json& v, void* component, const std
         break;
     case FieldKind::Color: *static_cast<Rgb*>(member) = readColor(v, pointer, field.range); break;
     case FieldKind::Bool: *static_cast<bool*>(member) = readBool(v, pointer); break;
+    case FieldKind::VectorList: {
+        // The count (field.range) is checked by the component's finish, whose
+        // message names the entity.
+        if (!v.is_array()) refuse(pointer, "expected an array of vectors, got " + describeFound(v));
+        auto& list = *static_cast<std::vector<Vec2>*>(member);
+        list.clear();
+        for (std::size_t i = 0; i < v.size(); ++i) list.push_back(readVector(v[i], child(pointer, i)));
+        break;
+    }
     case FieldKind::String: *static_cast<std::string*>(member) = readString(v, pointer); break;
     case FieldKind::EntityRef: {
         // Resolved here, once: in memory the field is a handle.
@@ -213,6 +222,11 @@ Json fieldJson(const FieldInfo& field, const void* component, const Registry& re
         return j;
     }
     case FieldKind::Bool: return *static_cast<const bool*>(member);
+    case FieldKind::VectorList: {
+        Json list = Json::array();
+        for (const Vec2 p : *static_cast<const std::vector<Vec2>*>(member)) list.push_back(vectorJson(p));
+        return list;
+    }
     case FieldKind::String: return *static_cast<const std::string*>(member);
     case FieldKind::EntityRef: {
         // The end's name now (checkSceneRelations refuses an unnamed or
@@ -235,7 +249,7 @@ std::string entityLabel(std::size_t index, const Json& entity) {
 }
 
 void readComponent(const ComponentInfo& info, const Json& value, Registry& registry, Entity e,
-                   const std::string& pointer, const EntityNames& names) {
+                   const std::string& pointer, const EntityNames& names, const std::string& entity) {
     void* component = info.emplaceDefault(registry, e);
     if (info.inlineValue) {
         readField(info.fields.front(), value, component, pointer, names);
@@ -263,8 +277,14 @@ void readComponent(const ComponentInfo& info, const Json& value, Registry& regis
         const std::string problem = info.finish(component);
         if (!problem.empty()) {
             const auto colon = problem.find(':');
-            const std::string where = problem.substr(0, colon);
-            refuse(where.empty() ? pointer : child(pointer, where), problem.substr(colon + 2));
+            // WHERE may go deeper than one field ("vertices/3").
+            std::string at = pointer;
+            for (std::size_t from = 0; from < colon;) {
+                const std::size_t slash = std::min(problem.find('/', from), colon);
+                at = child(at, problem.substr(from, slash - from));
+                from = slash + 1;
+            }
+            refuse(at, (info.finishNamesEntity ? entity + ": " : std::string()) + problem.substr(colon + 2));
         }
     }
 }
@@ -281,7 +301,7 @@ void readEntity(const Json& entityJson, std::size_t index, Registry& registry, E
             if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
             refuse(child(pointer, key), message + " Known components: " + joinNames(known));
         }
-        readComponent(*info, value, registry, e, child(pointer, key), names);
+        readComponent(*info, value, registry, e, child(pointer, key), names, entityLabel(index, entityJson));
     }
     for (const ComponentInfo& info : componentTable()) {
         if (!info.has(registry, e)) continue;
@@ -563,9 +583,10 @@ std::string checkSceneRelations(const Scene& scene) {
     }
     for (std::size_t i = 0; i < entities.size(); ++i) {
         const Entity e = entities[i];
-        const int shapes = int(registry.has<Radius>(e)) + int(registry.has<Box>(e)) + int(registry.has<Plane>(e));
+        const int shapes = int(registry.has<Radius>(e)) + int(registry.has<Box>(e)) + int(registry.has<Polygon>(e)) +
+                           int(registry.has<Plane>(e));
         if (shapes > 1)
-            return child("/entities", i) + ": an entity has at most one shape (radius, box or plane), got " +
+            return child("/entities", i) + ": an entity has at most one shape (radius, box, polygon or plane), got " +
                    std::to_string(shapes);
         if (registry.has<Plane>(e) && registry.has<Position>(e))
             return child("/entities", i) + "/position: a plane is placed by its normal and offset, not a position";

@@ -44,6 +44,11 @@ Json fieldSchema(const FieldInfo& f) {
         }
         break;
     case FieldKind::EntityRef: j = Json{{"type", "string"}, {"minLength", 1}}; break;
+    case FieldKind::VectorList:
+        j = Json{{"type", "array"}, {"items", ref("vector")}};
+        if (std::isfinite(f.range.min)) j["minItems"] = int(f.range.min);
+        if (std::isfinite(f.range.max)) j["maxItems"] = int(f.range.max);
+        break;
     }
     if (!f.description.empty()) j["description"] = f.description;
     return j;

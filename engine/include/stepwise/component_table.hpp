@@ -32,6 +32,8 @@ enum class FieldKind {
     /// entity exists, and the saver writes the current name, so a rename
     /// never breaks the reference.
     EntityRef,
+    /// std::vector<Vec2>, JSON [{"x","y"}, ...]; `range` bounds the count
+    VectorList,
 };
 
 /// Inclusive/exclusive bounds for Number fields. Every number must also be
@@ -80,6 +82,10 @@ struct ComponentInfo {
     /// Cross-field check and normalisation after the fields are read.
     /// Returns "" when fine, else "FIELD: message" (FIELD may be empty).
     std::string (*finish)(void* component) = nullptr;
+    /// The loader's message for a `finish` refusal also names the entity
+    /// ("entity 3 (\"wedge\"): ..."): for shapes, whose problems are about
+    /// the body as a whole.
+    bool finishNamesEntity = false;
 };
 
 /// The table, in the order components are written to files.

@@ -16,6 +16,7 @@
 #include <span>
 #include <string_view>
 #include <string>
+#include <vector>
 
 namespace stepwise {
 
@@ -35,6 +36,32 @@ struct Static { bool value = true; };
 struct Radius { double value = 0.5; };
 /// Box shape, full width and height in metres (> 0), rotated by `Angle`.
 struct Box { double width = 1.0; double height = 1.0; };
+/// Convex polygon shape: 3 to 8 vertices in metres relative to `Position`,
+/// counter-clockwise, rotated by `Angle` about `Position`. Mass is spread
+/// evenly, so the centre of mass is the polygon's centroid, which need not be
+/// `Position`; `Velocity` is the centre of mass's. The loader refuses
+/// non-convex, clockwise and degenerate lists (polygonProblem() says why).
+struct Polygon {
+    /// Default: a triangle whose centroid is its position (exact binary
+    /// fractions, so it round-trips as written).
+    std::vector<Vec2> vertices{{-0.5, -0.25}, {0.5, -0.25}, {0.0, 0.5}};
+};
+
+/// "" when `vertices` is a valid polygon shape, else why not, as
+/// "INDEX: message" (INDEX the offending vertex, or empty for the whole
+/// list). The loader, the world and the editor all ask this one function.
+std::string polygonProblem(const std::vector<Vec2>& vertices);
+
+/// Area (m^2), centroid (metres, in the vertices' frame) and the second
+/// moment of area about the centroid (m^4) of a valid polygon. Moment of
+/// inertia for mass m is m * secondMoment / area.
+struct PolygonMassProperties {
+    double area = 0.0;
+    Vec2 centroid;
+    double secondMoment = 0.0;
+};
+PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& vertices);
+
 /// Orientation, radians, counter-clockwise.
 struct Angle { double value = 0.0; };
 /// Angular velocity, rad/s, counter-clockwise.

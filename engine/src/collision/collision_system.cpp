@@ -25,13 +25,40 @@ double momentOfInertia(const Shape& shape, double mass) {
         return mass * (w * w + h * h) / 12.0;
     }
     case ShapeKind::Plane: return 0.0;
+    case ShapeKind::Polygon: {
+        // Fan of triangles (0, vi, vi+1) about the centre of mass (the
+        // origin of the outline): each has area cross(vi, vi+1)/2 and polar
+        // second moment area/6 (vi.vi + vi.vi+1 + vi+1.vi+1); I = m J / A.
+        const ConvexPolygon& p = *shape.polygon;
+        double area = 0.0, polar = 0.0;
+        for (int i = 0; i < p.count; ++i) {
+            const Vec2 a = p.vertices[i], b = p.vertices[(i + 1) % p.count];
+            const double triangle = 0.5 * cross(a, b);
+            area += triangle;
+            polar += triangle / 6.0 * (dot(a, a) + dot(a, b) + dot(b, b));
+        }
+        return mass * polar / area;
+    }
     }
     return 0.0;
+}
+
+Vec2 CollisionSystem::centreOfMass(std::size_t i, std::span<const Vec2> x) const {
+    const Collider& c = colliders_[i];
+    const Vec2 p = c.body >= 0 ? x[std::size_t(c.body)] : c.staticPosition;
+    // Bodies whose centre of mass is their position take it as it is, bit
+    // for bit (no + 0 that would turn -0 into +0).
+    if (c.centreOfMass.x == 0.0 && c.centreOfMass.y == 0.0) return p;
+    return p + rotate(Rot::fromAngle(angles_[i]), c.centreOfMass);
 }
 
 void CollisionSystem::add(const Collider& c, double angle, double angularVelocity) {
     const std::uint32_t index = std::uint32_t(colliders_.size());
     colliders_.push_back(c);
+    if (c.shape.kind == ShapeKind::Polygon) {
+        polygons_.push_back(*c.shape.polygon);
+        colliders_.back().shape.polygon = &polygons_.back();
+    }
     const bool dynamic = c.body >= 0 && c.mass > 0.0;
     angles_.push_back(angle);
     angularVelocities_.push_back(dynamic ? angularVelocity : 0.0);
@@ -39,9 +66,11 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     const double inertia = !dynamic ? 0.0 : c.solverOnly ? c.inertia : momentOfInertia(c.shape, c.mass);
     colliders_.back().inertia = inertia;
     invInertia_.push_back(inertia > 0.0 ? 1.0 / inertia : 0.0);
-    maxExtent_.push_back(c.solverOnly ? 0.0
-                         : c.shape.kind == ShapeKind::Circle ? c.shape.radius
-                                                             : length(c.shape.halfExtents));
+    maxExtent_.push_back(c.solverOnly                          ? 0.0
+                         : c.shape.kind == ShapeKind::Circle    ? c.shape.radius
+                         : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius
+                                                              : length(c.shape.halfExtents));
+    if (dynamic && (c.centreOfMass.x != 0.0 || c.centreOfMass.y != 0.0)) offsetBodies_.push_back(index);
     if (c.solverOnly) {
         // in the solver only: no broad phase, no narrow phase
     } else if (c.shape.kind == ShapeKind::Plane) {
@@ -143,7 +172,7 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
     stepStartAngle_.assign(angles_.begin(), angles_.end());
     for (std::size_t i = 0; i < n; ++i) {
         const Collider& c = colliders_[i];
-        centres_[i] = c.body >= 0 ? x[std::size_t(c.body)] : c.staticPosition;
+        centres_[i] = centreOfMass(i, x);
         stepStart_[i] = centres_[i];
         // Speculative margin: how far any point of the shape can travel this
         // step, so a contact exists before a fast body reaches a surface.
@@ -258,6 +287,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
     }
 
+    offsetAngleBefore_.resize(offsetBodies_.size());
+    for (std::size_t k = 0; k < offsetBodies_.size(); ++k) offsetAngleBefore_[k] = angles_[offsetBodies_[k]];
     // Positions: the integrator moved x with the unconstrained velocity; add
     // the contact velocity change over the substep. Angles integrate here
     // (only contacts make torque).
@@ -270,6 +301,17 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         angles_[i] += h * b.w;
         b.dp = x[body] - stepStart_[i];
         b.dq = Rot::fromAngle(angles_[i] - stepStartAngle_[i]);
+    }
+    // A body turning about a centre of mass off its position moves its
+    // position: p = c - R(angle) offset, with the centre c moved as above.
+    for (std::size_t k = 0; k < offsetBodies_.size(); ++k) {
+        const std::uint32_t i = offsetBodies_[k];
+        const Collider& c = colliders_[i];
+        SolverBody& b = bodies_[solverIndex_[i]];
+        const std::size_t body = std::size_t(c.body);
+        x[body] -= rotate(Rot::fromAngle(angles_[i]), c.centreOfMass) -
+                   rotate(Rot::fromAngle(offsetAngleBefore_[k]), c.centreOfMass);
+        b.dp = centreOfMass(i, std::span<const Vec2>(x.data(), x.size())) - stepStart_[i];
     }
     for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse) {
         if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, false);

@@ -15,6 +15,7 @@
 #include "stepwise/world.hpp"
 
 #include <cstdint>
+#include <deque>
 #include <span>
 #include <vector>
 
@@ -35,6 +36,12 @@ struct Collider {
     /// Moment of inertia about the centre, kg m^2: given for solverOnly
     /// bodies, set by add() from the shape for the others.
     double inertia = 0.0;
+    /// Centre of mass relative to the body's position, in the body frame,
+    /// metres: non-zero for a polygon whose centroid is not its position.
+    /// The state vector then holds the position (the file's value, so saves
+    /// round-trip exactly) and the velocity of the centre of mass; contacts
+    /// work about the centre of mass and turning the body moves its position.
+    Vec2 centreOfMass;
 };
 
 /// Solid-shape moment of inertia about the centre, kg m^2.
@@ -96,6 +103,11 @@ public:
 
     /// Sets the rotational state: undoes a step's change (after a
     /// divergence), or resumes from a snapshot.
+    /// Centre of mass of collider i in the world (its position plus the
+    /// rotated offset), metres, at the given body positions.
+    Vec2 centreOfMass(std::size_t i, std::span<const Vec2> x) const;
+
+    /// Undoes a step's rotational change (after a divergence).
     void restoreRotation(std::span<const double> angles, std::span<const double> angularVelocities) {
         angles_.assign(angles.begin(), angles.end());
         angularVelocities_.assign(angularVelocities.begin(), angularVelocities.end());
@@ -114,6 +126,9 @@ private:
     void addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m, std::span<const Vec2> centres);
 
     std::vector<Collider> colliders_;
+    std::deque<ConvexPolygon> polygons_;  // the polygon shapes' outlines (addresses stay fixed)
+    std::vector<std::uint32_t> offsetBodies_;  // dynamic colliders whose centre of mass is off their position
+    std::vector<double> offsetAngleBefore_;    // their angles at the start of the substep, rad
     std::vector<double> angles_, angularVelocities_;
     std::vector<double> invMass_, invInertia_, maxExtent_;
     std::vector<std::uint32_t> finite_;  // colliders that are not planes (broad-phase proxies)

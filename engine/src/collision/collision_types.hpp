@@ -4,12 +4,13 @@
 
 #include "stepwise/vec2.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
 namespace stepwise::collision {
 
-enum class ShapeKind : std::uint8_t { Circle, Box, Plane };
+enum class ShapeKind : std::uint8_t { Circle, Box, Plane, Polygon };
 
 /// Rotation as cosine/sine, so rotating a vector is 4 multiplies.
 struct Rot {
@@ -24,6 +25,32 @@ inline Vec2 invRotate(Rot q, Vec2 v) { return {q.c * v.x + q.s * v.y, -q.s * v.x
 inline Vec2 perp(Vec2 v) { return {-v.y, v.x}; }
 inline Vec2 crossSV(double w, Vec2 r) { return {-w * r.y, w * r.x}; }
 
+/// Most vertices a polygon shape may have (the scene format's limit).
+inline constexpr int kMaxPolygonVertices = 8;
+
+/// A convex polygon in its body's frame, centred on its centre of mass:
+/// counter-clockwise vertices, and normal i the outward unit normal of the
+/// edge from vertex i to vertex i+1.
+struct ConvexPolygon {
+    int count = 0;
+    Vec2 vertices[kMaxPolygonVertices];
+    Vec2 normals[kMaxPolygonVertices];
+    double radius = 0.0;  ///< farthest vertex from the centre of mass, metres
+    /// Builds from vertices already relative to the centre of mass (valid:
+    /// convex, counter-clockwise, 3..8).
+    static ConvexPolygon fromVertices(const Vec2* v, int n) {
+        ConvexPolygon p;
+        p.count = n;
+        for (int i = 0; i < n; ++i) {
+            p.vertices[i] = v[i];
+            const Vec2 edge = v[(i + 1) % n] - v[i];
+            p.normals[i] = Vec2{edge.y, -edge.x} / std::sqrt(edge.x * edge.x + edge.y * edge.y);
+            p.radius = std::max(p.radius, std::sqrt(v[i].x * v[i].x + v[i].y * v[i].y));
+        }
+        return p;
+    }
+};
+
 /// Geometry of one collider in its body's frame.
 struct Shape {
     ShapeKind kind = ShapeKind::Circle;
@@ -31,6 +58,9 @@ struct Shape {
     Vec2 halfExtents;         ///< boxes, metres
     Vec2 normal{0.0, 1.0};    ///< planes: unit normal, world frame
     double offset = 0.0;      ///< planes: dot(normal, p) >= offset is outside
+    /// Polygons: the outline about the centre of mass. Owned by whoever made
+    /// the shape (the collision system keeps its polygons at fixed addresses).
+    const ConvexPolygon* polygon = nullptr;
 };
 
 /// One contact point of a manifold.

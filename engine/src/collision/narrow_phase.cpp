@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 
 namespace stepwise::collision {
 
@@ -70,7 +71,201 @@ int clipSegment(const ClipVertex in[2], ClipVertex out[2], Vec2 n, double offset
     return count;
 }
 
+/// A convex polygon placed in the world: counter-clockwise vertices and
+/// outward unit normals (normal i belongs to the edge from vertex i to i+1).
+struct WorldPolygon {
+    int count = 0;
+    Vec2 vertices[kMaxPolygonVertices];
+    Vec2 normals[kMaxPolygonVertices];
+};
+
+WorldPolygon worldPolygon(const ConvexPolygon& poly, Vec2 p, Rot q) {
+    WorldPolygon out;
+    out.count = poly.count;
+    for (int i = 0; i < poly.count; ++i) {
+        out.vertices[i] = p + rotate(q, poly.vertices[i]);
+        out.normals[i] = rotate(q, poly.normals[i]);
+    }
+    return out;
+}
+
+/// A box as a 4-gon, with the corner order of worldBox (so its feature ids
+/// against polygons read like box-box ones).
+WorldPolygon worldPolygon(const BoxPolygon& box) {
+    WorldPolygon out;
+    out.count = 4;
+    for (int i = 0; i < 4; ++i) {
+        out.vertices[i] = box.vertices[i];
+        out.normals[i] = box.normals[i];
+    }
+    return out;
+}
+
+/// Largest separation of B from A's face planes, and that face: for each
+/// face, B's deepest vertex along -n (its support point) measured from the
+/// face. Positive: a separating axis.
+std::pair<int, double> maxSeparation(const WorldPolygon& a, const WorldPolygon& b) {
+    int bestEdge = 0;
+    double best = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < a.count; ++i) {
+        const Vec2 n = a.normals[i], v = a.vertices[i];
+        double deepest = std::numeric_limits<double>::infinity();
+        for (int k = 0; k < b.count; ++k) deepest = std::min(deepest, dot(n, b.vertices[k] - v));
+        if (deepest > best) {
+            best = deepest;
+            bestEdge = i;
+        }
+    }
+    return {bestEdge, best};
+}
+
+/// The manifold from reference face `refEdge` of `ref` and the edge of
+/// `inc` most facing it: the incident edge clipped against the reference
+/// face's side planes. Side-plane points get ids sideId + refEdge and
+/// sideId + sideStride + refEdge (boxes and polygons keep their own ranges,
+/// so box ids are what they always were).
+Manifold clipIncidentEdge(const WorldPolygon& ref, int refEdge, const WorldPolygon& inc, bool flip, double margin,
+                          std::uint32_t sideId, std::uint32_t sideStride) {
+    Manifold m;
+    const Vec2 n = ref.normals[refEdge];
+    int incEdge = 0;
+    double minDot = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < inc.count; ++i) {
+        const double d = dot(n, inc.normals[i]);
+        if (d < minDot) {
+            minDot = d;
+            incEdge = i;
+        }
+    }
+    const int incNext = (incEdge + 1) % inc.count;
+    const ClipVertex incident[2] = {{inc.vertices[incEdge], std::uint32_t(incEdge)},
+                                    {inc.vertices[incNext], std::uint32_t(incNext)}};
+    const Vec2 v1 = ref.vertices[refEdge], v2 = ref.vertices[(refEdge + 1) % ref.count];
+    const Vec2 t = (v2 - v1) / length(v2 - v1);
+    ClipVertex clipped1[2], clipped2[2];
+    if (clipSegment(incident, clipped1, -t, -dot(t, v1), sideId + std::uint32_t(refEdge)) < 2) return m;
+    if (clipSegment(clipped1, clipped2, t, dot(t, v2), sideId + sideStride + std::uint32_t(refEdge)) < 2) return m;
+
+    m.normal = flip ? -n : n;
+    for (const ClipVertex& cv : clipped2) {
+        const double separation = dot(n, cv.v - v1);
+        if (separation > margin) continue;
+        ManifoldPoint& p = m.points[m.pointCount++];
+        p.separation = separation;
+        p.point = cv.v - 0.5 * separation * n;
+        p.id = (std::uint32_t(flip) << 16) | (std::uint32_t(refEdge) << 8) | cv.id;
+    }
+    return m;
+}
+
+/// Separating axis test over both polygons' face normals, then the
+/// incident edge clipped (clipIncidentEdge): up to two points. Feature ids:
+/// (reference edge << 8) | (incident vertex, or 16 + reference edge / 24 +
+/// reference edge for a point cut by a side plane), plus bit 16 when B's
+/// face is the reference.
+Manifold collideWorldPolygons(const WorldPolygon& a, const WorldPolygon& b, double margin) {
+    const auto [edgeA, separationA] = maxSeparation(a, b);
+    if (separationA > margin) return Manifold{};
+    const auto [edgeB, separationB] = maxSeparation(b, a);
+    if (separationB > margin) return Manifold{};
+    // The boxes' rule: A's face unless B's is clearly better, so the
+    // reference face does not flicker between steps.
+    const bool flip = separationB > 0.98 * separationA + 0.0005;
+    return clipIncidentEdge(flip ? b : a, flip ? edgeB : edgeA, flip ? a : b, flip, margin, 16, kMaxPolygonVertices);
+}
+
+/// Polygon A (in the world) against circle B: the exact closest point of
+/// the outline, or, with the centre inside, the face it is least deep under.
+Manifold collideWorldPolygonCircle(const WorldPolygon& a, double r, Vec2 pB, double margin) {
+    Manifold m;
+    int face = 0;
+    double faceSeparation = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < a.count; ++i) {
+        const double s = dot(a.normals[i], pB - a.vertices[i]);
+        if (s > faceSeparation) {
+            faceSeparation = s;
+            face = i;
+        }
+    }
+    if (faceSeparation - r > margin) return m;
+    Vec2 surface;
+    double separation;
+    if (faceSeparation <= 0.0) {
+        // Centre inside: out through the nearest face.
+        m.normal = a.normals[face];
+        surface = pB - faceSeparation * m.normal;
+        separation = faceSeparation - r;
+    } else {
+        // Outside: the nearest point over all edges (at most 8; exact
+        // where the best face's own segment test can pick the wrong vertex).
+        double best = std::numeric_limits<double>::infinity();
+        for (int i = 0; i < a.count; ++i) {
+            const Vec2 v1 = a.vertices[i], edge = a.vertices[(i + 1) % a.count] - v1;
+            const double u = std::clamp(dot(pB - v1, edge) / lengthSquared(edge), 0.0, 1.0);
+            const Vec2 q = v1 + u * edge;
+            const double d2 = lengthSquared(pB - q);
+            if (d2 < best) {
+                best = d2;
+                surface = q;
+            }
+        }
+        const double dist = std::sqrt(best);
+        separation = dist - r;
+        if (separation > margin) return m;
+        m.normal = dist > 0.0 ? (pB - surface) / dist : a.normals[face];
+    }
+    m.pointCount = 1;
+    m.points[0].separation = separation;
+    m.points[0].point = 0.5 * (surface + (pB - r * m.normal));
+    return m;
+}
+
+/// Plane A against polygon B: B's two deepest vertices within the margin,
+/// ids the vertex numbers (in that order, for warm starting).
+Manifold collidePlaneWorldPolygon(Vec2 n, double offset, const WorldPolygon& b, double margin) {
+    Manifold m;
+    int first = -1, second = -1;
+    double s[kMaxPolygonVertices];
+    for (int i = 0; i < b.count; ++i) {
+        s[i] = dot(n, b.vertices[i]) - offset;
+        if (s[i] > margin) continue;
+        if (first < 0 || s[i] < s[first]) {
+            second = first;
+            first = i;
+        } else if (second < 0 || s[i] < s[second]) {
+            second = i;
+        }
+    }
+    m.normal = n;
+    for (int i : {first, second}) {
+        if (i < 0) continue;
+        ManifoldPoint& p = m.points[m.pointCount++];
+        p.separation = s[i];
+        p.point = b.vertices[i] - 0.5 * s[i] * n;
+        p.id = std::uint32_t(i);
+    }
+    if (m.pointCount == 2 && m.points[0].id > m.points[1].id) std::swap(m.points[0], m.points[1]);
+    return m;
+}
+
 } // namespace
+
+Manifold collidePolygons(const ConvexPolygon& a, Vec2 pA, Rot qA, const ConvexPolygon& b, Vec2 pB, Rot qB,
+                         double margin) {
+    return collideWorldPolygons(worldPolygon(a, pA, qA), worldPolygon(b, pB, qB), margin);
+}
+
+Manifold collideBoxPolygon(Vec2 hA, Vec2 pA, Rot qA, const ConvexPolygon& b, Vec2 pB, Rot qB, double margin) {
+    return collideWorldPolygons(worldPolygon(worldBox(hA, pA, qA)), worldPolygon(b, pB, qB), margin);
+}
+
+Manifold collidePolygonCircle(const ConvexPolygon& a, Vec2 pA, Rot qA, double rB, Vec2 pB, double margin) {
+    return collideWorldPolygonCircle(worldPolygon(a, pA, qA), rB, pB, margin);
+}
+
+Manifold collidePlanePolygon(Vec2 n, double offset, const ConvexPolygon& b, Vec2 pB, Rot qB, double margin) {
+    return collidePlaneWorldPolygon(n, offset, worldPolygon(b, pB, qB), margin);
+}
 
 Manifold collideCircles(double rA, Vec2 pA, double rB, Vec2 pB, double margin) {
     Manifold m;
@@ -121,50 +316,17 @@ Manifold collideBoxCircle(Vec2 h, Vec2 pA, Rot qA, double r, Vec2 pB, double mar
 }
 
 Manifold collideBoxes(Vec2 hA, Vec2 pA, Rot qA, Vec2 hB, Vec2 pB, Rot qB, double margin) {
-    Manifold m;
     const BoxPolygon a = worldBox(hA, pA, qA), b = worldBox(hB, pB, qB);
     const auto [edgeA, separationA] = maxSeparation(a, b);
-    if (separationA > margin) return m;
+    if (separationA > margin) return Manifold{};
     const auto [edgeB, separationB] = maxSeparation(b, a);
-    if (separationB > margin) return m;
+    if (separationB > margin) return Manifold{};
 
     // Prefer A's face unless B's is clearly better: keeps the reference face
     // from flickering between steps when the two are nearly equal.
     const bool flip = separationB > 0.98 * separationA + 0.0005;
-    const BoxPolygon& ref = flip ? b : a;
-    const BoxPolygon& inc = flip ? a : b;
-    const int refEdge = flip ? edgeB : edgeA;
-    const Vec2 n = ref.normals[refEdge];
-
-    int incEdge = 0;
-    double minDot = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < 4; ++i) {
-        const double d = dot(n, inc.normals[i]);
-        if (d < minDot) {
-            minDot = d;
-            incEdge = i;
-        }
-    }
-    const ClipVertex incident[2] = {
-        {inc.vertices[incEdge], std::uint32_t(incEdge)},
-        {inc.vertices[(incEdge + 1) % 4], std::uint32_t((incEdge + 1) % 4)},
-    };
-    const Vec2 v1 = ref.vertices[refEdge], v2 = ref.vertices[(refEdge + 1) % 4];
-    const Vec2 t = (v2 - v1) / length(v2 - v1);
-    ClipVertex clipped1[2], clipped2[2];
-    if (clipSegment(incident, clipped1, -t, -dot(t, v1), 8 + std::uint32_t(refEdge)) < 2) return m;
-    if (clipSegment(clipped1, clipped2, t, dot(t, v2), 12 + std::uint32_t(refEdge)) < 2) return m;
-
-    m.normal = flip ? -n : n;
-    for (const ClipVertex& cv : clipped2) {
-        const double separation = dot(n, cv.v - v1);
-        if (separation > margin) continue;
-        ManifoldPoint& p = m.points[m.pointCount++];
-        p.separation = separation;
-        p.point = cv.v - 0.5 * separation * n;
-        p.id = (std::uint32_t(flip) << 16) | (std::uint32_t(refEdge) << 8) | cv.id;
-    }
-    return m;
+    return clipIncidentEdge(worldPolygon(flip ? b : a), flip ? edgeB : edgeA, worldPolygon(flip ? a : b), flip, margin,
+                            8, 4);
 }
 
 Manifold collidePlaneCircle(Vec2 n, double offset, double r, Vec2 pB, double margin) {
@@ -179,32 +341,7 @@ Manifold collidePlaneCircle(Vec2 n, double offset, double r, Vec2 pB, double mar
 }
 
 Manifold collidePlaneBox(Vec2 n, double offset, Vec2 h, Vec2 pB, Rot qB, double margin) {
-    Manifold m;
-    const BoxPolygon box = worldBox(h, pB, qB);
-    // The two deepest corners within the margin.
-    int first = -1, second = -1;
-    double s[4];
-    for (int i = 0; i < 4; ++i) {
-        s[i] = dot(n, box.vertices[i]) - offset;
-        if (s[i] > margin) continue;
-        if (first < 0 || s[i] < s[first]) {
-            second = first;
-            first = i;
-        } else if (second < 0 || s[i] < s[second]) {
-            second = i;
-        }
-    }
-    m.normal = n;
-    for (int i : {first, second}) {
-        if (i < 0) continue;
-        ManifoldPoint& p = m.points[m.pointCount++];
-        p.separation = s[i];
-        p.point = box.vertices[i] - 0.5 * s[i] * n;
-        p.id = std::uint32_t(i);
-    }
-    // Keep a stable order (by corner id) so warm starting matches points.
-    if (m.pointCount == 2 && m.points[0].id > m.points[1].id) std::swap(m.points[0], m.points[1]);
-    return m;
+    return collidePlaneWorldPolygon(n, offset, worldPolygon(worldBox(h, pB, qB)), margin);
 }
 
 Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot qB, double margin) {
@@ -212,6 +349,26 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
         m.normal = -m.normal;
         return m;
     };
+    if (a.kind == ShapeKind::Polygon || b.kind == ShapeKind::Polygon) {
+        // Polygon first: every pair with a polygon is written as polygon (or
+        // plane, or box) A against B, then flipped back.
+        if (a.kind == ShapeKind::Polygon) {
+            switch (b.kind) {
+            case ShapeKind::Circle: return collidePolygonCircle(*a.polygon, pA, qA, b.radius, pB, margin);
+            case ShapeKind::Box: return flipped(collideBoxPolygon(b.halfExtents, pB, qB, *a.polygon, pA, qA, margin));
+            case ShapeKind::Polygon: return collidePolygons(*a.polygon, pA, qA, *b.polygon, pB, qB, margin);
+            case ShapeKind::Plane: return flipped(collidePlanePolygon(b.normal, b.offset, *a.polygon, pA, qA, margin));
+            }
+            return Manifold{};
+        }
+        switch (a.kind) {
+        case ShapeKind::Circle: return flipped(collidePolygonCircle(*b.polygon, pB, qB, a.radius, pA, margin));
+        case ShapeKind::Box: return collideBoxPolygon(a.halfExtents, pA, qA, *b.polygon, pB, qB, margin);
+        case ShapeKind::Plane: return collidePlanePolygon(a.normal, a.offset, *b.polygon, pB, qB, margin);
+        case ShapeKind::Polygon: break;
+        }
+        return Manifold{};
+    }
     switch (a.kind) {
     case ShapeKind::Circle:
         if (b.kind == ShapeKind::Circle) return collideCircles(a.radius, pA, b.radius, pB, margin);
@@ -225,12 +382,22 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
         if (b.kind == ShapeKind::Circle) return collidePlaneCircle(a.normal, a.offset, b.radius, pB, margin);
         if (b.kind == ShapeKind::Box) return collidePlaneBox(a.normal, a.offset, b.halfExtents, pB, qB, margin);
         return Manifold{};  // two infinite walls never collide
+    case ShapeKind::Polygon: break;  // handled above
     }
     return Manifold{};
 }
 
 Aabb computeAabb(const Shape& shape, Vec2 p, Rot q) {
     if (shape.kind == ShapeKind::Circle) return {p - Vec2{shape.radius, shape.radius}, p + Vec2{shape.radius, shape.radius}};
+    if (shape.kind == ShapeKind::Polygon) {
+        Aabb box{p + rotate(q, shape.polygon->vertices[0]), p + rotate(q, shape.polygon->vertices[0])};
+        for (int i = 1; i < shape.polygon->count; ++i) {
+            const Vec2 v = p + rotate(q, shape.polygon->vertices[i]);
+            box.lower = {std::min(box.lower.x, v.x), std::min(box.lower.y, v.y)};
+            box.upper = {std::max(box.upper.x, v.x), std::max(box.upper.y, v.y)};
+        }
+        return box;
+    }
     const Vec2 h = shape.halfExtents;
     const Vec2 e{std::abs(q.c) * h.x + std::abs(q.s) * h.y, std::abs(q.s) * h.x + std::abs(q.c) * h.y};
     return {p - e, p + e};

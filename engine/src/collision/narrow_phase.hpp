@@ -22,7 +22,15 @@ Manifold collideBoxes(Vec2 hA, Vec2 pA, Rot qA, Vec2 hB, Vec2 pB, Rot qB, double
 Manifold collidePlaneCircle(Vec2 n, double offset, double rB, Vec2 pB, double margin);
 Manifold collidePlaneBox(Vec2 n, double offset, Vec2 hB, Vec2 pB, Rot qB, double margin);
 
-/// World-space bounding box of a circle or box (planes have none).
+/// Polygons (outlines about their centre of mass at pA/pB). Box A and plane
+/// A against polygon B; polygon A against circle B.
+Manifold collidePolygons(const ConvexPolygon& a, Vec2 pA, Rot qA, const ConvexPolygon& b, Vec2 pB, Rot qB,
+                         double margin);
+Manifold collideBoxPolygon(Vec2 hA, Vec2 pA, Rot qA, const ConvexPolygon& b, Vec2 pB, Rot qB, double margin);
+Manifold collidePolygonCircle(const ConvexPolygon& a, Vec2 pA, Rot qA, double rB, Vec2 pB, double margin);
+Manifold collidePlanePolygon(Vec2 n, double offset, const ConvexPolygon& b, Vec2 pB, Rot qB, double margin);
+
+/// World-space bounding box of a circle, box or polygon (planes have none).
 Aabb computeAabb(const Shape& shape, Vec2 p, Rot q);
 
 } // namespace stepwise::collision

@@ -303,6 +303,19 @@ Result<World> World::build(const Scene& scene) {
     f.boidsOn = !f.boids.body.empty();
     if (f.boidsOn) f.boids.prepare();
 
+    // Polygons: the loader refuses bad outlines, but a scene built in code or
+    // edited in the editor reaches here unchecked.
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        const Polygon* poly = reg.tryGet<Polygon>(order[i]);
+        if (!poly) continue;
+        if (std::string problem = polygonProblem(poly->vertices); !problem.empty()) {
+            const Name* pname = reg.tryGet<Name>(order[i]);
+            const auto colon = problem.find(':');
+            return Error{entityLabel(i, pname ? &pname->value : nullptr) + ": polygon.vertices" +
+                         (colon == 0 ? "" : "[" + problem.substr(0, colon) + "]") + problem.substr(colon)};
+        }
+    }
+
     // Shapes: the collision stages, only when some entity has one.
     std::string jointProblem;
     w.collision = detail::buildCollisions(scene, bodyOf, kNoBody, &jointProblem);
@@ -674,6 +687,10 @@ EnergyReport World::energy() const {
             if (col.body < 0) continue;
             const double spin = contacts->angularVelocity(c);
             e.kinetic += 0.5 * col.inertia * spin * spin;
+            // Gravity acts at the centre of mass, which the state's position
+            // is not for an off-centre polygon.
+            const Vec2 offset = contacts->centreOfMass(c, detail::asVec2(x, f.n)) - detail::asVec2(x, f.n)[std::size_t(col.body)];
+            e.gravity -= col.mass * (w.settings.gravity.x * offset.x + w.settings.gravity.y * offset.y);
         }
     }
     e.springs = f.springEnergy(x);

@@ -38,6 +38,7 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         system = std::make_unique<collision::CollisionSystem>();
         system->settings().iterations = scene.world.solverIterations;
     };
+    collision::ConvexPolygon polygon;  // copied by add()
     for (const Entity e : reg.entities()) {
         collision::Collider c;
         if (const Radius* r = reg.tryGet<Radius>(e)) {
@@ -46,6 +47,17 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         } else if (const Box* b = reg.tryGet<Box>(e)) {
             c.shape.kind = collision::ShapeKind::Box;
             c.shape.halfExtents = {0.5 * b->width, 0.5 * b->height};
+        } else if (const Polygon* poly = reg.tryGet<Polygon>(e)) {
+            // The engine works about the centre of mass: the outline is
+            // shifted so the centroid is its origin, and the offset kept.
+            const PolygonMassProperties props = polygonMassProperties(poly->vertices);
+            Vec2 local[collision::kMaxPolygonVertices];
+            const int count = int(poly->vertices.size());
+            for (int i = 0; i < count; ++i) local[i] = poly->vertices[std::size_t(i)] - props.centroid;
+            polygon = collision::ConvexPolygon::fromVertices(local, count);
+            c.shape.kind = collision::ShapeKind::Polygon;
+            c.shape.polygon = &polygon;
+            c.centreOfMass = props.centroid;
         } else if (const Plane* p = reg.tryGet<Plane>(e)) {
             c.shape.kind = collision::ShapeKind::Plane;
             c.shape.normal = p->normal;

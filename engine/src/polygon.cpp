@@ -1,0 +1,104 @@
+// Polygon shapes: the one validity check (loader, world, editor) and the
+// mass properties the engine derives from the outline.
+
+#include "stepwise/components.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace stepwise {
+
+namespace {
+
+std::string pointText(Vec2 p) {
+    std::ostringstream s;
+    s << "{\"x\": " << p.x << ", \"y\": " << p.y << "}";
+    return s.str();
+}
+
+} // namespace
+
+std::string polygonProblem(const std::vector<Vec2>& v) {
+    const std::size_t n = v.size();
+    if (n < 3 || n > 8) return ": expected 3 to 8 vertices, got " + std::to_string(n);
+    for (const Vec2& p : v)
+        if (!isFinite(p)) return ": expected finite vertices";
+    // Tolerances are relative to the polygon's size, so a 1 mm triangle and a
+    // 1 km one are judged alike. extent: the largest coordinate span, metres.
+    Vec2 lo = v[0], hi = v[0];
+    for (const Vec2& p : v) {
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+    }
+    const double extent = std::max(hi.x - lo.x, hi.y - lo.y);
+    // Closer than a billionth of the size: the edge between them has no
+    // usable direction (its normal would be rounding noise).
+    const double samePoint = 1e-9 * extent;
+    for (std::size_t j = 1; j < n; ++j)
+        for (std::size_t i = 0; i < j; ++i)
+            if (length(v[j] - v[i]) <= samePoint)
+                return std::to_string(j) + ": vertex " + std::to_string(j) + " " + pointText(v[j]) +
+                       " is the same point as vertex " + std::to_string(i) + "; a polygon needs distinct vertices";
+    // All on one line: no area, so no mass distribution and no inside.
+    std::size_t far = 1;
+    for (std::size_t k = 2; k < n; ++k)
+        if (lengthSquared(v[k] - v[0]) > lengthSquared(v[far] - v[0])) far = k;
+    const Vec2 axis = v[far] - v[0];
+    double offLine = 0.0;
+    for (const Vec2& p : v) offLine = std::max(offLine, std::abs(cross(axis, p - v[0])) / length(axis));
+    if (offLine <= 1e-9 * extent) return ": the vertices lie on one line, so the polygon has no area";
+    double twiceArea = 0.0;
+    for (std::size_t i = 1; i + 1 < n; ++i) twiceArea += cross(v[i] - v[0], v[i + 1] - v[0]);
+    if (twiceArea < 0.0)
+        return ": the vertices run clockwise; list them counter-clockwise (reverse the list)";
+    // Each corner must turn left: sin of the turn below 1e-9 is a straight
+    // corner (a vertex on the line between its neighbours), negative a dent.
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec2 before = v[i] - v[(i + n - 1) % n], after = v[(i + 1) % n] - v[i];
+        const double turn = cross(before, after);
+        if (std::abs(turn) <= 1e-9 * length(before) * length(after))
+            return std::to_string(i) + ": vertex " + std::to_string(i) + " " + pointText(v[i]) +
+                   " lies on the straight line between its neighbours; remove it";
+        if (turn < 0.0)
+            return std::to_string(i) + ": not convex: the outline turns clockwise at vertex " + std::to_string(i) +
+                   " " + pointText(v[i]) + "; a polygon shape must be convex (split the shape into convex pieces)";
+    }
+    // Left turns everywhere but wound round more than once (a star drawn
+    // without lifting the pen): some vertex lies outside some edge.
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec2 a = v[i], edge = v[(i + 1) % n] - a;
+        for (std::size_t k = 0; k < n; ++k) {
+            if (k == i || k == (i + 1) % n) continue;
+            if (cross(edge, v[k] - a) <= 0.0)
+                return std::to_string(k) + ": not convex: the outline crosses itself (vertex " + std::to_string(k) +
+                       " is not inside edge " + std::to_string(i) + "-" + std::to_string((i + 1) % n) + ")";
+        }
+    }
+    return {};
+}
+
+PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& v) {
+    // Fan of triangles (v0, vi, vi+1), measured from v0 so that vertices far
+    // from the origin lose no digits. A triangle (0, e1, e2) has area
+    // cross(e1, e2)/2, centroid (e1 + e2)/3 and polar second moment about 0
+    // of area/6 * (e1.e1 + e1.e2 + e2.e2).
+    PolygonMassProperties out;
+    if (v.size() < 3) return out;
+    Vec2 firstMoment;
+    double polarAboutV0 = 0.0;
+    for (std::size_t i = 1; i + 1 < v.size(); ++i) {
+        const Vec2 e1 = v[i] - v[0], e2 = v[i + 1] - v[0];
+        const double area = 0.5 * cross(e1, e2);
+        out.area += area;
+        firstMoment += (area / 3.0) * (e1 + e2);
+        polarAboutV0 += area / 6.0 * (dot(e1, e1) + dot(e1, e2) + dot(e2, e2));
+    }
+    const Vec2 c = firstMoment / out.area;  // centroid relative to v0
+    out.centroid = v[0] + c;
+    // Parallel axis theorem: J_v0 = J_centroid + A |c|^2.
+    out.secondMoment = polarAboutV0 - out.area * lengthSquared(c);
+    return out;
+}
+
+} // namespace stepwise
