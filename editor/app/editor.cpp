@@ -196,6 +196,29 @@ void Editor::pruneSelection() {
     if (!doc.scene.registry.alive(springStart_)) springStart_ = {};
 }
 
+void Editor::startReferencePick(const ComponentInfo& component, const FieldInfo& field, std::vector<Entity> entities) {
+    referencePick = ReferencePick{&component, &field, std::move(entities)};
+    note("pick " + std::string(component.name) + "." + std::string(field.key) +
+         ": click a body in the viewport or the entity list (Esc cancels)");
+}
+
+bool Editor::finishReferencePick(Entity target) {
+    if (!referencePick) return false;
+    const ReferencePick p = *referencePick;
+    referencePick.reset();
+    if (!isBody(doc.scene.registry, target)) {
+        note("pick cancelled: " + displayName(doc.scene.registry, target) + " is not a body");
+        return false;
+    }
+    std::string problem;
+    const std::string what = "set " + std::string(p.component->name) + "." + std::string(p.field->key) + " to " +
+                             displayName(doc.scene.registry, target);
+    if (applyEdit(what, [&](Scene& s) { return setFieldOnAll(s, *p.component, *p.field, target, p.entities, &problem) > 0; }))
+        return true;
+    status = problem.empty() ? "nothing changed" : "refused: " + problem;
+    return false;
+}
+
 void Editor::select(std::vector<Entity> entities) {
     selection = std::move(entities);
     pruneSelection();
@@ -344,6 +367,11 @@ bool Editor::handleShortcut(Key key, std::uint8_t mods) {
     case Key::Backspace: return deleteSelection();
     case Key::Escape:
         springStart_ = {};
+        if (referencePick) {
+            referencePick.reset();
+            note("pick cancelled");
+            return true;
+        }
         if (drag_ == Drag::None) selection.clear();
         return true;
     case Key::F1: uiRequest = UiRequest::Help; return true;
@@ -419,6 +447,12 @@ void Editor::handleViewportEvent(const InputEvent& e) {
         }
         additive_ = (e.mods & (kModShift | kModCtrl)) != 0;
         Entity hit = pick(doc.scene, world, pickRadius());
+        if (referencePick) {
+            // Whatever the tool: this click answers the inspector's pick.
+            if (hit.isNull()) note("pick: no body there (Esc cancels)");
+            else finishReferencePick(hit);
+            return;
+        }
         switch (tool) {
         case Tool::Select:
         case Tool::Rotate: {

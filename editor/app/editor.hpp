@@ -13,6 +13,8 @@
 
 #include "render/frame.hpp"
 
+#include "stepwise/component_table.hpp"
+
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -81,6 +83,21 @@ public:
     std::uint64_t newMergeKey() { return ++mergeCounter_; }
     bool undo();
     bool redo();
+
+    /// Choosing the entity an entity-reference field (a spring end) points
+    /// at: armed from the inspector, finished by clicking a body in the
+    /// viewport or the entity list. Ends are picked, never typed.
+    struct ReferencePick {
+        const ComponentInfo* component = nullptr;
+        const FieldInfo* field = nullptr;
+        std::vector<Entity> entities;  ///< whose field is set
+    };
+    std::optional<ReferencePick> referencePick;
+    void startReferencePick(const ComponentInfo& component, const FieldInfo& field, std::vector<Entity> entities);
+    /// Sets the armed field to `target` as one undoable edit (refused like
+    /// any inspector edit: the status names the entity and the field).
+    /// Returns true when the edit was made; the pick ends either way.
+    bool finishReferencePick(Entity target);
 
     void select(std::vector<Entity> entities);
     void selectAll();

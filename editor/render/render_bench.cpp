@@ -50,12 +50,14 @@ Scene makeScene(int bodies) {
     for (int a = 0; a < 4; ++a)
         add(Name{std::string("sun").append(std::to_string(a))}, Position{{(a - 1.5) * 28.0, 8.0 * ((a % 2) ? 1 : -1)}}, Static{true},
             Mass{40.0}, Attractor{0.5}, Radius{0.8}, Color{{1.0, 0.8, 0.4}});
+    std::vector<Entity> made;
     for (int i = 0; i < bodies; ++i) {
         const Vec2 p{(rng.next() - 0.5) * width, (rng.next() - 0.5) * height};
         const Vec2 v{(rng.next() - 0.5) * 8.0, (rng.next() - 0.5) * 8.0};
         const Rgb c{0.35 + 0.6 * rng.next(), 0.45 + 0.4 * rng.next(), 0.6 + 0.4 * rng.next()};
         Entity e = add(Name{std::string("b").append(std::to_string(i))}, Position{p}, Velocity{v}, Mass{0.5 + rng.next()}, Color{c},
                        Angle{rng.next() * 6.28});
+        made.push_back(e);
         if (i % 4 == 3)
             scene.registry.emplace(e, Box{0.25 + 0.3 * rng.next(), 0.15 + 0.2 * rng.next()});
         else
@@ -64,8 +66,7 @@ Scene makeScene(int bodies) {
     // A few hundred springs between neighbours in creation order.
     for (int i = 0; i + 1 < bodies && i < 600; i += 3)
         add(Name{std::string("s").append(std::to_string(i))},
-            Spring{std::string("b").append(std::to_string(i)), std::string("b").append(std::to_string(i + 1)),
-                   std::nullopt, 5.0, 0.1, 1.0});
+            Spring{made[std::size_t(i)], made[std::size_t(i) + 1], std::nullopt, 5.0, 0.1, 1.0});
     return scene;
 }
 
