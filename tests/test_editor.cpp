@@ -827,3 +827,63 @@ TEST(Inspector, RefusesAtEditTimeWhatTheLoaderRefusesNamingEntityAndField) {
     // Nothing of it reached the scene.
     EXPECT_EQ(textOf(f.ed.doc.scene), before);
 }
+
+TEST(Editing, DeletingABodyWithASpringSaysWhatGoes) {
+    Fixture f("default.json");
+    f.ed.select({f.named("bob")});
+    EXPECT_EQ(f.ed.deleteLabel(f.ed.selection), "delete 1 body and 1 spring");
+    ASSERT_TRUE(f.ed.deleteSelection());
+    EXPECT_EQ(f.ed.status, "delete 1 body and 1 spring");
+    EXPECT_EQ(f.ed.commands.labels().back(), "delete 1 body and 1 spring");
+}
+
+TEST(Editing, PasteAndDuplicateLandAtTheCursor) {
+    Fixture f("default.json");
+    f.ed.select({f.named("bob")});
+    f.ed.copySelection();
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseMove, {6.0, 9.0}));
+    ASSERT_TRUE(f.ed.paste());
+    ASSERT_EQ(f.ed.selection.size(), 1u);
+    const Vec2 pasted = f.ed.doc.scene.registry.tryGet<Position>(f.ed.selection[0])->value;
+    EXPECT_NEAR(pasted.x, 6.0, 1e-9);
+    EXPECT_NEAR(pasted.y, 9.0, 1e-9);
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseMove, {-3.0, 10.0}));
+    ASSERT_TRUE(f.ed.duplicateSelection());
+    const Vec2 dup = f.ed.doc.scene.registry.tryGet<Position>(f.ed.selection[0])->value;
+    EXPECT_NEAR(dup.x, -3.0, 1e-9);
+    EXPECT_NEAR(dup.y, 10.0, 1e-9);
+}
+
+TEST(Simulation, StepCounterIsClearedByResetNewAndOpen) {
+    Fixture f("default.json");
+    for (int i = 0; i < 5; ++i) f.ed.stepForward();
+    ASSERT_EQ(f.ed.sim.steps(), 5u);
+    f.ed.resetSimulation();
+    EXPECT_EQ(f.ed.sim.steps(), 0u);
+    for (int i = 0; i < 3; ++i) f.ed.stepForward();
+    f.ed.newDocument();
+    EXPECT_EQ(f.ed.sim.steps(), 0u);
+    ASSERT_TRUE(f.ed.open(kLevels / "orbit.json"));
+    for (int i = 0; i < 2; ++i) f.ed.stepForward();
+    ASSERT_TRUE(f.ed.open(kLevels / "default.json"));
+    EXPECT_EQ(f.ed.sim.steps(), 0u);
+}
+
+TEST(Files, LevelsFolderIsFoundFromTheExecutableNotTheWorkingFolder) {
+    TempDir elsewhere;
+    // A build folder in a checkout: <src>/build/stepwise -> <src>/levels.
+    const std::filesystem::path levels = findLevelsDirectory(std::filesystem::path(STEPWISE_BINARY).parent_path(), elsewhere.path);
+    EXPECT_TRUE(std::filesystem::exists(levels / "default.json")) << levels;
+    // Nothing beside the executable: the working folder's levels/, then the folder itself.
+    EXPECT_EQ(findLevelsDirectory({}, elsewhere.path), std::filesystem::absolute(elsewhere.path));
+    // Save as asks before writing over another file, not over the document's own.
+    const std::filesystem::path mine = elsewhere.path / "mine.json", other = elsewhere.path / "other.json";
+    std::ofstream(mine) << "{}";
+    std::ofstream(other) << "{}";
+    EXPECT_TRUE(replacesAnotherFile(other, mine));
+    EXPECT_FALSE(replacesAnotherFile(mine, mine));
+    EXPECT_FALSE(replacesAnotherFile(elsewhere.path / "new.json", mine));
+    EXPECT_TRUE(replacesAnotherFile(other, {}));  // untitled
+    EXPECT_EQ(dialogFolder(mine, levels), std::filesystem::absolute(elsewhere.path));
+    EXPECT_EQ(dialogFolder({}, levels), levels);
+}

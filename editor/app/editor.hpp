@@ -102,6 +102,9 @@ public:
     void select(std::vector<Entity> entities);
     void selectAll();
     bool deleteSelection();
+    /// What deleting `entities` takes with it, by kind, as the undo label:
+    /// "delete 1 body and 1 spring".
+    std::string deleteLabel(const std::vector<Entity>& entities) const;
     bool duplicateSelection();
     void copySelection();
     bool paste();
@@ -162,6 +165,10 @@ private:
     void replaceDocument(Document next);
     void pruneSelection();
     Vec2 snapped(Vec2 world) const;
+    /// Offset that puts copies of `entities` (in `src`) under the cursor;
+    /// without a cursor, `count` x (0.5, -0.5) m beside the originals.
+    Vec2 placementOffset(const Registry& src, const std::vector<Entity>& entities, int count) const;
+    bool mouseKnown_ = false;  ///< the cursor has been over the viewport
     double pickRadius() const;
     void placeAt(Vec2 world);
 

@@ -198,6 +198,7 @@ bool Simulation::reset(Scene& scene) {
     state_ = SimState::Editing;
     world_.reset();
     history_.clear();
+    steps_ = 0;  // the step counter belongs to the run that ended
     stale_ = true;
     message_.clear();
     diverged_ = false;

@@ -449,9 +449,14 @@ void simToolbar(UiState& ui, Editor& ed) {
     ImGui::EndDisabled();
     ImGui::SameLine();
     float scale = float(ed.sim.timeScale);
-    ImGui::SetNextItemWidth(110 * ui.scale);
-    if (ImGui::SliderFloat("##timescale", &scale, 0.05f, 4.0f, "time x%.2f", ImGuiSliderFlags_Logarithmic))
+    // The value is written beside the slider: inside it, the handle sat on
+    // top of the digits.
+    ImGui::SetNextItemWidth(80 * ui.scale);
+    if (ImGui::SliderFloat("##timescale", &scale, 0.05f, 4.0f, "", ImGuiSliderFlags_Logarithmic))
         ed.sim.timeScale = scale;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Simulated seconds per real second (Ctrl+click to type)");
+    ImGui::SameLine(0, 4 * ui.scale);
+    ImGui::Text("time x%.2f", ed.sim.timeScale);
     ImGui::SameLine();
     bool breakOn = !ed.sim.breakOnContact.isNull();
     const bool canBreak = ed.selection.size() == 1;
@@ -672,20 +677,69 @@ void contactsTab(UiState& ui, Editor& ed) {
         return;
     }
     const auto contacts = w->contacts();
-    ImGui::Text("%zu contacts this step", contacts.size());
-    if (contacts.empty()) return;
     const Registry& reg = ed.doc.scene.registry;
-    if (ImGui::BeginTable("contacts", 6, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_Borders |
-                                             ImGuiTableFlags_Resizable)) {
+    ImGui::Text("%zu contacts this step", contacts.size());
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(180 * ui.scale);
+    ImGui::InputTextWithHint("##contactfilter", "filter by body name", &ui.contactFilter);
+    ImGui::SameLine();
+    ImGui::TextColored(kDim, "(?)");
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("normal: unit, from a to b. depth > 0: the shapes overlap by that much; depth < 0: a gap "
+                          "(a speculative contact, not touching yet).\nimpulse: normal and tangent (friction) "
+                          "impulse the solver applied this step. The pair that stopped the run is in red.");
+    if (contacts.empty()) return;
+    // Rows shown: filtered by name, in the order the header asks for.
+    std::vector<std::size_t> rows;
+    for (std::size_t i = 0; i < contacts.size(); ++i) {
+        if (!ui.contactFilter.empty()) {
+            const ContactRecord& c = contacts[i];
+            const bool match = editor::displayName(reg, c.a).find(ui.contactFilter) != std::string::npos ||
+                               (reg.alive(c.b) && editor::displayName(reg, c.b).find(ui.contactFilter) != std::string::npos);
+            if (!match) continue;
+        }
+        rows.push_back(i);
+    }
+    if (ImGui::BeginTable("contacts", 7, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_Borders |
+                                             ImGuiTableFlags_Resizable | ImGuiTableFlags_Sortable)) {
         ImGui::TableSetupScrollFreeze(0, 1);
-        for (const char* h : {"a", "b", "point [m]", "normal", "depth [m]", "impulse [N s]"}) ImGui::TableSetupColumn(h);
+        for (const char* h : {"a", "b", "point [m]", "normal", "depth [m]", "normal impulse [N s]", "tangent impulse [N s]"})
+            ImGui::TableSetupColumn(h);
         ImGui::TableHeadersRow();
+        if (const ImGuiTableSortSpecs* sort = ImGui::TableGetSortSpecs(); sort && sort->SpecsCount > 0) {
+            const int column = sort->Specs[0].ColumnIndex;
+            const bool descending = sort->Specs[0].SortDirection == ImGuiSortDirection_Descending;
+            auto key = [&](std::size_t i) -> double {
+                const ContactRecord& c = contacts[i];
+                switch (column) {
+                case 2: return c.point.x;
+                case 3: return c.normal.y;
+                case 4: return c.depth;
+                case 5: return c.normalImpulse;
+                case 6: return c.tangentImpulse;
+                default: return 0.0;
+                }
+            };
+            std::stable_sort(rows.begin(), rows.end(), [&](std::size_t x, std::size_t y) {
+                if (column <= 1) {
+                    const Entity ex = column == 0 ? contacts[x].a : contacts[x].b;
+                    const Entity ey = column == 0 ? contacts[y].a : contacts[y].b;
+                    const std::string nx = reg.alive(ex) ? editor::displayName(reg, ex) : std::string();
+                    const std::string ny = reg.alive(ey) ? editor::displayName(reg, ey) : std::string();
+                    return descending ? ny < nx : nx < ny;
+                }
+                return descending ? key(y) < key(x) : key(x) < key(y);
+            });
+        }
         ImGuiListClipper clipper;
-        clipper.Begin(int(contacts.size()));
+        clipper.Begin(int(rows.size()));
         while (clipper.Step())
             for (int i = clipper.DisplayStart; i < clipper.DisplayEnd; ++i) {
-                const ContactRecord& c = contacts[std::size_t(i)];
+                const ContactRecord& c = contacts[rows[std::size_t(i)]];
                 ImGui::TableNextRow();
+                if (const auto& broke = ed.sim.contactPair;
+                    broke && ((broke->first == c.a && broke->second == c.b) || (broke->first == c.b && broke->second == c.a)))
+                    ImGui::TableSetBgColor(ImGuiTableBgTarget_RowBg1, IM_COL32(150, 50, 45, 160));
                 ImGui::TableNextColumn();
                 const bool selected = std::find(ed.selection.begin(), ed.selection.end(), c.a) != ed.selection.end() &&
                                       (c.b.isNull() || std::find(ed.selection.begin(), ed.selection.end(), c.b) != ed.selection.end());
@@ -706,10 +760,11 @@ void contactsTab(UiState& ui, Editor& ed) {
                 ImGui::Text("%.4g", c.depth);
                 ImGui::TableNextColumn();
                 ImGui::Text("%.4g", c.normalImpulse);
+                ImGui::TableNextColumn();
+                ImGui::Text("%.4g", c.tangentImpulse);
             }
         ImGui::EndTable();
     }
-    (void)ui;
 }
 
 void plotsTab(UiState& ui, Editor& ed) {
@@ -896,6 +951,33 @@ void helpWindow(UiState& ui) {
     ImGui::End();
 }
 
+} // namespace
+
+std::string displayableText(const std::string& text) {
+    // Typographic quotes and dashes (UTF-8 E2 80 xx) that the font has no
+    // glyph for are shown as their ASCII look-alikes instead of '?'.
+    const ImFont* font = ImGui::GetFont();
+    std::string out;
+    out.reserve(text.size());
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c == 0xE2 && i + 2 < text.size() && static_cast<unsigned char>(text[i + 1]) == 0x80) {
+            const auto d = static_cast<unsigned char>(text[i + 2]);
+            const ImWchar codepoint = ImWchar(0x2000 + (d & 0x3F));
+            const char* ascii = d == 0x98 || d == 0x99 ? "'" : d == 0x9C || d == 0x9D ? "\"" : d == 0x93 || d == 0x94 ? "-" : nullptr;
+            if (ascii && (!font || !font->FindGlyphNoFallback(codepoint))) {
+                out += ascii;
+                i += 2;
+                continue;
+            }
+        }
+        out += char(c);
+    }
+    return out;
+}
+
+namespace {
+
 std::vector<std::string> listLevelFiles(const std::string& dir) {
     std::vector<std::string> out;
     std::error_code ec;
@@ -1052,7 +1134,7 @@ void dialogs(UiState& ui, Editor& ed) {
     ImGui::SetNextWindowSizeConstraints(ImVec2(360 * ui.scale, 0), ImVec2(900 * ui.scale, 600 * ui.scale));
     if (ImGui::BeginPopupModal("Error", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
         ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + 640 * ui.scale);
-        ImGui::TextColored(kRed, "%s", ed.errorModal.c_str());
+        ImGui::TextColored(kRed, "%s", displayableText(ed.errorModal).c_str());
         ImGui::PopTextWrapPos();
         if (ImGui::Button("OK") || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Enter))) {
             ed.errorModal.clear();

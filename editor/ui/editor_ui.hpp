@@ -61,7 +61,7 @@ struct UiState {
     bool viewportHovered = false;
 
     // Dialog buffers
-    std::string openPath, saveAsPath, entityFilter;
+    std::string openPath, saveAsPath, entityFilter, contactFilter;
     bool openDialogRequested = false, saveAsDialogRequested = false, saveStateRequested = false;
     std::optional<std::string> recoveryOffer;  ///< path of a recovery file to offer once
     std::optional<std::string> replaceConfirm; ///< Save as onto this existing file: asked first
@@ -120,6 +120,10 @@ void drawEditorUi(UiState& ui, editor::Editor& ed);
 
 /// The inspector panel (inspector.cpp): driven by the component table.
 void drawInspector(UiState& ui, editor::Editor& ed);
+
+/// `text` with the typographic quotes and dashes the current font has no
+/// glyph for replaced by ASCII (else ImGui draws '?').
+std::string displayableText(const std::string& text);
 
 /// The World the panels read: the running one, else the edit-mode preview.
 const World* panelWorld(UiState& ui, editor::Editor& ed);

@@ -113,9 +113,12 @@ void Session::loadFonts() {
         config.OversampleV = 1;
         config.PixelSnapH = true;
         std::error_code ec;
+        // Latin-1 and General Punctuation: the loader's messages quote
+        // typographic quotes (“ ” ‘ ’) pasted into a level, and dashes.
+        static const ImWchar kRanges[] = {0x0020, 0x00FF, 0x2010, 0x205E, 0};
         for (const char* path : kFontPaths)
             if (std::filesystem::exists(path, ec) &&
-                io.Fonts->AddFontFromFileTTF(path, std::round(size * 1.1f), &config)) {
+                io.Fonts->AddFontFromFileTTF(path, std::round(size * 1.1f), &config, kRanges)) {
                 loaded = true;
                 break;
             }
