@@ -84,7 +84,7 @@ TEST_F(PanelFrames, TypographicQuotesTheFontLacksAreShownAsAscii) {
     // ImGui's built-in font has no U+201C: the error modal showed '?'.
     ImGui::GetIO().DisplaySize = {800, 600};
     ImGui::NewFrame();
-    EXPECT_EQ(stepwise::ui::displayableText("typographic quote \xE2\x80\x9C where JSON needs \"; \xE2\x80\x98a\xE2\x80\x99"),
+    EXPECT_EQ(stepwise::ui::displayableText("typographic quote \xE2\x80\x9C where JSON needs \"; \xE2\x80\x98" "a\xE2\x80\x99"),
               "typographic quote \" where JSON needs \"; 'a'");
     ImGui::EndFrame();
 }
