@@ -875,4 +875,174 @@ TEST(PolygonTool, ConvexHullIsCounterClockwiseWithoutCollinearPoints) {
     ASSERT_EQ(hull.size(), 4u);
     EXPECT_EQ(polygonProblem(hull), "");
     EXPECT_EQ(convexHull({{0, 0}, {1, 1}, {2, 2}}).size(), 2u);
+
+// ---- handles in memory, names in files ------------------------------------------------
+
+namespace {
+
+/// Renames `e` through the inspector's path (setFieldOnAll on "name").
+bool rename(Fixture& f, Entity e, const std::string& to, std::string* problem = nullptr) {
+    const ComponentInfo* name = findComponent("name");
+    return f.ed.applyEdit("rename", [&](Scene& s) {
+        return setFieldOnAll(s, *name, name->fields[0], std::string(to), {e}, problem) > 0;
+    });
+}
+
+} // namespace
+
+TEST(Springs, RenamingABodyKeepsItsSpringPlaysAndSavesTheNewName) {
+    // default.json: "pendulum spring" holds "bob" 2.2 m below an anchor.
+    Fixture f("default.json");
+    const Entity bob = f.named("bob");
+    ASSERT_FALSE(bob.isNull());
+    ASSERT_EQ(springsAttachedTo(f.ed.doc.scene.registry, bob).size(), 1u);
+    ASSERT_TRUE(rename(f, bob, "pendulum"));
+    EXPECT_EQ(f.named("bob"), Entity{});
+    EXPECT_EQ(springsAttachedTo(f.ed.doc.scene.registry, bob).size(), 1u) << "the spring follows the body, not its old name";
+    EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), "");
+
+    // Play two seconds: without its spring bob would fall about 20 m; on it
+    // it swings at about the rest length from the anchor (0, 7.5).
+    f.ed.togglePlay();
+    ASSERT_EQ(f.ed.sim.state(), SimState::Playing) << f.ed.sim.message();
+    f.ed.togglePlay();
+    for (int i = 0; i < 120; ++i) f.ed.stepForward();
+    ASSERT_TRUE(f.ed.sim.message().empty() || f.ed.sim.message().find("no entity") == std::string::npos)
+        << f.ed.sim.message();
+    const Vec2 p = f.ed.doc.scene.registry.tryGet<Position>(bob)->value;
+    EXPECT_LT(length(p - Vec2{0.0, 7.5}), 3.5) << "bob at " << p.x << ", " << p.y;
+    f.ed.resetSimulation();
+
+    // Saved with the new name, and it loads back attached.
+    const std::filesystem::path out = f.tmp.path / "renamed.json";
+    ASSERT_TRUE(f.ed.saveAs(out)) << f.ed.errorModal;
+    const std::string text = readFile(out);
+    EXPECT_NE(text.find("\"a\": \"pendulum\""), std::string::npos) << text;
+    EXPECT_EQ(text.find("\"bob\""), std::string::npos) << text;
+    Result<Scene> back = loadSceneFile(out);
+    ASSERT_TRUE(back) << back.error();
+    const Entity spring = findByName(back->registry, "pendulum spring");
+    ASSERT_FALSE(spring.isNull());
+    EXPECT_EQ(back->registry.tryGet<Spring>(spring)->a, findByName(back->registry, "pendulum"));
+}
+
+TEST(Springs, EndsArePickedInTheViewportOrTheEntityList) {
+    Fixture f("default.json");
+    const Entity spring = f.named("pendulum spring");
+    const ComponentInfo* info = findComponent("spring");
+    const FieldInfo* a = &info->fields[0];
+    ASSERT_EQ(a->kind, FieldKind::EntityRef);
+    f.ed.select({spring});
+    // Viewport: arm the pick, click the wrecking ball; the Select tool does
+    // not select it, the click answers the pick.
+    f.ed.startReferencePick(*info, *a, {spring});
+    f.click(f.positionOf("wrecking ball"));
+    EXPECT_FALSE(f.ed.referencePick.has_value());
+    EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Spring>(spring)->a, f.named("wrecking ball"));
+    EXPECT_EQ(f.ed.selection, std::vector<Entity>{spring});
+    ASSERT_TRUE(f.ed.undo());
+    EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Spring>(spring)->a, f.named("bob"));
+    // The entity list calls finishReferencePick with the row's entity; a
+    // wall is not a body and is refused.
+    f.ed.startReferencePick(*info, *a, {spring});
+    EXPECT_FALSE(f.ed.finishReferencePick(f.named("floor")));
+    EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Spring>(spring)->a, f.named("bob"));
+    // Esc cancels an armed pick.
+    f.ed.startReferencePick(*info, *a, {spring});
+    EXPECT_TRUE(f.ed.handleShortcut(Key::Escape, 0));
+    EXPECT_FALSE(f.ed.referencePick.has_value());
+}
+
+TEST(Inspector, RefusesAtEditTimeWhatTheLoaderRefusesNamingEntityAndField) {
+    Fixture f("default.json");
+    const std::string before = textOf(f.ed.doc.scene);
+    const Entity bob = f.named("bob");
+    ASSERT_TRUE(f.ed.doc.scene.registry.has<Radius>(bob));
+    std::string problem;
+    // A second shape.
+    EXPECT_FALSE(f.ed.applyEdit("add box", [&](Scene& s) { return addComponentToAll(s, *findComponent("box"), {bob}, &problem) > 0; }));
+    EXPECT_EQ(problem, "\"bob\" box: an entity has at most one shape (radius, box or plane), got 2");
+    // A speed whose kinetic energy overflows.
+    const ComponentInfo* velocity = findComponent("velocity");
+    EXPECT_FALSE(f.ed.applyEdit("v", [&](Scene& s) {
+        return setFieldOnAll(s, *velocity, velocity->fields[0], Vec2{1e308, 0.0}, {bob}, &problem) > 0;
+    }));
+    EXPECT_EQ(problem.rfind("\"bob\" velocity: expected a speed up to 1e150 m/s", 0), 0u) << problem;
+    // The same numbers are refused by the loader.
+    EXPECT_FALSE(parseScene(R"({"entities": [{"position": {"x": 0, "y": 0}, "velocity": {"x": 1e308, "y": 0}}]})", "t.json"));
+    // A duplicate name.
+    EXPECT_FALSE(rename(f, bob, "floor", &problem));
+    EXPECT_NE(problem.find("duplicate name \"floor\""), std::string::npos) << problem;
+    // Removing the position of a body that has a velocity.
+    EXPECT_FALSE(f.ed.applyEdit("rm", [&](Scene& s) {
+        return removeComponentFromAll(s, *findComponent("position"), {bob}, &problem) > 0;
+    }));
+    EXPECT_EQ(problem.rfind("\"bob\"", 0), 0u) << problem;
+    EXPECT_NE(problem.find("needs \"position\""), std::string::npos) << problem;
+    // Mass out of range names the entity and the field.
+    const ComponentInfo* mass = findComponent("mass");
+    EXPECT_FALSE(f.ed.applyEdit("m", [&](Scene& s) { return setFieldOnAll(s, *mass, mass->fields[0], -1.0, {bob}, &problem) > 0; }));
+    EXPECT_EQ(problem, "\"bob\" mass: expected a number > 0");
+    // Nothing of it reached the scene.
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+}
+
+TEST(Editing, DeletingABodyWithASpringSaysWhatGoes) {
+    Fixture f("default.json");
+    f.ed.select({f.named("bob")});
+    EXPECT_EQ(f.ed.deleteLabel(f.ed.selection), "delete 1 body and 1 spring");
+    ASSERT_TRUE(f.ed.deleteSelection());
+    EXPECT_EQ(f.ed.status, "delete 1 body and 1 spring");
+    EXPECT_EQ(f.ed.commands.labels().back(), "delete 1 body and 1 spring");
+}
+
+TEST(Editing, PasteAndDuplicateLandAtTheCursor) {
+    Fixture f("default.json");
+    f.ed.select({f.named("bob")});
+    f.ed.copySelection();
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseMove, {6.0, 9.0}));
+    ASSERT_TRUE(f.ed.paste());
+    ASSERT_EQ(f.ed.selection.size(), 1u);
+    const Vec2 pasted = f.ed.doc.scene.registry.tryGet<Position>(f.ed.selection[0])->value;
+    EXPECT_NEAR(pasted.x, 6.0, 1e-9);
+    EXPECT_NEAR(pasted.y, 9.0, 1e-9);
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseMove, {-3.0, 10.0}));
+    ASSERT_TRUE(f.ed.duplicateSelection());
+    const Vec2 dup = f.ed.doc.scene.registry.tryGet<Position>(f.ed.selection[0])->value;
+    EXPECT_NEAR(dup.x, -3.0, 1e-9);
+    EXPECT_NEAR(dup.y, 10.0, 1e-9);
+}
+
+TEST(Simulation, StepCounterIsClearedByResetNewAndOpen) {
+    Fixture f("default.json");
+    for (int i = 0; i < 5; ++i) f.ed.stepForward();
+    ASSERT_EQ(f.ed.sim.steps(), 5u);
+    f.ed.resetSimulation();
+    EXPECT_EQ(f.ed.sim.steps(), 0u);
+    for (int i = 0; i < 3; ++i) f.ed.stepForward();
+    f.ed.newDocument();
+    EXPECT_EQ(f.ed.sim.steps(), 0u);
+    ASSERT_TRUE(f.ed.open(kLevels / "orbit.json"));
+    for (int i = 0; i < 2; ++i) f.ed.stepForward();
+    ASSERT_TRUE(f.ed.open(kLevels / "default.json"));
+    EXPECT_EQ(f.ed.sim.steps(), 0u);
+}
+
+TEST(Files, LevelsFolderIsFoundFromTheExecutableNotTheWorkingFolder) {
+    TempDir elsewhere;
+    // A build folder in a checkout: <src>/build/stepwise -> <src>/levels.
+    const std::filesystem::path levels = findLevelsDirectory(std::filesystem::path(STEPWISE_BINARY).parent_path(), elsewhere.path);
+    EXPECT_TRUE(std::filesystem::exists(levels / "default.json")) << levels;
+    // Nothing beside the executable: the working folder's levels/, then the folder itself.
+    EXPECT_EQ(findLevelsDirectory({}, elsewhere.path), std::filesystem::absolute(elsewhere.path));
+    // Save as asks before writing over another file, not over the document's own.
+    const std::filesystem::path mine = elsewhere.path / "mine.json", other = elsewhere.path / "other.json";
+    std::ofstream(mine) << "{}";
+    std::ofstream(other) << "{}";
+    EXPECT_TRUE(replacesAnotherFile(other, mine));
+    EXPECT_FALSE(replacesAnotherFile(mine, mine));
+    EXPECT_FALSE(replacesAnotherFile(elsewhere.path / "new.json", mine));
+    EXPECT_TRUE(replacesAnotherFile(other, {}));  // untitled
+    EXPECT_EQ(dialogFolder(mine, levels), std::filesystem::absolute(elsewhere.path));
+    EXPECT_EQ(dialogFolder({}, levels), levels);
 }

@@ -130,3 +130,101 @@ TEST(EditorScreenshotDetects, AMovedBodyFailsTheComparison) {
     fs::remove(out);
     fs::remove(level);
 }
+
+// ---- the viewport shows what `stepwise render` shows --------------------------------
+//
+// The editor draws its viewport into a rectangle of a larger window; the
+// renderer alone draws a whole image. The two must agree pixel for pixel
+// (within the golden tolerance) for the same level, camera and size, at any
+// window size: a shader that measures from the window instead of the
+// rectangle (planes were drawn 254 px low at 1280x800) fails here, even when
+// the editor's own goldens were recorded with the fault.
+
+namespace {
+
+struct ViewportState {
+    int x = 0, y = 0, w = 0, h = 0;
+    double cx = 0, cy = 0, zoom = 0;
+};
+
+/// The viewport rectangle and camera from `--debug-state` output.
+bool readViewportState(const fs::path& file, ViewportState& s) {
+    const std::string text = readFile(file);
+    const auto vp = text.find("\"viewport\": [");
+    const auto cam = text.find("\"camera\": [");
+    if (vp == std::string::npos || cam == std::string::npos) return false;
+    double x, y, w, h;
+    if (std::sscanf(text.c_str() + vp, "\"viewport\": [%lf, %lf, %lf, %lf]", &x, &y, &w, &h) != 4) return false;
+    if (std::sscanf(text.c_str() + cam, "\"camera\": [%lf, %lf, %lf]", &s.cx, &s.cy, &s.zoom) != 3) return false;
+    s.x = int(x);
+    s.y = int(y);
+    s.w = int(w);
+    s.h = int(h);
+    return true;
+}
+
+Image crop(const Image& image, int x0, int y0, int w, int h) {
+    Image out{w, h, std::vector<std::uint8_t>(std::size_t(w) * std::size_t(h) * 3)};
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            std::copy_n(image.pixel(x0 + x, y0 + y), 3, out.pixel(x, y));
+    return out;
+}
+
+class ViewportMatchesRender : public ::testing::TestWithParam<const char*> {};
+
+} // namespace
+
+TEST_P(ViewportMatchesRender, AtThisWindowSize) {
+    const std::string size = GetParam();
+    fs::create_directories(kOut);
+    const std::string stem = "viewport_" + size;
+    const fs::path editorPng = kOut / (stem + "-editor.png"), statePath = kOut / (stem + "-state.json");
+    const fs::path renderPng = kOut / (stem + "-render.png");
+    const std::string level = "levels/default.json";  // a floor plane, boxes and circles resting on it
+    std::string cmd = "cd '" + kSource.string() + "' && '" + std::string(STEPWISE_BINARY) + "' edit " + level +
+                      " --builtin-font --size " + size + " --screenshot '" + editorPng.string() + "' --debug-state '" +
+                      statePath.string() + "' 2>/dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    ViewportState vs;
+    ASSERT_TRUE(readViewportState(statePath, vs)) << readFile(statePath);
+    ASSERT_GE(vs.w, 16);
+    ASSERT_GE(vs.h, 16);
+    Result<Image> editor = readPng(editorPng.string());
+    ASSERT_TRUE(editor) << editor.error();
+    ASSERT_LE(vs.x + vs.w, editor->width);
+    ASSERT_LE(vs.y + vs.h, editor->height);
+
+    // The editor starts editing (no World: contacts are not drawn) with the
+    // velocity overlay, and its viewport has the HUD without a caption.
+    char camera[128];
+    std::snprintf(camera, sizeof camera, "%.17g,%.17g,%.17g", vs.cx, vs.cy, vs.zoom);
+    cmd = "cd '" + kSource.string() + "' && '" + std::string(STEPWISE_BINARY) + "' render " + level + " --width " +
+          std::to_string(vs.w) + " --height " + std::to_string(vs.h) + " --camera " + camera +
+          " --overlay velocity --no-caption --out '" + renderPng.string() + "' 2>/dev/null >/dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    Result<Image> rendered = readPng(renderPng.string());
+    ASSERT_TRUE(rendered) << rendered.error();
+
+    Image viewport = crop(*editor, vs.x, vs.y, vs.w, vs.h);
+    // The cursor readout (ImGui text, bottom right of the viewport) is the
+    // editor's own: taken from the render so it does not count.
+    for (int y = std::max(0, vs.h - 24); y < vs.h; ++y)
+        for (int x = std::max(0, vs.w - 270); x < vs.w; ++x) std::copy_n(rendered->pixel(x, y), 3, viewport.pixel(x, y));
+    const ScreenshotSettings settings;
+    const ImageDiff diff = compareImages(*rendered, viewport, settings.channelTolerance);
+    ASSERT_TRUE(diff.sameSize);
+    if (diff.fraction() > settings.maxDifferingFraction) {
+        const fs::path diffPath = kOut / (stem + "-diff.png");
+        (void)writeFileAtomically(kOut / (stem + "-viewport.png"), encodePng(viewport));
+        (void)writeFileAtomically(diffPath, encodePng(diff.visual));
+        FAIL() << size << ": " << diff.differing << " of " << diff.total << " viewport pixels differ from `stepwise render` (box "
+               << diff.x0 << "," << diff.y0 << " - " << diff.x1 << "," << diff.y1 << "); diff " << diffPath;
+    }
+    fs::remove(editorPng);
+    fs::remove(renderPng);
+    fs::remove(statePath);
+}
+
+INSTANTIATE_TEST_SUITE_P(Sizes, ViewportMatchesRender, ::testing::Values("1600x900", "1280x720", "1280x800", "480x360", "320x240"),
+                         [](const ::testing::TestParamInfo<const char*>& p) { return std::string(p.param); });

@@ -15,6 +15,11 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <memory>
+
 namespace {
 
 using stepwise::ui::applyTheme;
@@ -75,6 +80,15 @@ TEST_F(PanelFrames, APanelAloneLeavesItsBackgroundToTheClear) {
     EXPECT_EQ(backgroundVertices("B"), 0);
 }
 
+TEST_F(PanelFrames, TypographicQuotesTheFontLacksAreShownAsAscii) {
+    // ImGui's built-in font has no U+201C: the error modal showed '?'.
+    ImGui::GetIO().DisplaySize = {800, 600};
+    ImGui::NewFrame();
+    EXPECT_EQ(stepwise::ui::displayableText("typographic quote \xE2\x80\x9C where JSON needs \"; \xE2\x80\x98" "a\xE2\x80\x99"),
+              "typographic quote \" where JSON needs \"; 'a'");
+    ImGui::EndFrame();
+}
+
 TEST_F(PanelFrames, OverlappingPanelsDrawTheirBackgrounds) {
     frame({400, 0});
     frame({400, 0});
@@ -130,6 +144,101 @@ TEST(SessionFrame, PresentsThePreviousFrameAfterPhysicsAndBeforeDrawing) {
     EXPECT_EQ(stepsAtPresent, ed.sim.steps());    // and nothing stepped after
     EXPECT_TRUE(atPresent.rgb == shown.rgb);      // the previous frame, untouched
     EXPECT_FALSE(session.capture(w, h).rgb == shown.rgb);  // then this frame was drawn
+}
+
+// ---- layout across window sizes and restarts --------------------------------------
+
+std::unique_ptr<stepwise::ui::Session> persistentSession(const std::filesystem::path& configDir) {
+    stepwise::ui::SessionOptions options;
+    options.persist = true;
+    options.deterministic = true;
+    options.builtinFont = true;
+    options.configDir = configDir;
+    auto created = stepwise::ui::Session::create(
+        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    EXPECT_TRUE(created.ok()) << created.error();
+    return created.ok() ? std::move(*created) : nullptr;
+}
+
+const char* const kPanels[] = {"Tools", "Entities", "Viewport", "Inspector", "World", "Debug"};
+
+/// "" when every panel lies inside the w x h window, else which one does not.
+std::string panelOffScreen(int w, int h) {
+    for (const char* name : kPanels) {
+        const ImGuiWindow* win = ImGui::FindWindowByName(name);
+        if (!win) return std::string(name) + " missing";
+        const ImRect r = win->Rect();
+        if (r.Min.x < -0.5f || r.Min.y < -0.5f || r.Max.x > float(w) + 0.5f || r.Max.y > float(h) + 0.5f)
+            return std::string(name) + " at (" + std::to_string(r.Min.x) + ", " + std::to_string(r.Min.y) + ") - (" +
+                   std::to_string(r.Max.x) + ", " + std::to_string(r.Max.y) + ") in " + std::to_string(w) + "x" +
+                   std::to_string(h);
+    }
+    return {};
+}
+
+ImRect panelRect(const char* name) { return ImGui::FindWindowByName(name)->Rect(); }
+
+TEST(Layout, ShrinkingToTinyAndBackRestoresThePanelsAndIsNotSaved) {
+    const std::filesystem::path config = std::filesystem::temp_directory_path() / ("stepwise-layout-tiny-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(config);
+    auto context = stepwise::render::OffscreenRenderer::create(1280, 800);
+    ASSERT_TRUE(context.ok()) << context.error();
+    ImRect inspectorBefore, viewportBefore;
+    {
+        auto session = persistentSession(config);
+        ASSERT_TRUE(session);
+        for (int i = 0; i < 3; ++i) session->frame(1280, 800, 1.0 / 60.0);
+        inspectorBefore = panelRect("Inspector");
+        viewportBefore = panelRect("Viewport");
+        for (int i = 0; i < 5; ++i) session->frame(40, 30, 1.0 / 60.0);  // ImGui piles every panel at the top left
+        session->saveSettings();  // quitting while tiny must not save the pile
+        for (int i = 0; i < 3; ++i) session->frame(1280, 800, 1.0 / 60.0);
+        EXPECT_EQ(panelOffScreen(1280, 800), "");
+        EXPECT_NEAR(panelRect("Inspector").Min.x, inspectorBefore.Min.x, 1.0f);
+        EXPECT_NEAR(panelRect("Inspector").Min.y, inspectorBefore.Min.y, 1.0f);
+        EXPECT_NEAR(panelRect("Viewport").GetWidth(), viewportBefore.GetWidth(), 1.0f);
+    }
+    {
+        // Restarted after the save made while tiny: the good layout comes back.
+        auto session = persistentSession(config);
+        ASSERT_TRUE(session);
+        for (int i = 0; i < 3; ++i) session->frame(1280, 800, 1.0 / 60.0);
+        EXPECT_EQ(panelOffScreen(1280, 800), "");
+        EXPECT_NEAR(panelRect("Inspector").Min.x, inspectorBefore.Min.x, 1.0f);
+        EXPECT_NEAR(panelRect("Viewport").GetWidth(), viewportBefore.GetWidth(), 1.0f);
+    }
+    std::filesystem::remove_all(config);
+}
+
+TEST(Layout, ALayoutSavedAt1600x900OpensOnScreenAt1280x720AndResetRestoresTheDefault) {
+    const std::filesystem::path config = std::filesystem::temp_directory_path() / ("stepwise-layout-sizes-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(config);
+    auto context = stepwise::render::OffscreenRenderer::create(1600, 900);
+    ASSERT_TRUE(context.ok()) << context.error();
+    {
+        auto session = persistentSession(config);
+        ASSERT_TRUE(session);
+        for (int i = 0; i < 3; ++i) session->frame(1600, 900, 1.0 / 60.0);
+        EXPECT_EQ(panelOffScreen(1600, 900), "");
+        session->saveSettings();
+    }
+    auto session = persistentSession(config);
+    ASSERT_TRUE(session);
+    for (int i = 0; i < 3; ++i) session->frame(1280, 720, 1.0 / 60.0);
+    EXPECT_EQ(panelOffScreen(1280, 720), "");
+    // Move a panel, then View > Reset layout: back to the default rectangles.
+    ImGui::SetWindowPos("Inspector", ImVec2(20, 30));
+    session->frame(1280, 720, 1.0 / 60.0);
+    ASSERT_NEAR(panelRect("Inspector").Min.x, 20.0f, 1.0f);
+    session->ui().resetLayoutRequested = true;
+    session->frame(1280, 720, 1.0 / 60.0);
+    const stepwise::ui::PanelRects defaults = stepwise::ui::defaultLayout(1280, 720, session->ui().scale);
+    EXPECT_NEAR(panelRect("Inspector").Min.x, defaults.inspectorPos.x, 0.5f);
+    EXPECT_NEAR(panelRect("Inspector").Min.y, defaults.inspectorPos.y, 0.5f);
+    EXPECT_NEAR(panelRect("Viewport").GetWidth(), defaults.viewportSize.x, 0.5f);
+    EXPECT_NEAR(panelRect("Debug").Min.y, defaults.debugPos.y, 0.5f);
+    session.reset();
+    std::filesystem::remove_all(config);
 }
 
 } // namespace

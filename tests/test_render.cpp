@@ -186,9 +186,10 @@ TEST(RenderBatching, ContactMarkersAndAnchoredSpringsDoNotSplitBatches) {
     // segments. Drawn item by item they used to start a new batch (a draw
     // call) per item: 4,000 draw calls for 2,000 contacts.
     Scene scene = packedCircles(10, 20);
+    const std::vector<Entity> order = scene.registry.entities();  // the floor, then c0 .. c199
     for (int i = 0; i < 20; ++i) {
         Entity s = scene.registry.create();
-        scene.registry.emplace<Spring>(s, {std::string("c").append(std::to_string(180 + i)), "", Vec2{0.5 * i, 8.0}, 50.0, 0.5, 2.0});
+        scene.registry.emplace<Spring>(s, {order.at(std::size_t(1 + 180 + i)), Entity{}, Vec2{0.5 * i, 8.0}, 50.0, 0.5, 2.0});
     }
     Result<World> world = World::build(scene);
     ASSERT_TRUE(world.ok()) << world.error();
@@ -276,6 +277,36 @@ TEST(RenderBatching, SameInputSameFloats) {
     const DrawData a = buildDrawData(input, 640, 480), b = buildDrawData(input, 640, 480);
     ASSERT_EQ(a.batches.size(), b.batches.size());
     for (std::size_t i = 0; i < a.batches.size(); ++i) EXPECT_EQ(a.batches[i].data, b.batches[i].data);
+}
+
+TEST(RenderContacts, AFloorContactArrowPointsOutOfTheFloor) {
+    // A ball resting on y = 0: the contact's normal points from the ball
+    // into the floor; the arrow shows the impulse on the ball, upwards.
+    Scene scene;
+    const Entity floor = scene.registry.create();
+    scene.registry.emplace<Plane>(floor, {{0.0, 1.0}, 0.0});
+    const Entity ball = scene.registry.create();
+    scene.registry.emplace<Position>(ball, {{0.0, 0.49}});
+    scene.registry.emplace<Velocity>(ball, {{0.0, 0.0}});
+    scene.registry.emplace<Mass>(ball, {1.0});
+    scene.registry.emplace<Radius>(ball, {0.5});
+    Result<World> world = World::build(scene);
+    ASSERT_TRUE(world.ok()) << world.error();
+    ASSERT_TRUE(world->step());
+    ASSERT_FALSE(world->contacts().empty());
+    FrameInput input;
+    input.scene = &scene;
+    input.world = &*world;
+    input.camera = Camera{{0.0, 0.0}, 40.0};
+    input.overlays = *parseOverlayList("contacts");
+    input.hud = false;
+    const DrawData data = buildDrawData(input, 400, 300);
+    int arrows = 0;
+    for (const Batch& b : data.batches)
+        if (b.kind == BatchKind::Arrow)
+            for (std::size_t i = 0; i < b.count(); ++i, ++arrows)
+                EXPECT_GT(b.data[i * 9 + 3], b.data[i * 9 + 1]) << "tip below the base: the arrow points into the floor";
+    EXPECT_GT(arrows, 0);
 }
 
 } // namespace

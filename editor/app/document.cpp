@@ -64,6 +64,39 @@ std::filesystem::path configDirectory() {
     return std::filesystem::path(".stepwise");
 }
 
+std::filesystem::path executableDirectory() {
+    std::error_code ec;
+    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    return ec ? std::filesystem::path() : exe.parent_path();
+}
+
+std::filesystem::path findLevelsDirectory(const std::filesystem::path& exeDir, const std::filesystem::path& workingDir) {
+    std::error_code ec;
+    std::vector<std::filesystem::path> candidates;
+    if (!exeDir.empty())
+        for (const char* relative : {"levels", "../levels", "../share/stepwise/levels"})
+            candidates.push_back(exeDir / relative);
+    candidates.push_back(workingDir / "levels");
+    for (const std::filesystem::path& c : candidates)
+        if (std::filesystem::is_directory(c, ec)) return std::filesystem::weakly_canonical(c, ec);
+    return std::filesystem::absolute(workingDir, ec);
+}
+
+std::filesystem::path dialogFolder(const std::filesystem::path& documentPath, const std::filesystem::path& levelsDir) {
+    std::error_code ec;
+    if (!documentPath.empty()) {
+        const std::filesystem::path folder = std::filesystem::absolute(documentPath, ec).parent_path();
+        if (std::filesystem::is_directory(folder, ec)) return folder;
+    }
+    return levelsDir;
+}
+
+bool replacesAnotherFile(const std::filesystem::path& target, const std::filesystem::path& documentPath) {
+    std::error_code ec;
+    if (!std::filesystem::exists(target, ec)) return false;
+    return documentPath.empty() || !std::filesystem::equivalent(target, documentPath, ec);
+}
+
 void Settings::addRecent(const std::string& file) {
     std::erase(recentFiles, file);
     recentFiles.insert(recentFiles.begin(), file);
@@ -82,6 +115,14 @@ Settings Settings::load(const std::filesystem::path& configDir) {
             char* end = nullptr;
             const float f = std::strtof(value.c_str(), &end);
             if (end != value.c_str() && f >= 6.0f && f <= 64.0f) s.fontSize = f;
+        } else if (key == "panel") {
+            // A damaged line is skipped: the panel then starts at its default.
+            std::istringstream fields(value);
+            std::string name;
+            std::array<float, 4> r{};
+            if (fields >> name >> r[0] >> r[1] >> r[2] >> r[3] && r[2] > 0.0f && r[3] > 0.0f && r[2] <= 1.0f &&
+                r[3] <= 1.0f && r[0] >= -1.0f && r[0] <= 1.0f && r[1] >= -1.0f && r[1] <= 1.0f)
+                s.panels[name] = r;
         }
     }
     return s;
@@ -94,6 +135,12 @@ Result<void> Settings::save(const std::filesystem::path& configDir) const {
     std::string text;
     for (const std::string& f : recentFiles) text += "recent " + f + "\n";
     if (fontSize > 0.0f) text += "font_size " + std::to_string(fontSize) + "\n";
+    for (const auto& [name, r] : panels) {
+        std::ostringstream line;
+        line.precision(6);
+        line << "panel " << name << ' ' << r[0] << ' ' << r[1] << ' ' << r[2] << ' ' << r[3] << '\n';
+        text += line.str();
+    }
     return writeFileAtomically(configDir / "settings.txt", text);
 }
 

@@ -8,7 +8,9 @@
 #include "stepwise/result.hpp"
 #include "stepwise/scene.hpp"
 
+#include <array>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -50,9 +52,30 @@ std::filesystem::path configDirectory();
 /// What persists between runs: recent files and the font size. Kept in
 /// CONFIG/settings.txt as "key value" lines (a format that tolerates being
 /// hand-edited or truncated: unknown or bad lines are skipped).
+/// The folder holding the running executable (from /proc/self/exe), or an
+/// empty path when it cannot be read.
+std::filesystem::path executableDirectory();
+
+/// Where the level files are, whatever folder the editor was started from:
+/// `levels/` beside the executable, one folder up (build/stepwise in a source
+/// checkout), or `../share/stepwise/levels` (an installed copy); failing
+/// those, `levels/` under `workingDir`, then `workingDir` itself. Absolute.
+std::filesystem::path findLevelsDirectory(const std::filesystem::path& exeDir, const std::filesystem::path& workingDir);
+
+/// The folder the Open and Save as dialogs start in: the open document's
+/// folder, else `levelsDir`.
+std::filesystem::path dialogFolder(const std::filesystem::path& documentPath, const std::filesystem::path& levelsDir);
+
+/// True when saving to `target` would write over a file other than the
+/// document's own (`documentPath`): Save as asks first.
+bool replacesAnotherFile(const std::filesystem::path& target, const std::filesystem::path& documentPath);
+
 struct Settings {
     std::vector<std::string> recentFiles;  ///< newest first, at most 10
     float fontSize = 0.0f;                 ///< pixels; 0 = from the display's DPI
+    /// Panel rectangles as fractions (x, y, w, h) of the window, by panel
+    /// name ("panel NAME x y w h" lines): the layout, whatever the window size.
+    std::map<std::string, std::array<float, 4>> panels;
     void addRecent(const std::string& file);
     static Settings load(const std::filesystem::path& configDir);
     Result<void> save(const std::filesystem::path& configDir) const;

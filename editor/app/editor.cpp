@@ -207,6 +207,29 @@ void Editor::pruneSelection() {
     if (!doc.scene.registry.alive(springStart_)) springStart_ = {};
 }
 
+void Editor::startReferencePick(const ComponentInfo& component, const FieldInfo& field, std::vector<Entity> entities) {
+    referencePick = ReferencePick{&component, &field, std::move(entities)};
+    note("pick " + std::string(component.name) + "." + std::string(field.key) +
+         ": click a body in the viewport or the entity list (Esc cancels)");
+}
+
+bool Editor::finishReferencePick(Entity target) {
+    if (!referencePick) return false;
+    const ReferencePick p = *referencePick;
+    referencePick.reset();
+    if (!isBody(doc.scene.registry, target)) {
+        note("pick cancelled: " + displayName(doc.scene.registry, target) + " is not a body");
+        return false;
+    }
+    std::string problem;
+    const std::string what = "set " + std::string(p.component->name) + "." + std::string(p.field->key) + " to " +
+                             displayName(doc.scene.registry, target);
+    if (applyEdit(what, [&](Scene& s) { return setFieldOnAll(s, *p.component, *p.field, target, p.entities, &problem) > 0; }))
+        return true;
+    status = problem.empty() ? "nothing changed" : "refused: " + problem;
+    return false;
+}
+
 void Editor::select(std::vector<Entity> entities) {
     selection = std::move(entities);
     pruneSelection();
@@ -214,11 +237,51 @@ void Editor::select(std::vector<Entity> entities) {
 
 void Editor::selectAll() { select(doc.scene.registry.entities()); }
 
+Vec2 Editor::placementOffset(const Registry& src, const std::vector<Entity>& entities, int count) const {
+    // The copies' centre goes under the cursor (snapped like a placement);
+    // with no cursor over the viewport yet, beside the originals.
+    Vec2 sum;
+    int n = 0;
+    for (Entity e : entities)
+        if (const Position* p = src.tryGet<Position>(e)) {
+            sum += p->value;
+            ++n;
+        }
+    if (!mouseKnown_ || n == 0) return Vec2{0.5 * count, -0.5 * count};
+    return snapped(view.toWorld(mouse_)) - sum / double(n);
+}
+
+std::string Editor::deleteLabel(const std::vector<Entity>& doomed) const {
+    // Says what goes, by kind: "delete 1 body and 1 spring".
+    const Registry& reg = doc.scene.registry;
+    std::size_t bodies = 0, springs = 0, walls = 0, others = 0;
+    std::vector<Entity> all = doomed;
+    for (Entity s : attachedTo(reg, doomed)) all.push_back(s);
+    for (Entity e : all) {
+        if (!reg.alive(e)) continue;
+        if (reg.has<Spring>(e)) ++springs;
+        else if (reg.has<Plane>(e)) ++walls;
+        else if (isBody(reg, e)) ++bodies;
+        else ++others;
+    }
+    std::vector<std::string> parts;
+    auto add = [&](std::size_t n, const char* one, const char* many) {
+        if (n) parts.push_back(std::to_string(n) + " " + (n == 1 ? one : many));
+    };
+    add(bodies, "body", "bodies");
+    add(springs, "spring", "springs");
+    add(walls, "wall", "walls");
+    add(others, "entity", "entities");
+    std::string label = "delete ";
+    for (std::size_t i = 0; i < parts.size(); ++i)
+        label += (i == 0 ? "" : i + 1 == parts.size() ? " and " : ", ") + parts[i];
+    return label;
+}
+
 bool Editor::deleteSelection() {
     if (selection.empty()) return false;
     const std::vector<Entity> doomed = selection;
-    const bool done = applyEdit("delete " + std::to_string(doomed.size()) + " entit" + (doomed.size() == 1 ? "y" : "ies"),
-                                [&](Scene& s) { return destroyWithSprings(s, doomed) > 0; });
+    const bool done = applyEdit(deleteLabel(doomed), [&](Scene& s) { return destroyWithSprings(s, doomed) > 0; });
     selection.clear();
     return done;
 }
@@ -229,7 +292,7 @@ bool Editor::duplicateSelection() {
     const std::vector<Entity> source = selection;
     const bool done = applyEdit("duplicate", [&](Scene& s) {
         const Registry copy = s.registry;  // read from a stable copy while creating
-        created = cloneEntities(copy, source, s, {0.5, -0.5});
+        created = cloneEntities(copy, source, s, placementOffset(copy, source, 1));
         return !created.empty();
     });
     if (done) selection = created;
@@ -248,7 +311,7 @@ bool Editor::paste() {
     if (clipboardEntities_.empty()) return false;
     ++pasteCount_;
     std::vector<Entity> created;
-    const Vec2 offset{0.5 * pasteCount_, -0.5 * pasteCount_};
+    const Vec2 offset = placementOffset(clipboard_.registry, clipboardEntities_, pasteCount_);
     const bool done = applyEdit("paste", [&](Scene& s) {
         // Handles to bodies outside the copy mean something only in the
         // document they were copied from.
@@ -362,6 +425,11 @@ bool Editor::handleShortcut(Key key, std::uint8_t mods) {
     case Key::Escape:
         springStart_ = {};
         polygonClicks_.clear();
+        if (referencePick) {
+            referencePick.reset();
+            note("pick cancelled");
+            return true;
+        }
         if (drag_ == Drag::None) selection.clear();
         return true;
     case Key::F1: uiRequest = UiRequest::Help; return true;
@@ -430,6 +498,7 @@ void Editor::handleViewportEvent(const InputEvent& e) {
         return;
     case T::MouseDown: {
         mouse_ = px;
+        mouseKnown_ = true;
         dragStartPx_ = px;
         dragButton_ = e.button;
         const Vec2 world = view.toWorld(px);
@@ -444,6 +513,12 @@ void Editor::handleViewportEvent(const InputEvent& e) {
         }
         additive_ = (e.mods & (kModShift | kModCtrl)) != 0;
         Entity hit = pick(doc.scene, world, pickRadius());
+        if (referencePick) {
+            // Whatever the tool: this click answers the inspector's pick.
+            if (hit.isNull()) note("pick: no body there (Esc cancels)");
+            else finishReferencePick(hit);
+            return;
+        }
         switch (tool) {
         case Tool::Select:
         case Tool::Rotate: {
@@ -578,6 +653,7 @@ void Editor::handleViewportEvent(const InputEvent& e) {
     case T::MouseMove: {
         const Vec2 prev = mouse_;
         mouse_ = px;
+        mouseKnown_ = true;
         const Vec2 world = view.toWorld(px);
         switch (drag_) {
         case Drag::Pan: view.pan(px - prev); return;
@@ -634,6 +710,7 @@ void Editor::handleViewportEvent(const InputEvent& e) {
     }
     case T::MouseUp: {
         mouse_ = px;
+        mouseKnown_ = true;
         const Drag finished = drag_;
         drag_ = Drag::None;
         endEdit();

@@ -13,6 +13,8 @@
 
 #include "render/frame.hpp"
 
+#include "stepwise/component_table.hpp"
+
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -82,9 +84,27 @@ public:
     bool undo();
     bool redo();
 
+    /// Choosing the entity an entity-reference field (a spring end) points
+    /// at: armed from the inspector, finished by clicking a body in the
+    /// viewport or the entity list. Ends are picked, never typed.
+    struct ReferencePick {
+        const ComponentInfo* component = nullptr;
+        const FieldInfo* field = nullptr;
+        std::vector<Entity> entities;  ///< whose field is set
+    };
+    std::optional<ReferencePick> referencePick;
+    void startReferencePick(const ComponentInfo& component, const FieldInfo& field, std::vector<Entity> entities);
+    /// Sets the armed field to `target` as one undoable edit (refused like
+    /// any inspector edit: the status names the entity and the field).
+    /// Returns true when the edit was made; the pick ends either way.
+    bool finishReferencePick(Entity target);
+
     void select(std::vector<Entity> entities);
     void selectAll();
     bool deleteSelection();
+    /// What deleting `entities` takes with it, by kind, as the undo label:
+    /// "delete 1 body and 1 spring".
+    std::string deleteLabel(const std::vector<Entity>& entities) const;
     bool duplicateSelection();
     void copySelection();
     bool paste();
@@ -163,6 +183,10 @@ private:
     void replaceDocument(Document next);
     void pruneSelection();
     Vec2 snapped(Vec2 world) const;
+    /// Offset that puts copies of `entities` (in `src`) under the cursor;
+    /// without a cursor, `count` x (0.5, -0.5) m beside the originals.
+    Vec2 placementOffset(const Registry& src, const std::vector<Entity>& entities, int count) const;
+    bool mouseKnown_ = false;  ///< the cursor has been over the viewport
     double pickRadius() const;
     void placeAt(Vec2 world);
     /// The regular polygon the current drag describes (world metres), or

@@ -360,6 +360,7 @@ bool Simulation::reset(Scene& scene) {
     history_.clear();
     historyStateBytes_ = 0;
     sceneAtBuild_.reset();
+    steps_ = 0;  // the step counter belongs to the run that ended
     stale_ = true;
     message_.clear();
     diverged_ = false;

@@ -659,6 +659,13 @@ void addEditCommand(CLI::App& app, int& exitCode) {
             exitCode = kExitBadInput;
             return;
         }
+        // Started from another folder with no level named: the default level
+        // beside the executable, not a "levels/default.json" that is not there.
+        std::error_code ec;
+        if (o->level == "levels/default.json" && !std::filesystem::exists(o->level, ec))
+            o->level = (editor::findLevelsDirectory(editor::executableDirectory(), std::filesystem::current_path(ec)) /
+                        "default.json")
+                           .string();
         const bool headless = o->headless || !o->script.empty() || !o->screenshot.empty();
         exitCode = headless ? runScripted(*o, w, h) : runWindow(*o, w, h);
     });

@@ -41,6 +41,7 @@ struct RenderOptions {
     std::string select;
     int trail = 48;
     bool noHud = false;
+    bool noCaption = false;
 };
 
 /// "X,Y,ZOOM" -> Camera; the error names the argument.
@@ -200,8 +201,9 @@ int render(const RenderOptions& o) {
             }
         }
         if (world) world->writeBack(*scene);
-        input.caption = levelName + "  |  t = " + number(scene->world.time) + " s  |  step " +
-                        std::to_string(stepsTaken) + "  |  " + scene->world.integrator;
+        input.caption = o.noCaption ? std::string()
+                                    : levelName + "  |  t = " + number(scene->world.time) + " s  |  step " +
+                                          std::to_string(stepsTaken) + "  |  " + scene->world.integrator;
 
         const auto start = std::chrono::steady_clock::now();
         render::DrawData drawn;
@@ -252,6 +254,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--select", o->select, "Comma-separated entity names to highlight");
     cmd->add_option("--trail", o->trail, "Trail length, recorded steps")->check(CLI::Range(2, 100000));
     cmd->add_flag("--no-hud", o->noHud, "Omit the caption, scale bar and legend");
+    cmd->add_flag("--no-caption", o->noCaption,
+                  "Omit the caption only (the editor's viewport has none: tests compare the two)");
     cmd->callback([o, &exitCode] { exitCode = render(*o); });
 }
 

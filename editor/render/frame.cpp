@@ -961,11 +961,13 @@ void Builder::contacts() {
         const ContactRecord& c = records[i];
         const Vec2 p = points[i];
         if (!thin.keep(p, selected_.count(c.a) != 0 || selected_.count(c.b) != 0)) continue;
-        // Normal arrow: length from the normal impulse (a short stub when
-        // the contact carried none, so the normal still shows).
+        // The impulse on body a, which is along -normal (the normal points
+        // from a to b): out of a floor, not into it. Length from the normal
+        // impulse (a short stub when the contact carried none, so the
+        // direction still shows).
         const double m = std::abs(c.normalImpulse);
         const double len = m > 0.0 ? std::max(8.0, arrowLength(m, ref, arrowRef_, 3.2 * arrowRef_)) : 10.0;
-        arrow(p, p + c.normal * len, thin.active() ? 1.0 : 1.5, kContactNormal);
+        arrow(p, p - c.normal * len, thin.active() ? 1.0 : 1.5, kContactNormal);
         disc(p, thin.active() ? 2.0 : 3.0, 0.0, kContactPoint, kFlat);
     }
     legend_.push_back({"contact impulse", kContactNormal, ref, "N s"});

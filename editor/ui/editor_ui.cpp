@@ -76,10 +76,17 @@ PanelRects defaultLayout(float width, float height, float scale) {
     PanelRects r;
     const float menu = 13.0f * scale + 8.0f;    // menu bar: font height + frame padding
     const float status = 13.0f * scale + 10.0f;  // status bar
-    const float left = std::round(230.0f * scale), right = std::round(330.0f * scale);
+    float left = std::round(230.0f * scale), right = std::round(330.0f * scale);
+    // A narrow window: the side panels give way so the viewport keeps 40%
+    // of the width (at 320 px wide it was pushed off the right edge).
+    if (width - left - right < 0.4f * width) {
+        const float shrink = 0.6f * width / (left + right);
+        left = std::floor(left * shrink);
+        right = std::floor(right * shrink);
+    }
     const float bottom = std::round(std::min(230.0f * scale, 0.3f * height));
     const float top = menu, usable = height - menu - status;
-    const float centerW = std::max(100.0f, width - left - right);
+    const float centerW = width - left - right;
     const float toolsH = std::round(std::min(300.0f * scale, usable * 0.45f));
     r.toolsPos = {0, top};
     r.toolsSize = {left, toolsH};
@@ -95,6 +102,29 @@ PanelRects defaultLayout(float width, float height, float scale) {
     r.worldPos = {left + centerW, top + inspectorH};
     r.worldSize = {right, usable - inspectorH};
     return r;
+}
+
+void placePanel(const UiState& ui, const char* name, ImVec2 defaultPos, ImVec2 defaultSize) {
+    const ImVec2 display = ImGui::GetIO().DisplaySize;
+    if (ui.applyLayout == UiState::ApplyLayout::Default) {
+        ImGui::SetNextWindowPos(defaultPos, ImGuiCond_Always);
+        ImGui::SetNextWindowSize(defaultSize, ImGuiCond_Always);
+        return;
+    }
+    if (ui.applyLayout == UiState::ApplyLayout::Fractions) {
+        if (const auto it = ui.panelFractions.find(name); it != ui.panelFractions.end()) {
+            const ImVec4 f = it->second;
+            // Scaled to the window, then kept inside it.
+            ImVec2 size(std::min(f.z * display.x, display.x), std::min(f.w * display.y, display.y));
+            ImVec2 pos(std::clamp(f.x * display.x, 0.0f, display.x - size.x),
+                       std::clamp(f.y * display.y, 0.0f, display.y - size.y));
+            ImGui::SetNextWindowPos(ImVec2(std::round(pos.x), std::round(pos.y)), ImGuiCond_Always);
+            ImGui::SetNextWindowSize(ImVec2(std::round(size.x), std::round(size.y)), ImGuiCond_Always);
+            return;
+        }
+    }
+    ImGui::SetNextWindowPos(defaultPos, ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(defaultSize, ImGuiCond_FirstUseEver);
 }
 
 bool beginPanel(const char* name, bool* open, ImGuiWindowFlags flags) {
@@ -182,6 +212,46 @@ namespace {
 
 // ---- menus -----------------------------------------------------------------------
 
+// ---- layout ------------------------------------------------------------------------
+
+const char* const kPanelNames[] = {"Tools", "Entities", "Viewport", "Inspector", "World", "Debug"};
+
+bool usableLayoutSize(ImVec2 display) { return display.x >= kMinLayoutWidth && display.y >= kMinLayoutHeight; }
+
+/// Decides this frame's placement: the default (Reset layout, or nothing
+/// known), the remembered fractions scaled to a window whose size changed
+/// (or that was too small to lay out meanwhile, when ImGui clamped every
+/// panel towards the top left), or wherever the panels are (ImGui's own).
+void beginLayout(UiState& ui, ImVec2 display) {
+    ui.applyLayout = UiState::ApplyLayout::None;
+    if (!usableLayoutSize(display)) {
+        ui.layoutInterrupted = true;  // nothing is recorded; the panels come back when the window does
+        return;
+    }
+    if (ui.resetLayoutRequested) {
+        ui.resetLayoutRequested = false;
+        ui.applyLayout = UiState::ApplyLayout::Default;
+    } else if (!ui.panelFractions.empty() &&
+               (ui.layoutInterrupted || display.x != ui.layoutDisplay.x || display.y != ui.layoutDisplay.y)) {
+        ui.applyLayout = UiState::ApplyLayout::Fractions;
+    }
+    ui.layoutInterrupted = false;
+}
+
+/// Records where the panels are, as fractions of the window, when the
+/// window is large enough to hold a layout; never while it is not, so a
+/// window shrunk to 40x30 neither keeps nor saves the pile it makes.
+void endLayout(UiState& ui, ImVec2 display) {
+    if (!usableLayoutSize(display)) return;
+    for (const char* name : kPanelNames) {
+        const ImGuiWindow* w = ImGui::FindWindowByName(name);
+        if (!w || !w->WasActive) continue;
+        ui.panelFractions[name] = ImVec4(w->Pos.x / display.x, w->Pos.y / display.y, w->Size.x / display.x,
+                                         w->Size.y / display.y);
+    }
+    ui.layoutDisplay = display;
+}
+
 void menuBar(UiState& ui, Editor& ed) {
     if (!ImGui::BeginMainMenuBar()) return;
     if (ImGui::BeginMenu("File")) {
@@ -234,6 +304,11 @@ void menuBar(UiState& ui, Editor& ed) {
         ImGui::MenuItem("Inspector", nullptr, &ui.showInspector);
         ImGui::MenuItem("World", nullptr, &ui.showWorld);
         ImGui::MenuItem("Debug (contacts, plots, profile)", nullptr, &ui.showDebug);
+        if (ImGui::MenuItem("Reset layout")) {
+            // Every panel back where a first start puts it, and shown.
+            ui.resetLayoutRequested = true;
+            ui.showTools = ui.showEntities = ui.showInspector = ui.showWorld = ui.showDebug = true;
+        }
         if (ui.fontSizeSetting) {
             ImGui::Separator();
             float size = *ui.fontSizeSetting > 0 ? *ui.fontSizeSetting : 13.0f * ui.scale;
@@ -265,8 +340,7 @@ void menuBar(UiState& ui, Editor& ed) {
 
 void toolsPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     if (!ui.showTools) return;
-    ImGui::SetNextWindowPos(r.toolsPos, ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(r.toolsSize, ImGuiCond_FirstUseEver);
+    placePanel(ui, "Tools", r.toolsPos, r.toolsSize);
     if (beginPanel("Tools", &ui.showTools)) {
         const float bw = (ImGui::GetContentRegionAvail().x - ImGui::GetStyle().ItemSpacing.x) / 2;
         for (int t = 0; t < int(Tool::Count); ++t) {
@@ -332,8 +406,7 @@ void toolsPanel(UiState& ui, Editor& ed, const PanelRects& r) {
 
 void entitiesPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     if (!ui.showEntities) return;
-    ImGui::SetNextWindowPos(r.entitiesPos, ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(r.entitiesSize, ImGuiCond_FirstUseEver);
+    placePanel(ui, "Entities", r.entitiesPos, r.entitiesSize);
     if (beginPanel("Entities", &ui.showEntities)) {
         const Registry& reg = ed.doc.scene.registry;
         ImGui::SetNextItemWidth(-1);
@@ -364,7 +437,9 @@ void entitiesPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                 ImGui::PushID(int(e.index));
                 const std::string label = editor::displayName(reg, e);
                 if (ImGui::Selectable(label.c_str(), selected)) {
-                    if (ImGui::GetIO().KeyCtrl || ImGui::GetIO().KeyShift) {
+                    if (ed.referencePick) {
+                        ed.finishReferencePick(e);  // the inspector asked for a body: this is the answer
+                    } else if (ImGui::GetIO().KeyCtrl || ImGui::GetIO().KeyShift) {
                         if (selected) std::erase(ed.selection, e);
                         else ed.selection.push_back(e);
                     } else {
@@ -397,9 +472,14 @@ void simToolbar(UiState& ui, Editor& ed) {
     ImGui::EndDisabled();
     ImGui::SameLine();
     float scale = float(ed.sim.timeScale);
-    ImGui::SetNextItemWidth(110 * ui.scale);
-    if (ImGui::SliderFloat("##timescale", &scale, 0.05f, 4.0f, "time x%.2f", ImGuiSliderFlags_Logarithmic))
+    // The value is written beside the slider: inside it, the handle sat on
+    // top of the digits.
+    ImGui::SetNextItemWidth(80 * ui.scale);
+    if (ImGui::SliderFloat("##timescale", &scale, 0.05f, 4.0f, "", ImGuiSliderFlags_Logarithmic))
         ed.sim.timeScale = scale;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Simulated seconds per real second (Ctrl+click to type)");
+    ImGui::SameLine(0, 4 * ui.scale);
+    ImGui::Text("time x%.2f", ed.sim.timeScale);
     ImGui::SameLine();
     bool breakOn = !ed.sim.breakOnContact.isNull();
     const bool canBreak = ed.selection.size() == 1;
@@ -415,8 +495,7 @@ void simToolbar(UiState& ui, Editor& ed) {
 }
 
 void viewportPanel(UiState& ui, Editor& ed, const PanelRects& r) {
-    ImGui::SetNextWindowPos(r.viewportPos, ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(r.viewportSize, ImGuiCond_FirstUseEver);
+    placePanel(ui, "Viewport", r.viewportPos, r.viewportSize);
     ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
     // The scene is drawn into the window before ImGui (Session::frame), so
     // this panel has no background of its own, and it stays behind every
@@ -489,8 +568,7 @@ void viewportPanel(UiState& ui, Editor& ed, const PanelRects& r) {
 
 void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     if (!ui.showWorld) return;
-    ImGui::SetNextWindowPos(r.worldPos, ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(r.worldSize, ImGuiCond_FirstUseEver);
+    placePanel(ui, "World", r.worldPos, r.worldSize);
     if (beginPanel("World", &ui.showWorld)) {
         WorldSettings ws = ed.doc.scene.world;
         auto edited = [&](const char* label) {
@@ -621,20 +699,69 @@ void contactsTab(UiState& ui, Editor& ed) {
         return;
     }
     const auto contacts = w->contacts();
-    ImGui::Text("%zu contacts this step", contacts.size());
-    if (contacts.empty()) return;
     const Registry& reg = ed.doc.scene.registry;
-    if (ImGui::BeginTable("contacts", 6, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_Borders |
-                                             ImGuiTableFlags_Resizable)) {
+    ImGui::Text("%zu contacts this step", contacts.size());
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(180 * ui.scale);
+    ImGui::InputTextWithHint("##contactfilter", "filter by body name", &ui.contactFilter);
+    ImGui::SameLine();
+    ImGui::TextColored(kDim, "(?)");
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("normal: unit, from a to b. depth > 0: the shapes overlap by that much; depth < 0: a gap "
+                          "(a speculative contact, not touching yet).\nimpulse: normal and tangent (friction) "
+                          "impulse the solver applied this step. The pair that stopped the run is in red.");
+    if (contacts.empty()) return;
+    // Rows shown: filtered by name, in the order the header asks for.
+    std::vector<std::size_t> rows;
+    for (std::size_t i = 0; i < contacts.size(); ++i) {
+        if (!ui.contactFilter.empty()) {
+            const ContactRecord& c = contacts[i];
+            const bool match = editor::displayName(reg, c.a).find(ui.contactFilter) != std::string::npos ||
+                               (reg.alive(c.b) && editor::displayName(reg, c.b).find(ui.contactFilter) != std::string::npos);
+            if (!match) continue;
+        }
+        rows.push_back(i);
+    }
+    if (ImGui::BeginTable("contacts", 7, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_Borders |
+                                             ImGuiTableFlags_Resizable | ImGuiTableFlags_Sortable)) {
         ImGui::TableSetupScrollFreeze(0, 1);
-        for (const char* h : {"a", "b", "point [m]", "normal", "depth [m]", "impulse [N s]"}) ImGui::TableSetupColumn(h);
+        for (const char* h : {"a", "b", "point [m]", "normal", "depth [m]", "normal impulse [N s]", "tangent impulse [N s]"})
+            ImGui::TableSetupColumn(h);
         ImGui::TableHeadersRow();
+        if (const ImGuiTableSortSpecs* sort = ImGui::TableGetSortSpecs(); sort && sort->SpecsCount > 0) {
+            const int column = sort->Specs[0].ColumnIndex;
+            const bool descending = sort->Specs[0].SortDirection == ImGuiSortDirection_Descending;
+            auto key = [&](std::size_t i) -> double {
+                const ContactRecord& c = contacts[i];
+                switch (column) {
+                case 2: return c.point.x;
+                case 3: return c.normal.y;
+                case 4: return c.depth;
+                case 5: return c.normalImpulse;
+                case 6: return c.tangentImpulse;
+                default: return 0.0;
+                }
+            };
+            std::stable_sort(rows.begin(), rows.end(), [&](std::size_t x, std::size_t y) {
+                if (column <= 1) {
+                    const Entity ex = column == 0 ? contacts[x].a : contacts[x].b;
+                    const Entity ey = column == 0 ? contacts[y].a : contacts[y].b;
+                    const std::string nx = reg.alive(ex) ? editor::displayName(reg, ex) : std::string();
+                    const std::string ny = reg.alive(ey) ? editor::displayName(reg, ey) : std::string();
+                    return descending ? ny < nx : nx < ny;
+                }
+                return descending ? key(y) < key(x) : key(x) < key(y);
+            });
+        }
         ImGuiListClipper clipper;
-        clipper.Begin(int(contacts.size()));
+        clipper.Begin(int(rows.size()));
         while (clipper.Step())
             for (int i = clipper.DisplayStart; i < clipper.DisplayEnd; ++i) {
-                const ContactRecord& c = contacts[std::size_t(i)];
+                const ContactRecord& c = contacts[rows[std::size_t(i)]];
                 ImGui::TableNextRow();
+                if (const auto& broke = ed.sim.contactPair;
+                    broke && ((broke->first == c.a && broke->second == c.b) || (broke->first == c.b && broke->second == c.a)))
+                    ImGui::TableSetBgColor(ImGuiTableBgTarget_RowBg1, IM_COL32(150, 50, 45, 160));
                 ImGui::TableNextColumn();
                 const bool selected = std::find(ed.selection.begin(), ed.selection.end(), c.a) != ed.selection.end() &&
                                       (c.b.isNull() || std::find(ed.selection.begin(), ed.selection.end(), c.b) != ed.selection.end());
@@ -655,10 +782,11 @@ void contactsTab(UiState& ui, Editor& ed) {
                 ImGui::Text("%.4g", c.depth);
                 ImGui::TableNextColumn();
                 ImGui::Text("%.4g", c.normalImpulse);
+                ImGui::TableNextColumn();
+                ImGui::Text("%.4g", c.tangentImpulse);
             }
         ImGui::EndTable();
     }
-    (void)ui;
 }
 
 void plotsTab(UiState& ui, Editor& ed) {
@@ -764,8 +892,7 @@ void historyTab(Editor& ed) {
 
 void debugPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     if (!ui.showDebug) return;
-    ImGui::SetNextWindowPos(r.debugPos, ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(r.debugSize, ImGuiCond_FirstUseEver);
+    placePanel(ui, "Debug", r.debugPos, r.debugSize);
     if (beginPanel("Debug", &ui.showDebug)) {
         if (ImGui::BeginTabBar("debugtabs")) {
             const char* names[] = {"Contacts", "Plots", "Profile", "History"};
@@ -846,6 +973,33 @@ void helpWindow(UiState& ui) {
     ImGui::End();
 }
 
+} // namespace
+
+std::string displayableText(const std::string& text) {
+    // Typographic quotes and dashes (UTF-8 E2 80 xx) that the font has no
+    // glyph for are shown as their ASCII look-alikes instead of '?'.
+    const ImFont* font = ImGui::GetFont();
+    std::string out;
+    out.reserve(text.size());
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c == 0xE2 && i + 2 < text.size() && static_cast<unsigned char>(text[i + 1]) == 0x80) {
+            const auto d = static_cast<unsigned char>(text[i + 2]);
+            const ImWchar codepoint = ImWchar(0x2000 + (d & 0x3F));
+            const char* ascii = d == 0x98 || d == 0x99 ? "'" : d == 0x9C || d == 0x9D ? "\"" : d == 0x93 || d == 0x94 ? "-" : nullptr;
+            if (ascii && (!font || !font->FindGlyphNoFallback(codepoint))) {
+                out += ascii;
+                i += 2;
+                continue;
+            }
+        }
+        out += char(c);
+    }
+    return out;
+}
+
+namespace {
+
 std::vector<std::string> listLevelFiles(const std::string& dir) {
     std::vector<std::string> out;
     std::error_code ec;
@@ -874,7 +1028,11 @@ void dialogs(UiState& ui, Editor& ed) {
     }
     if (ui.saveAsDialogRequested) {
         ImGui::OpenPopup("Save as");
-        if (ui.saveAsPath.empty()) ui.saveAsPath = ed.doc.path.empty() ? ui.levelsDir + "/untitled.json" : ed.doc.path.string();
+        // An absolute suggestion in a folder that exists, wherever the
+        // editor was started from.
+        if (ui.saveAsPath.empty())
+            ui.saveAsPath = ed.doc.path.empty() ? (std::filesystem::path(ui.levelsDir) / "untitled.json").string()
+                                                : ed.doc.path.string();
         ui.saveAsDialogRequested = false;
     }
     if (ui.saveStateRequested) {
@@ -904,9 +1062,10 @@ void dialogs(UiState& ui, Editor& ed) {
     ImGui::SetNextWindowPos(center, ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
     ImGui::SetNextWindowSize(ImVec2(520 * ui.scale, 0), ImGuiCond_Appearing);
     if (ImGui::BeginPopupModal("Open level")) {
-        ImGui::TextColored(kDim, "Levels in %s", ui.levelsDir.c_str());
+        const std::string folder = editor::dialogFolder(ed.doc.path, ui.levelsDir).string();
+        ImGui::TextColored(kDim, "Levels in %s", folder.c_str());
         ImGui::BeginChild("levels", ImVec2(0, 200 * ui.scale), true);
-        for (const std::string& f : listLevelFiles(ui.levelsDir))
+        for (const std::string& f : listLevelFiles(folder))
             if (ImGui::Selectable(f.c_str(), f == ui.openPath, ImGuiSelectableFlags_AllowDoubleClick)) {
                 ui.openPath = f;
                 if (ImGui::IsMouseDoubleClicked(0)) {
@@ -935,13 +1094,41 @@ void dialogs(UiState& ui, Editor& ed) {
                 ImGui::InputText("##saveas", &ui.saveAsPath, ImGuiInputTextFlags_EnterReturnsTrue);
             if ((ImGui::Button("Save") || enter) && !ui.saveAsPath.empty()) {
                 ImGui::CloseCurrentPopup();
-                if (std::string(name) == "Save as") ed.saveAs(ui.saveAsPath);
-                else ed.saveStateAs(ui.saveAsPath);
+                if (editor::replacesAnotherFile(ui.saveAsPath, ed.doc.path)) {
+                    // Another file is there: ask before writing over it.
+                    ui.replaceConfirm = ui.saveAsPath;
+                    ui.replaceIsState = std::string(name) != "Save as";
+                } else if (std::string(name) == "Save as") {
+                    ed.saveAs(ui.saveAsPath);
+                } else {
+                    ed.saveStateAs(ui.saveAsPath);
+                }
             }
             ImGui::SameLine();
             if (ImGui::Button("Cancel")) ImGui::CloseCurrentPopup();
             ImGui::EndPopup();
         }
+    }
+    if (ui.replaceConfirm && !ImGui::IsPopupOpen("Replace file?")) ImGui::OpenPopup("Replace file?");
+    ImGui::SetNextWindowPos(center, ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
+    if (ImGui::BeginPopupModal("Replace file?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+        ImGui::Text("%s already exists.", ui.replaceConfirm ? ui.replaceConfirm->c_str() : "");
+        ImGui::Text("Replace it with %s?", ui.replaceIsState ? "the simulation state" : ed.doc.title().c_str());
+        if (ImGui::Button("Replace")) {
+            if (ui.replaceConfirm) {
+                if (ui.replaceIsState) ed.saveStateAs(*ui.replaceConfirm);
+                else ed.saveAs(*ui.replaceConfirm);
+            }
+            ui.replaceConfirm.reset();
+            ImGui::CloseCurrentPopup();
+        }
+        ImGui::SameLine();
+        if (ImGui::Button("Cancel") || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) {
+            ed.note("not saved: " + (ui.replaceConfirm ? *ui.replaceConfirm : std::string()) + " was kept");
+            ui.replaceConfirm.reset();
+            ImGui::CloseCurrentPopup();
+        }
+        ImGui::EndPopup();
     }
     if (ui.recoveryOffer) {
         ImGui::OpenPopup("Recover unsaved changes?");
@@ -969,7 +1156,7 @@ void dialogs(UiState& ui, Editor& ed) {
     ImGui::SetNextWindowSizeConstraints(ImVec2(360 * ui.scale, 0), ImVec2(900 * ui.scale, 600 * ui.scale));
     if (ImGui::BeginPopupModal("Error", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
         ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + 640 * ui.scale);
-        ImGui::TextColored(kRed, "%s", ed.errorModal.c_str());
+        ImGui::TextColored(kRed, "%s", displayableText(ed.errorModal).c_str());
         ImGui::PopTextWrapPos();
         if (ImGui::Button("OK") || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Enter))) {
             ed.errorModal.clear();
@@ -984,13 +1171,13 @@ void dialogs(UiState& ui, Editor& ed) {
 void drawEditorUi(UiState& ui, Editor& ed) {
     const ImGuiViewport* vp = ImGui::GetMainViewport();
     const PanelRects r = defaultLayout(vp->Size.x, vp->Size.y, ui.scale);
+    beginLayout(ui, vp->Size);
     menuBar(ui, ed);
     toolsPanel(ui, ed, r);
     entitiesPanel(ui, ed, r);
     viewportPanel(ui, ed, r);
     if (ui.showInspector) {
-        ImGui::SetNextWindowPos(r.inspectorPos, ImGuiCond_FirstUseEver);
-        ImGui::SetNextWindowSize(r.inspectorSize, ImGuiCond_FirstUseEver);
+        placePanel(ui, "Inspector", r.inspectorPos, r.inspectorSize);
         drawInspector(ui, ed);
     }
     worldPanel(ui, ed, r);
@@ -998,6 +1185,7 @@ void drawEditorUi(UiState& ui, Editor& ed) {
     statusBar(ui, ed);
     helpWindow(ui);
     dialogs(ui, ed);
+    endLayout(ui, vp->Size);
 }
 
 } // namespace stepwise::ui

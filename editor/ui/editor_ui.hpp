@@ -27,13 +27,29 @@ struct PanelRects {
 };
 PanelRects defaultLayout(float width, float height, float scale);
 
+/// Below this window size no layout is recorded or saved (ImGui piles the
+/// panels at the top left); the last good one comes back when it grows.
+constexpr float kMinLayoutWidth = 320.0f, kMinLayoutHeight = 240.0f;
+
 struct UiState {
     float scale = 1.0f;                 ///< UI scale (DPI or font size / 13)
     bool deterministic = false;         ///< scripted mode: hide wall-clock numbers
+    /// Folder of the level files (absolute, found by editor::findLevelsDirectory).
     std::string levelsDir = "levels";
     std::vector<std::string>* recentFiles = nullptr;  ///< owned by the session's Settings
     float* fontSizeSetting = nullptr;
     bool fontChanged = false;
+
+    // Layout: each panel's rectangle as fractions (x, y, w, h) of the window,
+    // from the last frame whose window was large enough; saved in the
+    // settings and scaled to the window at start and on every resize, so a
+    // layout from 1600x900 opens on-screen at 1280x720.
+    std::map<std::string, ImVec4, std::less<>> panelFractions;
+    ImVec2 layoutDisplay{0, 0};          ///< window size the fractions were recorded at
+    bool layoutInterrupted = false;      ///< the window was too small since the last recording
+    bool resetLayoutRequested = false;   ///< View > Reset layout
+    enum class ApplyLayout : std::uint8_t { None, Fractions, Default };
+    ApplyLayout applyLayout = ApplyLayout::None;  ///< this frame's placement (beginLayout)
 
     // Windows
     bool showTools = true, showEntities = true, showInspector = true, showWorld = true, showDebug = true;
@@ -45,13 +61,18 @@ struct UiState {
     bool viewportHovered = false;
 
     // Dialog buffers
-    std::string openPath, saveAsPath, entityFilter;
+    std::string openPath, saveAsPath, entityFilter, contactFilter;
     bool openDialogRequested = false, saveAsDialogRequested = false, saveStateRequested = false;
     std::optional<std::string> recoveryOffer;  ///< path of a recovery file to offer once
+    std::optional<std::string> replaceConfirm; ///< Save as onto this existing file: asked first
+    bool replaceIsState = false;               ///< ... for "Save simulation state as"
 
     // Inspector edit coalescing: the widget being dragged and its merge key.
     ImGuiID activeWidget = 0;
     std::uint64_t activeKey = 0;
+    /// A number field clicked once without a drag: it takes typed text
+    /// from the next frame on.
+    ImGuiID typeInto = 0;
 
     // Timing (ms), averaged, for the status bar and the profile
     double frameMs = 0.0, uiMs = 0.0, sceneMs = 0.0, stepMs = 0.0;
@@ -88,12 +109,19 @@ void applyTheme(float scale);
 /// panel dragged onto another has its background again from that frame.
 bool beginPanel(const char* name, bool* open, ImGuiWindowFlags flags = 0);
 
+/// SetNextWindowPos/Size for panel `name` by this frame's layout decision.
+void placePanel(const UiState& ui, const char* name, ImVec2 defaultPos, ImVec2 defaultSize);
+
 /// Builds every panel for this frame. Call between ImGui::NewFrame and
 /// ImGui::Render.
 void drawEditorUi(UiState& ui, editor::Editor& ed);
 
 /// The inspector panel (inspector.cpp): driven by the component table.
 void drawInspector(UiState& ui, editor::Editor& ed);
+
+/// `text` with the typographic quotes and dashes the current font has no
+/// glyph for replaced by ASCII (else ImGui draws '?').
+std::string displayableText(const std::string& text);
 
 /// The World the panels read: the running one, else the edit-mode preview.
 const World* panelWorld(UiState& ui, editor::Editor& ed);

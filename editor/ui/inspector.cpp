@@ -32,12 +32,15 @@ float speedFor(double v) { return float(std::max(1e-3, std::abs(v) * 0.005)); }
 
 /// Shows the widget for one field; returns true with `value` updated when
 /// the user changed it.
-bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const Registry& reg) {
+/// `typeNow`: focus the number field so typing goes into it (a single click
+/// on it, last frame, without a drag).
+bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const Registry& reg, bool typeNow) {
     const double* lo = std::isfinite(f.range.min) ? &f.range.min : nullptr;
     const double* hi = std::isfinite(f.range.max) ? &f.range.max : nullptr;
     switch (f.kind) {
     case FieldKind::Number: {
         double& v = std::get<double>(value);
+        if (typeNow) ImGui::SetKeyboardFocusHere();
         return ImGui::DragScalar(label, ImGuiDataType_Double, &v, speedFor(v), lo, hi, "%.6g");
     }
     case FieldKind::OptionalNumber: {
@@ -52,6 +55,7 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
             return changed;
         }
         double d = *v;
+        if (typeNow) ImGui::SetKeyboardFocusHere();
         if (ImGui::DragScalar(label, ImGuiDataType_Double, &d, speedFor(d), lo, hi, "%.6g")) {
             v = d;
             changed = true;
@@ -61,6 +65,7 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
     case FieldKind::Vector: {
         Vec2& v = std::get<Vec2>(value);
         double xy[2] = {v.x, v.y};
+        if (typeNow) ImGui::SetKeyboardFocusHere();
         if (!ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, speedFor(std::max(std::abs(v.x), std::abs(v.y))),
                                 nullptr, nullptr, "%.5g"))
             return false;
@@ -78,6 +83,7 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
             return changed;
         }
         double xy[2] = {v->x, v->y};
+        if (typeNow) ImGui::SetKeyboardFocusHere();
         if (ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, 0.01f, nullptr, nullptr, "%.5g")) {
             v = Vec2{xy[0], xy[1]};
             changed = true;
@@ -214,7 +220,25 @@ void drawInspector(UiState& ui, Editor& ed) {
                 if (mixed) label += " (mixed)";
                 ImGui::PushID(f.key.empty() ? "value" : f.key.data());
                 const ImGuiID id = ImGui::GetID(label.c_str());
-                const bool changed = fieldWidget(f, value, label.c_str(), reg);
+                const bool typeNow = ui.typeInto == id;
+                if (typeNow) ui.typeInto = 0;
+                const bool changed = fieldWidget(f, value, label.c_str(), reg, typeNow);
+                // ImGui's drag fields take typed text only after a double
+                // click; a designer clicks once and types, and the digits
+                // then went to the tool shortcuts. A click released without
+                // a drag opens the text field on the next frame.
+                const bool numeric = f.kind == FieldKind::Number || f.kind == FieldKind::OptionalNumber ||
+                                     f.kind == FieldKind::Vector || f.kind == FieldKind::OptionalVector;
+                const ImGuiIO& io = ImGui::GetIO();
+                if (numeric && ImGui::IsItemDeactivated() && ImGui::IsMouseReleased(ImGuiMouseButton_Left) &&
+                    io.MouseDragMaxDistanceSqr[0] < io.MouseDragThreshold * io.MouseDragThreshold)
+                    ui.typeInto = id;
+                if (f.kind == FieldKind::EntityRef) {
+                    ImGui::SameLine();
+                    if (ImGui::SmallButton("pick")) ed.startReferencePick(info, f, selection);
+                    if (ImGui::IsItemHovered())
+                        ImGui::SetTooltip("Click, then click a body in the viewport or the entity list (Esc cancels)");
+                }
                 if (ImGui::IsItemHovered() && !f.description.empty())
                     ImGui::SetTooltip("%.*s%s%s", int(f.description.size()), f.description.data(),
                                       f.kind == FieldKind::Number ? "\nrange: " : "",

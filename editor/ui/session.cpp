@@ -35,9 +35,14 @@ Result<std::unique_ptr<Session>> Session::create(render::GetProcAddress getProc,
     if (!options.configDir.empty()) ed.configDir = options.configDir;
     if (options.persist) s->settings_ = editor::Settings::load(ed.configDir);
     s->ui_.deterministic = options.deterministic;
-    s->ui_.levelsDir = options.levelsDir;
+    std::error_code cwdError;
+    s->ui_.levelsDir = !options.levelsDir.empty()
+                           ? options.levelsDir
+                           : editor::findLevelsDirectory(editor::executableDirectory(), std::filesystem::current_path(cwdError))
+                                 .string();
     s->ui_.recentFiles = &s->settings_.recentFiles;
     s->ui_.fontSizeSetting = &s->settings_.fontSize;
+    for (const auto& [name, r] : s->settings_.panels) s->ui_.panelFractions[name] = ImVec4(r[0], r[1], r[2], r[3]);
 
     IMGUI_CHECKVERSION();
     s->imgui_ = ImGui::CreateContext();
@@ -108,9 +113,12 @@ void Session::loadFonts() {
         config.OversampleV = 1;
         config.PixelSnapH = true;
         std::error_code ec;
+        // Latin-1 and General Punctuation: the loader's messages quote
+        // typographic quotes (“ ” ‘ ’) pasted into a level, and dashes.
+        static const ImWchar kRanges[] = {0x0020, 0x00FF, 0x2010, 0x205E, 0};
         for (const char* path : kFontPaths)
             if (std::filesystem::exists(path, ec) &&
-                io.Fonts->AddFontFromFileTTF(path, std::round(size * 1.1f), &config)) {
+                io.Fonts->AddFontFromFileTTF(path, std::round(size * 1.1f), &config, kRanges)) {
                 loaded = true;
                 break;
             }
@@ -134,13 +142,22 @@ bool Session::openAtStart(const std::filesystem::path& level) {
 
 void Session::saveSettings() {
     if (!options_.persist) return;
+    for (const auto& [name, f] : ui_.panelFractions) settings_.panels[name] = {f.x, f.y, f.z, f.w};
     (void)settings_.save(editor_.configDir);
-    if (!iniPath_.empty()) ImGui::SaveIniSettingsToDisk(iniPath_.c_str());
+    // imgui.ini holds the panels' pixel rectangles; written only from a
+    // window large enough to lay out (a 40x30 window's pile is never saved).
+    const ImVec2 display = ImGui::GetIO().DisplaySize;
+    if (!iniPath_.empty() && display.x >= kMinLayoutWidth && display.y >= kMinLayoutHeight)
+        ImGui::SaveIniSettingsToDisk(iniPath_.c_str());
 }
 
 void Session::feedImGui(const std::vector<InputEvent>& events, int width, int height, double frameSeconds) {
     ImGuiIO& io = ImGui::GetIO();
     io.DisplaySize = ImVec2(float(width), float(height));
+    // ImGui saves imgui.ini by itself every few seconds: not while the
+    // window is too small to hold the layout (see saveSettings).
+    if (!iniPath_.empty())
+        io.IniFilename = width >= kMinLayoutWidth && height >= kMinLayoutHeight ? iniPath_.c_str() : nullptr;
     io.DeltaTime = float(std::max(frameSeconds, 1e-4));
     io.MouseWheel = 0.0f;
     for (const InputEvent& e : events) {

@@ -29,7 +29,9 @@ struct SessionOptions {
     bool builtinFont = false;     ///< ImGui's embedded font (deterministic screenshots everywhere)
     bool persist = true;          ///< imgui.ini and settings in the config folder
     bool deterministic = false;   ///< hide wall-clock numbers (scripted screenshots)
-    std::string levelsDir = "levels";
+    /// Folder of level files for the Open list and Save as; "" finds it
+    /// from the executable's place (editor::findLevelsDirectory).
+    std::string levelsDir;
     std::filesystem::path configDir;  ///< empty: editor::configDirectory()
 };
 
