@@ -258,10 +258,10 @@ TEST_F(Cli, EverySubcommandHasHelp) {
     }
 }
 
-// ---- Limits and bad input everywhere (issue 7) ------------------------------
+// ---- Limits and bad input everywhere ----------------------------------------
 
 TEST_F(Cli, ValidateRefusesOneEntityPastTheDocumentedLimitAndAcceptsTheLimit) {
-    // README "Limits": 1,000,000 entities. Empty entities keep the file at
+    // docs/format.md, "Limits": 1,000,000 entities. Empty entities keep the file at
     // 3 MB; the count is checked while parsing.
     const auto levelWith = [&](std::size_t n) {
         std::string text = "{\"entities\": [";
@@ -422,8 +422,7 @@ TEST_F(Cli, RenderAndBenchHaveHelp) {
 }
 
 // The scripted editor refuses a bad line at run time with the script's
-// file:line and what was wrong, and exits 2 (issue 6's scripted mode;
-// issue 7's "bad input everywhere").
+// file:line and what was wrong, and exits 2, as every bad input does.
 TEST_F(Cli, EditScriptNamesTheBadLineForAnUnknownSystemOrEntity) {
     const fs::path system = write("system.txt", "play\nsystem gravty off\n");
     Outcome o = stepwise("edit " + level("orbit.json") + " --builtin-font --size 640x400 --config " +
@@ -452,4 +451,21 @@ TEST_F(Cli, ClockwisePolygonExitsTwoNamingTheEntityAndLeavesTheOutputAlone) {
     EXPECT_EQ(readFile(out), "untouched");
     // The shipped polygon level runs.
     EXPECT_EQ(stepwise("run " + level("polygons.json") + " --steps 30").exitCode, 0);
+}
+
+// With no display the window must not start: Debian's SDL falls back to an
+// invisible "offscreen" driver, and the editor used to run there until
+// killed. `timeout` turns such a hang into exit code 124.
+TEST_F(Cli, EditWithNoDisplaySaysSoAndExitsOne) {
+    const fs::path err = dir_ / "stderr.txt";
+    const std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY -u SDL_VIDEODRIVER timeout 60 " +
+                                std::string(STEPWISE_BINARY) + " edit " + level("orbit.json") + " --config " +
+                                (dir_ / "cfg").string() + " >/dev/null 2>" + err.string() + " </dev/null";
+    const int status = std::system(command.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 1);
+    EXPECT_NE(readFile(err).find("stepwise: error: cannot start SDL video (is there a display? use "
+                                 "--script/--screenshot for headless runs)"),
+              std::string::npos)
+        << readFile(err);
 }

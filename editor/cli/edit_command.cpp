@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <numeric>
@@ -481,6 +482,17 @@ int runWindow(const EditOptions& o, int width, int height) {
                                 "runs): ") + SDL_GetError());
         return kExitFailure;
     }
+    // With no display, Debian's SDL 2.26 does not fail: it falls back to its
+    // invisible "offscreen" driver, and the editor would run a window nobody
+    // can see until it is killed. Such a driver is honoured only when asked
+    // for by name (SDL_VIDEODRIVER).
+    const char* driver = SDL_GetCurrentVideoDriver();
+    if (driver && (!std::strcmp(driver, "offscreen") || !std::strcmp(driver, "dummy")) && !SDL_getenv("SDL_VIDEODRIVER")) {
+        reportError(std::string("cannot start SDL video (is there a display? use --script/--screenshot for headless "
+                                "runs): SDL found no display, only its \"") + driver + "\" driver");
+        SDL_Quit();
+        return kExitFailure;
+    }
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_PROFILE_MASK, SDL_GL_CONTEXT_PROFILE_CORE);
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 3);
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_MINOR_VERSION, 3);
@@ -631,7 +643,7 @@ void addEditCommand(CLI::App& app, int& exitCode) {
     auto o = std::make_shared<EditOptions>();
     CLI::App* cmd = app.add_subcommand("edit", "Open the editor (SDL2 window; headless with --script/--screenshot)");
     cmd->add_option("level", o->level, "Level to open")->default_val("levels/default.json");
-    cmd->add_option("--script", o->script, "Replay input from this file (headless, OSMesa); see README.md, The editor");
+    cmd->add_option("--script", o->script, "Replay input from this file (headless, OSMesa); see docs/editor.md");
     cmd->add_option("--screenshot", o->screenshot, "Headless: write the whole editor as a PNG at the end");
     cmd->add_option("--size", o->size, "Window size WxH")->default_val("1280x800");
     cmd->add_option("--font-size", o->fontSize, "UI font size in pixels (default: 13 x display DPI / 96)")
