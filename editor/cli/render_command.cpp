@@ -122,6 +122,16 @@ int render(const RenderOptions& o) {
     std::optional<Scene> scene = loadLevelOrReport(o.level);
     if (!scene) return kExitBadInput;
     if (o.integrator) scene->world.integrator = *o.integrator;
+    {
+        // Every frame's file before any step: writable, not the level.
+        std::vector<OutputFile> outputs;
+        for (int frame = 0; frame < o.frames; ++frame) outputs.push_back({"--out", frameName(o.out, frame, o.frames)});
+        if (std::string problem = checkOutputs({o.level}, outputs); !problem.empty()) {
+            if (problem.rfind("stepwise: error: ", 0) == 0) std::cerr << problem << "\n";
+            else reportError("--out: " + problem);
+            return kExitBadInput;
+        }
+    }
 
     std::vector<Entity> selection;
     if (!o.select.empty()) {
@@ -229,7 +239,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     CLI::App* cmd = app.add_subcommand("render", "Render a level to PNG headlessly (OSMesa; no display needed)");
     cmd->add_option("LEVEL", o->level, "Level file (JSON)")->required();
     cmd->add_option("--out", o->out, "Output PNG (a sequence adds -0000, -0001, ... before the extension)")
-        ->required();
+        ->required()
+        ->check(outputFileName());
     cmd->add_option("--steps", o->steps, "Steps to simulate before the (first) frame")
         ->check(wholeNumberAtLeastZero());
     cmd->add_option("--integrator", o->integrator, "Integrator (overrides world.integrator)")
