@@ -679,7 +679,8 @@ void addEditCommand(CLI::App& app, int& exitCode) {
         ->check(CLI::Range(1, 100000));
     cmd->add_option("--bench-bodies", o->benchBodies, "Benchmark a generated level of N circles instead of LEVEL")
         ->check(CLI::Range(1, 1000000));
-    cmd->add_option("--debug-state", o->debugState, "Write the editor's state (mode, time, positions) to this JSON file");
+    cmd->add_option("--debug-state", o->debugState, "Write the editor's state (mode, time, positions) to this JSON file")
+        ->check(outputFileName());
     cmd->add_flag("--headless", o->headless, "Run through OSMesa without a window (implied by --script/--screenshot)");
     cmd->add_flag("--show-timings", o->showTimings, "Headless: show wall-clock timings (screenshots then differ run to run)");
     cmd->add_flag("--no-vsync", o->noVsync, "Window: do not wait for the display's refresh");
