@@ -538,6 +538,19 @@ TEST_F(Cli, AnOutputThatIsTheInputOrAnotherOutputIsRefusedBeforeStepping) {
     EXPECT_EQ(readFile(file), text);
 }
 
+// A render sequence that diverged left the frames before the divergence:
+// now every frame waits in a temporary until the whole run succeeded.
+TEST_F(Cli, ARenderSequenceThatDivergesWritesNoFrame) {
+    const fs::path file = write("stiff.json", R"({"world": {"gravity": {"x": 0, "y": 0}, "dt": 0.1, "integrator": "explicit_euler"},
+      "entities": [{"name": "bob", "position": {"x": 1.5, "y": 0}},
+                   {"name": "s", "spring": {"a": "bob", "anchor": {"x": 0, "y": 0}, "k": 1e6, "rest_length": 1}}]})");
+    Outcome o = stepwise("render " + file.string() + " --out " + (dir_ / "f.png").string() +
+                         " --width 64 --height 64 --frames 3 --every 2000");
+    EXPECT_EQ(o.exitCode, 3) << o.err;
+    EXPECT_NE(o.err.find(" before frame 1; no frame written\n"), std::string::npos) << o.err;
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1) << "only the level";
+}
+
 /// Runs `command` as the unprivileged user nobody when this process is
 /// root (root may write any file, so a read-only file means nothing to it).
 std::string asUnprivileged(const std::string& command) {

@@ -22,6 +22,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 namespace stepwise::cli {
 
@@ -189,6 +190,10 @@ int render(const RenderOptions& o) {
     input.hud = !o.noHud;
 
     const bool tty = ::isatty(2) && o.frames > 1;
+    // Each frame goes to a temporary next to its file; all are put in
+    // place at the end, so a run that fails (exit 2 or 3) writes nothing.
+    std::vector<StreamedFileWriter> written;
+    written.reserve(std::size_t(o.frames));
     const std::string levelName = std::filesystem::path(o.level).filename().string();
     long long stepsTaken = 0;
     double renderMs = 0.0;
@@ -199,7 +204,8 @@ int render(const RenderOptions& o) {
             if (Result<void> stepped = world->step(); !stepped) {
                 if (tty) std::fputc('\n', stderr);
                 reportError(o.level + ": simulation diverged at " + stepped.error() + " (integrator " +
-                            world->settings().integrator + "); " + std::to_string(frame) + " frame(s) written");
+                            world->settings().integrator + ") before frame " + std::to_string(frame) +
+                            "; no frame written");
                 return kExitDiverged;
             }
             trails.record(*world);
@@ -218,13 +224,22 @@ int render(const RenderOptions& o) {
         input.scales = drawn.scales;
 
         const std::string path = frameName(o.out, frame, o.frames);
-        if (Result<void> written = writeFileAtomically(path, render::encodePng(image)); !written) {
+        Result<StreamedFileWriter> writer = StreamedFileWriter::open(path);
+        Result<void> done = writer ? writer->write(render::encodePng(image)) : Result<void>(Error{writer.error()});
+        if (done) done = writer->finish();
+        if (!done) {
             if (tty) std::fputc('\n', stderr);
-            reportError("--out: " + written.error());
+            reportError("--out: " + done.error());
             return kExitBadInput;
         }
+        written.push_back(std::move(*writer));
         if (tty) progress(frame + 1, o.frames);
     }
+    for (StreamedFileWriter& frameFile : written)
+        if (Result<void> done = frameFile.commit(); !done) {
+            reportError("--out: " + done.error());
+            return kExitBadInput;
+        }
     std::cout << "wrote " << (o.frames == 1 ? o.out : frameName(o.out, 0, o.frames) + " .. " +
                                                           frameName(o.out, o.frames - 1, o.frames))
               << " (" << o.width << "x" << o.height << ", " << stepsTaken << " steps, " << instances
