@@ -100,16 +100,6 @@ struct ShapeStop {
     std::string message;
 };
 
-std::string escapePointerToken(std::string_view token) {
-    std::string out;
-    for (char c : token) {
-        if (c == '~') out += "~0";
-        else if (c == '/') out += "~1";
-        else out += c;
-    }
-    return out;
-}
-
 /// A const char* that tells the handler how far the lexer has read: the
 /// handler's callbacks carry no position, but nlohmann's lexer reads one
 /// character at a time through this iterator, so after a string token the
@@ -412,6 +402,16 @@ Result<void> parseLevelJson(std::string_view text, std::string_view sourceName, 
         return Error{prefix + "not a valid level: " + e.what()};
     }
     return {};
+}
+
+std::string escapePointerToken(std::string_view token) {
+    std::string out;
+    for (char c : token) {
+        if (c == '~') out += "~0";
+        else if (c == '/') out += "~1";
+        else out += c;
+    }
+    return out;
 }
 
 std::string shortenForMessage(std::string_view message) {
