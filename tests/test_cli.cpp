@@ -753,8 +753,8 @@ TEST_F(Cli, AFailedScriptCommandStopsTheRunWithAMessage) {
     }
     // `save` of a level that has no file yet.
     const fs::path script = write("s.txt", "new\nsave\n");
-    Outcome o = stepwise("edit --builtin-font --size 640x400 --config " + (dir_ / "cfg").string() + " --script " +
-                         script.string());
+    Outcome o = stepwise("edit " + level + " --builtin-font --size 640x400 --config " + (dir_ / "cfg").string() +
+                         " --script " + script.string());
     EXPECT_EQ(o.exitCode, 2);
     EXPECT_EQ(o.err, "stepwise: error: " + script.string() + ":2: save: the level has no file yet; use saveas PATH\n");
 }
