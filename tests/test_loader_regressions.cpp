@@ -192,3 +192,139 @@ TEST(LoaderRegressions, EveryFileInTheFuzzCorpusSatisfiesTheFuzzersProperty) {
     }
     EXPECT_GE(files, 6);
 }
+
+// ---- Issue 14: the JSON itself -----------------------------------------------
+
+// Duplicate keys were accepted, the last one winning: a level with "mass"
+// twice loaded with the second. Refused now, naming the second by its JSON
+// Pointer and place, and the first by its place.
+TEST(LoaderRegressions, DuplicateKeysAreRefusedWithThePointerOfTheSecond) {
+    EXPECT_EQ(refusal(R"({"entities": [{"name": "a", "mass": 1, "mass": 2}]})"),
+              "t.json:1:40: error: /entities/0/mass: duplicate key \"mass\" (first at line 1, column 29); a key "
+              "may appear once in an object");
+    EXPECT_EQ(refusal("{\"entities\": [],\n \"entities\": [{}]}"),
+              "t.json:2:2: error: /entities: duplicate key \"entities\" (first at line 1, column 2); a key may "
+              "appear once in an object");
+    EXPECT_EQ(refusal(R"({"world": {"dt": 0.01, "dt": 0.02}, "entities": []})"),
+              "t.json:1:24: error: /world/dt: duplicate key \"dt\" (first at line 1, column 12); a key may appear "
+              "once in an object");
+    // Spelled differently, the same key: "m\u0061ss" is "mass".
+    EXPECT_EQ(refusal(R"({"entities": [{"mass": 1, "m\u0061ss": 2}]})"),
+              "t.json:1:27: error: /entities/0/mass: duplicate key \"mass\" (first at line 1, column 16); a key "
+              "may appear once in an object");
+    // Past 16 keys the keys seen are kept in a hash map: same answer.
+    std::string many = R"({"entities": [{"velocity": {)";
+    for (int i = 0; i < 40; ++i) many += "\"k" + std::to_string(i) + "\": 0, ";
+    many += R"("k7": 1}}]})";
+    const std::string r = refusal(many);
+    EXPECT_NE(r.find("error: /entities/0/velocity/k7: duplicate key \"k7\""), std::string::npos) << r;
+    // A key with an escaped quote and slash is found and named by pointer.
+    EXPECT_EQ(refusal(R"({"entities": [{"a/\"b": 1, "a/\"b": 2}]})"),
+              "t.json:1:28: error: /entities/0/a~1\"b: duplicate key \"a/\"b\" (first at line 1, column 16); a key "
+              "may appear once in an object");
+    // The same key in different objects is fine.
+    EXPECT_EQ(refusal(R"({"entities": [{"name": "a", "position": {"x": 0, "y": 0}}, {"name": "b", "position": {"x": 1, "y": 0}}]})"),
+              "");
+}
+
+// nlohmann's lexer takes a NUL byte for the end of the input, so a level
+// followed by a NUL and anything at all loaded.
+TEST(LoaderRegressions, ANulByteAnywhereIsRefused) {
+    const std::string level = "{\"entities\": []}\n";
+    EXPECT_EQ(refusal(level + std::string(1, '\0') + "garbage"),
+              "t.json:2:1: error: a NUL byte; a level file is text and has none (a file cut short or padded by a "
+              "crash often ends in NUL bytes)");
+    EXPECT_EQ(refusal(level + std::string(1, '\0')).substr(0, 27), "t.json:2:1: error: a NUL by");
+    EXPECT_EQ(refusal(std::string("{\"entities\": [{\"name\": \"a") + '\0' + "\"}]}").substr(0, 30),
+              "t.json:1:26: error: a NUL byte");
+}
+
+// The entity count saw only the objects directly in "entities": every other
+// shape built its whole DOM first (60 MB of [[{}, {}, ...]] took 23 s and
+// 1.5 GB). Every value counts now, in the file and in one entity.
+TEST(LoaderRegressions, EveryJsonValueCountsTowardsTheLimits) {
+    LoadLimits limits;
+    limits.maxValues = 100;
+    std::string numbers = "[";
+    for (int i = 0; i < 200; ++i) numbers += i ? ",0" : "0";
+    numbers += "]";
+    const std::string text = R"({"entities": [{"name": "a", "tag": )" + numbers + "}]}";
+    Result<Scene> r = parseScene(text, "t.json", limits);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error(), "t.json:1:227: error: more than 100 JSON values (numbers, strings, objects, arrays); the "
+                         "limit is 100 (a level uses about 14 per entity)");
+    // Nested objects count as well as their members.
+    std::string nested = R"({"entities": [{"name": )";
+    for (int i = 0; i < 120; ++i) nested += "{\"a\": ";
+    nested += "1";
+    for (int i = 0; i < 120; ++i) nested += "}";
+    nested += "}]}";
+    limits.maxDepth = 200;
+    r = parseScene(nested, "t.json", limits);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().find("more than 100 JSON values"), std::string::npos) << r.error();
+    // One entity: at most maxValuesPerEntity.
+    limits = LoadLimits{};
+    limits.maxValuesPerEntity = 50;
+    r = parseScene(text, "t.json", limits);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error(), "t.json:1:131: error: /entities/0: more than 50 JSON values in one entity; the limit is 50");
+    // "world" and "view" hold a few settings: 10,000 values at most.
+    std::string gravity = R"({"entities": [], "world": {"gravity": [)";
+    for (int i = 0; i < 20000; ++i) gravity += i ? ",0" : "0";
+    r = parseScene(gravity + "]}}", "t.json");
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error(), "t.json:1:20038: error: /world: more than 10000 JSON values; this section holds a few settings");
+    // A real entity is far below it.
+    EXPECT_EQ(refusal(R"({"entities": [{"name": "a", "position": {"x": 0, "y": 0}, "velocity": {"x": 0, "y": 0},
+                          "mass": 1, "radius": 0.5, "color": {"x": 1, "y": 0, "z": 0}}]})"),
+              "");
+}
+
+// Wrong shapes that hold many values are refused at their first child, with
+// the message the component layer gives for them, before any DOM is built.
+TEST(LoaderRegressions, ArraysWhereObjectsBelongAreRefusedAtTheirFirstChild) {
+    LoadLimits limits;
+    limits.maxValues = 10;  // far fewer than these files hold: refused before the count is reached
+    std::string list;
+    for (int i = 0; i < 50; ++i) list += i ? ", {}" : "{}";
+    Result<Scene> r = parseScene(R"({"entities": [{}, [)" + list + "]]}", "t.json", limits);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error(), "t.json: error: /entities/1: expected an entity object {\"component\": value, ...}, got an array");
+    r = parseScene("[" + list + "]", "t.json", limits);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error(), "t.json: error: expected a level object {\"entities\": [...]}, got an array");
+    r = parseScene(R"({"entities": {"a": )" + std::string("[") + list + "]}}", "t.json", limits);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error(), "t.json: error: /entities: expected an array of entities, got an object");
+    // Empty ones still get the component layer's "empty" wording.
+    EXPECT_EQ(refusal(R"({"entities": [[]]})"),
+              "t.json: error: /entities/0: expected an entity object {\"component\": value, ...}, got an empty array");
+}
+
+// A 10 MB unknown component name gave a 20 MB one-line message (the name
+// twice: in the pointer and quoted), and the "did you mean" search took
+// seconds on it. Long runs are cut in every loader message.
+TEST(LoaderRegressions, LongNamesAreCutInMessages) {
+    const std::string name(10u << 20, 'q');
+    const std::string r = refusal(R"({"entities": [{")" + name + R"(": 1}]})");
+    EXPECT_LT(r.size(), 1000u);
+    EXPECT_EQ(r.rfind("t.json: error: /entities/0/" + std::string(60, 'q') + "...(10485760 bytes): unknown component \"" +
+                          std::string(60, 'q') + "...(10485760 bytes)\" on entity 0",
+                      0),
+              0u)
+        << r;
+    EXPECT_NE(r.find("unknown component \"qqqqq"), std::string::npos) << r;
+    // A long entity name in a relation message, and a long string value.
+    const std::string longName(5000, 'n');
+    const std::string twice = refusal(R"({"entities": [{"name": ")" + longName + R"("}, {"name": ")" + longName + R"("}]})");
+    EXPECT_LT(twice.size(), 400u) << twice;
+    EXPECT_NE(twice.find("duplicate name \"nnnn"), std::string::npos) << twice;
+    EXPECT_NE(twice.find("...(5000 bytes)"), std::string::npos) << twice;
+    // Multi-byte characters are never split.
+    std::string accents;
+    for (int i = 0; i < 200; ++i) accents += "é";
+    const std::string cut = refusal(R"({"entities": [{")" + accents + R"(": 1}]})");
+    EXPECT_TRUE(fuzz::isValidUtf8(cut)) << cut;
+    EXPECT_NE(cut.find("...(400 bytes)"), std::string::npos) << cut;
+}

@@ -265,3 +265,57 @@ TEST(WorldCli, ExplicitBlowUpOnStiffChainExitsThree) {
 }
 
 } // namespace
+
+// Issue 14: a spring of k = 1e25 on 1 kg bodies makes M + h^2 K singular in
+// doubles (the masses are lost to rounding). The factorisation failed and
+// the step kept v1 = v0 for every body, a free falling one too, reporting
+// success. Refused now, like a non-finite value: the state stays at the
+// start of the step and the message names the spring's bodies only.
+TEST(World, AFailedImplicitSolveIsRefusedAndNamesOnlyItsBodies) {
+    for (const char* k : {"1e25", "1e100"})
+        for (const char* integrator : {"implicit_euler", "implicit_midpoint"}) {
+            Result<Scene> scene = parseScene(std::string(R"({"world": {"gravity": {"x": 0, "y": -9.81}, "integrator": ")") +
+                                                 integrator + R"(", "substeps": 2},
+              "entities": [{"name": "a", "position": {"x": 0, "y": 0}, "mass": 1},
+                           {"name": "b", "position": {"x": 1.5, "y": 0}, "mass": 1},
+                           {"name": "s", "spring": {"a": "a", "b": "b", "k": )" + std::string(k) + R"(, "rest_length": 1}},
+                           {"name": "free", "position": {"x": 5, "y": 0}, "mass": 1, "velocity": {"x": 1, "y": 0}}]})",
+                                             "t.json");
+            ASSERT_TRUE(scene) << scene.error();
+            World w = buildOrDie(*scene);
+            const std::string what = std::string(k) + " " + integrator;
+            ASSERT_EQ(w.stiffnessHints().size(), 1u) << what;
+            EXPECT_GT(w.stiffnessHints()[0].hOmega, 1e5) << what;
+            Result<void> stepped = w.step();
+            ASSERT_FALSE(stepped) << what;
+            EXPECT_EQ(stepped.error().rfind("step 1: " + std::string(integrator) + ": the linear ", 0), 0u)
+                << stepped.error();
+            EXPECT_NE(stepped.error().find("; bodies of the failing system: entity 0 (\"a\"), entity 1 (\"b\")."),
+                      std::string::npos)
+                << stepped.error();
+            EXPECT_EQ(w.time(), 0.0) << what;
+            EXPECT_EQ(w.bodyPosition(2).x, 5.0) << what;
+            EXPECT_EQ(w.bodyVelocity(2).x, 1.0) << what;
+            EXPECT_EQ(w.bodyPosition(1).x, 1.5) << what;
+        }
+}
+
+// Stiff but within doubles (k = 1e12, h omega = 2.4e4): the solve is
+// accepted and the spring relaxes to its rest length under implicit Euler
+// while the free body falls as in free fall.
+TEST(World, AStiffButSolvableImplicitSystemIsAccepted) {
+    Result<Scene> scene = parseScene(R"({"world": {"gravity": {"x": 0, "y": -9.81}, "integrator": "implicit_euler"},
+      "entities": [{"name": "a", "position": {"x": 0, "y": 0}, "mass": 1},
+                   {"name": "b", "position": {"x": 1.5, "y": 0}, "mass": 1},
+                   {"name": "s", "spring": {"a": "a", "b": "b", "k": 1e12, "rest_length": 1}},
+                   {"name": "free", "position": {"x": 5, "y": 0}, "mass": 1}]})",
+                                     "t.json");
+    ASSERT_TRUE(scene) << scene.error();
+    World w = buildOrDie(*scene);
+    EXPECT_TRUE(w.stiffnessHints().empty());
+    for (int i = 0; i < 60; ++i) ASSERT_TRUE(w.step());
+    EXPECT_NEAR(w.bodyPosition(1).x - w.bodyPosition(0).x, 1.0, 1e-9);
+    // Backward Euler under constant g: y_n = -g h^2 n (n + 1) / 2.
+    const double h = 1.0 / 60.0;
+    EXPECT_NEAR(w.bodyPosition(2).y, -9.81 * h * h * 60 * 61 / 2, 1e-9);
+}

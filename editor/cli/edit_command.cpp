@@ -167,6 +167,18 @@ int runScripted(const EditOptions& o, int width, int height) {
         }
         commands = std::move(*parsed);
     }
+    {
+        std::vector<OutputFile> outputs;
+        if (!o.screenshot.empty()) outputs.push_back({"--screenshot", o.screenshot});
+        if (!o.debugState.empty()) outputs.push_back({"--debug-state", o.debugState});
+        std::vector<std::string> inputs;
+        if (!o.level.empty()) inputs.push_back(o.level);
+        if (!o.script.empty()) inputs.push_back(o.script);
+        if (std::string problem = checkOutputs(inputs, outputs); !problem.empty() && problem.rfind("stepwise: error: ", 0) == 0) {
+            std::cerr << problem << "\n";
+            return kExitBadInput;
+        }
+    }
     if (!o.screenshot.empty()) {
         const std::filesystem::path parent = std::filesystem::path(o.screenshot).parent_path();
         std::error_code ec;
@@ -324,6 +336,17 @@ int runScripted(const EditOptions& o, int width, int height) {
             break;
         case K::Action: {
             const std::string& a = c.text;
+            // A command that fails in the editor opens an error dialog; in a
+            // script it stops the run with the dialog's text on stderr and
+            // exit 2, as a bad line does (open, saveas and savestate of a
+            // missing path exited 0 with nothing on stderr).
+            const std::string modalBefore = ed.errorModal;
+            auto failed = [&](const char* what) {
+                std::string why = ed.errorModal != modalBefore ? ed.errorModal : std::string();
+                for (char& ch : why)
+                    if (ch == '\n') ch = ' ';
+                failLine(std::string(what) + (why.empty() ? "" : ": " + why));
+            };
             const std::vector<std::string>& args = c.args;
             auto onOff = [&](const std::string& v, bool& out) {
                 if (v == "on") out = true;
@@ -337,7 +360,13 @@ int runScripted(const EditOptions& o, int width, int height) {
             } else if (a == "pause") {
                 if (ed.sim.state() == editor::SimState::Playing) ed.togglePlay();
             } else if (a == "step") {
-                for (int i = 0; i < c.count; ++i) ed.stepForward();
+                for (int i = 0; i < c.count && status == kExitOk; ++i) {
+                    ed.stepForward();
+                    // A diverged step, or a level that cannot be simulated.
+                    if (ed.sim.diverged() || ed.sim.message().rfind("cannot simulate", 0) == 0)
+                        failLine("step " + std::to_string(i + 1) + " of " + std::to_string(c.count) + ": " +
+                                 ed.sim.message());
+                }
             } else if (a == "stepback") {
                 for (int i = 0; i < c.count; ++i) ed.stepBack();
             } else if (a == "reset") ed.resetSimulation();
@@ -345,10 +374,16 @@ int runScripted(const EditOptions& o, int width, int height) {
             else if (a == "redo") ed.redo();
             else if (a == "fit") ed.fitView();
             else if (a == "new") ed.newDocument();
-            else if (a == "open") ed.open(args[0]);
-            else if (a == "save") ed.save();
-            else if (a == "saveas") ed.saveAs(args[0]);
-            else if (a == "savestate") ed.saveStateAs(args[0]);
+            else if (a == "open") {
+                if (!ed.open(args[0])) failed("open failed");
+            } else if (a == "save") {
+                if (ed.doc.path.empty()) failLine("save: the level has no file yet; use saveas PATH");
+                else if (!ed.save()) failed("save failed");
+            } else if (a == "saveas") {
+                if (!ed.saveAs(args[0])) failed("saveas failed");
+            } else if (a == "savestate") {
+                if (!ed.saveStateAs(args[0])) failed("savestate failed");
+            }
             else if (a == "tool") {
                 bool found = false;
                 static const char* names[] = {"select", "rotate", "circle", "box", "plane", "spring", "attractor", "boids", "joint", "polygon"};
@@ -408,7 +443,10 @@ int runScripted(const EditOptions& o, int width, int height) {
                 if (Result<void> w = writeFileAtomically(args[0], render::encodePng(image)); !w) failLine(w.error());
                 break;
             }
-            frame();
+            // Any other action that opened an error dialog (play on a level
+            // that cannot be simulated, a step that diverged) failed too.
+            if (status == kExitOk && ed.errorModal != modalBefore && !ed.errorModal.empty()) failed(a.c_str());
+            if (status == kExitOk) frame();
             break;
         }
         }
@@ -654,7 +692,8 @@ void addEditCommand(CLI::App& app, int& exitCode) {
         ->check(CLI::Range(1, 100000));
     cmd->add_option("--bench-bodies", o->benchBodies, "Benchmark a generated level of N circles instead of LEVEL")
         ->check(CLI::Range(1, 1000000));
-    cmd->add_option("--debug-state", o->debugState, "Write the editor's state (mode, time, positions) to this JSON file");
+    cmd->add_option("--debug-state", o->debugState, "Write the editor's state (mode, time, positions) to this JSON file")
+        ->check(outputFileName());
     cmd->add_flag("--headless", o->headless, "Run through OSMesa without a window (implied by --script/--screenshot)");
     cmd->add_flag("--show-timings", o->showTimings, "Headless: show wall-clock timings (screenshots then differ run to run)");
     cmd->add_flag("--no-vsync", o->noVsync, "Window: do not wait for the display's refresh");

@@ -22,6 +22,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 namespace stepwise::cli {
 
@@ -123,6 +124,16 @@ int render(const RenderOptions& o) {
     std::optional<Scene> scene = loadLevelOrReport(o.level);
     if (!scene) return kExitBadInput;
     if (o.integrator) scene->world.integrator = *o.integrator;
+    {
+        // Every frame's file before any step: writable, not the level.
+        std::vector<OutputFile> outputs;
+        for (int frame = 0; frame < o.frames; ++frame) outputs.push_back({"--out", frameName(o.out, frame, o.frames)});
+        if (std::string problem = checkOutputs({o.level}, outputs); !problem.empty()) {
+            if (problem.rfind("stepwise: error: ", 0) == 0) std::cerr << problem << "\n";
+            else reportError("--out: " + problem);
+            return kExitBadInput;
+        }
+    }
 
     std::vector<Entity> selection;
     if (!o.select.empty()) {
@@ -180,6 +191,10 @@ int render(const RenderOptions& o) {
     input.hud = !o.noHud;
 
     const bool tty = ::isatty(2) && o.frames > 1;
+    // Each frame goes to a temporary next to its file; all are put in
+    // place at the end, so a run that fails (exit 2 or 3) writes nothing.
+    std::vector<StreamedFileWriter> written;
+    written.reserve(std::size_t(o.frames));
     const std::string levelName = std::filesystem::path(o.level).filename().string();
     long long stepsTaken = 0;
     double renderMs = 0.0;
@@ -196,7 +211,8 @@ int render(const RenderOptions& o) {
             if (run.divergence) {
                 if (tty) std::fputc('\n', stderr);
                 reportError(o.level + ": simulation diverged at " + *run.divergence + " (integrator " +
-                            world->settings().integrator + "); " + std::to_string(frame) + " frame(s) written");
+                            world->settings().integrator + ") before frame " + std::to_string(frame) +
+                            "; no frame written");
                 return kExitDiverged;
             }
         }
@@ -215,13 +231,22 @@ int render(const RenderOptions& o) {
         input.scales = drawn.scales;
 
         const std::string path = frameName(o.out, frame, o.frames);
-        if (Result<void> written = writeFileAtomically(path, render::encodePng(image)); !written) {
+        Result<StreamedFileWriter> writer = StreamedFileWriter::open(path);
+        Result<void> done = writer ? writer->write(render::encodePng(image)) : Result<void>(Error{writer.error()});
+        if (done) done = writer->finish();
+        if (!done) {
             if (tty) std::fputc('\n', stderr);
-            reportError("--out: " + written.error());
+            reportError("--out: " + done.error());
             return kExitBadInput;
         }
+        written.push_back(std::move(*writer));
         if (tty) progress(frame + 1, o.frames);
     }
+    for (StreamedFileWriter& frameFile : written)
+        if (Result<void> done = frameFile.commit(); !done) {
+            reportError("--out: " + done.error());
+            return kExitBadInput;
+        }
     std::cout << "wrote " << (o.frames == 1 ? o.out : frameName(o.out, 0, o.frames) + " .. " +
                                                           frameName(o.out, o.frames - 1, o.frames))
               << " (" << o.width << "x" << o.height << ", " << stepsTaken << " steps, " << instances
@@ -236,7 +261,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     CLI::App* cmd = app.add_subcommand("render", "Render a level to PNG headlessly (OSMesa; no display needed)");
     cmd->add_option("LEVEL", o->level, "Level file (JSON)")->required();
     cmd->add_option("--out", o->out, "Output PNG (a sequence adds -0000, -0001, ... before the extension)")
-        ->required();
+        ->required()
+        ->check(outputFileName());
     cmd->add_option("--steps", o->steps, "Steps to simulate before the (first) frame")
         ->check(wholeNumberAtLeastZero());
     cmd->add_option("--integrator", o->integrator, "Integrator (overrides world.integrator)")

@@ -145,10 +145,12 @@ std::string checkOutputSpace(const std::optional<std::string>& path, const char*
     const double free = double(fs.f_bavail) * double(fs.f_frsize);
     const double need = (double(steps) + 1.0) * bytesPerStep;
     if (need <= free) return {};
-    char text[160];
-    std::snprintf(text, sizeof text, "%s: %lld steps need at least %.3g bytes (%.0f a step); the disk holding %s has %.3g free",
-                  option, steps, need, bytesPerStep, path->c_str(), free);
-    return text;
+    char figures[96];
+    std::snprintf(figures, sizeof figures, "%.3g bytes (%.0f a step)", need, bytesPerStep);
+    char available[32];
+    std::snprintf(available, sizeof available, "%.3g", free);
+    return std::string(option) + ": " + std::to_string(steps) + " steps need at least " + figures +
+           "; the disk holding " + *path + " has " + available + " free";
 }
 
 int run(const RunOptions& options) {

@@ -81,6 +81,10 @@ std::string parserDetail(const std::string& what) {
     return detail.empty() ? "not valid JSON" : detail;
 }
 
+/// Values allowed inside the top-level "world" and "view" objects (a world
+/// has about 15).
+constexpr std::size_t kMaxSectionValues = 10'000;
+
 /// A limit passed or a rule broken while parsing: thrown by the handler,
 /// caught in parseLevelJson. `offset` is where (npos: the message has no
 /// place, as the entity and depth limits never had).
@@ -95,16 +99,6 @@ struct ShapeStop {
     std::string pointer;
     std::string message;
 };
-
-std::string escapePointerToken(std::string_view token) {
-    std::string out;
-    for (char c : token) {
-        if (c == '~') out += "~0";
-        else if (c == '/') out += "~1";
-        else out += c;
-    }
-    return out;
-}
 
 /// A const char* that tells the handler how far the lexer has read: the
 /// handler's callbacks carry no position, but nlohmann's lexer reads one
@@ -225,6 +219,16 @@ private:
 
     std::size_t offset() const { return std::size_t(*cursor_ - text_.data()); }
 
+    /// Offset of the last character of the value just read. The lexer has
+    /// read one character past a number (and put it back), so step back
+    /// over that delimiter and any blanks.
+    std::size_t valueEnd() const {
+        std::size_t p = offset() ? offset() - 1 : 0;
+        const auto delimiter = [](char c) { return c == ',' || c == ']' || c == '}' || c == ':' || std::isspace(static_cast<unsigned char>(c)); };
+        while (p > 0 && delimiter(text_[p])) --p;
+        return p;
+    }
+
     bool inEntities() const {
         return open_ >= 2 && frames_[0].object && frames_[0].key == "entities" && !frames_[1].object;
     }
@@ -246,7 +250,7 @@ private:
             throw Stop{"more than " + std::to_string(limits_.maxValues) +
                            " JSON values (numbers, strings, objects, arrays); the limit is " +
                            std::to_string(limits_.maxValues) + " (a level uses about 14 per entity)",
-                       offset() ? offset() - 1 : 0};
+                       valueEnd()};
         if (open_ == 0) return;
         Frame& parent = frames_[std::size_t(open_ - 1)];
         if (!parent.object) ++parent.index;
@@ -258,12 +262,20 @@ private:
         if (open_ == 2 && frames_[0].object && frames_[0].key == "entities" && parent.object)
             throw ShapeStop{"/entities", "expected an array of entities, got an object"};
         if (open_ == 2 && inEntities()) entityStart_ = values_;
+        // "world" and "view" hold a dozen values; a huge array there would
+        // otherwise be built in full before the component layer refuses it.
+        if (open_ == 1 && parent.object && (parent.key == "world" || parent.key == "view")) sectionStart_ = values_;
+        if (open_ >= 2 && frames_[0].object && (frames_[0].key == "world" || frames_[0].key == "view") &&
+            values_ - sectionStart_ > kMaxSectionValues)
+            throw Stop{"/" + frames_[0].key + ": more than " + std::to_string(kMaxSectionValues) +
+                           " JSON values; this section holds a few settings",
+                       valueEnd()};
         if (open_ == 3 && inEntities() && !parent.object)
             throw ShapeStop{pointerTo(2), "expected an entity object {\"component\": value, ...}, got an array"};
         if (open_ >= 3 && inEntities() && values_ - entityStart_ >= limits_.maxValuesPerEntity)
             throw Stop{pointerTo(2) + ": more than " + std::to_string(limits_.maxValuesPerEntity) +
                            " JSON values in one entity; the limit is " + std::to_string(limits_.maxValuesPerEntity),
-                       offset() ? offset() - 1 : 0};
+                       valueEnd()};
     }
 
     void enter(bool object) {
@@ -342,7 +354,8 @@ private:
     int open_ = 0;
     std::size_t entities_ = 0;
     std::size_t values_ = 0;
-    std::size_t entityStart_ = 0;  ///< values_ when the current entity began
+    std::size_t entityStart_ = 0;   ///< values_ when the current entity began
+    std::size_t sectionStart_ = 0;  ///< values_ when "world" or "view" began
 };
 
 } // namespace
@@ -391,6 +404,16 @@ Result<void> parseLevelJson(std::string_view text, std::string_view sourceName, 
     return {};
 }
 
+std::string escapePointerToken(std::string_view token) {
+    std::string out;
+    for (char c : token) {
+        if (c == '~') out += "~0";
+        else if (c == '/') out += "~1";
+        else out += c;
+    }
+    return out;
+}
+
 std::string shortenForMessage(std::string_view message) {
     constexpr std::size_t kLongRun = 120, kKeep = 60, kMaxMessage = 4096;
     std::string out;
@@ -398,7 +421,7 @@ std::string shortenForMessage(std::string_view message) {
     std::size_t i = 0;
     while (i < message.size()) {
         std::size_t j = i;
-        while (j < message.size() && message[j] != ' ' && message[j] != '"' && message[j] != '/') ++j;
+        while (j < message.size() && message[j] != ' ' && message[j] != '"' && message[j] != '/' && message[j] != ':') ++j;
         if (j - i > kLongRun) {
             // Cut on a UTF-8 character boundary, never inside a character.
             std::size_t cut = i + kKeep;

@@ -29,8 +29,11 @@ using LevelJson = nlohmann::ordered_json;
 Result<void> parseLevelJson(std::string_view text, std::string_view sourceName, const LoadLimits& limits,
                             LevelJson& root);
 
+/// A key as a JSON Pointer token (RFC 6901): "~" -> "~0", "/" -> "~1".
+std::string escapePointerToken(std::string_view token);
+
 /// Messages quote names and values from the file: a run of more than 120
-/// bytes without a space, quote or slash is cut to its first 60 bytes and
+/// bytes without a space, quote, slash or colon is cut to its first 60 bytes and
 /// "...(N bytes)", and the whole message to 4,096 bytes, so a 10 MB key
 /// gives a one-line message, not a 20 MB one.
 std::string shortenForMessage(std::string_view message);

@@ -32,18 +32,8 @@ struct Refusal {
     std::string message;
 };
 
-std::string escapePointerToken(std::string_view token) {
-    std::string out;
-    for (char c : token) {
-        if (c == '~') out += "~0";
-        else if (c == '/') out += "~1";
-        else out += c;
-    }
-    return out;
-}
-
 std::string child(const std::string& pointer, std::string_view key) {
-    return pointer + "/" + escapePointerToken(key);
+    return pointer + "/" + detail::escapePointerToken(key);
 }
 std::string child(const std::string& pointer, std::size_t index) {
     return pointer + "/" + std::to_string(index);

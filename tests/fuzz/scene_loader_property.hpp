@@ -41,8 +41,14 @@ inline std::string checkLoaderProperty(std::string_view text) {
             return "refusal does not start with the file name: " + message;
         if (message.find('\n') != std::string::npos) return "refusal spans more than one line: " + message;
         if (!isValidUtf8(message)) return "refusal is not valid UTF-8: " + message;
+        // Long names and values are cut (json_reader.cpp): a message is at
+        // most 4,096 bytes plus the note saying it was cut.
+        if (message.size() > 4200) return "refusal is " + std::to_string(message.size()) + " bytes long";
         return {};
     }
+    // nlohmann's lexer stops at a NUL as at the end of the input; a level
+    // file has none, so nothing with one may load.
+    if (text.find('\0') != std::string_view::npos) return "a text with a NUL byte loaded";
     const std::string first = sceneToJsonText(*scene);
     Result<Scene> again = parseScene(first, "saved.json");
     if (!again) return "a loaded scene saved text that does not load: " + again.error() + "\n--- saved text:\n" + first;

@@ -24,7 +24,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace stepwise::detail {
@@ -36,7 +38,8 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 class ImplicitIntegrator final : public Integrator, private JacobianSink {
 public:
     ImplicitIntegrator(bool midpoint, const ForceModel& model)
-        : midpoint_(midpoint), n_(model.n), a_(2 * n_), xe_(2 * n_), ve_(2 * n_), rhs_(2 * n_), delta_(2 * n_) {
+        : midpoint_(midpoint), n_(model.n), a_(2 * n_), xe_(2 * n_), ve_(2 * n_), rhs_(2 * n_), delta_(2 * n_),
+          residual_(2 * n_) {
         buildPattern(model);
     }
 
@@ -48,6 +51,7 @@ public:
         beta_ = h * cx1;   // weight of dF/dx
         std::copy(v0, v0 + m, v1);  // initial guess: v1 = v0
         evaluations_ = 0;
+        failed_ = false;
         bool factored = false;
         double previous = 0.0;
         for (int iteration = 0; iteration < kNewtonMaxIterations; ++iteration) {
@@ -60,10 +64,18 @@ public:
             // rhs = -G(v1) = M (v0 - v1 + h a), newtons*s.
             for (std::size_t i = 0; i < m; ++i) rhs_[Eigen::Index(i)] = f.mass[i / 2] * (v0[i] - v1[i] + h * a_[i]);
             if (!factored) {
-                if (!factorize(f)) break;  // singular: keep the last iterate (the world's check catches non-finite)
+                if (!factorize(f)) {
+                    // Singular in doubles: the masses on the diagonal are
+                    // lost to rounding next to h^2 k (k >= ~1e20 for 1 kg at
+                    // 60 Hz). Keeping v1 = v0 froze every body, the free
+                    // ones too: refuse the step instead.
+                    fail("the linear system is singular in double precision (the factorisation failed)");
+                    break;
+                }
                 factored = true;
             }
             solve();
+            if (!solveAccurate()) break;
             // Converged when the update is below kNewtonRelativeTolerance of
             // the velocities or of what moves a position by one step's worth
             // of its own magnitude (|x|/h): below that, the update only
@@ -87,6 +99,7 @@ public:
         }
     }
     int lastEvaluations() const override { return evaluations_; }
+    const SolveFailure* lastFailure() const override { return failed_ ? &failure_ : nullptr; }
 
 private:
     // --- JacobianSink: A = M - alpha dF/dv - beta dF/dx, block by block.
@@ -181,6 +194,8 @@ private:
     bool factorize(const ForceModel& f) {
         std::fill(A_.valuePtr(), A_.valuePtr() + A_.nonZeros(), 0.0);
         double* values = A_.valuePtr();
+        massOf_.assign(f.mass.begin(), f.mass.begin() + std::ptrdiff_t(n_));
+        residual_.setZero();
         for (std::size_t i = 0; i < n_; ++i) {
             values[blockSlots_[i * 4 + 0]] = f.mass[i];
             values[blockSlots_[i * 4 + 3]] = f.mass[i];
@@ -200,6 +215,51 @@ private:
         return lu_.info() == Eigen::Success;
     }
 
+    /// The residual of the last solve against the matrix it factored: a
+    /// solve that "succeeds" on a nearly singular matrix (k = 1e100) gives
+    /// velocities off by orders of magnitude, a 96 km spring. The bodies
+    /// named are those whose rows the solve got wrong; bodies of other,
+    /// well-conditioned blocks (a free body) have residual ~0.
+    bool solveAccurate() {
+        residual_.noalias() = A_ * delta_;
+        residual_ -= rhs_;
+        const double rhsSize = rhs_.lpNorm<Eigen::Infinity>();
+        const double size = residual_.lpNorm<Eigen::Infinity>();
+        if (size <= kSolveRelativeResidual * rhsSize) return true;
+        if (!std::isfinite(rhsSize)) return true;  // non-finite forces: the world's check names them
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "the linear solve lost its accuracy (residual %.2g of the right-hand side; the system is too "
+                      "stiff for doubles at this dt)",
+                      rhsSize > 0.0 ? size / rhsSize : size);
+        fail(text);
+        return false;
+    }
+
+    void fail(const std::string& what) {
+        failed_ = true;
+        failure_.what = what;
+        failure_.bodies.clear();
+        const double rhsSize = rhs_.lpNorm<Eigen::Infinity>();
+        const bool solved = residual_.size() == rhs_.size() && residual_.allFinite();
+        for (std::size_t b = 0; b < n_; ++b) {
+            bool bad;
+            if (solved && failure_.what.rfind("the linear solve", 0) == 0) {
+                const double r = std::max(std::abs(residual_[Eigen::Index(2 * b)]),
+                                          std::abs(residual_[Eigen::Index(2 * b + 1)]));
+                bad = !(r <= kSolveRelativeResidual * rhsSize);
+            } else {
+                // Factorisation failed: the bodies whose mass is lost next to
+                // the stiffness on their diagonal.
+                const double* values = A_.valuePtr();
+                const double diag = std::max(std::abs(values[blockSlots_[b * 4 + 0]]),
+                                             std::abs(values[blockSlots_[b * 4 + 3]]));
+                bad = !(diag * std::numeric_limits<double>::epsilon() < massOf_[b]);
+            }
+            if (bad) failure_.bodies.push_back(b);
+        }
+    }
+
     void solve() {
         if (useLu_)
             delta_ = lu_.solve(rhs_);
@@ -210,7 +270,10 @@ private:
     bool midpoint_;
     std::size_t n_;
     std::vector<double> a_, xe_, ve_;
-    Eigen::VectorXd rhs_, delta_;
+    Eigen::VectorXd rhs_, delta_, residual_;
+    std::vector<double> massOf_;  ///< the masses of the last factorisation (naming failing bodies)
+    bool failed_ = false;
+    SolveFailure failure_;
     SparseMatrix A_;
     std::vector<std::size_t> blockSlots_;  ///< per block, 4 offsets into A_'s values (row-major in the block)
     std::vector<SpringSlots> springSlots_;

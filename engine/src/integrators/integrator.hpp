@@ -10,7 +10,9 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace stepwise::detail {
 
@@ -29,6 +31,13 @@ std::optional<IntegratorKind> integratorKind(std::string_view name);
 std::string_view integratorName(IntegratorKind kind);
 bool isImplicit(IntegratorKind kind);
 
+/// Why the last step's solve cannot be trusted, and the bodies of the
+/// failing system (dynamic body indices).
+struct SolveFailure {
+    std::string what;
+    std::vector<std::size_t> bodies;
+};
+
 class Integrator {
 public:
     virtual ~Integrator() = default;
@@ -45,6 +54,10 @@ public:
     /// over the state (at 1e4 bodies that pass cost a third of the step).
     /// False means "not checked", never "not finite": the world checks.
     virtual bool lastStepVerifiedFinite() const { return false; }
+    /// Set when the last step's linear solve failed or lost its accuracy
+    /// (implicit methods): the world refuses the step as it refuses a
+    /// non-finite value, instead of keeping a frozen or wrong state.
+    virtual const SolveFailure* lastFailure() const { return nullptr; }
 };
 
 /// Instruction sets the streaming kernels (semi-implicit Euler and RK4 with
@@ -74,6 +87,14 @@ double stabilityLimit(IntegratorKind kind, double zeta);
 /// this fraction of the velocity scale.
 inline constexpr double kNewtonRelativeTolerance = 1e-13;
 inline constexpr int kNewtonMaxIterations = 30;
+/// A linear solve of the implicit methods is refused when its residual
+/// |A dv - rhs| exceeds this fraction of |rhs| (infinity norms). A
+/// backward-stable solve leaves about eps * cond(A) of |rhs|, so this
+/// passes systems up to cond(A) ~ 1e10 (dt*sqrt(k/m) up to ~1e5).
+inline constexpr double kSolveRelativeResidual = 1e-6;
+/// dt*sqrt(k/m) past which `validate` warns for the implicit methods:
+/// cond(A) ~ (dt*sqrt(k/m))^2 reaches 1e10.
+inline constexpr double kImplicitConditioningLimit = 1e5;
 
 std::unique_ptr<Integrator> makeImplicitIntegrator(bool midpointRule, const ForceModel& model);
 

@@ -112,6 +112,19 @@ std::string WorldImpl::findNonFinite(std::uint64_t stepNumber) const {
     return {};
 }
 
+std::string WorldImpl::describeSolveFailure(const detail::SolveFailure& failure, std::uint64_t stepNumber) const {
+    std::string who;
+    const std::size_t shown = std::min<std::size_t>(failure.bodies.size(), 6);
+    for (std::size_t i = 0; i < shown; ++i) {
+        const std::size_t b = failure.bodies[i];
+        who += (i ? ", " : "") + entityLabel(bodySceneIndex[b], &bodyName[b]);
+    }
+    if (failure.bodies.size() > shown) who += " and " + std::to_string(failure.bodies.size() - shown) + " more";
+    return "step " + std::to_string(stepNumber) + ": " + settings.integrator + ": " + failure.what +
+           (who.empty() ? std::string() : "; bodies of the failing system: " + who) +
+           ". Lower the stiffness or dt (stepwise validate estimates the conditioning)";
+}
+
 void WorldImpl::setIntegratorKind(detail::IntegratorKind k) {
     kind = k;
     integrator = detail::makeIntegrator(k, model);
@@ -124,6 +137,12 @@ std::string StiffnessHint::message() const {
     char dtText[32];
     std::snprintf(dtText, sizeof dtText, "%.3g", largestStableDt);
     std::string text = "spring \"" + springName + "\": dt*sqrt(k/m) = " + format(hOmega) + " per substep ";
+    if (integrator.rfind("implicit_", 0) == 0)
+        return text + "makes " + integrator + "'s linear system ill-conditioned (condition number about " +
+               format(hOmega * hOmega) + ", past " + format(limit * limit) +
+               "): the solve in doubles loses up to that many of its 1e16 parts, and a step whose residual passes " +
+               "1e-6 is refused; largest dt for this spring is " +
+               dtText + " s (or add substeps, or lower k)";
     if (limit <= 0.0)
         return text + "and " + integrator +
                " is unstable on this spring at any dt (it spirals out); use semi_implicit_euler, velocity_verlet, "
@@ -406,6 +425,20 @@ Result<void> World::step() {
         w.integrator->step(f, w.x[w.current].data(), w.v[w.current].data(), w.x[next].data(), w.v[next].data(), h);
         evaluations += w.integrator->lastEvaluations();
         verifiedFinite = w.integrator->lastStepVerifiedFinite();
+        if (const detail::SolveFailure* failed = w.integrator->lastFailure()) {
+            // Refused like a non-finite value: the state stays at the start
+            // of the step (no buffer was flipped; with substeps, the backup).
+            if (substeps > 1) {
+                std::copy(w.backupX.begin(), w.backupX.end(), w.x[w.current].begin());
+                std::copy(w.backupV.begin(), w.backupV.end(), w.v[w.current].begin());
+            }
+            std::copy(w.angleBackup.begin(), w.angleBackup.end(), w.angle.begin());
+            if (contacts) {
+                contacts->endStep();
+                contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
+            }
+            return Error{w.describeSolveFailure(*failed, w.stats.step + 1)};
+        }
         // --- contact solve on the integrator's end-of-substep state
         if (contacts) {
             contacts->solveSubstep(detail::asVec2(w.x[next].data(), f.n), detail::asVec2(w.v[next].data(), f.n), h);
@@ -710,7 +743,7 @@ std::vector<StiffnessHint> World::stiffnessHints() const {
     const WorldImpl& w = *impl_;
     const detail::ForceModel& f = w.model;
     std::vector<StiffnessHint> hints;
-    if (detail::isImplicit(w.kind)) return hints;
+    const bool implicitMethod = detail::isImplicit(w.kind);
     const int substeps = w.settings.substeps;
     const double h = w.settings.dt / double(substeps);
     std::map<double, double> limitByZeta;  // cloth and chains share a few damping ratios
@@ -723,8 +756,16 @@ std::vector<StiffnessHint> World::stiffnessHints() const {
         const double mr = sp.b == kNoBody ? ma : ma * f.mass[sp.b] / (ma + f.mass[sp.b]);
         const double omega = std::sqrt(sp.k / mr);
         const double zeta = sp.c / (2.0 * std::sqrt(sp.k * mr));
+        // The implicit methods are stable at any dt, but their linear system
+        // M + h^2 K has condition number about (h omega)^2: past
+        // kImplicitConditioningLimit the solve in doubles loses its accuracy
+        // and the step is refused.
         auto it = limitByZeta.find(zeta);
-        if (it == limitByZeta.end()) it = limitByZeta.emplace(zeta, detail::stabilityLimit(w.kind, zeta)).first;
+        if (it == limitByZeta.end())
+            it = limitByZeta
+                     .emplace(zeta, implicitMethod ? detail::kImplicitConditioningLimit
+                                                   : detail::stabilityLimit(w.kind, zeta))
+                     .first;
         const double limit = it->second;
         const double hOmega = h * omega;
         if (!(hOmega > limit)) continue;

@@ -57,6 +57,9 @@ public:
     /// "step 42: entity 3 (\"ball\"): velocity.x became inf", or "" if the
     /// state is finite.
     std::string findNonFinite(std::uint64_t stepNumber) const;
+    /// "step 42: implicit_euler: the linear ...; bodies of the failing
+    /// system: entity 0 (\"a\"), entity 1 (\"b\")".
+    std::string describeSolveFailure(const detail::SolveFailure& failure, std::uint64_t stepNumber) const;
     void setIntegratorKind(detail::IntegratorKind k);
 };
 
