@@ -39,6 +39,11 @@ struct StepStats {
     /// Euler fuses them into its update and their time is in "integrate".
     std::vector<StageTime> systems;
     int forceEvaluations = 0;          ///< force evaluations in the last step (addition)
+    /// Internal steps accepted and rejected in the last step, over all its
+    /// substeps: dopri5 chooses them for world.tolerance; a fixed-step
+    /// integrator takes one per substep and rejects none.
+    int internalSteps = 0;
+    int rejectedSteps = 0;
 };
 
 /// Energy and momentum of the dynamic bodies, joules and kg*m/s.

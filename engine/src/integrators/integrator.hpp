@@ -10,6 +10,7 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace stepwise::detail {
@@ -23,6 +24,7 @@ enum class IntegratorKind {
     VelocityVerlet,     ///< kick-drift-kick (symplectic)                      order 2
     ImplicitEuler,      ///< backward Euler, Newton on v1 (L-stable)           order 1
     ImplicitMidpoint,   ///< implicit midpoint rule (symplectic, A-stable)     order 2
+    Dopri5,             ///< Dormand–Prince 5(4), error-controlled internal steps  order 5
 };
 
 std::optional<IntegratorKind> integratorKind(std::string_view name);
@@ -45,6 +47,24 @@ public:
     /// over the state (at 1e4 bodies that pass cost a third of the step).
     /// False means "not checked", never "not finite": the world checks.
     virtual bool lastStepVerifiedFinite() const { return false; }
+
+    // Error-controlled methods (dopri5); fixed-step methods keep the defaults.
+    /// Local error per internal step (world.tolerance).
+    virtual void setTolerance(double) {}
+    /// Internal steps accepted and rejected in the last step() (1 and 0 for
+    /// a fixed-step method).
+    virtual int lastAcceptedSteps() const { return 1; }
+    virtual int lastRejectedSteps() const { return 0; }
+    /// Not empty when the last step() could not meet its tolerance; the
+    /// world then undoes the step and reports this message.
+    virtual const std::string& lastFailure() const {
+        static const std::string none;
+        return none;
+    }
+    /// The controller's proposal for the next internal step, s (0: none);
+    /// carried across frames and saved (world.adaptive_step).
+    virtual double proposedStep() const { return 0.0; }
+    virtual void setProposedStep(double) {}
 };
 
 /// Instruction sets the streaming kernels (semi-implicit Euler and RK4 with
@@ -76,5 +96,6 @@ inline constexpr double kNewtonRelativeTolerance = 1e-13;
 inline constexpr int kNewtonMaxIterations = 30;
 
 std::unique_ptr<Integrator> makeImplicitIntegrator(bool midpointRule, const ForceModel& model);
+std::unique_ptr<Integrator> makeDopri5(const ForceModel& model);
 
 } // namespace stepwise::detail

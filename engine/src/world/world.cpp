@@ -110,6 +110,8 @@ std::string WorldImpl::findNonFinite(std::uint64_t stepNumber) const {
 void WorldImpl::setIntegratorKind(detail::IntegratorKind k) {
     kind = k;
     integrator = detail::makeIntegrator(k, model);
+    integrator->setTolerance(settings.tolerance);
+    integrator->setProposedStep(settings.adaptiveStep);
     settings.integrator = std::string(detail::integratorName(k));
 }
 
@@ -147,6 +149,12 @@ Result<World> World::build(const Scene& scene) {
     if (ws.substeps < 1) return Error{"world.substeps: expected an integer >= 1, got " + std::to_string(ws.substeps)};
     if (!isFinite(ws.gravity) || !std::isfinite(ws.G) || !std::isfinite(ws.time))
         return Error{"world: gravity, G and time must be finite"};
+    if (!(ws.tolerance > 0.0) || !(ws.tolerance <= 1.0))
+        return Error{"world.tolerance: expected a number in (0, 1], got " + format(ws.tolerance)};
+    if (!(ws.theta >= 0.0) || !(ws.theta <= 1.0))
+        return Error{"world.theta: expected a number in [0, 1], got " + format(ws.theta)};
+    if (!(ws.adaptiveStep >= 0.0) || !std::isfinite(ws.adaptiveStep))
+        return Error{"world.adaptive_step: expected a finite number >= 0, got " + format(ws.adaptiveStep)};
 
     const Registry& reg = scene.registry;
     const std::vector<Entity>& order = reg.entities();
@@ -195,6 +203,7 @@ Result<World> World::build(const Scene& scene) {
     f.gx = ws.gravity.x;
     f.gy = ws.gravity.y;
     f.G = ws.G;
+    f.theta = ws.theta;
 
     // Drag: dense per-body rates, only if some body has b > 0.
     f.dragB.assign(n, 0.0);
@@ -354,7 +363,8 @@ Result<void> World::step() {
         std::copy(w.v[w.current].begin(), w.v[w.current].end(), w.backupV.begin());
     }
     std::copy(w.angle.begin(), w.angle.end(), w.angleBackup.begin());
-    int evaluations = 0;
+    int evaluations = 0, internalSteps = 0, rejectedSteps = 0;
+    const std::string* failure = nullptr;  // the integrator could not meet its tolerance
     bool verifiedFinite = false;  // the last substep's integrator pass checked x, v
     double rotationSeconds = 0.0, contactSeconds = 0.0;
     collision::CollisionSystem* contacts = w.collision.get();
@@ -370,7 +380,14 @@ Result<void> World::step() {
         // --- forces + integrate
         w.integrator->step(f, w.x[w.current].data(), w.v[w.current].data(), w.x[next].data(), w.v[next].data(), h);
         evaluations += w.integrator->lastEvaluations();
+        internalSteps += w.integrator->lastAcceptedSteps();
+        rejectedSteps += w.integrator->lastRejectedSteps();
         verifiedFinite = w.integrator->lastStepVerifiedFinite();
+        if (!w.integrator->lastFailure().empty()) {
+            failure = &w.integrator->lastFailure();
+            w.current = next;  // the undo below expects the output buffer current
+            break;
+        }
         // --- contact solve on the integrator's end-of-substep state
         if (contacts) {
             contacts->solveSubstep(detail::asVec2(w.x[next].data(), f.n), detail::asVec2(w.v[next].data(), f.n), h);
@@ -390,14 +407,15 @@ Result<void> World::step() {
     // pass (fused kernels): then only if nothing changed them since (no
     // contact solve) is a second pass over the state skipped.
     const bool stateChecked = verifiedFinite && !contacts;
-    const bool finite = (stateChecked || (allFinite(w.xs(), m) && allFinite(w.vs(), m))) &&
+    const bool finite = !failure && (stateChecked || (allFinite(w.xs(), m) && allFinite(w.vs(), m))) &&
                         allFinite(w.angle.data(), w.angle.size()) &&
                         (!contacts || (allFinite(contacts->angles().data(), contacts->angles().size()) &&
                                        allFinite(contacts->angularVelocities().data(),
                                                  contacts->angularVelocities().size())));
     const Clock::time_point t2 = timed ? Clock::now() : Clock::time_point{};
     if (!finite) {
-        std::string message = w.findNonFinite(w.stats.step + 1);
+        std::string message =
+            failure ? "step " + std::to_string(w.stats.step + 1) + ": " + *failure : w.findNonFinite(w.stats.step + 1);
         // Undo: the step's input is still in the other buffer (one
         // substep) or in the backup (several).
         if (substeps == 1) {
@@ -408,11 +426,15 @@ Result<void> World::step() {
         }
         std::copy(w.angleBackup.begin(), w.angleBackup.end(), w.angle.begin());
         if (contacts) contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
+        w.integrator->setProposedStep(w.settings.adaptiveStep);
         return Error{message};
     }
     w.settings.time += w.settings.dt;
+    if (w.kind == detail::IntegratorKind::Dopri5) w.settings.adaptiveStep = w.integrator->proposedStep();
     ++w.stats.step;
     w.stats.forceEvaluations = evaluations;
+    w.stats.internalSteps = internalSteps;
+    w.stats.rejectedSteps = rejectedSteps;
     w.stats.contactCount = contacts ? contacts->contacts().size() : 0;
     w.stats.stages.clear();
     w.stats.systems.clear();
@@ -476,6 +498,7 @@ void World::writeBack(Scene& scene) const {
         }
     }
     scene.world.time = w.settings.time;
+    scene.world.adaptiveStep = w.settings.adaptiveStep;
 }
 
 const WorldSettings& World::settings() const { return impl_->settings; }
@@ -540,7 +563,7 @@ std::vector<StiffnessHint> World::stiffnessHints() const {
     const WorldImpl& w = *impl_;
     const detail::ForceModel& f = w.model;
     std::vector<StiffnessHint> hints;
-    if (detail::isImplicit(w.kind)) return hints;
+    if (!std::isfinite(detail::stabilityLimit(w.kind, 0.0))) return hints;  // implicit, dopri5
     const int substeps = w.settings.substeps;
     const double h = w.settings.dt / double(substeps);
     std::map<double, double> limitByZeta;  // cloth and chains share a few damping ratios
