@@ -128,18 +128,22 @@ void AttractorTree::accumulate(double px, double py, std::uint32_t self, double&
         if (d2 > node.open2) {
             // Far: the whole cell as one softened mass plus its
             // quadrupole. (dx, dy) = -r, from the point to the centre.
+            // One division and one square root per cell: 1/rho^3, and from
+            // it 1/rho^2 = rho/rho^3 and 1/rho^5.
             const double q = d2 + node.eps2;
             const double r = std::sqrt(q);
-            const double s = node.gm / (q * r);
+            const double i3 = 1.0 / (q * r);
+            const double i2 = i3 * r;
+            const double i5 = i3 * i2;
+            const double s = node.gm * i3;
             const double qrx = -(node.qxx * dx + node.qxy * dy), qry = -(node.qxy * dx + node.qyy * dy);  // Q r
             const double rqr = -(dx * qrx + dy * qry);
-            const double i5 = 1.0 / (q * q * r);
-            const double radial = 2.5 * rqr * i5 / q;  // times r = -(dx, dy)
+            const double radial = 2.5 * rqr * i5 * i2;  // times r = -(dx, dy)
             ax += s * dx + i5 * qrx + radial * dx;
             ay += s * dy + i5 * qry + radial * dy;
             if constexpr (Potential) {
                 // The quadrupole term is shared in proportion to G m.
-                const double phi = node.gm / r + 0.5 * rqr * i5;
+                const double phi = s * q + 0.5 * rqr * i5;  // s q = G M / rho, without a division
                 const double dynamicShare = node.gm != 0.0 ? node.gmDynamic / node.gm : 0.0;
                 *phiDynamic += dynamicShare * phi;
                 *phiFixed += (1.0 - dynamicShare) * phi;
@@ -157,7 +161,7 @@ void AttractorTree::accumulate(double px, double py, std::uint32_t self, double&
                 const double s = it.gm / (q * r);
                 ax += s * ex;
                 ay += s * ey;
-                if constexpr (Potential) (it.body == kNoBody ? *phiFixed : *phiDynamic) += it.gm / r;
+                if constexpr (Potential) (it.body == kNoBody ? *phiFixed : *phiDynamic) += s * q;
             }
             i = node.skip;
         } else {
