@@ -13,6 +13,7 @@
 #include "stepwise/integrators.hpp"
 #include "stepwise/world.hpp"
 #include "world/world_impl.hpp"
+#include "report/scenes.hpp"
 
 #include <benchmark/benchmark.h>
 #include <boost/numeric/odeint/stepper/generation.hpp>
@@ -255,36 +256,12 @@ void BM_LayoutSpringsSplit(benchmark::State& state) {
 
 // --- Barnes–Hut ---------------------------------------------------------------
 
-// n attractors of total mass 1 at rest in the unit disc (the scene of
-// test_forces' error bound and of the accuracy report's panel).
-Scene attractorDisc(std::size_t n, double theta) {
-    Scene s;
-    s.world.gravity = {0.0, 0.0};
-    s.world.dt = 0.01;
-    s.world.theta = theta;
-    std::uint64_t state = 0x9E3779B97F4A7C15ull;
-    auto uniform = [&state] {
-        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return double((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
-    };
-    for (std::size_t i = 0; i < n; ++i) {
-        const double r = std::sqrt(uniform()), a = 2.0 * M_PI * uniform();
-        Entity e = s.registry.create();
-        s.registry.emplace<Position>(e, {{r * std::cos(a), r * std::sin(a)}});
-        s.registry.emplace<Mass>(e, {1.0 / double(n)});
-        s.registry.emplace<Attractor>(e, {0.01});
-    }
-    return s;
-}
-
 // One attractor force evaluation: exact (theta 0) or through the tree
 // (theta 0.5, the default), the tree forced on at every size so that the
 // crossover with exact summation shows (kTreeMinAttractors).
 void BM_Attractors(benchmark::State& state, double theta) {
     const std::size_t n = std::size_t(state.range(0));
-    Result<World> built = World::build(attractorDisc(n, theta));
+    Result<World> built = World::build(report::attractorDisc(n, theta));
     if (!built) {
         state.SkipWithError(built.error().c_str());
         return;
@@ -303,7 +280,7 @@ void BM_Attractors(benchmark::State& state, double theta) {
 // `stepwise run --trace` does): the trace must not double the cost.
 void BM_AttractorStep(benchmark::State& state, double theta, bool traced) {
     const std::size_t n = std::size_t(state.range(0));
-    Result<World> built = World::build(attractorDisc(n, theta));
+    Result<World> built = World::build(report::attractorDisc(n, theta));
     if (!built) {
         state.SkipWithError(built.error().c_str());
         return;

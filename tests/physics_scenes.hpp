@@ -116,29 +116,6 @@ struct Kepler {
     }
 };
 
-/// n dynamic attractors of total mass 1 (G = 1) at rest, scattered
-/// uniformly over the unit disc by a fixed generator (the same scene on
-/// every run), softening 0.01 m: the n-body case Barnes–Hut is for.
-inline Scene attractorDisc(std::size_t n, double theta, const std::string& integrator = "semi_implicit_euler",
-                           double dt = 0.01) {
-    Scene s = emptyScene(integrator, dt);
-    s.world.theta = theta;
-    std::uint64_t state = 0x9E3779B97F4A7C15ull;
-    auto uniform = [&state] {  // splitmix64 -> [0, 1)
-        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return double((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
-    };
-    for (std::size_t i = 0; i < n; ++i) {
-        const double r = std::sqrt(uniform()), a = 2.0 * std::numbers::pi * uniform();
-        const Entity e = addBody(s, "s" + std::to_string(i), {r * std::cos(a), r * std::sin(a)}, {0.0, 0.0},
-                                 1.0 / double(n));
-        s.registry.emplace<Attractor>(e, {0.01});
-    }
-    return s;
-}
-
 inline World buildOrDie(const Scene& s) {
     Result<World> w = World::build(s);
     if (!w) throw std::runtime_error("World::build failed: " + w.error());

@@ -3,6 +3,7 @@
 // and the analytic Jacobians against finite differences.
 
 #include "physics_scenes.hpp"
+#include "report/scenes.hpp"
 
 #include "world/world_impl.hpp"
 
@@ -261,8 +262,8 @@ TEST(BarnesHut, TenThousandAttractorsAfterFiveStepsWithinOnePercentOfTheDistance
     // metre they move is the attraction's doing, and the tree's error is
     // compared with that. Exact pairwise summation (theta 0) is the reference.
     const std::size_t n = 10000;
-    World exact = buildOrDie(attractorDisc(n, 0.0));
-    World tree = buildOrDie(attractorDisc(n, 0.5));
+    World exact = buildOrDie(report::attractorDisc(n, 0.0));
+    World tree = buildOrDie(report::attractorDisc(n, 0.5));
     ASSERT_TRUE(tree.impl().model.usesTree());
     ASSERT_FALSE(exact.impl().model.usesTree());
     const std::vector<Vec2> start = positions(exact);
@@ -290,8 +291,8 @@ TEST(BarnesHut, BelowTheCrossoverAndAtThetaZeroTheSumIsExact) {
     // Fewer attractors than kTreeMinAttractors: exact summation is faster
     // and satisfies any theta, so the bits equal theta = 0's.
     const std::size_t n = detail::ForceModel::kTreeMinAttractors - 1;
-    World a = buildOrDie(attractorDisc(n, 0.0));
-    World b = buildOrDie(attractorDisc(n, 0.9));
+    World a = buildOrDie(report::attractorDisc(n, 0.0));
+    World b = buildOrDie(report::attractorDisc(n, 0.9));
     EXPECT_FALSE(b.impl().model.usesTree());
     for (int i = 0; i < 3; ++i) {
         ASSERT_TRUE(a.step().ok());
@@ -303,12 +304,12 @@ TEST(BarnesHut, BelowTheCrossoverAndAtThetaZeroTheSumIsExact) {
 
 TEST(BarnesHut, ForceErrorShrinksWithThetaAndTheEnergyComesFromTheTreeToo) {
     const std::size_t n = 2000;
-    const World exact = buildOrDie(attractorDisc(n, 0.0));
+    const World exact = buildOrDie(report::attractorDisc(n, 0.0));
     const std::vector<Vec2> reference = exact.bodyForces();
     const double exactEnergy = exact.energy().attractors;
     double previous = INFINITY;
     for (double theta : {1.0, 0.7, 0.5, 0.3}) {
-        const World w = buildOrDie(attractorDisc(n, theta));
+        const World w = buildOrDie(report::attractorDisc(n, theta));
         const std::vector<Vec2> f = w.bodyForces();
         double err2 = 0.0, ref2 = 0.0;
         for (std::size_t b = 0; b < n; ++b) {
@@ -328,8 +329,8 @@ TEST(BarnesHut, AnEnergyTraceChangesNoBitOfTheRun) {
     // and the next step reuses them: a run that logs energy every step must
     // be the run that does not, bit for bit, exact or through the tree.
     for (double theta : {0.0, 0.5}) {
-        World quiet = buildOrDie(attractorDisc(600, theta, "rk4"));
-        World traced = buildOrDie(attractorDisc(600, theta, "rk4"));
+        World quiet = buildOrDie(report::attractorDisc(600, theta, "rk4"));
+        World traced = buildOrDie(report::attractorDisc(600, theta, "rk4"));
         for (int i = 0; i < 4; ++i) {
             ASSERT_TRUE(quiet.step().ok());
             (void)traced.energy();

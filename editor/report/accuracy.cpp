@@ -9,6 +9,7 @@
 #include "report/accuracy.hpp"
 #include "report/odeint_implicit.hpp"
 #include "report/cpu_clock.hpp"
+#include "report/scenes.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
@@ -376,28 +377,6 @@ double runOdeintDopri5(const detail::ForceModel& model, const std::vector<double
 
 // --- Barnes–Hut ---------------------------------------------------------------
 
-// n attractors of total mass 1 at rest, uniform over the unit disc (fixed
-// generator), softening 0.01 m: the scene of test_forces' bound.
-Scene attractorDisc(std::size_t n, double theta) {
-    Scene s;
-    s.world.gravity = {0.0, 0.0};
-    s.world.dt = 0.01;
-    s.world.theta = theta;
-    std::uint64_t state = 0x9E3779B97F4A7C15ull;
-    auto uniform = [&state] {  // splitmix64 -> [0, 1)
-        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return double((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
-    };
-    for (std::size_t i = 0; i < n; ++i) {
-        const double r = std::sqrt(uniform()), a = 2.0 * std::numbers::pi * uniform();
-        Entity e = body(s, "s" + std::to_string(i), {r * std::cos(a), r * std::sin(a)}, {0.0, 0.0}, 1.0 / double(n));
-        s.registry.emplace<Attractor>(e, {0.01});
-    }
-    return s;
-}
-
 struct BarnesHutSummary {
     std::size_t n = 0;
     double exactSecondsPerEvaluation = 0.0;
@@ -601,47 +580,34 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
         const std::vector<double> tolerances =
             quick ? std::vector<double>{1e-3, 1e-5, 1e-7, 1e-9}
                   : std::vector<double>{1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11};
+        // One row: `scene` under `integrator` for `steps` steps of dt.
+        auto measure = [&](const Scene& scene, const std::string& integrator, double dt, long steps, double parameter) {
+            AccuracyRow row{p.name, integrator, dt, steps, 0.0, 0.0, p.referenceName, parameter};
+            std::vector<double> x;
+            auto once = [&]() -> double {
+                World w = buildWorld(scene, integrator, dt);
+                const auto t0 = Clock::now();
+                for (long i = 0; i < steps; ++i)
+                    if (!w.step().ok()) return -1.0;
+                const double s = std::chrono::duration<double>(Clock::now() - t0).count();
+                x = finalPositions(w);
+                return s;
+            };
+            row.secondsPerStep = bestSecondsPerStep(once, steps, minSeconds, maxRepeats);
+            row.error = row.secondsPerStep < 0 ? std::numeric_limits<double>::infinity()
+                                               : positionError(x.data(), p.reference);
+            rows.push_back(row);
+        };
         for (std::string_view integrator : integratorNames()) {
             if (integrator == "dopri5") {
                 for (double tolerance : tolerances) {
-                    AccuracyRow row{p.name, "dopri5", frame, frames, 0.0, 0.0, p.referenceName, tolerance};
                     Scene scene = p.scene;
                     scene.world.tolerance = tolerance;
-                    std::vector<double> x;
-                    auto once = [&]() -> double {
-                        World w = buildWorld(scene, "dopri5", frame);
-                        const auto t0 = Clock::now();
-                        for (long i = 0; i < frames; ++i)
-                            if (!w.step().ok()) return -1.0;
-                        const double sec = std::chrono::duration<double>(Clock::now() - t0).count();
-                        x = finalPositions(w);
-                        return sec;
-                    };
-                    row.secondsPerStep = bestSecondsPerStep(once, frames, minSeconds, maxRepeats);
-                    row.error = row.secondsPerStep < 0 ? std::numeric_limits<double>::infinity()
-                                                       : positionError(x.data(), p.reference);
-                    rows.push_back(row);
+                    measure(scene, "dopri5", frame, frames, tolerance);
                 }
                 continue;
             }
-            for (long steps : p.stepCounts) {
-                const double dt = p.T / double(steps);
-                AccuracyRow row{p.name, std::string(integrator), dt, steps, 0.0, 0.0, p.referenceName};
-                std::vector<double> x;
-                auto once = [&]() -> double {
-                    World w = buildWorld(p.scene, row.method, dt);
-                    const auto t0 = Clock::now();
-                    for (long i = 0; i < steps; ++i)
-                        if (!w.step().ok()) return -1.0;
-                    const double s = std::chrono::duration<double>(Clock::now() - t0).count();
-                    x = finalPositions(w);
-                    return s;
-                };
-                row.secondsPerStep = bestSecondsPerStep(once, steps, minSeconds, maxRepeats);
-                row.error = row.secondsPerStep < 0 ? std::numeric_limits<double>::infinity()
-                                                   : positionError(x.data(), p.reference);
-                rows.push_back(row);
-            }
+            for (long steps : p.stepCounts) measure(p.scene, std::string(integrator), p.T / double(steps), steps, 0.0);
         }
 
         // Peers: same model, same initial state.

@@ -19,6 +19,9 @@ template <bool Potential>
 Vec2 ForceModel::exactField(double px, double py, std::uint32_t self, const double* x, double* phiFixed,
                             double* phiDynamic) const {
     Vec2 acc = gravityOn ? Vec2{gx, gy} : Vec2{};
+    // Potential sums in locals, stored once at the end: through the
+    // pointers each addition would wait on the previous store.
+    double fixedSum = 0.0, dynamicSum = 0.0;
     for (const AttractorData& at : attractors) {
         if (at.body == self && self != kNoBody) continue;
         const double ax = at.body == kNoBody ? at.px : x[2 * at.body];
@@ -34,7 +37,11 @@ Vec2 ForceModel::exactField(double px, double py, std::uint32_t self, const doub
         acc.y += s * dy;
         // G m / r = s q: a multiply instead of a second division (the
         // divider is the bottleneck of this loop), within an ulp.
-        if constexpr (Potential) (at.body == kNoBody ? *phiFixed : *phiDynamic) += s * q;
+        if constexpr (Potential) (at.body == kNoBody ? fixedSum : dynamicSum) += s * q;
+    }
+    if constexpr (Potential) {
+        *phiFixed += fixedSum;
+        *phiDynamic += dynamicSum;
     }
     return acc;
 }

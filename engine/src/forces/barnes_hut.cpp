@@ -120,6 +120,7 @@ void AttractorTree::accumulate(double px, double py, std::uint32_t self, double&
                                double* phiDynamic) const {
     const Node* nodes = nodes_.data();
     const std::uint32_t count = std::uint32_t(nodes_.size());
+    double fixedSum = 0.0, dynamicSum = 0.0;  // potential, in registers (see exactField)
     std::uint32_t i = 0;
     while (i < count) {
         const Node& node = nodes[i];
@@ -145,8 +146,8 @@ void AttractorTree::accumulate(double px, double py, std::uint32_t self, double&
                 // The quadrupole term is shared in proportion to G m.
                 const double phi = s * q + 0.5 * rqr * i5;  // s q = G M / rho, without a division
                 const double dynamicShare = node.gm != 0.0 ? node.gmDynamic / node.gm : 0.0;
-                *phiDynamic += dynamicShare * phi;
-                *phiFixed += (1.0 - dynamicShare) * phi;
+                dynamicSum += dynamicShare * phi;
+                fixedSum += (1.0 - dynamicShare) * phi;
             }
             i = node.skip;
         } else if (node.leaf) {
@@ -161,12 +162,16 @@ void AttractorTree::accumulate(double px, double py, std::uint32_t self, double&
                 const double s = it.gm / (q * r);
                 ax += s * ex;
                 ay += s * ey;
-                if constexpr (Potential) (it.body == kNoBody ? *phiFixed : *phiDynamic) += s * q;
+                if constexpr (Potential) (it.body == kNoBody ? fixedSum : dynamicSum) += s * q;
             }
             i = node.skip;
         } else {
             ++i;  // open: the first child follows its parent
         }
+    }
+    if constexpr (Potential) {
+        *phiFixed += fixedSum;
+        *phiDynamic += dynamicSum;
     }
 }
 
