@@ -2,7 +2,9 @@
 // and 1e6 particles, with gravity + drag and with a spring chain; a stream
 // copy of the same bytes as the memory-bandwidth peer; RK4 against
 // Boost.Odeint's runge_kutta4 on the same problem and force code; and the
-// state-layout measurement (interleaved x,y per body vs split x[], y[]).
+// state-layout measurement (interleaved x,y per body vs split x[], y[]);
+// Barnes–Hut against exact pairwise attraction (and the size where the tree
+// starts to pay); dopri5 against Odeint's controlled runge_kutta_dopri5.
 // Not part of ctest: compare ratios from one run, the machine is shared.
 //
 //   build/bench/stepwise_bench --benchmark_filter=... --benchmark_min_time=0.2
@@ -11,9 +13,12 @@
 #include "stepwise/integrators.hpp"
 #include "stepwise/world.hpp"
 #include "world/world_impl.hpp"
+#include "report/scenes.hpp"
 
 #include <benchmark/benchmark.h>
+#include <boost/numeric/odeint/stepper/generation.hpp>
 #include <boost/numeric/odeint/stepper/runge_kutta4.hpp>
+#include <boost/numeric/odeint/stepper/runge_kutta_dopri5.hpp>
 
 #include <cmath>
 #include <cstring>
@@ -250,11 +255,126 @@ void BM_LayoutSpringsSplit(benchmark::State& state) {
                                                       benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+// --- Barnes–Hut ---------------------------------------------------------------
+
+// One attractor force evaluation: exact (theta 0) or through the tree
+// (theta 0.5, the default), the tree forced on at every size so that the
+// crossover with exact summation shows (kTreeMinAttractors).
+void BM_Attractors(benchmark::State& state, double theta) {
+    const std::size_t n = std::size_t(state.range(0));
+    Result<World> built = World::build(report::attractorDisc(n, theta));
+    if (!built) {
+        state.SkipWithError(built.error().c_str());
+        return;
+    }
+    detail::ForceModel& model = built->impl().model;
+    model.treeMinAttractors = 0;
+    std::vector<double> a(2 * n);
+    for (auto _ : state) {
+        model.accelerations(built->impl().xs(), built->impl().vs(), a.data());
+        benchmark::DoNotOptimize(a.data());
+    }
+    perParticle(state, n);
+}
+
+// A whole step, with and without World::energy() after it (what
+// `stepwise run --trace` does): the trace must not double the cost.
+void BM_AttractorStep(benchmark::State& state, double theta, bool traced) {
+    const std::size_t n = std::size_t(state.range(0));
+    Result<World> built = World::build(report::attractorDisc(n, theta));
+    if (!built) {
+        state.SkipWithError(built.error().c_str());
+        return;
+    }
+    built->setProfiling(false);
+    // A trace starts with the energy of step 0 (stepwise run --trace writes
+    // that row before the first step); without it the first timed step
+    // would pay for a force pass the trace saves on every later one.
+    double sink = traced ? built->energy().attractors : 0.0;
+    for (auto _ : state) {
+        if (!built->step().ok()) {
+            state.SkipWithError("diverged");
+            break;
+        }
+        if (traced) sink += built->energy().attractors;
+    }
+    benchmark::DoNotOptimize(sink);
+}
+
+// --- dopri5 against Odeint ----------------------------------------------------
+
+// One period of Kepler e = 0.9 (60 frames) at tolerance state.range(0) = -log10.
+Scene keplerScene(double tolerance) {
+    Scene s;
+    s.world.gravity = {0.0, 0.0};
+    s.world.integrator = "dopri5";
+    s.world.tolerance = tolerance;
+    s.world.dt = 2.0 * M_PI / 60.0;
+    Entity sun = s.registry.create();
+    s.registry.emplace<Position>(sun, {{0.0, 0.0}});
+    s.registry.emplace<Static>(sun, {true});
+    s.registry.emplace<Attractor>(sun, {0.0});
+    Entity planet = s.registry.create();
+    s.registry.emplace<Position>(planet, {{0.1, 0.0}});
+    s.registry.emplace<Velocity>(planet, {{0.0, std::sqrt(1.9 / 0.1)}});
+    return s;
+}
+
+void BM_Dopri5Kepler(benchmark::State& state) {
+    const double tolerance = std::pow(10.0, -double(state.range(0)));
+    double error = 0.0;
+    for (auto _ : state) {
+        Result<World> w = World::build(keplerScene(tolerance));
+        w->setProfiling(false);
+        for (int f = 0; f < 60; ++f)
+            if (!w->step().ok()) state.SkipWithError("dopri5 failed");
+        error = std::hypot(w->bodyPosition(0).x - 0.1, w->bodyPosition(0).y);
+    }
+    state.counters["error_m"] = error;
+}
+
+void BM_OdeintDopri5Kepler(benchmark::State& state) {
+    namespace odeint = boost::numeric::odeint;
+    const double tolerance = std::pow(10.0, -double(state.range(0)));
+    Result<World> w = World::build(keplerScene(tolerance));
+    const detail::ForceModel& model = w->impl().model;
+    auto sys = [&model](const std::vector<double>& s, std::vector<double>& dsdt, double) {
+        dsdt[0] = s[2];
+        dsdt[1] = s[3];
+        model.accelerations(s.data(), s.data() + 2, dsdt.data() + 2);
+    };
+    const double frame = w->settings().dt;
+    double error = 0.0;
+    for (auto _ : state) {
+        std::vector<double> y{0.1, 0.0, 0.0, std::sqrt(1.9 / 0.1)};
+        auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_dopri5<std::vector<double>>());
+        double t = 0.0, dt = frame;
+        for (int f = 0; f < 60; ++f) {
+            const double end = double(f + 1) * frame;
+            while (t < end) {
+                double h = std::min(dt, end - t);
+                const bool landing = h == end - t;
+                double tt = t;
+                if (stepper.try_step(sys, y, tt, h) == odeint::success) {
+                    t = landing ? end : tt;
+                    if (!landing || h > dt) dt = h;
+                } else {
+                    dt = h;
+                }
+            }
+        }
+        error = std::hypot(y[0] - 0.1, y[1]);
+    }
+    state.counters["error_m"] = error;
+}
+
 const std::vector<std::int64_t> kSizes{10'000, 100'000, 1'000'000};
 
 int registerAll() {
     for (std::string_view name : integratorNames()) {
-        const bool implicit = name.rfind("implicit_", 0) == 0;
+        // Sparse Newton and dopri5's error-controlled steps on a
+        // million-body chain take seconds per step: those rows stop at 1e5.
+        const bool implicit = name.rfind("implicit_", 0) == 0 || name == "dopri5";
         for (std::int64_t n : kSizes) {
             benchmark::RegisterBenchmark(("Step/gravity_drag/" + std::string(name)).c_str(), BM_Step,
                                          Problem::GravityDrag, std::string(name))
@@ -281,6 +401,23 @@ int registerAll() {
         benchmark::RegisterBenchmark("Layout/euler_split", BM_LayoutEulerSplit)->Arg(n)->Unit(benchmark::kMicrosecond);
         benchmark::RegisterBenchmark("Layout/springs_interleaved", BM_LayoutSpringsInterleaved)->Arg(n)->Unit(benchmark::kMicrosecond);
         benchmark::RegisterBenchmark("Layout/springs_split", BM_LayoutSpringsSplit)->Arg(n)->Unit(benchmark::kMicrosecond);
+    }
+    for (std::int64_t n : {64, 128, 256, 512, 1024, 10'000}) {
+        benchmark::RegisterBenchmark("BarnesHut/exact", BM_Attractors, 0.0)->Arg(n)->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark("BarnesHut/tree_theta0.5", BM_Attractors, 0.5)->Arg(n)->Unit(benchmark::kMillisecond);
+    }
+    for (bool traced : {false, true})
+        for (double theta : {0.0, 0.5})
+            benchmark::RegisterBenchmark(("BarnesHut/step_theta" + std::string(theta > 0 ? "0.5" : "0") +
+                                          (traced ? "_traced" : "")).c_str(),
+                                         BM_AttractorStep, theta, traced)
+                ->Arg(10'000)
+                ->Unit(benchmark::kMillisecond);
+    for (std::int64_t digits : {6, 8, 10}) {
+        benchmark::RegisterBenchmark("Dopri5/kepler_e0.9", BM_Dopri5Kepler)->Arg(digits)->Unit(benchmark::kMicrosecond);
+        benchmark::RegisterBenchmark("OdeintDopri5/kepler_e0.9", BM_OdeintDopri5Kepler)
+            ->Arg(digits)
+            ->Unit(benchmark::kMicrosecond);
     }
     return 0;
 }

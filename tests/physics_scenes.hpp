@@ -7,6 +7,7 @@
 #include "stepwise/world.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <stdexcept>
 #include <string>

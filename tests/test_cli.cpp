@@ -374,7 +374,7 @@ TEST_F(Cli, RenderBadArgumentsExitTwoNameTheArgumentAndWriteNothing) {
         {orbit + " --out " + png.string() + " --trail 1", "--trail: Value 1 not in range 2 to 100000"},
         {orbit + " --out " + png.string() + " --integrator rk5",
          "--integrator: rk5 not in {explicit_euler,semi_implicit_euler,midpoint,trapezoid,rk4,velocity_verlet,"
-         "implicit_euler,implicit_midpoint}"},
+         "implicit_euler,implicit_midpoint,dopri5}"},
         {orbit + " --out " + png.string() + " --overlay velocity,bogus",
          "stepwise: error: --overlay: unknown overlay \"bogus\"; known overlays: velocity, velocity-field, "
          "force-field, force, contacts, aabb, trails, joints, all, none"},

@@ -3,12 +3,15 @@
 // and the analytic Jacobians against finite differences.
 
 #include "physics_scenes.hpp"
+#include "report/scenes.hpp"
 
 #include "world/world_impl.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <random>
 
@@ -243,3 +246,98 @@ TEST(Forces, ConservativeSceneConservesEnergyUnderRk4) {
 }
 
 } // namespace
+
+// --- Barnes–Hut ------------------------------------------------------------
+
+namespace {
+std::vector<Vec2> positions(const World& w) {
+    std::vector<Vec2> p(w.bodyCount());
+    for (std::size_t b = 0; b < p.size(); ++b) p[b] = w.bodyPosition(b);
+    return p;
+}
+} // namespace
+
+TEST(BarnesHut, TenThousandAttractorsAfterFiveStepsWithinOnePercentOfTheDistanceMoved) {
+    // The goal, as a bound: the bodies start at rest, so every
+    // metre they move is the attraction's doing, and the tree's error is
+    // compared with that. Exact pairwise summation (theta 0) is the reference.
+    const std::size_t n = 10000;
+    World exact = buildOrDie(report::attractorDisc(n, 0.0));
+    World tree = buildOrDie(report::attractorDisc(n, 0.5));
+    ASSERT_TRUE(tree.impl().model.usesTree());
+    ASSERT_FALSE(exact.impl().model.usesTree());
+    const std::vector<Vec2> start = positions(exact);
+    for (int i = 0; i < 5; ++i) {
+        ASSERT_TRUE(exact.step().ok());
+        ASSERT_TRUE(tree.step().ok());
+    }
+    double moved2 = 0.0, error2 = 0.0, worstError = 0.0, meanMoved = 0.0;
+    for (std::size_t b = 0; b < n; ++b) {
+        const double moved = length(exact.bodyPosition(b) - start[b]);
+        const double error = length(tree.bodyPosition(b) - exact.bodyPosition(b));
+        moved2 += moved * moved;
+        error2 += error * error;
+        meanMoved += moved / double(n);
+        worstError = std::max(worstError, error);
+    }
+    const double rmsMoved = std::sqrt(moved2 / double(n)), rmsError = std::sqrt(error2 / double(n));
+    EXPECT_GT(rmsMoved, 1e-4);  // they did move
+    EXPECT_LT(rmsError, 0.01 * rmsMoved) << "rms error " << rmsError << " m, rms distance moved " << rmsMoved << " m";
+    EXPECT_LT(worstError, 0.01 * meanMoved) << "worst error " << worstError << " m, mean distance moved " << meanMoved;
+    EXPECT_GT(rmsError, 0.0);  // and the tree really approximated
+}
+
+TEST(BarnesHut, BelowTheCrossoverAndAtThetaZeroTheSumIsExact) {
+    // Fewer attractors than kTreeMinAttractors: exact summation is faster
+    // and satisfies any theta, so the bits equal theta = 0's.
+    const std::size_t n = detail::ForceModel::kTreeMinAttractors - 1;
+    World a = buildOrDie(report::attractorDisc(n, 0.0));
+    World b = buildOrDie(report::attractorDisc(n, 0.9));
+    EXPECT_FALSE(b.impl().model.usesTree());
+    for (int i = 0; i < 3; ++i) {
+        ASSERT_TRUE(a.step().ok());
+        ASSERT_TRUE(b.step().ok());
+    }
+    const std::vector<Vec2> pa = positions(a), pb = positions(b);
+    EXPECT_EQ(std::memcmp(pa.data(), pb.data(), pa.size() * sizeof(Vec2)), 0);
+}
+
+TEST(BarnesHut, ForceErrorShrinksWithThetaAndTheEnergyComesFromTheTreeToo) {
+    const std::size_t n = 2000;
+    const World exact = buildOrDie(report::attractorDisc(n, 0.0));
+    const std::vector<Vec2> reference = exact.bodyForces();
+    const double exactEnergy = exact.energy().attractors;
+    double previous = INFINITY;
+    for (double theta : {1.0, 0.7, 0.5, 0.3}) {
+        const World w = buildOrDie(report::attractorDisc(n, theta));
+        const std::vector<Vec2> f = w.bodyForces();
+        double err2 = 0.0, ref2 = 0.0;
+        for (std::size_t b = 0; b < n; ++b) {
+            err2 += lengthSquared(f[b] - reference[b]);
+            ref2 += lengthSquared(reference[b]);
+        }
+        const double relative = std::sqrt(err2 / ref2);
+        EXPECT_LT(relative, previous) << theta;
+        EXPECT_LT(relative, 0.02 * theta * theta) << theta;  // monopole: error ~ theta^2
+        EXPECT_NEAR(w.energy().attractors, exactEnergy, 0.01 * theta * theta * std::fabs(exactEnergy)) << theta;
+        previous = relative;
+    }
+}
+
+TEST(BarnesHut, AnEnergyTraceChangesNoBitOfTheRun) {
+    // energy() computes the attractors' accelerations with their potential
+    // and the next step reuses them: a run that logs energy every step must
+    // be the run that does not, bit for bit, exact or through the tree.
+    for (double theta : {0.0, 0.5}) {
+        World quiet = buildOrDie(report::attractorDisc(600, theta, "rk4"));
+        World traced = buildOrDie(report::attractorDisc(600, theta, "rk4"));
+        for (int i = 0; i < 4; ++i) {
+            ASSERT_TRUE(quiet.step().ok());
+            (void)traced.energy();
+            ASSERT_TRUE(traced.step().ok());
+            (void)traced.energy();
+        }
+        const std::vector<Vec2> pq = positions(quiet), pt = positions(traced);
+        EXPECT_EQ(std::memcmp(pq.data(), pt.data(), pq.size() * sizeof(Vec2)), 0) << theta;
+    }
+}

@@ -141,7 +141,9 @@ TEST(SceneSave, LayoutIsTheContractsLayout) {
     "dt": 0.016666666666666666,
     "substeps": 1,
     "time": 0.0,
-    "solver_iterations": 8
+    "solver_iterations": 8,
+    "tolerance": 1e-06,
+    "theta": 0.5
   },
   "entities": [
     {
@@ -207,6 +209,12 @@ TEST(SceneErrors, WrongTypeNamesThePointerExpectedAndFound) {
               "t.json: error: /world/dt: expected a number in (0, 10], got -1");
     EXPECT_EQ(refusal(R"({"world": {"substeps": 2.5}, "entities": []})"),
               "t.json: error: /world/substeps: expected an integer in [1, 1000], got 2.5");
+    EXPECT_EQ(refusal(R"({"world": {"theta": 1.5}, "entities": []})"),
+              "t.json: error: /world/theta: expected a number in [0, 1], got 1.5");
+    EXPECT_EQ(refusal(R"({"world": {"tolerance": 0}, "entities": []})"),
+              "t.json: error: /world/tolerance: expected a number in (0, 1], got 0");
+    EXPECT_EQ(refusal(R"({"world": {"adaptive_step": -1}, "entities": []})"),
+              "t.json: error: /world/adaptive_step: expected a number in [0, 10], got -1");
     EXPECT_EQ(refusal(R"({"entities": [{"color": {"x": 1.5, "y": 0, "z": 0}}]})"),
               "t.json: error: /entities/0/color/x: expected a number in [0, 1], got 1.5");
     EXPECT_EQ(refusal(R"({"entities": [{"position": {"x": 1, "w": 0}}]})"),
@@ -227,7 +235,7 @@ TEST(SceneErrors, UnknownComponentNamesEntityAndSuggests) {
     EXPECT_EQ(refusal(R"({"world": {"integrator": "rk5"}, "entities": []})"),
               "t.json: error: /world/integrator: unknown integrator \"rk5\"; did you mean \"rk4\"? Known integrators: "
               "explicit_euler, semi_implicit_euler, midpoint, trapezoid, rk4, velocity_verlet, implicit_euler, "
-              "implicit_midpoint");
+              "implicit_midpoint, dopri5");
 }
 
 TEST(SceneErrors, SpringToMissingEntity) {

@@ -8,6 +8,8 @@
 
 #include "report/accuracy.hpp"
 #include "report/odeint_implicit.hpp"
+#include "report/cpu_clock.hpp"
+#include "report/scenes.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
@@ -17,12 +19,15 @@
 
 #include <boost/numeric/odeint/stepper/euler.hpp>
 #include <boost/numeric/odeint/stepper/modified_midpoint.hpp>
+#include <boost/numeric/odeint/stepper/generation.hpp>
 #include <boost/numeric/odeint/stepper/runge_kutta4.hpp>
+#include <boost/numeric/odeint/stepper/runge_kutta_dopri5.hpp>
 #include <boost/numeric/odeint/stepper/symplectic_euler.hpp>
 #include <boost/numeric/odeint/stepper/velocity_verlet.hpp>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -37,7 +42,7 @@
 namespace stepwise::report {
 
 namespace odeint = boost::numeric::odeint;
-using Clock = std::chrono::steady_clock;
+using Clock = ThreadCpuClock;  // CPU time: see cpu_clock.hpp
 using State = std::vector<double>;
 
 namespace {
@@ -341,6 +346,115 @@ double runOdeintImplicitEuler(const detail::ForceModel& model, const std::vector
     return runOdeintImplicitEulerDense(m, x0.data(), v0.data(), dt, steps, accel, jacobian, xOut.data());
 }
 
+// Odeint's controlled runge_kutta_dopri5 over the same frames as the
+// engine's dopri5: each frame is covered by try_step calls, the last one
+// shortened to land on the frame's end, and the step size is carried from
+// frame to frame (as integrate_adaptive does within one call).
+double runOdeintDopri5(const detail::ForceModel& model, const std::vector<double>& x0, const std::vector<double>& v0,
+                       double frame, long frames, double tolerance, std::vector<double>& xOut) {
+    const std::size_t m = x0.size();
+    State y(2 * m);
+    std::copy(x0.begin(), x0.end(), y.begin());
+    std::copy(v0.begin(), v0.end(), y.begin() + long(m));
+    auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_dopri5<State>());
+    OdeSystem sys{&model, m};
+    const auto t0 = Clock::now();
+    double t = 0.0, dt = frame;
+    for (long f = 0; f < frames; ++f) {
+        const double end = double(f + 1) * frame;
+        long tries = 0;
+        while (t < end) {
+            if (++tries > 10000000) return -1.0;
+            double h = std::min(dt, end - t);
+            const bool landing = h == end - t;
+            double tt = t;
+            if (stepper.try_step(sys, y, tt, h) == odeint::success) {
+                t = landing ? end : tt;
+                if (!landing || h > dt) dt = h;  // a landing step does not shrink the proposal
+            } else {
+                dt = h;
+            }
+        }
+    }
+    const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    xOut.assign(y.begin(), y.begin() + long(m));
+    return seconds;
+}
+
+// --- Barnes–Hut ---------------------------------------------------------------
+
+struct BarnesHutSummary {
+    std::size_t n = 0;
+    double exactSecondsPerEvaluation = 0.0;
+    // Five steps of semi-implicit Euler from rest, tree at theta 0.5 against exact.
+    double exactFiveSteps = 0.0, treeFiveSteps = 0.0, rmsError = 0.0, rmsMoved = 0.0;
+    double exactTraced = 0.0, treeTraced = 0.0;  // the same five steps with energy() after each
+};
+
+// One force evaluation per theta against exact summation: relative RMS
+// force error and seconds per evaluation.
+BarnesHutSummary barnesHut(bool quick, std::vector<AccuracyRow>& rows, std::ostream& log) {
+    BarnesHutSummary out;
+    out.n = 10000;
+    log << "bench accuracy: barnes_hut (" << out.n << " attractors)\n" << std::flush;
+    const Scene exactScene = attractorDisc(out.n, 0.0);
+    World exact = buildWorld(exactScene, "semi_implicit_euler", 0.01);
+    const detail::ForceModel& exactModel = exact.impl().model;
+    const std::size_t m = 2 * out.n;
+    const double* x = exact.impl().xs();
+    const double* v = exact.impl().vs();
+    std::vector<double> reference(m), a(m);
+    auto timeEvaluation = [&](const detail::ForceModel& model, std::vector<double>& acc, int repeats) {
+        double best = std::numeric_limits<double>::infinity();
+        for (int r = 0; r < repeats; ++r) {
+            const auto t0 = Clock::now();
+            model.accelerations(x, v, acc.data());
+            best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count());
+        }
+        return best;
+    };
+    out.exactSecondsPerEvaluation = timeEvaluation(exactModel, reference, quick ? 1 : 2);
+    double ref2 = 0.0;
+    for (double r : reference) ref2 += r * r;
+    for (double theta : {0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 1.0}) {
+        detail::ForceModel model = exactModel;
+        model.theta = theta;
+        const double seconds = timeEvaluation(model, a, quick ? 3 : 10);
+        double err2 = 0.0;
+        for (std::size_t i = 0; i < m; ++i) err2 += (a[i] - reference[i]) * (a[i] - reference[i]);
+        AccuracyRow row{"barnes_hut", "barnes_hut", 0.0, 1, std::sqrt(err2 / ref2), seconds, "exact pairwise sum"};
+        row.parameter = theta;
+        rows.push_back(row);
+    }
+    // The goal: five steps at theta 0.5 against exact, error against the
+    // distance moved; and the same with an energy trace.
+    auto fiveSteps = [&](double theta, bool traced, std::vector<double>& xEnd) {
+        World w = buildWorld(attractorDisc(out.n, theta), "semi_implicit_euler", 0.01);
+        if (traced) (void)w.energy();  // a trace's row for step 0, as `stepwise run --trace` writes it
+        const auto t0 = Clock::now();
+        for (int i = 0; i < 5; ++i) {
+            if (!w.step().ok()) throw std::runtime_error("barnes_hut run diverged");
+            if (traced) (void)w.energy();
+        }
+        const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+        xEnd = finalPositions(w);
+        return seconds;
+    };
+    std::vector<double> xExact, xTree, xStart = finalPositions(exact);
+    out.exactFiveSteps = fiveSteps(0.0, false, xExact);
+    out.treeFiveSteps = fiveSteps(0.5, false, xTree);
+    out.exactTraced = fiveSteps(0.0, true, xExact);
+    out.treeTraced = fiveSteps(0.5, true, xTree);
+    double e2 = 0.0, d2 = 0.0;
+    for (std::size_t i = 0; i < m; ++i) {
+        e2 += (xTree[i] - xExact[i]) * (xTree[i] - xExact[i]);
+        d2 += (xExact[i] - xStart[i]) * (xExact[i] - xStart[i]);
+    }
+    out.rmsError = std::sqrt(2.0 * e2 / double(m));
+    out.rmsMoved = std::sqrt(2.0 * d2 / double(m));
+    return out;
+}
+
 // --- Output -----------------------------------------------------------------
 
 std::string num(double v, int digits = 6) {
@@ -351,7 +465,7 @@ std::string num(double v, int digits = 6) {
 }
 
 std::string writeGnuplot(const std::vector<Problem>& problems, const std::vector<AccuracyRow>& rows,
-                         const std::filesystem::path& dir) {
+                         const std::filesystem::path& dir, double exactSecondsPerEvaluation) {
     // One data file per problem, one block (index) per method.
     std::ostringstream script;
     script << "set terminal pngcairo size 1800,1150 font 'DejaVu Sans,10' noenhanced\n"
@@ -401,6 +515,23 @@ std::string writeGnuplot(const std::vector<Problem>& problems, const std::vector
         }
         script << "\n";
     }
+    // Sixth panel: Barnes–Hut force error against the time of one
+    // evaluation, labelled by theta; exact summation is the vertical line.
+    {
+        const std::filesystem::path data = dir / "accuracy_barnes_hut.dat";
+        std::ofstream out(data);
+        for (const AccuracyRow& r : rows)
+            if (r.problem == "barnes_hut") out << r.secondsPerStep << " " << r.error << " " << r.parameter << "\n";
+        script << "set title 'Barnes-Hut, 10,000 attractors: force error vs time per evaluation'\n"
+               << "set xlabel 'CPU time per force evaluation (s)'\nset ylabel 'relative RMS force error'\n"
+               << "set arrow 1 from " << exactSecondsPerEvaluation << ", graph 0 to " << exactSecondsPerEvaluation
+               << ", graph 1 nohead dt 2 lc rgb 'black'\n"
+               << "set label 1 'exact pairwise' at " << exactSecondsPerEvaluation << ", graph 0.5 right offset -0.5,0\n"
+               << "set xrange [" << exactSecondsPerEvaluation / 1000.0 << ":" << exactSecondsPerEvaluation * 3.0 << "]\n"
+               << "plot '" << data.string() << "' using 1:2 with linespoints lc 1 pt 7 lw 1.5 title 'tree (theta)', '' "
+               << "using 1:2:(sprintf('%.1f', $3)) with labels offset 0,1 font ',8' notitle\n"
+               << "unset arrow 1\nunset label 1\nset xrange [*:*]\n";
+    }
     script << "unset multiplot\n";
     const std::filesystem::path scriptPath = dir / "accuracy.gp";
     std::ofstream(scriptPath) << script.str();
@@ -446,24 +577,42 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
         }
         log << "bench accuracy: " << p.name << " (reference: " << p.referenceName << ")\n" << std::flush;
 
+        // dopri5 chooses its own steps within each frame: it runs in 10
+        // frames over the horizon (at 60 frames per second every frame of
+        // the smooth problems is one step and the tolerance would not
+        // matter), and the tolerance is swept.
+        const long frames = 10;
+        const double frame = p.T / double(frames);
+        const std::vector<double> tolerances =
+            quick ? std::vector<double>{1e-3, 1e-5, 1e-7, 1e-9}
+                  : std::vector<double>{1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11};
+        // One row: `scene` under `integrator` for `steps` steps of dt.
+        auto measure = [&](const Scene& scene, const std::string& integrator, double dt, long steps, double parameter) {
+            AccuracyRow row{p.name, integrator, dt, steps, 0.0, 0.0, p.referenceName, parameter};
+            std::vector<double> x;
+            auto once = [&]() -> double {
+                World w = buildWorld(scene, integrator, dt);
+                const auto t0 = Clock::now();
+                if (!advance(w, std::uint64_t(steps)).ok()) return -1.0;
+                const double s = std::chrono::duration<double>(Clock::now() - t0).count();
+                x = finalPositions(w);
+                return s;
+            };
+            row.secondsPerStep = bestSecondsPerStep(once, steps, minSeconds, maxRepeats);
+            row.error = row.secondsPerStep < 0 ? std::numeric_limits<double>::infinity()
+                                               : positionError(x.data(), p.reference);
+            rows.push_back(row);
+        };
         for (std::string_view integrator : integratorNames()) {
-            for (long steps : p.stepCounts) {
-                const double dt = p.T / double(steps);
-                AccuracyRow row{p.name, std::string(integrator), dt, steps, 0.0, 0.0, p.referenceName};
-                std::vector<double> x;
-                auto once = [&]() -> double {
-                    World w = buildWorld(p.scene, row.method, dt);
-                    const auto t0 = Clock::now();
-                    if (!advance(w, std::uint64_t(steps)).ok()) return -1.0;
-                    const double s = std::chrono::duration<double>(Clock::now() - t0).count();
-                    x = finalPositions(w);
-                    return s;
-                };
-                row.secondsPerStep = bestSecondsPerStep(once, steps, minSeconds, maxRepeats);
-                row.error = row.secondsPerStep < 0 ? std::numeric_limits<double>::infinity()
-                                                   : positionError(x.data(), p.reference);
-                rows.push_back(row);
+            if (integrator == "dopri5") {
+                for (double tolerance : tolerances) {
+                    Scene scene = p.scene;
+                    scene.world.tolerance = tolerance;
+                    measure(scene, "dopri5", frame, frames, tolerance);
+                }
+                continue;
             }
+            for (long steps : p.stepCounts) measure(p.scene, std::string(integrator), p.T / double(steps), steps, 0.0);
         }
 
         // Peers: same model, same initial state.
@@ -496,6 +645,15 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
             peers.emplace_back("odeint_implicit_euler", [&](double dt, long n, std::vector<double>& x) {
                 return runOdeintImplicitEuler(model, x0, v0, dt, n, x);
             });
+        for (double tolerance : tolerances) {
+            AccuracyRow row{p.name, "odeint_dopri5", frame, frames, 0.0, 0.0, p.referenceName, tolerance};
+            std::vector<double> x;
+            auto once = [&]() { return runOdeintDopri5(model, x0, v0, frame, frames, tolerance, x); };
+            row.secondsPerStep = bestSecondsPerStep(once, frames, minSeconds, maxRepeats);
+            row.error = row.secondsPerStep < 0 ? std::numeric_limits<double>::infinity()
+                                               : positionError(x.data(), p.reference);
+            rows.push_back(row);
+        }
         for (const auto& [name, runner] : peers) {
             for (long steps : p.stepCounts) {
                 const double dt = p.T / double(steps);
@@ -510,15 +668,17 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
         }
     }
 
+    const BarnesHutSummary tree = barnesHut(quick, rows, log);
+
     // CSV.
     {
         std::ofstream csv(options.out / "accuracy.csv");
-        csv << "problem,method,dt,steps,error_m,seconds_per_step,reference\n";
+        csv << "problem,method,dt,steps,error_m,seconds_per_step,reference,parameter\n";
         for (const AccuracyRow& r : rows)
             csv << r.problem << "," << r.method << "," << num(r.dt, 17) << "," << r.steps << ","
                 << (std::isfinite(r.error) ? num(r.error, 6) : "inf") << ","
                 << (r.secondsPerStep > 0 ? num(r.secondsPerStep, 6) : "") << ",\""
-                << r.reference << "\"\n";
+                << r.reference << "\"," << num(r.parameter, 6) << "\n";
         if (!csv) return "cannot write " + (options.out / "accuracy.csv").string();
     }
 
@@ -531,6 +691,13 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
               "seconds per step (best of repeats, one thread). `odeint_*` rows: Boost.Odeint steppers on the "
               "same ODE and the same force code. "
            << (quick ? "Quick run (`--quick`): fewer dt and repeats.\n\n" : "\n\n");
+        md << "`dopri5` and `odeint_dopri5` (Odeint's controlled runge_kutta_dopri5, the same frames, the step "
+              "carried across them) run in 10 frames over each horizon and sweep the tolerance instead of dt: "
+              "their \"error at each dt\" columns are at each tolerance (";
+        for (std::size_t i = 0; i < rows.size(); ++i)
+            if (rows[i].method == "dopri5" && rows[i].problem == problems.front().name)
+                md << num(rows[i].parameter, 2) << " ";
+        md << ").\n\n";
         for (const Problem& p : problems) {
             md << "## " << p.title << "\n\nHorizon " << num(p.T, 4) << " s; reference: " << p.referenceName
                << ".\n\n| method | order (finest dt) | cost to 1e-3 m (s) | cost to 1e-6 m (s) | error at each dt (";
@@ -548,7 +715,7 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
                 if (rs.size() >= 2) {
                     const AccuracyRow& a = *rs[rs.size() - 2];
                     const AccuracyRow& b = *rs.back();
-                    if (std::isfinite(a.error) && std::isfinite(b.error) && a.error > 0 && b.error > 0)
+                    if (std::isfinite(a.error) && std::isfinite(b.error) && a.error > 0 && b.error > 0 && a.dt != b.dt)
                         order = num(std::log(a.error / b.error) / std::log(a.dt / b.dt), 3);
                 }
                 auto cost = [&](double tol) {
@@ -566,10 +733,30 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
             }
             md << "\n";
         }
+        md << "## Barnes–Hut: force error against time\n\n" << tree.n
+           << " attractors of total mass 1 at rest in the unit disc (softening 0.01 m). One force evaluation per "
+              "theta; error: RMS over bodies of the acceleration error over RMS acceleration, against exact "
+              "pairwise summation (theta 0), which took "
+           << num(tree.exactSecondsPerEvaluation, 3) << " s.\n\n| theta | relative force error | s per evaluation | "
+              "fraction of exact |\n|---|---|---|---|\n";
+        for (const AccuracyRow& r : rows)
+            if (r.problem == "barnes_hut")
+                md << "| " << num(r.parameter, 2) << " | " << num(r.error, 3) << " | " << num(r.secondsPerStep, 3) << " | "
+                   << num(r.secondsPerStep / tree.exactSecondsPerEvaluation, 3) << " |\n";
+        md << "\nFive steps of semi_implicit_euler (dt 0.01 s) from rest, theta 0.5 against exact: "
+           << num(tree.treeFiveSteps, 3) << " s against " << num(tree.exactFiveSteps, 3) << " s ("
+           << num(100.0 * tree.treeFiveSteps / tree.exactFiveSteps, 3) << "% of the exact time); RMS position error "
+           << num(tree.rmsError, 3) << " m = " << num(100.0 * tree.rmsError / tree.rmsMoved, 3)
+           << "% of the RMS distance moved (" << num(tree.rmsMoved, 3) << " m). With World::energy() after every step "
+           << "(what --trace does): exact " << num(tree.exactTraced, 3) << " s (" << num(tree.exactTraced / tree.exactFiveSteps, 3)
+           << "x untraced), tree " << num(tree.treeTraced, 3) << " s (" << num(tree.treeTraced / tree.treeFiveSteps, 3)
+           << "x).\n\n";
         md << "![work-precision](accuracy.png)\n";
         if (!md) return "cannot write " + (options.out / "accuracy.md").string();
     }
-    if (std::string problem = writeGnuplot(problems, rows, options.out); !problem.empty()) return problem;
+    if (std::string problem = writeGnuplot(problems, rows, options.out, tree.exactSecondsPerEvaluation);
+        !problem.empty())
+        return problem;
     if (rowsOut) *rowsOut = std::move(rows);
     return {};
 }

@@ -4,7 +4,8 @@
 // problems with analytic or converged reference answers, at several dt.
 // Writes accuracy.csv, accuracy.md and a work-precision plot accuracy.png
 // (SciML style: error against CPU time per step, log-log, one panel per
-// problem, one line per method).
+// problem, one line per method), plus a panel of the Barnes–Hut force error
+// against time for a range of theta, with exact summation as the peer.
 
 #include <filesystem>
 #include <iosfwd>
@@ -26,6 +27,10 @@ struct AccuracyRow {
     double error = 0.0;              ///< max position error over bodies at the end, m (inf: diverged)
     double secondsPerStep = 0.0;     ///< CPU (wall, single thread) seconds per step; -1: World::step stopped on divergence
     std::string reference;           ///< "analytic" or "rk4 dt=..."
+    /// dopri5 rows: world.tolerance (dt is then the frame interval);
+    /// Barnes–Hut rows: theta (error is the relative force error and
+    /// secondsPerStep the time of one force evaluation). 0 otherwise.
+    double parameter = 0.0;
 };
 
 /// Runs the report. Progress goes to `log`. Returns "" or an error message

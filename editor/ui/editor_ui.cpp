@@ -641,6 +641,37 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
             edited("solver iterations");
         }
         done();
+        // Error control (dopri5) and Barnes–Hut (attractors): shown when the
+        // scene uses them.
+        if (ws.integrator == "dopri5") {
+            const double tolMin = 1e-14, tolMax = 1e-1;
+            if (ImGui::DragScalar("tolerance", ImGuiDataType_Double, &ws.tolerance, 0.01f, &tolMin, &tolMax, "%.1e",
+                                  ImGuiSliderFlags_Logarithmic))
+                edited("tolerance");
+            done();
+            if (world) {
+                const StepStats& st = world->lastStats();
+                ImGui::TextColored(kDim, "internal steps %d, rejected %d (last frame)", st.internalSteps,
+                                   st.rejectedSteps);
+            }
+            ImGui::PushTextWrapPos(0.0f);
+            ImGui::TextColored(kDim, "with contacts: error-controlled steps inside each substep (dt/substeps); "
+                                     "contacts are solved at substep ends, at fixed rate");
+            ImGui::PopTextWrapPos();
+        }
+        bool attractors = false;
+        if (world)
+            for (std::string_view system : world->activeSystems()) attractors = attractors || system == "attractors";
+        if (attractors) {
+            const double thetaMin = 0.0, thetaMax = 1.0;
+            if (ImGui::DragScalar("theta (Barnes-Hut)", ImGuiDataType_Double, &ws.theta, 0.005f, &thetaMin, &thetaMax,
+                                  "%.3g"))
+                edited("theta");
+            done();
+            if (ImGui::IsItemHovered())
+                ImGui::SetTooltip("opening angle: 0 sums every pair exactly; larger is faster and less exact. "
+                                  "Small scenes are summed exactly whatever theta says (it is faster there)");
+        }
         ImGui::PopItemWidth();
 
         // Systems: which the scene needs, a switch each, and their cost.

@@ -306,8 +306,9 @@ void readEntity(const Json& entityJson, std::size_t index, Registry& registry, E
 void readWorld(const Json& v, WorldSettings& world) {
     const std::string pointer = "/world";
     if (!v.is_object()) refuse(pointer, "expected an object, got " + describeFound(v));
-    static constexpr std::array<std::string_view, 7> kKeys{"gravity", "G",    "integrator",       "dt",
-                                                           "substeps", "time", "solver_iterations"};
+    static constexpr std::array<std::string_view, 10> kKeys{
+        "gravity", "G", "integrator", "dt", "substeps", "time", "solver_iterations", "tolerance", "theta",
+        "adaptive_step"};
     for (const auto& [key, value] : v.items()) {
         const std::string at = child(pointer, key);
         if (key == "gravity") world.gravity = readVector(value, at);
@@ -316,6 +317,9 @@ void readWorld(const Json& v, WorldSettings& world) {
         else if (key == "substeps") world.substeps = int(readInteger(value, at, 1, 1000));
         else if (key == "time") world.time = readNumber(value, at, NumberRange{});
         else if (key == "solver_iterations") world.solverIterations = int(readInteger(value, at, 1, 1000));
+        else if (key == "tolerance") world.tolerance = readNumber(value, at, NumberRange{0.0, 1.0, true});
+        else if (key == "theta") world.theta = readNumber(value, at, NumberRange{0.0, 1.0});
+        else if (key == "adaptive_step") world.adaptiveStep = readNumber(value, at, NumberRange{0.0, 10.0});
         else if (key == "integrator") {
             std::string name = readString(value, at);
             if (!isIntegratorName(name)) {
@@ -829,6 +833,9 @@ std::string sceneToJsonText(const Scene& scene) {
     world["substeps"] = scene.world.substeps;
     world["time"] = scene.world.time;
     world["solver_iterations"] = scene.world.solverIterations;
+    world["tolerance"] = scene.world.tolerance;
+    world["theta"] = scene.world.theta;
+    if (scene.world.adaptiveStep > 0.0) world["adaptive_step"] = scene.world.adaptiveStep;
     root["world"] = std::move(world);
     if (scene.view) {
         Json view = Json::object();

@@ -24,6 +24,18 @@ struct WorldSettings {
     int substeps = 1;                        ///< each step is `substeps` steps of dt/substeps
     double time = 0.0;                       ///< simulated seconds so far
     int solverIterations = 8;                ///< contact solver velocity iterations (addition)
+    /// Local error per internal step for the error-controlled integrator
+    /// (dopri5): each component's error is held to tolerance * (1 + |value|).
+    double tolerance = 1e-6;
+    /// Barnes–Hut opening angle for attractors, 0..1: a cell of side s is
+    /// taken as one mass beyond s/theta (+ its centre-of-mass offset); 0 sums
+    /// every pair exactly. 0.5 keeps the force error near 1e-3 (bench
+    /// accuracy, Barnes–Hut panel).
+    double theta = 0.5;
+    /// dopri5's proposed next internal step, s (addition): part of the
+    /// state, so that a saved and reloaded run continues bit for bit. 0: none
+    /// yet (the first step tries the whole frame).
+    double adaptiveStep = 0.0;
 
     friend bool operator==(const WorldSettings&, const WorldSettings&) = default;
 };

@@ -40,6 +40,11 @@ struct StepStats {
     /// Euler fuses them into its update and their time is in "integrate".
     std::vector<StageTime> systems;
     int forceEvaluations = 0;          ///< force evaluations in the last step (addition)
+    /// Internal steps accepted and rejected in the last step, over all its
+    /// substeps: dopri5 chooses them for world.tolerance; a fixed-step
+    /// integrator takes one per substep and rejects none.
+    int internalSteps = 0;
+    int rejectedSteps = 0;
 };
 
 /// Energy and momentum of the dynamic bodies, joules and kg*m/s.
@@ -120,6 +125,7 @@ struct WorldLayout {
 struct WorldState {
     std::shared_ptr<const WorldLayout> layout;
     double time = 0.0;            ///< seconds
+    double adaptiveStep = 0.0;    ///< dopri5's proposed internal step, s (world.adaptive_step)
     std::uint64_t steps = 0;      ///< StepStats::step
     std::vector<double> x, v;     ///< bodies, interleaved (x0, y0, x1, ...): metres, m/s
     std::vector<double> spinAngle;             ///< spinBodies, rad

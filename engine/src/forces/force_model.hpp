@@ -18,6 +18,7 @@
 // contain has no data and is never visited ("model only what a scene
 // needs").
 
+#include "forces/barnes_hut.hpp"
 #include "stepwise/entity.hpp"
 #include "stepwise/vec2.hpp"
 
@@ -149,6 +150,14 @@ public:
     std::vector<SpringData> springs;
     double G = 1.0;
     std::vector<AttractorData> attractors;
+    /// Barnes–Hut opening angle (world.theta): 0 sums every pair exactly.
+    /// The tree is used only from kTreeMinAttractors attractors on; below
+    /// that exact summation is the faster of the two (bench
+    /// BarnesHut/crossover), and exact answers satisfy any theta.
+    double theta = 0.0;
+    static constexpr std::size_t kTreeMinAttractors = 256;
+    std::size_t treeMinAttractors = kTreeMinAttractors;  ///< benchmarks lower it to find the crossover
+    bool usesTree() const { return theta > 0.0 && attractors.size() >= treeMinAttractors; }
     bool boidsOn = false;
     BoidSystem boids;
 
@@ -178,6 +187,10 @@ public:
     Vec2 fieldAt(double px, double py, std::uint32_t self, const double* x) const;
 
     double springEnergy(const double* x) const;
+    /// Potential of the attractors at x, J. Computed in the same walk as
+    /// their accelerations, which are kept: the next force evaluation at
+    /// the same positions (the next step's first) reuses them, so an energy
+    /// trace costs about one pass, not an extra one.
     double attractorEnergy(const double* x) const;
 
     void resetTimers() const { systemSeconds.fill(0.0); }
@@ -185,6 +198,19 @@ public:
 private:
     void applySprings(const double* x, const double* v, double* a) const;
     void applyAttractors(const double* x, double* a) const;
+    /// Attractor acceleration of every body into acc (2n), and with
+    /// `Potential` the potential energy, J. Same acceleration bits either way.
+    template <bool Potential>
+    double attractorPass(const double* x, double* acc) const;
+    template <bool Potential>
+    Vec2 exactField(double px, double py, std::uint32_t self, const double* x, double* phiFixed,
+                    double* phiDynamic) const;
+
+    mutable AttractorTree tree_;
+    /// Accelerations computed by attractorEnergy(), valid for the positions
+    /// cacheX_ (compared whole, so a hit is exactly a recomputation).
+    mutable std::vector<double> cacheX_, cacheAcc_, scratchAcc_;
+    mutable double cacheTheta_ = -1.0;
 };
 
 /// Scoped timer for one system call; no clock reads when profiling is off.

@@ -399,12 +399,13 @@ std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind, const ForceModel
         case IntegratorKind::VelocityVerlet: return std::make_unique<VelocityVerlet>(n);
         case IntegratorKind::ImplicitEuler: return makeImplicitIntegrator(false, model);
         case IntegratorKind::ImplicitMidpoint: return makeImplicitIntegrator(true, model);
+        case IntegratorKind::Dopri5: return makeDopri5(model);
     }
     return nullptr;
 }
 
 std::optional<IntegratorKind> integratorKind(std::string_view name) {
-    for (int k = 0; k <= int(IntegratorKind::ImplicitMidpoint); ++k)
+    for (int k = 0; k <= int(IntegratorKind::Dopri5); ++k)
         if (integratorName(IntegratorKind(k)) == name) return IntegratorKind(k);
     return std::nullopt;
 }
@@ -419,6 +420,7 @@ std::string_view integratorName(IntegratorKind kind) {
         case IntegratorKind::VelocityVerlet: return "velocity_verlet";
         case IntegratorKind::ImplicitEuler: return "implicit_euler";
         case IntegratorKind::ImplicitMidpoint: return "implicit_midpoint";
+        case IntegratorKind::Dopri5: return "dopri5";
     }
     return "?";
 }

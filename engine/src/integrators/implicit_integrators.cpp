@@ -330,7 +330,8 @@ Scalar scalarStep(IntegratorKind kind, Scalar s, double h, double zeta) {
             return {x1, vh + 0.5 * h * f(x1, vp)};
         }
         case IntegratorKind::ImplicitEuler:
-        case IntegratorKind::ImplicitMidpoint: break;
+        case IntegratorKind::ImplicitMidpoint:
+        case IntegratorKind::Dopri5: break;
     }
     return s;
 }
@@ -347,7 +348,10 @@ double spectralRadius(IntegratorKind kind, double h, double zeta) {
 } // namespace
 
 double stabilityLimit(IntegratorKind kind, double zeta) {
-    if (isImplicit(kind)) return std::numeric_limits<double>::infinity();
+    // dopri5 cannot spiral out: its controller shrinks the internal step
+    // until the error (and so the growth) is within tolerance. Stiffness
+    // costs it steps, not stability.
+    if (isImplicit(kind) || kind == IntegratorKind::Dopri5) return std::numeric_limits<double>::infinity();
     constexpr double kStep = 0.005, kMax = 50.0, kSlack = 1e-12;
     for (double y = kStep; y <= kMax; y += kStep) {
         if (spectralRadius(kind, y, zeta) <= 1.0 + kSlack) continue;

@@ -25,6 +25,7 @@ enum class IntegratorKind {
     VelocityVerlet,     ///< kick-drift-kick (symplectic)                      order 2
     ImplicitEuler,      ///< backward Euler, Newton on v1 (L-stable)           order 1
     ImplicitMidpoint,   ///< implicit midpoint rule (symplectic, A-stable)     order 2
+    Dopri5,             ///< Dormand–Prince 5(4), error-controlled internal steps  order 5
 };
 
 std::optional<IntegratorKind> integratorKind(std::string_view name);
@@ -58,6 +59,24 @@ public:
     /// (implicit methods): the world refuses the step as it refuses a
     /// non-finite value, instead of keeping a frozen or wrong state.
     virtual const SolveFailure* lastFailure() const { return nullptr; }
+
+    // Error-controlled methods (dopri5); fixed-step methods keep the defaults.
+    /// Local error per internal step (world.tolerance).
+    virtual void setTolerance(double) {}
+    /// Internal steps accepted and rejected in the last step() (1 and 0 for
+    /// a fixed-step method).
+    virtual int lastAcceptedSteps() const { return 1; }
+    virtual int lastRejectedSteps() const { return 0; }
+    /// Not empty when the last step() could not meet its tolerance; the
+    /// world then undoes the step and reports this message.
+    virtual const std::string& lastToleranceFailure() const {
+        static const std::string none;
+        return none;
+    }
+    /// The controller's proposal for the next internal step, s (0: none);
+    /// carried across frames and saved (world.adaptive_step).
+    virtual double proposedStep() const { return 0.0; }
+    virtual void setProposedStep(double) {}
 };
 
 /// Instruction sets the streaming kernels (semi-implicit Euler and RK4 with
@@ -97,5 +116,6 @@ inline constexpr double kSolveRelativeResidual = 1e-6;
 inline constexpr double kImplicitConditioningLimit = 1e5;
 
 std::unique_ptr<Integrator> makeImplicitIntegrator(bool midpointRule, const ForceModel& model);
+std::unique_ptr<Integrator> makeDopri5(const ForceModel& model);
 
 } // namespace stepwise::detail

@@ -128,6 +128,8 @@ std::string WorldImpl::describeSolveFailure(const detail::SolveFailure& failure,
 void WorldImpl::setIntegratorKind(detail::IntegratorKind k) {
     kind = k;
     integrator = detail::makeIntegrator(k, model);
+    integrator->setTolerance(settings.tolerance);
+    integrator->setProposedStep(settings.adaptiveStep);
     settings.integrator = std::string(detail::integratorName(k));
 }
 
@@ -171,6 +173,12 @@ Result<World> World::build(const Scene& scene) {
     if (ws.substeps < 1) return Error{"world.substeps: expected an integer >= 1, got " + std::to_string(ws.substeps)};
     if (!isFinite(ws.gravity) || !std::isfinite(ws.G) || !std::isfinite(ws.time))
         return Error{"world: gravity, G and time must be finite"};
+    if (!(ws.tolerance > 0.0) || !(ws.tolerance <= 1.0))
+        return Error{"world.tolerance: expected a number in (0, 1], got " + format(ws.tolerance)};
+    if (!(ws.theta >= 0.0) || !(ws.theta <= 1.0))
+        return Error{"world.theta: expected a number in [0, 1], got " + format(ws.theta)};
+    if (!(ws.adaptiveStep >= 0.0) || !std::isfinite(ws.adaptiveStep))
+        return Error{"world.adaptive_step: expected a finite number >= 0, got " + format(ws.adaptiveStep)};
 
     const Registry& reg = scene.registry;
     const std::vector<Entity>& order = reg.entities();
@@ -217,6 +225,7 @@ Result<World> World::build(const Scene& scene) {
     f.gx = ws.gravity.x;
     f.gy = ws.gravity.y;
     f.G = ws.G;
+    f.theta = ws.theta;
 
     // Drag: dense per-body rates, only if some body has b > 0.
     f.dragB.assign(n, 0.0);
@@ -408,7 +417,8 @@ Result<void> World::step() {
         std::copy(w.v[w.current].begin(), w.v[w.current].end(), w.backupV.begin());
     }
     std::copy(w.angle.begin(), w.angle.end(), w.angleBackup.begin());
-    int evaluations = 0;
+    int evaluations = 0, internalSteps = 0, rejectedSteps = 0;
+    const std::string* failure = nullptr;  // the integrator could not meet its tolerance
     bool verifiedFinite = false;  // the last substep's integrator pass checked x, v
     double rotationSeconds = 0.0, contactSeconds = 0.0;
     collision::CollisionSystem* contacts = w.collision.get();
@@ -424,6 +434,8 @@ Result<void> World::step() {
         // --- forces + integrate
         w.integrator->step(f, w.x[w.current].data(), w.v[w.current].data(), w.x[next].data(), w.v[next].data(), h);
         evaluations += w.integrator->lastEvaluations();
+        internalSteps += w.integrator->lastAcceptedSteps();
+        rejectedSteps += w.integrator->lastRejectedSteps();
         verifiedFinite = w.integrator->lastStepVerifiedFinite();
         if (const detail::SolveFailure* failed = w.integrator->lastFailure()) {
             // Refused like a non-finite value: the state stays at the start
@@ -438,6 +450,11 @@ Result<void> World::step() {
                 contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
             }
             return Error{w.describeSolveFailure(*failed, w.stats.step + 1)};
+        }
+        if (!w.integrator->lastToleranceFailure().empty()) {
+            failure = &w.integrator->lastToleranceFailure();
+            w.current = next;  // the undo below expects the output buffer current
+            break;
         }
         // --- contact solve on the integrator's end-of-substep state
         if (contacts) {
@@ -458,14 +475,15 @@ Result<void> World::step() {
     // pass (fused kernels): then only if nothing changed them since (no
     // contact solve) is a second pass over the state skipped.
     const bool stateChecked = verifiedFinite && !contacts;
-    const bool finite = (stateChecked || (allFinite(w.xs(), m) && allFinite(w.vs(), m))) &&
+    const bool finite = !failure && (stateChecked || (allFinite(w.xs(), m) && allFinite(w.vs(), m))) &&
                         allFinite(w.angle.data(), w.angle.size()) &&
                         (!contacts || (allFinite(contacts->angles().data(), contacts->angles().size()) &&
                                        allFinite(contacts->angularVelocities().data(),
                                                  contacts->angularVelocities().size())));
     const Clock::time_point t2 = timed ? Clock::now() : Clock::time_point{};
     if (!finite) {
-        std::string message = w.findNonFinite(w.stats.step + 1);
+        std::string message =
+            failure ? "step " + std::to_string(w.stats.step + 1) + ": " + *failure : w.findNonFinite(w.stats.step + 1);
         // Undo: the step's input is still in the other buffer (one
         // substep) or in the backup (several).
         if (substeps == 1) {
@@ -476,11 +494,15 @@ Result<void> World::step() {
         }
         std::copy(w.angleBackup.begin(), w.angleBackup.end(), w.angle.begin());
         if (contacts) contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
+        w.integrator->setProposedStep(w.settings.adaptiveStep);
         return Error{message};
     }
     w.settings.time += w.settings.dt;
+    if (w.kind == detail::IntegratorKind::Dopri5) w.settings.adaptiveStep = w.integrator->proposedStep();
     ++w.stats.step;
     w.stats.forceEvaluations = evaluations;
+    w.stats.internalSteps = internalSteps;
+    w.stats.rejectedSteps = rejectedSteps;
     w.stats.contactCount = contacts ? contacts->contacts().size() : 0;
     w.stats.stages.clear();
     w.stats.systems.clear();
@@ -522,7 +544,7 @@ namespace {
 /// shapes).
 void writeStateBack(const WorldLayout& layout, const double* x, const double* v, std::span<const double> spinAngle,
                     std::span<const double> colliderAngle, std::span<const double> colliderSpin, double time,
-                    Scene& scene) {
+                    double adaptiveStep, Scene& scene) {
     Registry& reg = scene.registry;
     for (std::size_t b = 0; b < layout.bodies.size(); ++b) {
         const Entity e = layout.bodies[b];
@@ -546,6 +568,7 @@ void writeStateBack(const WorldLayout& layout, const double* x, const double* v,
         if (reg.has<AngularVelocity>(e) || spin != 0.0) reg.emplace<AngularVelocity>(e, AngularVelocity{spin});
     }
     scene.world.time = time;
+    scene.world.adaptiveStep = adaptiveStep;
 }
 
 } // namespace
@@ -557,11 +580,11 @@ void World::writeBack(Scene& scene) const {
         angles = w.collision->angles();
         spins = w.collision->angularVelocities();
     }
-    writeStateBack(*w.layout, w.xs(), w.vs(), w.angle, angles, spins, w.settings.time, scene);
+    writeStateBack(*w.layout, w.xs(), w.vs(), w.angle, angles, spins, w.settings.time, w.settings.adaptiveStep, scene);
 }
 
 void WorldState::writeBack(Scene& scene) const {
-    writeStateBack(*layout, x.data(), v.data(), spinAngle, colliderAngle, colliderSpin, time, scene);
+    writeStateBack(*layout, x.data(), v.data(), spinAngle, colliderAngle, colliderSpin, time, adaptiveStep, scene);
 }
 
 namespace {
@@ -613,6 +636,7 @@ WorldState World::saveState() const {
     WorldState s;
     s.layout = w.layout;
     s.time = w.settings.time;
+    s.adaptiveStep = w.settings.adaptiveStep;
     s.steps = w.stats.step;
     s.x.assign(w.x[w.current].begin(), w.x[w.current].end());
     s.v.assign(w.v[w.current].begin(), w.v[w.current].end());
@@ -639,6 +663,8 @@ Result<void> World::restoreState(const WorldState& s) {
     }
     w.stats.contactCount = 0;
     w.settings.time = s.time;
+    w.settings.adaptiveStep = s.adaptiveStep;
+    w.integrator->setProposedStep(s.adaptiveStep);
     w.stats.step = s.steps;
     return {};
 }
@@ -744,6 +770,7 @@ std::vector<StiffnessHint> World::stiffnessHints() const {
     const detail::ForceModel& f = w.model;
     std::vector<StiffnessHint> hints;
     const bool implicitMethod = detail::isImplicit(w.kind);
+    if (w.kind == detail::IntegratorKind::Dopri5) return hints;  // error-controlled: no fixed-step limit
     const int substeps = w.settings.substeps;
     const double h = w.settings.dt / double(substeps);
     std::map<double, double> limitByZeta;  // cloth and chains share a few damping ratios
