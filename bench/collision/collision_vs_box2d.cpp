@@ -4,11 +4,13 @@
 // engines, from their final positions with Stepwise's narrow phase, so
 // Box2D's polygon skin does not flatter or penalise it.
 //
-//   collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR] [--scene NAME]
+//   collision_vs_box2d [--quick] [--sweep] [--out DIR] [--write-levels DIR] [--scene NAME]
 //
 // --quick runs a fifth of the simulated time, once; otherwise each engine
 // runs three times, alternating, and the fastest run counts. --scene runs
 // only that scene (pile, pyramid or rain), e.g. while tuning the solver.
+// --sweep runs every setting (substeps x iterations) of both engines and, with
+// --out DIR, writes the work-precision plot DIR/collisions_work_precision.png.
 
 #include "collision/collision_scenes.hpp"
 
@@ -25,6 +27,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -172,7 +175,9 @@ Outcome runStepwise(const Scene& initial, int steps, std::size_t topIndex) {
     return out;
 }
 
-Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex) {
+/// Box2D stepped `substeps` times per frame with dt / substeps, with
+/// `velocityIterations` (and 3 position iterations) per call.
+Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex, int substeps = 1, int velocityIterations = 8) {
     const std::vector<Pose> poses0 = initialPoses(scene);
     b2World world(b2Vec2(float(scene.world.gravity.x), float(scene.world.gravity.y)));
     // Sleeping off: Stepwise has no sleeping, so both engines do the same
@@ -213,7 +218,9 @@ Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex) {
     }
     const float dt = float(scene.world.dt);
     const auto start = std::chrono::steady_clock::now();
-    for (int i = 0; i < steps; ++i) world.Step(dt, 8, 3);  // the issue's 8 velocity, 3 position iterations
+    // Default: the issue's 8 velocity, 3 position iterations, one call per frame.
+    for (int i = 0; i < steps; ++i)
+        for (int s = 0; s < substeps; ++s) world.Step(dt / float(substeps), velocityIterations, 3);
     Outcome out;
     out.msPerStep = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / steps;
     std::vector<Pose> poses = poses0;
@@ -270,14 +277,100 @@ BroadPhaseTimes timeBroadPhases(const std::vector<Pose>& poses) {
     return t;
 }
 
+/// The work-precision picture for contacts: ms/step against the deepest
+/// overlap at the end, for each setting (substeps x iterations) of each
+/// engine on each scene, in the same run. Writes collisions_sweep.csv and
+/// .md, and collisions_work_precision.png (gnuplot) into `outDir`.
+int runSweep(const std::vector<bench::NamedScene>& scenes, bool quick, const std::string& outDir) {
+    struct Setting {
+        int substeps, iterations;
+    };
+    const std::vector<Setting> mineSettings{{1, 1}, {1, 2}, {1, 4}, {1, 8}, {2, 1}, {2, 2},
+                                            {4, 1}, {4, 2}, {8, 1}, {8, 2}, {16, 1}};
+    const std::vector<Setting> peerSettings{{1, 1}, {1, 2}, {1, 4}, {1, 8}, {2, 8}, {4, 8}, {8, 8}};
+    std::ostringstream csv, md;
+    csv << "scene,engine,substeps,iterations,ms_per_step,deepest_overlap_m\n";
+    md << "| scene | engine | substeps | iterations | ms/step | deepest overlap (mm) |\n|---|---|---|---|---|---|\n";
+    std::ostringstream data;  // gnuplot blocks: one per scene x engine
+    std::vector<std::string> blocks;
+    for (const auto& s : scenes) {
+        const int steps = int(std::lround((quick ? 0.2 : 1.0) * s.seconds / s.scene.world.dt));
+        const std::size_t top = initialPoses(s.scene).size() - 1;
+        for (int engine = 0; engine < 2; ++engine) {
+            const std::vector<Setting>& settings = engine == 0 ? mineSettings : peerSettings;
+            if (!blocks.empty()) data << "\n\n";
+            blocks.push_back(s.name + (engine == 0 ? " Stepwise" : " Box2D 2.4.1"));
+            data << "# " << blocks.back() << "\n";
+            for (const Setting& set : settings) {
+                Outcome out;
+                if (engine == 0) {
+                    Scene scene = s.scene;
+                    scene.world.substeps = set.substeps;
+                    scene.world.solverIterations = set.iterations;
+                    out = runStepwise(scene, steps, top);
+                } else {
+                    out = runBox2d(s.scene, steps, top, set.substeps, set.iterations);
+                }
+                const char* name = engine == 0 ? "Stepwise" : "Box2D 2.4.1";
+                char line[256];
+                std::snprintf(line, sizeof line, "| %s | %s | %d | %d | %.3f | %.2f |\n", s.name.c_str(), name,
+                              set.substeps, set.iterations, out.msPerStep, 1e3 * out.deepestOverlap);
+                md << line;
+                std::cout << line << std::flush;
+                csv << s.name << "," << name << "," << set.substeps << "," << set.iterations << "," << out.msPerStep
+                    << "," << out.deepestOverlap << "\n";
+                data << out.msPerStep << " " << std::max(1e-2, 1e3 * out.deepestOverlap) << " \"" << set.substeps
+                     << "x" << set.iterations << "\"\n";
+            }
+        }
+    }
+    if (outDir.empty()) return 0;
+    fs::create_directories(outDir);
+    const fs::path dir(outDir);
+    for (const auto& [name, text] : {std::pair<std::string, std::string>{"collisions_sweep.csv", csv.str()},
+                                     {"collisions_sweep.md", md.str()},
+                                     {"collisions_sweep.dat", data.str()}}) {
+        if (Result<void> r = writeFileAtomically(dir / name, text); !r) {
+            std::cerr << r.error() << "\n";
+            return 2;
+        }
+    }
+    std::ostringstream gp;
+    gp << "set terminal pngcairo size 1500,520 font 'DejaVu Sans,10' noenhanced\n"
+       << "set output '" << (dir / "collisions_work_precision.png").string() << "'\n"
+       << "set multiplot layout 1," << scenes.size()
+       << " title 'Contacts, work-precision: ms/step against deepest overlap at the end (Stepwise solid, Box2D 2.4.1 "
+          "dashed; labels: substeps x iterations)'\n"
+       << "set logscale xy\nset grid\nset xlabel 'ms per step'\nset ylabel 'deepest overlap (mm)'\n"
+       << "set key top right font ',8'\n";
+    for (std::size_t k = 0; k < scenes.size(); ++k) {
+        gp << "set title '" << scenes[k].name << "'\nplot '" << (dir / "collisions_sweep.dat").string() << "' index "
+           << 2 * k << " using 1:2 with linespoints lc 1 pt 7 title 'Stepwise', '' index " << 2 * k
+           << " using 1:2:3 with labels offset 0,0.8 font ',7' notitle, '' index " << 2 * k + 1
+           << " using 1:2 with linespoints lc 2 dt 2 pt 6 title 'Box2D 2.4.1', '' index " << 2 * k + 1
+           << " using 1:2:3 with labels offset 0,-0.8 font ',7' tc lt 2 notitle\n";
+    }
+    gp << "unset multiplot\n";
+    const fs::path script = dir / "collisions_work_precision.gp";
+    std::ofstream(script) << gp.str();
+    const std::string command = "gnuplot '" + script.string() + "' 2>'" + (dir / "gnuplot.log").string() + "'";
+    if (std::system(command.c_str()) != 0) {
+        std::cerr << "collision_vs_box2d: gnuplot failed; see " << (dir / "gnuplot.log").string() << "\n";
+        return 2;
+    }
+    std::cout << "wrote " << (dir / "collisions_work_precision.png").string() << "\n";
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
-    bool quick = false;
+    bool quick = false, sweep = false;
     std::string outDir, levelsDir, only;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--quick") quick = true;
+        else if (arg == "--sweep") sweep = true;
         else if (arg == "--out" && i + 1 < argc) outDir = argv[++i];
         else if (arg == "--write-levels" && i + 1 < argc) levelsDir = argv[++i];
         else if (arg == "--scene" && i + 1 < argc) only = argv[++i];
@@ -285,7 +378,7 @@ int main(int argc, char** argv) {
             g_broadPhase = argv[++i];
         else {
             std::cerr << "collision_vs_box2d: error: unknown argument \"" << arg
-                      << "\"; usage: collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain]\n";
+                      << "\"; usage: collision_vs_box2d [--quick] [--sweep] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain]\n";
             return 2;
         }
     }
@@ -308,6 +401,7 @@ int main(int argc, char** argv) {
         }
         return 0;
     }
+    if (sweep) return runSweep(scenes, quick, outDir);
     std::ostringstream md;
     md << "| scene | bodies | steps | Stepwise ms/step | Box2D 2.4.1 ms/step | speed ratio (Box2D/Stepwise) | deepest overlap "
           "Stepwise / Box2D (mm) | deepest overlap of the collision shapes Stepwise / Box2D (mm) | top-box drift Stepwise / "

@@ -86,6 +86,10 @@ int run(const RunOptions& options) {
         return kExitBadInput;
     }
     World& world = built.value();
+    // Before playing: a pile the level's substeps cannot hold (stderr, so
+    // the summary on stdout stays one line).
+    if (const std::optional<PileHint> pile = world.pileHint())
+        std::cerr << options.level << ": warning: " << pile->message() << "\n";
 
     std::string csv;
     if (options.trace) {

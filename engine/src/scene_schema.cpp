@@ -96,7 +96,13 @@ std::string sceneJsonSchema() {
                             {"dt", Json{{"type", "number"}, {"exclusiveMinimum", 0}, {"maximum", 10}}},
                             {"substeps", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}},
                             {"time", Json{{"type", "number"}}},
-                            {"solver_iterations", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}}}}};
+                            {"solver_iterations", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}},
+                            {"restitution_threshold",
+                             Json{{"type", "number"},
+                                  {"minimum", 0},
+                                  {"maximum", 1e6},
+                                  {"description", "m/s: slower impacts do not bounce; absent: derived from gravity and "
+                                                  "the substep (zero gravity: every approach bounces)"}}}}}};
     Json view = Json{{"type", "object"},
                      {"description", "camera: centre in metres, zoom in pixels per metre at 720 px image height"},
                      {"additionalProperties", false},
