@@ -4,11 +4,14 @@
 // engines, from their final positions with Stepwise's narrow phase, so
 // Box2D's polygon skin does not flatter or penalise it.
 //
-//   collision_vs_box2d [--quick] [--sweep] [--out DIR] [--write-levels DIR] [--scene NAME]
+//   collision_vs_box2d [--quick] [--sweep] [--adversarial] [--crowd N] [--out DIR] [--write-levels DIR] [--scene NAME]
 //
 // --quick runs a fifth of the simulated time, once; otherwise each engine
 // runs three times, alternating, and the fastest run counts. --scene runs
 // only that scene (pile, pyramid or rain), e.g. while tuning the solver.
+// --adversarial times issue 13's scenes (fast crowds, one huge shape, free
+// fall) as ratios against the crowd at rest; --crowd N runs N circles
+// started at one point (wrap in /usr/bin/time -v for the peak memory).
 // --sweep runs every setting (substeps x iterations) of both engines and, with
 // --out DIR, writes the work-precision plot DIR/collisions_work_precision.png.
 
@@ -362,15 +365,83 @@ int runSweep(const std::vector<bench::NamedScene>& scenes, bool quick, const std
     return 0;
 }
 
+/// Adversarial scenes of issue 13: ms/step of each, as ratios against the
+/// same crowd at rest in the same run. `crowd` > 0 instead runs only N
+/// circles started at one point for 60 steps (for /usr/bin/time -v).
+int runAdversarial(int crowd) {
+    const auto circle = [](Scene& s, Vec2 p, Vec2 v, double r, bool isStatic) {
+        const Entity e = s.registry.create();
+        s.registry.emplace<Position>(e, Position{p});
+        if (isStatic) s.registry.emplace<Static>(e, Static{true});
+        else s.registry.emplace<Velocity>(e, Velocity{v});
+        s.registry.emplace<Radius>(e, Radius{r});
+    };
+    const auto world = [](Vec2 g) {
+        Scene s;
+        s.world.gravity = g;
+        s.world.substeps = 4;
+        s.world.solverIterations = 2;
+        return s;
+    };
+    const auto msPerStep = [](const Scene& scene, int warm, int steps) {
+        Result<World> w = World::build(scene);
+        if (!w) {
+            std::cerr << w.error() << "\n";
+            std::exit(2);
+        }
+        w->setProfiling(false);
+        for (int i = 0; i < warm; ++i) (void)w->step();
+        const auto start = std::chrono::steady_clock::now();
+        for (int i = 0; i < steps; ++i) (void)w->step();
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / steps;
+    };
+    if (crowd > 0) {
+        Scene s = world({0.0, 0.0});
+        for (int i = 0; i < crowd; ++i) circle(s, {0.0, 0.0}, {}, 0.25, false);
+        const auto start = std::chrono::steady_clock::now();
+        const double first = msPerStep(s, 0, 1);
+        const double sixty = msPerStep(s, 0, 60);
+        std::printf("%d circles at one point: first step %.1f ms, 60 steps %.1f ms/step (total %.1f s)\n", crowd, first,
+                    sixty, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        return 0;
+    }
+    const auto spaced = [&](double speed, double hugeRadius) {
+        Scene s = world({0.0, 0.0});
+        for (int i = 0; i < 10000; ++i) circle(s, {double(i % 100), double(i / 100)}, {speed, 0.0}, 0.25, false);
+        if (hugeRadius > 0.0) circle(s, {50.0, -hugeRadius - 5.0}, {}, hugeRadius, true);
+        return s;
+    };
+    const double rest = msPerStep(spaced(0.0, 0.0), 2, 20);
+    std::printf("10,000 circles 1 m apart at rest: %.3f ms/step\n", rest);
+    for (const double speed : {100.0, 1000.0}) {
+        const double ms = msPerStep(spaced(speed, 0.0), 2, 20);
+        std::printf("  all moving at %g m/s: %.3f ms/step (%.2fx at rest)\n", speed, ms, ms / rest);
+    }
+    for (const double radius : {100.0, 1e6}) {
+        const double ms = msPerStep(spaced(0.0, radius), 2, 20);
+        std::printf("  with one static circle of radius %g: %.3f ms/step (%.2fx)\n", radius, ms, ms / rest);
+    }
+    Scene fall = world({0.0, -9.81});
+    for (int i = 0; i < 1000; ++i) circle(fall, {double(i % 40), double(i / 40)}, {}, 0.25, false);
+    const double early = msPerStep(fall, 0, 60);
+    const double late = msPerStep(fall, 600, 60);
+    std::printf("1,000 circles falling, no floor: %.3f ms/step in the first second, %.3f after 10 s (%.2fx)\n", early,
+                late, late / early);
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
-    bool quick = false, sweep = false;
+    bool quick = false, sweep = false, adversarial = false;
+    int crowd = 0;
     std::string outDir, levelsDir, only;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--quick") quick = true;
         else if (arg == "--sweep") sweep = true;
+        else if (arg == "--adversarial") adversarial = true;
+        else if (arg == "--crowd" && i + 1 < argc) crowd = std::atoi(argv[++i]);
         else if (arg == "--out" && i + 1 < argc) outDir = argv[++i];
         else if (arg == "--write-levels" && i + 1 < argc) levelsDir = argv[++i];
         else if (arg == "--scene" && i + 1 < argc) only = argv[++i];
@@ -378,10 +449,11 @@ int main(int argc, char** argv) {
             g_broadPhase = argv[++i];
         else {
             std::cerr << "collision_vs_box2d: error: unknown argument \"" << arg
-                      << "\"; usage: collision_vs_box2d [--quick] [--sweep] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain]\n";
+                      << "\"; usage: collision_vs_box2d [--quick] [--sweep] [--adversarial] [--crowd N] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain]\n";
             return 2;
         }
     }
+    if (adversarial || crowd > 0) return runAdversarial(crowd);
     std::vector<bench::NamedScene> scenes = bench::benchmarkScenes();
     if (!only.empty()) {
         std::erase_if(scenes, [&](const bench::NamedScene& s) { return s.name != only; });
