@@ -14,6 +14,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 using namespace stepwise;
 
@@ -324,3 +326,21 @@ TEST(CollisionHard, LevelWithoutSubstepsSavesWithoutGainingThem) {
     EXPECT_EQ(w->settings().solverIterations, 5);
 }
 
+
+TEST(CollisionHard, ValidateAndRunWarnAboutThePileBeforePlaying) {
+    Scene s = tallPile();
+    s.world.substeps = 1;
+    const std::string path = ::testing::TempDir() + "collide_tall_pile_1.json";
+    ASSERT_TRUE(saveSceneFile(s, path));
+    for (const char* command : {"validate", "run --steps 1"}) {
+        const std::string line = std::string(STEPWISE_BINARY) + " " + command + " '" + path + "' 2>&1 >/dev/null";
+        FILE* pipe = ::popen(line.c_str(), "r");
+        ASSERT_NE(pipe, nullptr);
+        std::string err;
+        char buffer[512];
+        while (std::fgets(buffer, sizeof buffer, pipe)) err += buffer;
+        ::pclose(pipe);
+        EXPECT_NE(err.find("warning: piles up to 30 bodies deep: expected sinkage "), std::string::npos) << command << ": " << err;
+        EXPECT_NE(err.find(" substeps would hold it under 2%"), std::string::npos) << command << ": " << err;
+    }
+}
