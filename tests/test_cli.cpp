@@ -163,7 +163,7 @@ TEST_F(Cli, RunWritesTheSceneWithTimeAdvanced) {
     Outcome o = stepwise("run " + file.string() + " --steps 100 --out " + out.string());
     ASSERT_EQ(o.exitCode, 0) << o.err;
     const std::string saved = readFile(out);
-    EXPECT_NE(saved.find("\"time\": 1.0000000000000007,"), std::string::npos)
+    EXPECT_NE(saved.find("\"time\": 1.0000000000000007"), std::string::npos)
         << "100 additions of 0.01 give this double exactly:\n" << saved.substr(0, 300);
     EXPECT_NE(saved.find("\"integrator\": \"rk4\""), std::string::npos);
 }
@@ -232,7 +232,7 @@ TEST_F(Cli, RunsTheCourseNotesLevel) {
     Outcome o = stepwise("run " + level("course_notes.json") + " --steps 60 --out " + out.string());
     EXPECT_EQ(o.exitCode, 0) << o.err;
     // 60 additions of 1/60 in doubles give this value exactly.
-    EXPECT_NE(readFile(out).find("\"time\": 1.0000000000000013,"), std::string::npos) << readFile(out);
+    EXPECT_NE(readFile(out).find("\"time\": 1.0000000000000013"), std::string::npos) << readFile(out);
 }
 
 TEST_F(Cli, ContactsFileHasOneLinePerStepWithEveryContact) {

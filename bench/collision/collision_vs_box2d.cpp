@@ -4,13 +4,18 @@
 // engines, from their final positions with Stepwise's narrow phase, so
 // Box2D's polygon skin does not flatter or penalise it.
 //
-//   collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR] [--scene NAME]
+//   collision_vs_box2d [--quick] [--sweep] [--adversarial] [--crowd N] [--out DIR] [--write-levels DIR] [--scene NAME]
 //
 // --quick runs a fifth of the simulated time, once; otherwise each engine
 // runs three times, alternating, and the fastest run counts. --scene runs
 // only that scene (pile, pyramid or rain), e.g. while tuning the solver;
 // --scene polygons runs the polygon pile (issue 15), which is not in the
 // default set and prints one line.
+// --adversarial times issue 13's scenes (fast crowds, one huge shape, free
+// fall) as ratios against the crowd at rest; --crowd N runs N circles
+// started at one point (wrap in /usr/bin/time -v for the peak memory).
+// --sweep runs every setting (substeps x iterations) of both engines and, with
+// --out DIR, writes the work-precision plot DIR/collisions_work_precision.png.
 
 #include "collision/collision_scenes.hpp"
 
@@ -28,6 +33,7 @@
 #include <ctime>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -174,7 +180,9 @@ Outcome runStepwise(const Scene& initial, int steps, std::size_t topIndex) {
     return out;
 }
 
-Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex) {
+/// Box2D stepped `substeps` times per frame with dt / substeps, with
+/// `velocityIterations` (and 3 position iterations) per call.
+Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex, int substeps = 1, int velocityIterations = 8) {
     const std::vector<Pose> poses0 = initialPoses(scene);
     b2World world(b2Vec2(float(scene.world.gravity.x), float(scene.world.gravity.y)));
     // Sleeping off: Stepwise has no sleeping, so both engines do the same
@@ -215,7 +223,9 @@ Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex) {
     }
     const float dt = float(scene.world.dt);
     const auto start = std::chrono::steady_clock::now();
-    for (int i = 0; i < steps; ++i) world.Step(dt, 8, 3);  // Box2D 2.4.1's recommended 8 velocity, 3 position iterations
+    // Default: the issue's 8 velocity, 3 position iterations, one call per frame.
+    for (int i = 0; i < steps; ++i)
+        for (int s = 0; s < substeps; ++s) world.Step(dt / float(substeps), velocityIterations, 3);
     Outcome out;
     out.msPerStep = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / steps;
     std::vector<Pose> poses = poses0;
@@ -394,14 +404,168 @@ PileOutcome runPolygonPileBox2d(const Scene& scene, int steps) {
     return out;
 }
 
+/// The work-precision picture for contacts: ms/step against the deepest
+/// overlap at the end, for each setting (substeps x iterations) of each
+/// engine on each scene, in the same run. Writes collisions_sweep.csv and
+/// .md, and collisions_work_precision.png (gnuplot) into `outDir`.
+int runSweep(const std::vector<bench::NamedScene>& scenes, bool quick, const std::string& outDir) {
+    struct Setting {
+        int substeps, iterations;
+    };
+    const std::vector<Setting> mineSettings{{1, 1}, {1, 2}, {1, 4}, {1, 8}, {2, 1}, {2, 2},
+                                            {4, 1}, {4, 2}, {8, 1}, {8, 2}, {16, 1}};
+    const std::vector<Setting> peerSettings{{1, 1}, {1, 2}, {1, 4}, {1, 8}, {2, 8}, {4, 8}, {8, 8}};
+    std::ostringstream csv, md;
+    csv << "scene,engine,substeps,iterations,ms_per_step,deepest_overlap_m\n";
+    md << "| scene | engine | substeps | iterations | ms/step | deepest overlap (mm) |\n|---|---|---|---|---|---|\n";
+    std::ostringstream data;  // gnuplot blocks: one per scene x engine
+    std::vector<std::string> blocks;
+    for (const auto& s : scenes) {
+        const int steps = int(std::lround((quick ? 0.2 : 1.0) * s.seconds / s.scene.world.dt));
+        const std::size_t top = initialPoses(s.scene).size() - 1;
+        for (int engine = 0; engine < 2; ++engine) {
+            const std::vector<Setting>& settings = engine == 0 ? mineSettings : peerSettings;
+            if (!blocks.empty()) data << "\n\n";
+            blocks.push_back(s.name + (engine == 0 ? " Stepwise" : " Box2D 2.4.1"));
+            data << "# " << blocks.back() << "\n";
+            for (const Setting& set : settings) {
+                Outcome out;
+                if (engine == 0) {
+                    Scene scene = s.scene;
+                    scene.world.substeps = set.substeps;
+                    scene.world.solverIterations = set.iterations;
+                    out = runStepwise(scene, steps, top);
+                } else {
+                    out = runBox2d(s.scene, steps, top, set.substeps, set.iterations);
+                }
+                const char* name = engine == 0 ? "Stepwise" : "Box2D 2.4.1";
+                char line[256];
+                std::snprintf(line, sizeof line, "| %s | %s | %d | %d | %.3f | %.2f |\n", s.name.c_str(), name,
+                              set.substeps, set.iterations, out.msPerStep, 1e3 * out.deepestOverlap);
+                md << line;
+                std::cout << line << std::flush;
+                csv << s.name << "," << name << "," << set.substeps << "," << set.iterations << "," << out.msPerStep
+                    << "," << out.deepestOverlap << "\n";
+                data << out.msPerStep << " " << std::max(1e-2, 1e3 * out.deepestOverlap) << " \"" << set.substeps
+                     << "x" << set.iterations << "\"\n";
+            }
+        }
+    }
+    if (outDir.empty()) return 0;
+    fs::create_directories(outDir);
+    const fs::path dir(outDir);
+    for (const auto& [name, text] : {std::pair<std::string, std::string>{"collisions_sweep.csv", csv.str()},
+                                     {"collisions_sweep.md", md.str()},
+                                     {"collisions_sweep.dat", data.str()}}) {
+        if (Result<void> r = writeFileAtomically(dir / name, text); !r) {
+            std::cerr << r.error() << "\n";
+            return 2;
+        }
+    }
+    std::ostringstream gp;
+    gp << "set terminal pngcairo size 1500,520 font 'DejaVu Sans,10' noenhanced\n"
+       << "set output '" << (dir / "collisions_work_precision.png").string() << "'\n"
+       << "set multiplot layout 1," << scenes.size()
+       << " title 'Contacts, work-precision: ms/step against deepest overlap at the end (Stepwise solid, Box2D 2.4.1 "
+          "dashed; labels: substeps x iterations)'\n"
+       << "set logscale xy\nset grid\nset xlabel 'ms per step'\nset ylabel 'deepest overlap (mm)'\n"
+       << "set key top right font ',8'\n";
+    for (std::size_t k = 0; k < scenes.size(); ++k) {
+        gp << "set title '" << scenes[k].name << "'\nplot '" << (dir / "collisions_sweep.dat").string() << "' index "
+           << 2 * k << " using 1:2 with linespoints lc 1 pt 7 title 'Stepwise', '' index " << 2 * k
+           << " using 1:2:3 with labels offset 0,0.8 font ',7' notitle, '' index " << 2 * k + 1
+           << " using 1:2 with linespoints lc 2 dt 2 pt 6 title 'Box2D 2.4.1', '' index " << 2 * k + 1
+           << " using 1:2:3 with labels offset 0,-0.8 font ',7' tc lt 2 notitle\n";
+    }
+    gp << "unset multiplot\n";
+    const fs::path script = dir / "collisions_work_precision.gp";
+    std::ofstream(script) << gp.str();
+    const std::string command = "gnuplot '" + script.string() + "' 2>'" + (dir / "gnuplot.log").string() + "'";
+    if (std::system(command.c_str()) != 0) {
+        std::cerr << "collision_vs_box2d: gnuplot failed; see " << (dir / "gnuplot.log").string() << "\n";
+        return 2;
+    }
+    std::cout << "wrote " << (dir / "collisions_work_precision.png").string() << "\n";
+    return 0;
+}
+
+/// Adversarial scenes of issue 13: ms/step of each, as ratios against the
+/// same crowd at rest in the same run. `crowd` > 0 instead runs only N
+/// circles started at one point for 60 steps (for /usr/bin/time -v).
+int runAdversarial(int crowd) {
+    const auto circle = [](Scene& s, Vec2 p, Vec2 v, double r, bool isStatic) {
+        const Entity e = s.registry.create();
+        s.registry.emplace<Position>(e, Position{p});
+        if (isStatic) s.registry.emplace<Static>(e, Static{true});
+        else s.registry.emplace<Velocity>(e, Velocity{v});
+        s.registry.emplace<Radius>(e, Radius{r});
+    };
+    const auto world = [](Vec2 g) {
+        Scene s;
+        s.world.gravity = g;
+        s.world.substeps = 4;
+        s.world.solverIterations = 2;
+        return s;
+    };
+    const auto msPerStep = [](const Scene& scene, int warm, int steps) {
+        Result<World> w = World::build(scene);
+        if (!w) {
+            std::cerr << w.error() << "\n";
+            std::exit(2);
+        }
+        w->setProfiling(false);
+        for (int i = 0; i < warm; ++i) (void)w->step();
+        const auto start = std::chrono::steady_clock::now();
+        for (int i = 0; i < steps; ++i) (void)w->step();
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / steps;
+    };
+    if (crowd > 0) {
+        Scene s = world({0.0, 0.0});
+        for (int i = 0; i < crowd; ++i) circle(s, {0.0, 0.0}, {}, 0.25, false);
+        const auto start = std::chrono::steady_clock::now();
+        const double first = msPerStep(s, 0, 1);
+        const double sixty = msPerStep(s, 0, 60);
+        std::printf("%d circles at one point: first step %.1f ms, 60 steps %.1f ms/step (total %.1f s)\n", crowd, first,
+                    sixty, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        return 0;
+    }
+    const auto spaced = [&](double speed, double hugeRadius) {
+        Scene s = world({0.0, 0.0});
+        for (int i = 0; i < 10000; ++i) circle(s, {double(i % 100), double(i / 100)}, {speed, 0.0}, 0.25, false);
+        if (hugeRadius > 0.0) circle(s, {50.0, -hugeRadius - 5.0}, {}, hugeRadius, true);
+        return s;
+    };
+    const double rest = msPerStep(spaced(0.0, 0.0), 2, 20);
+    std::printf("10,000 circles 1 m apart at rest: %.3f ms/step\n", rest);
+    for (const double speed : {100.0, 1000.0}) {
+        const double ms = msPerStep(spaced(speed, 0.0), 2, 20);
+        std::printf("  all moving at %g m/s: %.3f ms/step (%.2fx at rest)\n", speed, ms, ms / rest);
+    }
+    for (const double radius : {100.0, 1e6}) {
+        const double ms = msPerStep(spaced(0.0, radius), 2, 20);
+        std::printf("  with one static circle of radius %g: %.3f ms/step (%.2fx)\n", radius, ms, ms / rest);
+    }
+    Scene fall = world({0.0, -9.81});
+    for (int i = 0; i < 1000; ++i) circle(fall, {double(i % 40), double(i / 40)}, {}, 0.25, false);
+    const double early = msPerStep(fall, 0, 60);
+    const double late = msPerStep(fall, 600, 60);
+    std::printf("1,000 circles falling, no floor: %.3f ms/step in the first second, %.3f after 10 s (%.2fx)\n", early,
+                late, late / early);
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
-    bool quick = false;
+    bool quick = false, sweep = false, adversarial = false;
+    int crowd = 0;
     std::string outDir, levelsDir, only;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--quick") quick = true;
+        else if (arg == "--sweep") sweep = true;
+        else if (arg == "--adversarial") adversarial = true;
+        else if (arg == "--crowd" && i + 1 < argc) crowd = std::atoi(argv[++i]);
         else if (arg == "--out" && i + 1 < argc) outDir = argv[++i];
         else if (arg == "--write-levels" && i + 1 < argc) levelsDir = argv[++i];
         else if (arg == "--scene" && i + 1 < argc) only = argv[++i];
@@ -409,10 +573,11 @@ int main(int argc, char** argv) {
             g_broadPhase = argv[++i];
         else {
             std::cerr << "collision_vs_box2d: error: unknown argument \"" << arg
-                      << "\"; usage: collision_vs_box2d [--quick] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain|polygons]\n";
+                      << "\"; usage: collision_vs_box2d [--quick] [--sweep] [--adversarial] [--crowd N] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain|polygons]\n";
             return 2;
         }
     }
+    if (adversarial || crowd > 0) return runAdversarial(crowd);
     if (only == "polygons") {
         // The polygon pile: ms per step, alternating engines, fastest of three.
         const Scene pile = polygonPileScene(400);
@@ -445,6 +610,7 @@ int main(int argc, char** argv) {
         }
         return 0;
     }
+    if (sweep) return runSweep(scenes, quick, outDir);
     std::ostringstream md;
     md << measuredOn(argc, argv) << "\n\n";
     md << "| scene | bodies | steps | Stepwise ms/step | Box2D 2.4.1 ms/step | speed ratio (Box2D/Stepwise) | deepest overlap "

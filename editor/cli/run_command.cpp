@@ -181,6 +181,10 @@ int run(const RunOptions& options) {
         return kExitBadInput;
     }
     World& world = built.value();
+    // Before playing: a pile the level's substeps cannot hold (stderr, so
+    // the summary on stdout stays one line).
+    if (const std::optional<PileHint> pile = world.pileHint())
+        std::cerr << options.level << ": warning: " << pile->message() << "\n";
 
     // The trace and contacts stream into temporaries next to their targets
     // (memory stays flat however long the run); they are put in place only

@@ -74,6 +74,8 @@ void addValidateCommand(CLI::App& app, int& exitCode) {
             std::cout << summary << "\n";
             for (const StiffnessHint& hint : world->stiffnessHints())
                 std::cerr << *level << ": warning: " << hint.message() << "\n";
+            if (const std::optional<PileHint> pile = world->pileHint())
+                std::cerr << *level << ": warning: " << pile->message() << "\n";
             for (const std::string& note : ineffectiveComponents(*scene))
                 std::cerr << *level << ": warning: " << note << "\n";
         } else {

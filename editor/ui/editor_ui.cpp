@@ -631,12 +631,15 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
         const double dtMin = 1e-6, dtMax = 1.0;
         if (ImGui::DragScalar("dt [s]", ImGuiDataType_Double, &ws.dt, 0.0001f, &dtMin, &dtMax, "%.6g")) edited("dt");
         done();
-        if (ImGui::DragInt("substeps", &ws.substeps, 0.1f, 1, 1000)) {
+        // 0: the level gives none and the engine chooses (shown as "auto");
+        // dragging gives it a value, which the level then keeps.
+        if (ImGui::DragInt("substeps", &ws.substeps, 0.1f, 1, 1000, ws.substeps == 0 ? "auto" : "%d")) {
             ws.substeps = std::clamp(ws.substeps, 1, 1000);
             edited("substeps");
         }
         done();
-        if (ImGui::DragInt("solver iterations", &ws.solverIterations, 0.1f, 1, 200)) {
+        if (ImGui::DragInt("solver iterations", &ws.solverIterations, 0.1f, 1, 200,
+                           ws.solverIterations == 0 ? "auto" : "%d")) {
             ws.solverIterations = std::clamp(ws.solverIterations, 1, 200);
             edited("solver iterations");
         }
@@ -671,6 +674,14 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
             if (ImGui::IsItemHovered())
                 ImGui::SetTooltip("opening angle: 0 sums every pair exactly; larger is faster and less exact. "
                                   "Small scenes are summed exactly whatever theta says (it is faster there)");
+        }
+        if (world) {
+            // A pile the level's substeps cannot hold: said before playing.
+            if (const std::optional<PileHint> pile = world->pileHint()) {
+                ImGui::PushTextWrapPos(0.0f);
+                ImGui::TextColored(kGold, "%s", pile->message().c_str());
+                ImGui::PopTextWrapPos();
+            }
         }
         ImGui::PopItemWidth();
 

@@ -306,9 +306,9 @@ void readEntity(const Json& entityJson, std::size_t index, Registry& registry, E
 void readWorld(const Json& v, WorldSettings& world) {
     const std::string pointer = "/world";
     if (!v.is_object()) refuse(pointer, "expected an object, got " + describeFound(v));
-    static constexpr std::array<std::string_view, 10> kKeys{
-        "gravity", "G", "integrator", "dt", "substeps", "time", "solver_iterations", "tolerance", "theta",
-        "adaptive_step"};
+    static constexpr std::array<std::string_view, 11> kKeys{
+        "gravity", "G", "integrator", "dt", "substeps", "time", "solver_iterations", "restitution_threshold",
+        "tolerance", "theta", "adaptive_step"};
     for (const auto& [key, value] : v.items()) {
         const std::string at = child(pointer, key);
         if (key == "gravity") world.gravity = readVector(value, at);
@@ -317,6 +317,7 @@ void readWorld(const Json& v, WorldSettings& world) {
         else if (key == "substeps") world.substeps = int(readInteger(value, at, 1, 1000));
         else if (key == "time") world.time = readNumber(value, at, NumberRange{});
         else if (key == "solver_iterations") world.solverIterations = int(readInteger(value, at, 1, 1000));
+        else if (key == "restitution_threshold") world.restitutionThreshold = readNumber(value, at, NumberRange{0.0, 1e6});
         else if (key == "tolerance") world.tolerance = readNumber(value, at, NumberRange{0.0, 1.0, true});
         else if (key == "theta") world.theta = readNumber(value, at, NumberRange{0.0, 1.0});
         else if (key == "adaptive_step") world.adaptiveStep = readNumber(value, at, NumberRange{0.0, 10.0});
@@ -830,9 +831,12 @@ std::string sceneToJsonText(const Scene& scene) {
     world["G"] = scene.world.G;
     world["integrator"] = scene.world.integrator;
     world["dt"] = scene.world.dt;
-    world["substeps"] = scene.world.substeps;
+    // Settings the file did not give stay absent (0 / no value), so a level
+    // that leaves them to the engine keeps doing so after a save.
+    if (scene.world.substeps > 0) world["substeps"] = scene.world.substeps;
     world["time"] = scene.world.time;
-    world["solver_iterations"] = scene.world.solverIterations;
+    if (scene.world.solverIterations > 0) world["solver_iterations"] = scene.world.solverIterations;
+    if (scene.world.restitutionThreshold) world["restitution_threshold"] = *scene.world.restitutionThreshold;
     world["tolerance"] = scene.world.tolerance;
     world["theta"] = scene.world.theta;
     if (scene.world.adaptiveStep > 0.0) world["adaptive_step"] = scene.world.adaptiveStep;

@@ -124,7 +124,13 @@ std::string sceneJsonSchema() {
                              Json{{"type", "number"},
                                   {"minimum", 0},
                                   {"maximum", 10},
-                                  {"description", "dopri5's proposed next internal step (s), saved for exact resume"}}}}}};
+                                  {"description", "dopri5's proposed next internal step (s), saved for exact resume"}}},
+                            {"restitution_threshold",
+                             Json{{"type", "number"},
+                                  {"minimum", 0},
+                                  {"maximum", 1e6},
+                                  {"description", "m/s: slower impacts do not bounce; absent: derived from gravity and "
+                                                  "the substep (zero gravity: every approach bounces)"}}}}}};
     Json view = Json{{"type", "object"},
                      {"description", "camera: centre in metres, zoom in pixels per metre at 720 px image height"},
                      {"additionalProperties", false},

@@ -21,9 +21,17 @@ struct WorldSettings {
     double G = 1.0;                          ///< gravitational constant for attractors, N*m^2/kg^2
     std::string integrator = "semi_implicit_euler";
     double dt = 1.0 / 60.0;                  ///< seconds per step
-    int substeps = 1;                        ///< each step is `substeps` steps of dt/substeps
+    /// Each step is `substeps` steps of dt/substeps. 0: not given (a file
+    /// without the key); World::build then chooses from the scene
+    /// (chooseSubsteps in world.hpp), and a save writes no key.
+    int substeps = 0;
     double time = 0.0;                       ///< simulated seconds so far
-    int solverIterations = 8;                ///< contact solver velocity iterations (addition)
+    /// Contact solver velocity iterations (addition). 0: not given; World::build
+    /// uses 8, or its own choice when substeps is not given either.
+    int solverIterations = 0;
+    /// m/s: impacts slower than this do not bounce. Absent: derived from
+    /// gravity and the substep (derivedRestitutionThreshold in world.hpp).
+    std::optional<double> restitutionThreshold;
     /// Local error per internal step for the error-controlled integrator
     /// (dopri5): each component's error is held to tolerance * (1 + |value|).
     double tolerance = 1e-6;

@@ -138,6 +138,37 @@ struct WorldState {
     /// Writes the bodies' state and the time into `scene`, as
     /// World::writeBack did when the snapshot was taken.
     void writeBack(Scene& scene) const;
+/// What the engine runs when a level gives no `substeps` (and no
+/// `solver_iterations`): enough substeps for the deepest pile the scene can
+/// build to rest with its deepest overlap under 1% of a body's diameter
+/// (expectedPileOverlap), at most 16. See docs (collide.md).
+struct ContactSettingsChoice {
+    int substeps = 1;
+    int iterations = 8;        ///< 8 at 1 substep (the old default), else 2
+    int stackDepth = 0;        ///< bodies in the deepest column the scene can pile up
+    double diameter = 0.0;     ///< metres, the median dynamic shape's size
+    double gravity = 0.0;      ///< m/s^2, |world.gravity|
+};
+ContactSettingsChoice chooseContactSettings(const Scene& scene);
+/// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
+/// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
+/// compresses by load / (m_n omega^2), omega = 2 pi min(60 Hz, 1 / (4 h)),
+/// with a factor measured on the 30-row pile (docs: collide.md).
+double expectedPileOverlap(int depth, double gravity, double h);
+/// world.restitution_threshold when the level gives none: four times the
+/// speed gravity adds in one substep (m/s), so resting contacts never bounce
+/// and, with zero gravity, every approach does.
+double derivedRestitutionThreshold(double gravity, double h);
+
+/// A warning before playing: the level's own substeps let its deepest pile
+/// sink into itself by more than 2% of a diameter.
+struct PileHint {
+    int stackDepth = 0;
+    double expectedOverlap = 0.0;  ///< metres
+    double diameter = 0.0;         ///< metres
+    int substeps = 1;              ///< the level's
+    int substepsNeeded = 1;        ///< the fewest that keep it under 2% (16 at most)
+    std::string message() const;
 };
 
 class WorldImpl;
@@ -208,6 +239,9 @@ public:
 
     /// Springs past the integrator's stability limit at the current dt.
     std::vector<StiffnessHint> stiffnessHints() const;
+    /// Set when the scene's deepest pile would sink more than 2% of a
+    /// diameter at the running substeps (see PileHint).
+    std::optional<PileHint> pileHint() const;
 
     /// Net force a unit-mass probe at `point` would feel from the scene's
     /// field forces: gravity and attractors, through the same code the step

@@ -8,8 +8,17 @@ namespace stepwise::collision {
 void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
                            std::vector<ProxyPair>& pairs) {
     pairs.clear();
+    crowded_.clear();
     switch (kind_) {
-    case BroadPhaseKind::SweepAndPrune: sweepAndPrune(boxes, movable, pairs); break;
+    case BroadPhaseKind::SweepAndPrune:
+        sweepAndPrune(boxes, movable, pairs);
+        // A crowd (bodies on top of each other) makes n^2/2 pairs; the grid
+        // bounds them per body, so hand such a step to it.
+        if (pairs.size() > kDenseNeighbours * boxes.size() + 4096) {
+            pairs.clear();
+            uniformGrid(boxes, movable, pairs);
+        }
+        break;
     case BroadPhaseKind::UniformGrid: uniformGrid(boxes, movable, pairs); break;
     case BroadPhaseKind::BruteForce:
         for (std::uint32_t i = 0; i < boxes.size(); ++i)
@@ -65,21 +74,49 @@ void BroadPhase::sweepAndPrune(std::span<const Aabb> boxes, std::span<const std:
 void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
                              std::vector<ProxyPair>& pairs) {
     const std::uint32_t n = std::uint32_t(boxes.size());
+    overlapTests_ = 0;
+    crowded_.assign(n, 0);
     if (n == 0) return;
-    // Cell size: twice the mean box extent, so a typical box spans 1-4 cells.
-    // Big static boxes (walls) span many cells; that is the grid's weakness
-    // and why sweep and prune is the default.
-    double sum = 0.0;
-    Vec2 lo = boxes[0].lower;
-    for (const Aabb& b : boxes) {
-        sum += std::max(b.upper.x - b.lower.x, b.upper.y - b.lower.y);
-        lo.x = std::min(lo.x, b.lower.x);
-        lo.y = std::min(lo.y, b.lower.y);
+    // Cell size: twice the median box extent, so a typical box spans 1-4
+    // cells. The median, not the mean: one huge shape (a static circle of
+    // radius 1e6) would otherwise make the cells huge and put every body in
+    // one cell.
+    extents_.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i)
+        extents_[i] = std::max(boxes[i].upper.x - boxes[i].lower.x, boxes[i].upper.y - boxes[i].lower.y);
+    median_.assign(extents_.begin(), extents_.end());
+    std::nth_element(median_.begin(), median_.begin() + n / 2, median_.end());
+    const double cell = std::max(2.0 * median_[n / 2], 1e-6);
+    // Boxes much larger than a cell (walls, floors, a huge circle) stay out
+    // of the grid: they would span thousands of cells. Each is tested
+    // against every box instead, a tight loop of four comparisons
+    // (10,000 boxes: ~10 us per large box).
+    constexpr double kLargeCells = 8.0;
+    large_.clear();
+    Vec2 lo{0.0, 0.0};
+    bool first = true;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (extents_[i] > kLargeCells * cell) {
+            large_.push_back(i);
+            continue;
+        }
+        if (first || boxes[i].lower.x < lo.x) lo.x = boxes[i].lower.x;
+        if (first || boxes[i].lower.y < lo.y) lo.y = boxes[i].lower.y;
+        first = false;
     }
-    const double cell = std::max(2.0 * sum / n, 1e-6);
+    overlapTests_ += large_.size() * n;
+    for (const std::uint32_t a : large_) {
+        for (std::uint32_t b = 0; b < n; ++b) {
+            // Large-large pairs once (from the lower index).
+            if (b == a || (extents_[b] > kLargeCells * cell && b < a)) continue;
+            if (!(movable[a] || movable[b]) || !overlaps(boxes[a], boxes[b])) continue;
+            pairs.push_back(a < b ? ProxyPair{a, b} : ProxyPair{b, a});
+        }
+    }
     cellKeys_.clear();
     auto cellOf = [&](double v, double origin) { return std::int64_t(std::floor((v - origin) / cell)); };
     for (std::uint32_t i = 0; i < n; ++i) {
+        if (extents_[i] > kLargeCells * cell) continue;
         const std::int64_t x0 = cellOf(boxes[i].lower.x, lo.x), x1 = cellOf(boxes[i].upper.x, lo.x);
         const std::int64_t y0 = cellOf(boxes[i].lower.y, lo.y), y1 = cellOf(boxes[i].upper.y, lo.y);
         for (std::int64_t x = x0; x <= x1; ++x)
@@ -92,9 +129,30 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
         while (end < cellKeys_.size() && (cellKeys_[end] >> 32) == (cellKeys_[begin] >> 32)) ++end;
         const std::uint64_t cellKey = cellKeys_[begin] >> 32;
         const std::int64_t cx = std::int64_t(cellKey & 0xFFFF), cy = std::int64_t((cellKey >> 16) & 0xFFFF);
+        // A crowd (thousands of bodies started at one point) puts everything
+        // in one cell: all pairs would be n^2/2 (10,000 bodies: 50 million,
+        // out of memory). Past kDenseCell entries, each box pairs only with
+        // its next kDenseNeighbours in the cell's order by centre x: the
+        // pairs, and so memory and time, grow linearly, and the contacts
+        // still push the crowd apart until the cells thin out. An ordinary
+        // scene never has such a cell (a cell is two typical boxes wide).
+        std::size_t reach = end - begin;
+        if (end - begin > kDenseCell) {
+            std::sort(cellKeys_.begin() + std::ptrdiff_t(begin), cellKeys_.begin() + std::ptrdiff_t(end),
+                      [&](std::uint64_t l, std::uint64_t r) {
+                          const Aabb& bl = boxes[std::uint32_t(l)];
+                          const Aabb& br = boxes[std::uint32_t(r)];
+                          const double xl = bl.lower.x + bl.upper.x, xr = br.lower.x + br.upper.x;
+                          return xl != xr ? xl < xr : std::uint32_t(l) < std::uint32_t(r);
+                      });
+            reach = kDenseNeighbours;
+            for (std::size_t i = begin; i < end; ++i) crowded_[std::uint32_t(cellKeys_[i])] = 1;
+        }
         for (std::size_t i = begin; i < end; ++i) {
             const std::uint32_t a = std::uint32_t(cellKeys_[i]);
-            for (std::size_t j = i + 1; j < end; ++j) {
+            const std::size_t last = std::min(end, i + 1 + reach);
+            overlapTests_ += last - i - 1;
+            for (std::size_t j = i + 1; j < last; ++j) {
                 const std::uint32_t b = std::uint32_t(cellKeys_[j]);
                 if (!(movable[a] || movable[b]) || !overlaps(boxes[a], boxes[b])) continue;
                 // Report the pair only in the cell holding the lower corner of

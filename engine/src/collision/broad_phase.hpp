@@ -3,7 +3,8 @@
 // strategies, chosen by measurement (bench/collision/collision_vs_box2d.cpp; docs/collisions.md): sweep and
 // prune on x, and a uniform grid. Both return the same pairs in the same
 // order (sorted by (a, b)), so the solver's result does not depend on which
-// one ran.
+// one ran; the one exception is a crowd (a grid cell with more than
+// kDenseCell boxes), where the grid bounds the pairs per box.
 
 #include "collision/collision_types.hpp"
 
@@ -34,12 +35,22 @@ public:
     BroadPhaseKind kind() const { return kind_; }
 
     void findPairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
+    /// Box-against-box tests the last uniform-grid call made (its cost, for
+    /// tests: it must not grow with one huge shape or a crowd).
+    std::size_t lastGridOverlapTests() const { return overlapTests_; }
+    /// Per box of the last call: 1 when it sat in a crowded grid cell (more
+    /// than kDenseCell boxes); empty when no grid ran.
+    std::span<const std::uint8_t> crowded() const { return crowded_; }
 
 private:
     void sweepAndPrune(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
     void uniformGrid(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
 
     BroadPhaseKind kind_;
+    /// Grid cells with more entries than this are a crowd: each box there
+    /// pairs only with its next kDenseNeighbours boxes (by centre x).
+    static constexpr std::size_t kDenseCell = 64;
+    static constexpr std::size_t kDenseNeighbours = 16;
     struct SortedBox {
         double lowerX, upperX, lowerY, upperY;
         std::uint32_t index;
@@ -48,6 +59,10 @@ private:
     std::vector<std::uint32_t> order_;  // SAP: proxies sorted by lower.x (kept between steps: nearly sorted)
     std::vector<SortedBox> sorted_;     // SAP: the boxes in that order, packed for the sweep
     std::vector<std::uint64_t> cellKeys_;  // grid: (cell, proxy) entries
+    std::vector<double> extents_, median_;  // grid: each box's larger side, and a copy for the median (m)
+    std::vector<std::uint32_t> large_;
+    std::size_t overlapTests_ = 0;
+    std::vector<std::uint8_t> crowded_;     // grid: boxes too large for the cells
 };
 
 } // namespace stepwise::collision

@@ -78,6 +78,7 @@ public:
     joints::JointSettings& jointSettings() { return jointSettings_; }
     /// Joints of the last step, for the debugging views.
     std::span<const JointRecord> jointRecords() const { return jointRecords_; }
+    const SolverSettings& settings() const { return settings_; }
     /// Fixes the broad-phase strategy (tests, benchmarks); by default it is
     /// chosen per step from the number of shapes.
     void setBroadPhase(BroadPhaseKind kind) {
@@ -86,12 +87,15 @@ public:
     }
     const BroadPhase& broadPhase() const { return broadPhase_; }
 
-    /// Detection for the whole step: margins cover the motion of `dt`, so
-    /// contacts exist before fast bodies reach a surface.
+    /// Records the step-start state. Detection for the whole step runs in
+    /// the first solveSubstep, once the forces of the step are known: margins
+    /// cover the motion of `dt`, so contacts exist before fast bodies reach a
+    /// surface.
     void beginStep(std::span<const Vec2> x, std::span<const Vec2> v, double dt, int substeps);
     /// Contact solve for one substep of length h. On entry `x`, `v` hold the
     /// integrator's unconstrained end-of-substep state; on exit, the
     /// constrained one (positions move by h times the contact velocity change).
+    /// The first call of a step also runs the broad and narrow phases.
     void solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double h);
     /// Stores impulses for warm starting and builds the contact records.
     void endStep();
@@ -99,6 +103,9 @@ public:
     std::span<const ContactRecord> contacts() const { return records_; }
     void clearContactRecords() { records_.clear(); }
     std::size_t contactPointCount() const { return records_.size(); }
+    /// Broad-phase pairs and narrow-phase manifolds of the last detection.
+    std::size_t candidatePairCount() const { return pairs_.size(); }
+    std::size_t manifoldCount() const { return constraints_.size(); }
     const CollisionTimings& timings() const { return timings_; }
 
     /// Sets the rotational state: undoes a step's change (after a
@@ -124,6 +131,10 @@ public:
 private:
 
     void addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m, std::span<const Vec2> centres);
+    /// Broad and narrow phase at the step-start positions; `firstSubstepV`
+    /// is the unconstrained velocity after the first substep's forces.
+    void detect(std::span<const Vec2> firstSubstepV);
+    static Vec2 coincidentNormal(std::uint32_t a, std::uint32_t b);
 
     std::vector<Collider> colliders_;
     std::deque<ConvexPolygon> polygons_;  // the polygon shapes' outlines (addresses stay fixed)
@@ -142,7 +153,15 @@ private:
     std::vector<std::uint8_t> movable_;
     std::vector<ProxyPair> pairs_;
     std::vector<Vec2> centres_, stepStart_;
-    std::vector<double> stepStartAngle_, margins_;
+    std::vector<double> stepStartAngle_, margins_, spin_;
+    std::vector<Vec2> startV_, endV_;  // per collider: velocity at step start, predicted at step end (m/s)
+    bool detected_ = false;
+    struct SavedVelocity {
+        Vec2 v;
+        double w = 0.0;
+    };
+    std::vector<std::uint32_t> crowdBodies_;  // solver bodies in a crowded grid cell this step
+    std::vector<SavedVelocity> crowdSaved_;
     std::vector<SolverBody> bodies_;
     std::vector<ContactConstraint> constraints_;
     std::vector<ContactDetail> details_;  // parallel to constraints_

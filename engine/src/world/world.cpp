@@ -170,7 +170,11 @@ Result<World> World::build(const Scene& scene) {
         return Error{"world.integrator: unknown integrator \"" + ws.integrator + "\"; known: " + known};
     }
     if (!(ws.dt > 0.0) || !std::isfinite(ws.dt)) return Error{"world.dt: expected a finite number > 0, got " + format(ws.dt)};
-    if (ws.substeps < 1) return Error{"world.substeps: expected an integer >= 1, got " + std::to_string(ws.substeps)};
+    if (ws.substeps < 0) return Error{"world.substeps: expected an integer >= 1, got " + std::to_string(ws.substeps)};
+    if (ws.solverIterations < 0)
+        return Error{"world.solver_iterations: expected an integer >= 1, got " + std::to_string(ws.solverIterations)};
+    if (ws.restitutionThreshold && !(*ws.restitutionThreshold >= 0.0 && std::isfinite(*ws.restitutionThreshold)))
+        return Error{"world.restitution_threshold: expected a finite number >= 0, got " + format(*ws.restitutionThreshold)};
     if (!isFinite(ws.gravity) || !std::isfinite(ws.G) || !std::isfinite(ws.time))
         return Error{"world: gravity, G and time must be finite"};
     if (!(ws.tolerance > 0.0) || !(ws.tolerance <= 1.0))
@@ -348,6 +352,19 @@ Result<World> World::build(const Scene& scene) {
     std::string jointProblem;
     w.collision = detail::buildCollisions(scene, bodyOf, kNoBody, &jointProblem);
     if (!jointProblem.empty()) return Error{jointProblem};
+    // Settings the level left to the engine (world.hpp: chooseContactSettings,
+    // derivedRestitutionThreshold); settings() reports what runs.
+    const ContactSettingsChoice choice = chooseContactSettings(scene);
+    w.contactChoice = choice;
+    if (ws.substeps == 0) w.settings.substeps = choice.substeps;
+    if (ws.solverIterations == 0) w.settings.solverIterations = ws.substeps == 0 ? choice.iterations : 8;
+    const double substepLength = ws.dt / double(w.settings.substeps);
+    if (w.collision) {
+        w.collision->settings().iterations = w.settings.solverIterations;
+        w.collision->settings().restitutionThreshold =
+            ws.restitutionThreshold ? *ws.restitutionThreshold
+                                    : derivedRestitutionThreshold(length(ws.gravity), substepLength);
+    }
 
     // Spin: angle += h * angular velocity for dynamic bodies with both
     // (bodies with shapes or joints turn in the contact solver instead).
@@ -379,7 +396,7 @@ Result<World> World::build(const Scene& scene) {
     w.v[0].assign(v0.begin(), v0.end());
     w.x[1].assign(2 * n, 0.0);
     w.v[1].assign(2 * n, 0.0);
-    if (ws.substeps > 1) {
+    if (w.settings.substeps > 1) {
         w.backupX.assign(2 * n, 0.0);
         w.backupV.assign(2 * n, 0.0);
     }
@@ -806,6 +823,38 @@ std::vector<StiffnessHint> World::stiffnessHints() const {
         hints.push_back(std::move(hint));
     }
     return hints;
+}
+
+std::optional<PileHint> World::pileHint() const {
+    const WorldImpl& w = *impl_;
+    const ContactSettingsChoice& c = w.contactChoice;
+    if (!w.collision || c.stackDepth < 2 || !(c.diameter > 0.0)) return std::nullopt;
+    const double limit = 0.02 * c.diameter;  // the pile goal: overlap under 2% of a diameter
+    const int substeps = w.settings.substeps;
+    const double overlap = expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(substeps));
+    if (!(overlap > limit)) return std::nullopt;
+    PileHint hint;
+    hint.stackDepth = c.stackDepth;
+    hint.expectedOverlap = overlap;
+    hint.diameter = c.diameter;
+    hint.substeps = substeps;
+    hint.substepsNeeded = 16;
+    for (int s = substeps + 1; s <= 16; ++s)
+        if (expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(s)) <= limit) {
+            hint.substepsNeeded = s;
+            break;
+        }
+    return hint;
+}
+
+std::string PileHint::message() const {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "piles up to %d bodies deep: expected sinkage %.0f mm (%.1f%% of a %.2g m diameter) at %d substep%s; "
+                  "%d substeps would hold it under 2%%",
+                  stackDepth, 1e3 * expectedOverlap, 100.0 * expectedOverlap / diameter, diameter, substeps,
+                  substeps == 1 ? "" : "s", substepsNeeded);
+    return text;
 }
 
 Vec2 World::probeForce(Vec2 point, Vec2) const {

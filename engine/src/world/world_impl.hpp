@@ -44,6 +44,7 @@ public:
     /// no shapes (then the step has no collision stages). It owns the
     /// rotation of the bodies that have shapes: only contacts make torque.
     std::unique_ptr<collision::CollisionSystem> collision;
+    ContactSettingsChoice contactChoice;  ///< the scene's deepest pile (pileHint) and the engine's choice
     std::vector<double> collisionAngleBackup, collisionSpinBackup;  ///< undo after a divergence
     bool profiling = true;
     /// Entities of the state arrays (saveState/restoreState); set by build.
