@@ -157,7 +157,7 @@ TEST(CollisionHard, BallAtRestPulledByAStiffSpringStopsAtAThinWall) {
             staticBoxAt(s, {0.5, 0.0}, 0.05, 2.0);  // 5 cm wall, near face at x = 0.475
             const Entity spring = s.registry.create();
             // Rest length 0 at x = 2: k = 1e4, m = 1 (omega = 100 rad/s).
-            s.registry.emplace<Spring>(spring, Spring{"ball", "", Vec2{2.0, 0.0}, 1e4, 0.0, 0.0});
+            s.registry.emplace<Spring>(spring, Spring{ball, Entity{}, Vec2{2.0, 0.0}, 1e4, 0.0, 0.0});
             Result<World> w = World::build(s);
             ASSERT_TRUE(w) << w.error();
             double furthest = -1e9;

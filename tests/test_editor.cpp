@@ -861,7 +861,7 @@ TEST(PolygonTool, TheInspectorRefusesADentAndKeepsTheOldOutline) {
     std::string problem;
     const std::vector<Vec2> dent{{-1, -1}, {1, -1}, {-0.25, -0.25}, {-1, 1}};
     EXPECT_EQ(setFieldOnAll(f.ed.doc.scene, *info, info->fields[0], dent, {e}, &problem), 0u);
-    EXPECT_EQ(problem, "polygon: vertices/2: not convex: the outline turns clockwise at vertex 2 {\"x\": -0.25, \"y\": "
+    EXPECT_EQ(problem, "\"polygon\" polygon.vertices/2: not convex: the outline turns clockwise at vertex 2 {\"x\": -0.25, \"y\": "
                        "-0.25}; "
                        "a polygon shape must be convex (split the shape into convex pieces)");
     EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Polygon>(e)->vertices, before);
@@ -875,6 +875,7 @@ TEST(PolygonTool, ConvexHullIsCounterClockwiseWithoutCollinearPoints) {
     ASSERT_EQ(hull.size(), 4u);
     EXPECT_EQ(polygonProblem(hull), "");
     EXPECT_EQ(convexHull({{0, 0}, {1, 1}, {2, 2}}).size(), 2u);
+}
 
 // ---- handles in memory, names in files ------------------------------------------------
 
@@ -961,7 +962,7 @@ TEST(Inspector, RefusesAtEditTimeWhatTheLoaderRefusesNamingEntityAndField) {
     std::string problem;
     // A second shape.
     EXPECT_FALSE(f.ed.applyEdit("add box", [&](Scene& s) { return addComponentToAll(s, *findComponent("box"), {bob}, &problem) > 0; }));
-    EXPECT_EQ(problem, "\"bob\" box: an entity has at most one shape (radius, box or plane), got 2");
+    EXPECT_EQ(problem, "\"bob\" box: an entity has at most one shape (radius, box, polygon or plane), got 2");
     // A speed whose kinetic energy overflows.
     const ComponentInfo* velocity = findComponent("velocity");
     EXPECT_FALSE(f.ed.applyEdit("v", [&](Scene& s) {

@@ -239,7 +239,7 @@ TEST(SceneErrors, UnknownComponentNamesEntityAndSuggests) {
 
 TEST(SceneErrors, SpringToMissingEntity) {
     EXPECT_EQ(refusal(R"({"entities": [{"name": "a", "position": {"x": 0, "y": 0}}, {"spring": {"a": "a", "b": "ghost"}}]})"),
-              "t.json: error: /entities/1/spring/b: no entity is named \"ghost\"");
+              "t.json: error: /entities/1/spring/b: no entity is named \"ghost\" (spring on entity 1)");
     EXPECT_EQ(refusal(R"({"entities": [{"name": "a", "position": {"x": 0, "y": 0}}, {"spring": {"a": "a"}}]})"),
               "t.json: error: /entities/1/spring: expected either \"b\" (an entity name) or \"anchor\" (a point), got "
               "neither");

@@ -260,7 +260,11 @@ void readComponent(const ComponentInfo& info, const Json& value, Registry& regis
                 if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
                 refuse(child(pointer, key), message + " Known fields: " + joinNames(known));
             }
+            const std::size_t unresolvedBefore = names.unresolved.size();
             readField(*it, fieldValue, component, child(pointer, key), names);
+            // A name no entity has: say whose reference it is.
+            if (names.unresolved.size() > unresolvedBefore)
+                names.unresolved.back() += " (" + std::string(info.name) + " on " + entity + ")";
         }
     }
     if (info.finish) {

@@ -138,6 +138,8 @@ struct WorldState {
     /// Writes the bodies' state and the time into `scene`, as
     /// World::writeBack did when the snapshot was taken.
     void writeBack(Scene& scene) const;
+};
+
 /// What the engine runs when a level gives no `substeps` (and no
 /// `solver_iterations`): enough substeps for the deepest pile the scene can
 /// build to rest with its deepest overlap under 1% of a body's diameter
