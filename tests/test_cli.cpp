@@ -605,13 +605,6 @@ TEST_F(Cli, AReadOnlyOutputIsRefusedAndKept) {
 
 // The trace was held in memory to the end: 1e6 steps made a 95 MB file and
 // 178 MB resident. Streamed now: 100 times the steps, about the same peak.
-#if defined(__SANITIZE_ADDRESS__)
-#define STEPWISE_UNDER_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define STEPWISE_UNDER_ASAN 1
-#endif
-#endif
 TEST_F(Cli, TheTraceIsStreamedSoMemoryStaysFlat) {
 #ifdef STEPWISE_UNDER_ASAN
     GTEST_SKIP() << "AddressSanitizer keeps freed memory in quarantine, so peak RSS says nothing about streaming; the release stage measures it";

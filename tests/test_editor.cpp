@@ -38,20 +38,8 @@ std::string textOf(const Scene& s) { return sceneToJsonText(s); }
 using stepwise::test::readFile;
 
 /// A fresh temporary folder per test, removed afterwards.
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        path = std::filesystem::temp_directory_path() /
-               ("stepwise-editor-test-" + std::to_string(::getpid()) + "-" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::remove_all(path);
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::permissions(path, std::filesystem::perms::owner_all, ec);
-        std::filesystem::remove_all(path, ec);
-    }
+struct TempDir : stepwise::test::TempDir {
+    TempDir() : stepwise::test::TempDir("stepwise-editor-test") {}
 };
 
 /// Editor with a level open, a 800x600 viewport, config in a temp folder.

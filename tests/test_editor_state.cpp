@@ -29,18 +29,8 @@ namespace {
 
 const fs::path kLevels = fs::path(STEPWISE_SOURCE_DIR) / "levels";
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() / ("stepwise-editor-state-" + std::to_string(::getpid()) + "-" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
+struct TempDir : stepwise::test::TempDir {
+    TempDir() : stepwise::test::TempDir("stepwise-editor-state") {}
 };
 
 struct Fixture {
@@ -226,13 +216,6 @@ TEST(EditorState, ScriptedStepBackAndReplaySaveTheSameBytes) {
 // thousand edits (each moves one body) of a 2,000-body level; heap in use
 // measured with mallinfo2. The old stack held two copies of the scene per
 // command (and dropped all but the last 256 commands).
-#if defined(__SANITIZE_ADDRESS__)
-#define STEPWISE_UNDER_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define STEPWISE_UNDER_ASAN 1
-#endif
-#endif
 TEST(EditorState, AThousandEditsOfA2000BodyLevelHoldWhatChangedOnly) {
 #ifdef STEPWISE_UNDER_ASAN
     GTEST_SKIP() << "AddressSanitizer replaces malloc, so mallinfo2 reports nothing; the release stage measures it";

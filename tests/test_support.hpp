@@ -14,7 +14,39 @@
 #include <string>
 #include <thread>
 
+#include <gtest/gtest.h>
+
+// Memory measurements (peak RSS, mallinfo2) mean nothing under
+// AddressSanitizer: its quarantine holds freed memory and it replaces malloc.
+#if defined(__SANITIZE_ADDRESS__)
+#define STEPWISE_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define STEPWISE_UNDER_ASAN 1
+#endif
+#endif
+
 namespace stepwise::test {
+
+/// A fresh folder per test, named after `prefix`, the process and the test;
+/// removed with everything in it (made writable first) at the end.
+struct TempDir {
+    std::filesystem::path path;
+    explicit TempDir(const std::string& prefix) {
+        path = std::filesystem::temp_directory_path() /
+               (prefix + "-" + std::to_string(::getpid()) + "-" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        std::filesystem::remove_all(path);
+        std::filesystem::create_directories(path);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::permissions(path, std::filesystem::perms::owner_all, ec);
+        std::filesystem::remove_all(path, ec);
+    }
+};
 
 /// The whole file as bytes; empty when it cannot be read (tests compare
 /// against expected contents, so a missing file fails there, visibly).
