@@ -174,16 +174,11 @@ int runScripted(const EditOptions& o, int width, int height) {
         std::vector<std::string> inputs;
         if (!o.level.empty()) inputs.push_back(o.level);
         if (!o.script.empty()) inputs.push_back(o.script);
-        if (std::string problem = checkOutputs(inputs, outputs); !problem.empty() && problem.rfind("stepwise: error: ", 0) == 0) {
+        // Every output before the first frame: writable (the saver's own
+        // check, so a read-only or missing target is refused up front),
+        // not an input, not another output.
+        if (std::string problem = checkOutputs(inputs, outputs); !problem.empty()) {
             std::cerr << problem << "\n";
-            return kExitBadInput;
-        }
-    }
-    if (!o.screenshot.empty()) {
-        const std::filesystem::path parent = std::filesystem::path(o.screenshot).parent_path();
-        std::error_code ec;
-        if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
-            reportError("--screenshot: folder " + parent.string() + " does not exist");
             return kExitBadInput;
         }
     }
