@@ -420,7 +420,7 @@ std::string readFile(const fs::path& p) {
 TEST(Resume, RunOutThenRunOnEqualsOneLongRun) {
     const fs::path dir = fs::temp_directory_path() / ("stepwise_resume_" + std::to_string(::getpid()));
     fs::create_directories(dir);
-    for (const char* name : {"default.json", "ramp_friction.json", "pyramid.json"}) {
+    for (const char* name : {"default.json", "ramp_friction.json", "pyramid.json", "bridge.json"}) {
         const std::string level = (fs::path(STEPWISE_SOURCE_DIR) / "levels" / name).string();
         auto run = [&](const std::string& in, int steps, const fs::path& out) {
             const std::string cmd = std::string(STEPWISE_BINARY) + " run " + in + " --steps " + std::to_string(steps) +
