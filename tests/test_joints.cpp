@@ -472,6 +472,76 @@ TEST(JointPhysics, ReactionForceOfAHangingBodyIsItsWeight) {
     EXPECT_NEAR(w.joints()[0].force.y, -3.0 * 9.81, 1e-3);
 }
 
+// Anchors are in the body's frame, measured from its `position` (the frame
+// of a polygon's vertices), not from its centre of mass. A triangle whose
+// position is one of its vertices, hinged to the world there, is a physical
+// pendulum about that vertex. Before the fix the engine took the anchor
+// from the centroid: the triangle hung from its centroid, did not swing,
+// and its pivot vertex sank 1.33 m.
+TEST(JointPhysics, HingeAtAPolygonVertexIsAPhysicalPendulumAboutThatVertex) {
+    // Vertices (0,0), (-1,-2), (1,-2) about position (0,0): centroid
+    // (0,-4/3), d = 4/3 m below the pivot. I about the centroid is
+    // m (a^2 + b^2 + c^2) / 36 with sides 2, sqrt5, sqrt5: 7m/18; about the
+    // pivot 7m/18 + m d^2 = 13m/6.
+    const double g = 9.81, d = 4.0 / 3.0, theta0 = 0.4;
+    const Scene scene = load("{" + world(8) + R"(, "entities": [
+        {"name": "tri", "position": {"x": 0, "y": 0}, "angle": )" + num(theta0) + R"(, "mass": 3,
+         "polygon": {"vertices": [{"x": 0, "y": 0}, {"x": -1, "y": -2}, {"x": 1, "y": -2}]}},
+        {"name": "pin", "joint": {"type": "hinge", "a": "tri", "anchor": {"x": 0, "y": 0}}}]})");
+    World w = build(scene);
+    const double T0 = 2.0 * kPi * std::sqrt((13.0 / 6.0) / (g * d));
+    const double T = T0 * (1.0 + theta0 * theta0 / 16.0 + 11.0 * std::pow(theta0, 4) / 3072.0);
+    std::vector<double> crossings;  // upward zero crossings of the angle
+    double prevAngle = theta0, prevT = 0.0, pivotDrift = 0.0;
+    for (int i = 0; i < 60 * 20 && crossings.size() < 5; ++i) {
+        ASSERT_TRUE(w.step());
+        const double angle = w.saveState().colliderAngle.at(0), t = w.time();
+        if (prevAngle < 0.0 && angle >= 0.0) crossings.push_back(prevT + (t - prevT) * (-prevAngle) / (angle - prevAngle));
+        prevAngle = angle;
+        prevT = t;
+        // The body's position is the pivot vertex: it stays on the pin.
+        pivotDrift = std::max(pivotDrift, length(w.bodyPosition(0)));
+    }
+    ASSERT_GE(crossings.size(), 3u) << "the triangle does not swing";
+    const double measured = (crossings.back() - crossings.front()) / double(crossings.size() - 1);
+    std::printf("triangle pendulum about a vertex: period %.5f s, expected %.5f s (ratio %.6f); pivot drift %.2e m\n",
+                measured, T, measured / T, pivotDrift);
+    EXPECT_NEAR(measured / T, 1.0, 2e-4);  // measured 2e-6
+    EXPECT_LT(pivotDrift, 1e-3);            // measured 9e-6 m  // 0.1% of the 1 m pendulum
+}
+
+// Two triangles, each with its position at a vertex off its centroid, the
+// second hinged by that vertex to a vertex of the first: the joined
+// vertices stay together (within 1% of a 2 m side) as the pair swings.
+TEST(JointPhysics, HingedPolygonsKeepTheirVerticesTogether) {
+    const Scene scene = load("{" + world(8) + R"(, "entities": [
+        {"name": "upper", "position": {"x": 0, "y": 0}, "angle": 1.0,
+         "polygon": {"vertices": [{"x": 0, "y": 0}, {"x": -1, "y": -2}, {"x": 1, "y": -2}]}},
+        {"name": "lower", "position": {"x": 0, "y": 0}, "angle": 0.0,
+         "polygon": {"vertices": [{"x": 0, "y": 0}, {"x": -0.5, "y": -1}, {"x": 0.5, "y": -1}]}},
+        {"name": "top", "joint": {"type": "hinge", "a": "upper", "anchor": {"x": 0, "y": 0}}},
+        {"name": "knee", "joint": {"type": "hinge", "a": "lower", "b": "upper", "local_a": {"x": 0, "y": 0},
+                                   "local_b": {"x": 1, "y": -2}}}]})");
+    // The lower triangle starts away from the upper one's vertex: move it
+    // there so the joint starts closed.
+    Scene placed = scene;
+    const Vec2 vertex = collision::rotate(collision::Rot::fromAngle(1.0), Vec2{1.0, -2.0});
+    placed.registry.tryGet<Position>(named(placed, "lower"))->value = vertex;
+    World w = build(placed);
+    double worst = 0.0;
+    for (int i = 0; i < 300; ++i) {
+        ASSERT_TRUE(w.step());
+        // World position of the upper triangle's vertex (1,-2) and of the
+        // lower one's position (its vertex (0,0)).
+        const WorldState s = w.saveState();
+        const Vec2 upperVertex = w.bodyPosition(0) + collision::rotate(collision::Rot::fromAngle(s.colliderAngle.at(0)), Vec2{1.0, -2.0});
+        worst = std::max(worst, length(w.bodyPosition(1) - upperVertex));
+        EXPECT_LT(w.joints()[1].separation, 0.02);
+    }
+    std::printf("hinged triangles: joined vertices at most %.2e m apart\n", worst);
+    EXPECT_LT(worst, 0.02);
+}
+
 } // namespace
 namespace {
 
