@@ -542,6 +542,63 @@ TEST(JointPhysics, HingedPolygonsKeepTheirVerticesTogether) {
     EXPECT_LT(worst, 0.02);
 }
 
+// levels/car.json (issue 15: "a motorised car with hinged wheels driving
+// over polygon terrain"): every piece of its terrain is a polygon, and in
+// 10 s the car drives over all of it, upright, wheels on their axles and
+// never sunk into the ground.
+TEST(JointLevels, TheCarDrivesOverItsPolygonTerrain) {
+    Result<Scene> loaded = loadSceneFile(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "car.json");
+    ASSERT_TRUE(loaded) << loaded.error();
+    const Scene& scene = *loaded;
+    int terrain = 0;
+    double terrainEnd = -std::numeric_limits<double>::infinity(), highest = 0.0;
+    for (Entity e : scene.registry.entities()) {
+        const Static* fixed = scene.registry.tryGet<Static>(e);
+        if (!fixed || !fixed->value) continue;
+        const Polygon* poly = scene.registry.tryGet<Polygon>(e);
+        ASSERT_TRUE(poly) << "terrain piece " << scene.registry.tryGet<Name>(e)->value << " is not a polygon";
+        ++terrain;
+        for (const Vec2& v : poly->vertices) {
+            const Vec2 p = scene.registry.tryGet<Position>(e)->value + v;
+            if (p.y > 1.0) terrainEnd = std::max(terrainEnd, p.x);  // right end of the last rise
+            highest = std::max(highest, p.y);
+        }
+    }
+    EXPECT_GE(terrain, 8);
+    const Entity car = named(scene, "car"), rear = named(scene, "rear wheel"), front = named(scene, "front wheel");
+    const Joint* axle = scene.registry.tryGet<Joint>(named(scene, "rear axle"));
+    ASSERT_TRUE(axle);
+    const double link = length(axle->localA);  // chassis centre to axle, m
+    World w = build(scene);
+    std::size_t carBody = 0;
+    for (std::size_t b = 0; b < w.bodyCount(); ++b)
+        if (w.bodyEntity(b) == car) carBody = b;
+    const double startX = w.bodyPosition(carBody).x;
+    double worstSeparation = 0.0, worstTilt = 0.0, deepest = 0.0, topY = -1.0;
+    for (int i = 0; i < 600; ++i) {
+        ASSERT_TRUE(w.step());
+        worstSeparation = std::max(worstSeparation, largestSeparation(w));
+        Scene now = scene;
+        w.writeBack(now);
+        worstTilt = std::max(worstTilt, std::abs(now.registry.tryGet<Angle>(car) ? now.registry.tryGet<Angle>(car)->value : 0.0));
+        topY = std::max(topY, w.bodyPosition(carBody).y);
+        for (const ContactRecord& c : w.contacts())
+            if (c.a == rear || c.a == front || c.b == rear || c.b == front) deepest = std::max(deepest, c.depth);
+    }
+    const double travelled = w.bodyPosition(carBody).x - startX;
+    std::printf("car: %d polygon pieces; drove %.2f m in 10 s (past the last rise at x = %.1f m: %s); chassis top "
+                "%.2f m; largest axle separation %.2f mm (%.2f%% of the %.3f m link); tilt at most %.2f rad; wheels "
+                "at most %.1f mm into the ground\n",
+                terrain, travelled, terrainEnd, w.bodyPosition(carBody).x > terrainEnd ? "yes" : "no", topY,
+                1e3 * worstSeparation, 100.0 * worstSeparation / link, link, worstTilt, 1e3 * deepest);
+    EXPECT_GT(travelled, 30.0);                           // measured 37.4 m
+    EXPECT_GT(w.bodyPosition(carBody).x, terrainEnd);     // over every slope and bump
+    EXPECT_GT(topY, highest);                             // it climbed the top plateau
+    EXPECT_LT(worstSeparation, 0.01 * link);              // wheels stay on their axles (measured 0.38%)
+    EXPECT_LT(worstTilt, 0.6);                            // never tips over
+    EXPECT_LT(deepest, 0.01);                             // never sinks into it (measured 4.8 mm)
+}
+
 } // namespace
 namespace {
 
