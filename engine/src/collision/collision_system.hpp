@@ -76,6 +76,10 @@ public:
     /// Whether any collider has a shape (a system may hold only joints).
     bool hasShapes() const { return !finite_.empty() || !planes_.empty(); }
     joints::JointSettings& jointSettings() { return jointSettings_; }
+    /// The joints in solver (scene) order; their accumulated impulses are
+    /// the joints' warm start, saved and restored with the contacts' cache.
+    std::span<const joints::JointConstraint> jointConstraints() const { return joints_; }
+    std::span<joints::JointConstraint> jointConstraints() { return joints_; }
     /// Joints of the last step, for the debugging views.
     std::span<const JointRecord> jointRecords() const { return jointRecords_; }
     const SolverSettings& settings() const { return settings_; }
