@@ -11,7 +11,7 @@
 #include "app/simulation.hpp"
 #include "app/view_camera.hpp"
 
-#include "render/frame.hpp"
+#include "view/frame_input.hpp"
 
 #include "stepwise/component_table.hpp"
 

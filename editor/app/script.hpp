@@ -54,6 +54,9 @@ struct ScriptCommand {
 /// Parses a whole script. `name` prefixes messages ("demo.txt:3: ...").
 Result<std::vector<ScriptCommand>> parseScript(std::string_view text, std::string_view name);
 
+/// A finite number written whole ("1.5", "-2", "1e3"); false otherwise.
+bool parseScriptNumber(const std::string& text, double& out);
+
 /// "Ctrl+Shift+Z" -> key and modifiers.
 Result<std::pair<Key, std::uint8_t>> parseChord(std::string_view chord);
 
