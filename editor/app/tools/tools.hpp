@@ -1,0 +1,45 @@
+#pragma once
+/// \file tools.hpp
+/// The viewport tools and their table: for each tool, what a left click in
+/// the viewport does with it (an Editor member in editor/app/tools/, one
+/// file per tool family). Adding a tool is adding an enum value and its
+/// table entry (tools.cpp).
+
+#include "app/events.hpp"
+
+#include "stepwise/entity.hpp"
+#include "stepwise/vec2.hpp"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+namespace stepwise::editor {
+
+enum class Tool : std::uint8_t { Select, Rotate, Circle, Box, Plane, Spring, Attractor, Boids, Joint, Polygon, Count };
+inline constexpr std::size_t kToolCount = std::size_t(Tool::Count);
+
+std::string_view toolName(Tool t);
+/// Shortcut key of each tool ("1" .. "9", then "0").
+Key toolKey(Tool t);
+
+class Editor;
+
+/// A left-button press in the viewport, as a tool receives it.
+struct ToolPress {
+    Vec2 px;     ///< viewport pixels, origin top-left
+    Vec2 world;  ///< metres, not snapped
+    Entity hit;  ///< the entity under the cursor (within the pick radius), or null
+};
+
+struct ToolInfo {
+    Tool tool;
+    /// What a left click in the viewport does with this tool.
+    void (Editor::*press)(const ToolPress& press);
+};
+
+/// One entry per tool, in Tool order.
+const std::array<ToolInfo, kToolCount>& toolTable();
+
+} // namespace stepwise::editor
