@@ -415,10 +415,8 @@ bool Editor::handleShortcut(Key key, std::uint8_t mods) {
     case Key::G: snap = !snap; note(snap ? "snap on" : "snap off"); return true;
     default: break;
     }
-    if (key >= Key::Num0 && key <= Key::Num9 &&
-        (key == Key::Num0 ? std::uint16_t(Tool::Count) > 9
-                          : std::uint16_t(key) - std::uint16_t(Key::Num1) < std::uint16_t(Tool::Count))) {
-        tool = key == Key::Num0 ? Tool(9) : Tool(std::uint16_t(key) - std::uint16_t(Key::Num1));
+    if (const std::optional<Tool> picked = toolForKey(key)) {
+        tool = *picked;
         springStart_ = {};
         polygonClicks_.clear();
         note(std::string("tool: ") + std::string(toolName(tool)));

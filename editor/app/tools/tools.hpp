@@ -1,9 +1,10 @@
 #pragma once
 /// \file tools.hpp
-/// The viewport tools and their table: for each tool, what a left click in
-/// the viewport does with it (an Editor member in editor/app/tools/, one
-/// file per tool family). Adding a tool is adding an enum value and its
-/// table entry (tools.cpp).
+/// The viewport tools and their one table: for each tool its names (the
+/// script's, the toolbar's, the help window's), its key (its place in the
+/// table: 1..9, then 0) and what a left click in the viewport does with it
+/// (an Editor member in editor/app/tools/, one file per tool family).
+/// Adding a tool is adding an enum value and its table entry (tools.cpp).
 
 #include "app/events.hpp"
 
@@ -13,6 +14,8 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <string_view>
 
 namespace stepwise::editor {
@@ -20,9 +23,18 @@ namespace stepwise::editor {
 enum class Tool : std::uint8_t { Select, Rotate, Circle, Box, Plane, Spring, Attractor, Boids, Joint, Polygon, Count };
 inline constexpr std::size_t kToolCount = std::size_t(Tool::Count);
 
+/// The toolbar's and status line's name ("Wall").
 std::string_view toolName(Tool t);
 /// Shortcut key of each tool ("1" .. "9", then "0").
 Key toolKey(Tool t);
+/// The tool a shortcut key picks, if any.
+std::optional<Tool> toolForKey(Key key);
+/// The tool the script's `tool NAME` names ("plane"), if any.
+std::optional<Tool> toolFromScriptName(std::string_view name);
+/// Every script name joined by `separator` ("select|rotate|...").
+std::string toolScriptNames(std::string_view separator);
+/// Every help name joined by ", " ("select, rotate, ..., boid brush, ...").
+std::string toolHelpNames();
 
 class Editor;
 
@@ -35,6 +47,9 @@ struct ToolPress {
 
 struct ToolInfo {
     Tool tool;
+    std::string_view scriptName;  ///< `tool NAME` in scripts: lower case, one word
+    std::string_view label;       ///< toolbar, status line and undo labels
+    std::string_view helpName;    ///< the help window's list of tools
     /// What a left click in the viewport does with this tool.
     void (Editor::*press)(const ToolPress& press);
 };

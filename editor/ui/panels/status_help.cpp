@@ -28,35 +28,38 @@ namespace {
 /// Every shortcut, once, for the help window (the menus show their own
 /// shortcut hints; keep both in step).
 struct Shortcut {
-    const char* keys;
-    const char* what;
+    std::string keys;
+    std::string what;
 };
-const Shortcut kShortcuts[] = {
-    {"Space", "Play / pause"},
-    {"Right", "Step one dt (pauses)"},
-    {"Left", "Step back through the history"},
-    {"R", "Reset to the edited level"},
-    {"Ctrl+Z", "Undo"},
-    {"Ctrl+Shift+Z, Ctrl+Y", "Redo"},
-    {"Delete, Backspace", "Delete the selection (and springs attached to it)"},
-    {"Ctrl+D", "Duplicate the selection"},
-    {"Ctrl+C / Ctrl+V", "Copy / paste"},
-    {"Ctrl+A", "Select all"},
-    {"Esc", "Clear the selection, cancel a spring or a polygon"},
-    {"Enter", "Polygon tool: make the clicked outline (or right click)"},
-    {"Ctrl+S / Ctrl+Shift+S", "Save / save as"},
-    {"Ctrl+O / Ctrl+N", "Open / new level"},
-    {"Ctrl+Q", "Quit (asks about unsaved changes)"},
-    {"1 .. 9, 0", "Tools: select, rotate, circle, box, wall, spring, attractor, boid brush, joint, polygon"},
-    {"G", "Snap to grid on / off"},
-    {"F", "Frame the whole level"},
-    {"F1", "This help"},
-    {"Left drag", "Select tool: move the selection, or box-select on empty space"},
-    {"Shift/Ctrl+click", "Add to / remove from the selection"},
-    {"Middle or right drag", "Pan"},
-    {"Wheel", "Zoom about the cursor"},
-    {"Left drag while playing", "Pull a body with a mouse spring"},
-};
+const std::vector<Shortcut>& shortcuts() {
+    static const std::vector<Shortcut> list = {
+        {"Space", "Play / pause"},
+        {"Right", "Step one dt (pauses)"},
+        {"Left", "Step back through the history"},
+        {"R", "Reset to the edited level"},
+        {"Ctrl+Z", "Undo"},
+        {"Ctrl+Shift+Z, Ctrl+Y", "Redo"},
+        {"Delete, Backspace", "Delete the selection (and springs attached to it)"},
+        {"Ctrl+D", "Duplicate the selection"},
+        {"Ctrl+C / Ctrl+V", "Copy / paste"},
+        {"Ctrl+A", "Select all"},
+        {"Esc", "Clear the selection, cancel a spring or a polygon"},
+        {"Enter", "Polygon tool: make the clicked outline (or right click)"},
+        {"Ctrl+S / Ctrl+Shift+S", "Save / save as"},
+        {"Ctrl+O / Ctrl+N", "Open / new level"},
+        {"Ctrl+Q", "Quit (asks about unsaved changes)"},
+        {"1 .. 9, 0", "Tools: " + editor::toolHelpNames()},
+        {"G", "Snap to grid on / off"},
+        {"F", "Frame the whole level"},
+        {"F1", "This help"},
+        {"Left drag", "Select tool: move the selection, or box-select on empty space"},
+        {"Shift/Ctrl+click", "Add to / remove from the selection"},
+        {"Middle or right drag", "Pan"},
+        {"Wheel", "Zoom about the cursor"},
+        {"Left drag while playing", "Pull a body with a mouse spring"},
+    };
+    return list;
+}
 
 } // namespace
 
@@ -102,12 +105,12 @@ void helpWindow(UiState& ui) {
             ImGui::TableSetupColumn("keys", ImGuiTableColumnFlags_WidthFixed, 170 * ui.scale);
             ImGui::TableSetupColumn("does");
             ImGui::TableHeadersRow();
-            for (const Shortcut& s : kShortcuts) {
+            for (const Shortcut& s : shortcuts()) {
                 ImGui::TableNextRow();
                 ImGui::TableNextColumn();
-                ImGui::TextColored(kGold, "%s", s.keys);
+                ImGui::TextColored(kGold, "%s", s.keys.c_str());
                 ImGui::TableNextColumn();
-                ImGui::TextWrapped("%s", s.what);
+                ImGui::TextWrapped("%s", s.what.c_str());
             }
             ImGui::EndTable();
         }

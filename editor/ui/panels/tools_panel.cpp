@@ -32,7 +32,7 @@ void toolsPanel(UiState& ui, Editor& ed, const PanelRects& r) {
             const Tool tool = Tool(t);
             const bool active = ed.tool == tool;
             if (active) ImGui::PushStyleColor(ImGuiCol_Button, ImGui::GetStyleColorVec4(ImGuiCol_HeaderActive));
-            const std::string label = std::to_string((t + 1) % 10) + "  " + std::string(editor::toolName(tool));
+            const std::string label = std::string(editor::keyName(editor::toolKey(tool))) + "  " + std::string(editor::toolName(tool));
             if (ImGui::Button(label.c_str(), ImVec2(bw, 0))) {
                 ed.tool = tool;
             }
