@@ -198,6 +198,9 @@ private:
     void releaseWall(Vec2 px);
     void pressSpring(const ToolPress& press);          // link_tools.cpp
     void pressJoint(const ToolPress& press);
+    /// Spring and joint tools: while no first end is chosen, takes `hit` as
+    /// it when it is a body (or says to click one) and returns true.
+    bool takeFirstEnd(Entity hit, std::string_view toolWord, std::string_view otherwise);
     void pressBoids(const ToolPress& press);           // boids_tool.cpp
     void dragBoids(Vec2 world);
     void pressPolygon(const ToolPress& press);         // polygon_tool.cpp

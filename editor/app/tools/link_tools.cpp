@@ -9,19 +9,23 @@
 
 namespace stepwise::editor {
 
+bool Editor::takeFirstEnd(Entity hit, std::string_view toolWord, std::string_view otherwise) {
+    if (!springStart_.isNull()) return false;
+    const std::string word(toolWord);
+    if (!hit.isNull() && isBody(doc.scene.registry, hit)) {
+        springStart_ = hit;
+        note(word + ": click a second body, or " + std::string(otherwise) + " (Esc cancels)");
+    } else {
+        note(word + ": click a body first");
+    }
+    return true;
+}
+
 void Editor::pressSpring(const ToolPress& press) {
     const Vec2 world = press.world;
     const Entity hit = press.hit;
     const Registry& reg = doc.scene.registry;
-    if (springStart_.isNull()) {
-        if (!hit.isNull() && isBody(reg, hit)) {
-            springStart_ = hit;
-            note("spring: click a second body, or empty space for an anchor (Esc cancels)");
-        } else {
-            note("spring: click a body first");
-        }
-        return;
-    }
+    if (takeFirstEnd(hit, "spring", "empty space for an anchor")) return;
     const Entity a = springStart_;
     springStart_ = {};
     Entity created;
@@ -41,15 +45,7 @@ void Editor::pressJoint(const ToolPress& press) {
     // First click: body a. Second click: body b, or empty space for
     // the world; the second click's point is the anchor (for
     // distance and rope, b's end: a's end is its centre).
-    if (springStart_.isNull()) {
-        if (!hit.isNull() && isBody(reg, hit)) {
-            springStart_ = hit;
-            note("joint: click a second body, or empty space to join to the world (Esc cancels)");
-        } else {
-            note("joint: click a body first");
-        }
-        return;
-    }
+    if (takeFirstEnd(hit, "joint", "empty space to join to the world")) return;
     const Entity a = springStart_;
     springStart_ = {};
     const Entity b = !hit.isNull() && hit != a && isBody(reg, hit) ? hit : Entity{};

@@ -6,22 +6,16 @@
 
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
-#include "stepwise/scene_io.hpp"
 
-#include <imgui_internal.h>
 #include <imgui_stdlib.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 
 namespace stepwise::ui {
 
 using editor::Editor;
-using editor::Key;
-using editor::SimState;
-using editor::Tool;
 
 namespace {
 

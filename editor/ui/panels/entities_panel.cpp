@@ -5,23 +5,14 @@
 #include "app/scene_edit.hpp"
 
 #include "stepwise/components.hpp"
-#include "stepwise/integrators.hpp"
-#include "stepwise/scene_io.hpp"
 
-#include <imgui_internal.h>
 #include <imgui_stdlib.h>
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <filesystem>
 
 namespace stepwise::ui {
 
 using editor::Editor;
-using editor::Key;
-using editor::SimState;
-using editor::Tool;
 
 void entitiesPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     if (!ui.showEntities) return;
