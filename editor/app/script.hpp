@@ -12,7 +12,7 @@
 ///   wheel NOTCHES [X Y]           text "hello"
 ///   wait N                        (N frames; every command takes at least one)
 ///   play | pause | step [N] | stepback [N] | reset | undo | redo
-///   tool select|rotate|circle|box|plane|spring|attractor|boids
+///   tool select|rotate|circle|box|plane|spring|attractor|boids|joint|polygon (toolScriptNames)
 ///   select NAME...  | select none   overlay NAME on|off   system NAME on|off
 ///   snap on|off     timescale X     breakon NAME|none     fit
 ///   new | open PATH | save | saveas PATH | savestate PATH | screenshot PATH

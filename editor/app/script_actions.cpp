@@ -92,17 +92,9 @@ void saveState(ScriptActionRun& r) {
 }
 
 void tool(ScriptActionRun& r) {
-    Editor& ed = r.ed;
-    const std::vector<std::string>& args = r.c.args;
-    bool found = false;
-    static const char* names[] = {"select", "rotate", "circle", "box", "plane", "spring", "attractor", "boids", "joint", "polygon"};
-    static_assert(std::size(names) == std::size_t(Tool::Count), "a name per tool");
-    for (int t = 0; t < int(Tool::Count); ++t)
-        if (args[0] == names[t]) {
-            ed.tool = Tool(t);
-            found = true;
-        }
-    if (!found) r.failLine("tool: unknown tool \"" + args[0] + "\"");
+    const std::string& name = r.c.args[0];
+    if (const std::optional<Tool> t = toolFromScriptName(name)) r.ed.tool = *t;
+    else r.failLine("tool: unknown tool \"" + name + "\" (" + toolScriptNames(", ") + ")");
 }
 
 void select(ScriptActionRun& r) {
@@ -183,7 +175,7 @@ const std::vector<ScriptAction>& scriptActions() {
         {"reset", 0, 0, "reset", nullptr, [](ScriptActionRun& r) { r.ed.resetSimulation(); }},
         {"undo", 0, 0, "undo", nullptr, [](ScriptActionRun& r) { r.ed.undo(); }},
         {"redo", 0, 0, "redo", nullptr, [](ScriptActionRun& r) { r.ed.redo(); }},
-        {"tool", 1, 1, "tool select|rotate|circle|box|plane|spring|attractor|boids", nullptr, tool},
+        {"tool", 1, 1, "tool " + toolScriptNames("|"), nullptr, tool},
         {"select", 1, 1000, "select NAME... | select none | select all", nullptr, select},
         {"overlay", 2, 2, "overlay NAME on|off", nullptr, overlay},
         {"system", 2, 2, "system NAME on|off", nullptr, system},
