@@ -158,6 +158,25 @@ TEST(Resume, WithoutTheSolverStateLoadedContactsDoNotResumeExactly) {
     EXPECT_GE(carrying, 11);
 }
 
+// The shipped levels use hinges and a weld only: the slider, distance and
+// rope rows (and a spring weld) resume exactly too, from the file and from
+// a snapshot.
+TEST(Resume, EveryJointTypeResumesExactly) {
+    const fs::path level = fs::path(STEPWISE_SOURCE_DIR) / "tests" / "data" / "joints_every_type.json";
+    const std::string once = straight(level, 2 * kSteps);
+    EXPECT_TRUE(once == resumed(level, kSteps, true)) << "100 + save + load + 100 steps differs from 200 steps";
+    EXPECT_TRUE(once != resumed(level, kSteps, false)) << "without solver_state it should not be exact";
+    const Scene scene = load(level);
+    World w = build(scene);
+    ASSERT_TRUE(advance(w, kSteps).ok());
+    const WorldState middle = w.saveState();
+    ASSERT_EQ(middle.joints.size(), 5u);
+    ASSERT_TRUE(advance(w, kSteps).ok());
+    ASSERT_TRUE(w.restoreState(middle).ok());
+    ASSERT_TRUE(advance(w, kSteps).ok());
+    EXPECT_TRUE(once == savedText(w, scene)) << "step back 100 + step 100 differs";
+}
+
 // The joints' part of the section on its own: with the contacts' warm start
 // kept and the joints' dropped, the joint levels do not resume exactly.
 TEST(Resume, JointImpulsesAreWhatTheJointLevelsNeedToResume) {

@@ -467,6 +467,7 @@ Result<void> World::step() {
             if (contacts) {
                 contacts->endStep();
                 contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
+                contacts->undoSolverState();
             }
             return Error{w.describeSolveFailure(*failed, w.stats.step + 1)};
         }
@@ -512,7 +513,10 @@ Result<void> World::step() {
             std::copy(w.backupV.begin(), w.backupV.end(), w.v[w.current].begin());
         }
         std::copy(w.angleBackup.begin(), w.angleBackup.end(), w.angle.begin());
-        if (contacts) contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
+        if (contacts) {
+            contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
+            contacts->undoSolverState();
+        }
         w.integrator->setProposedStep(w.settings.adaptiveStep);
         return Error{message};
     }
