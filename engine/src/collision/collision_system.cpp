@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 
 namespace stepwise::collision {
 
@@ -340,10 +339,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // with static bodies may be twice as stiff, but under the same cap:
     // above it a heavy box on light boxes never comes to rest (measured).
     const double hertz = std::min(settings_.contactHertz, 0.25 / h);
-    static const bool rigidExp = std::getenv("STEPWISE_RIGID") != nullptr;
-    static const double rigidBeta = std::getenv("STEPWISE_RIGID_BETA") ? std::atof(std::getenv("STEPWISE_RIGID_BETA")) : 0.0;
-    const Softness soft = rigidExp ? Softness{rigidBeta / h, 1.0, 0.0} : Softness::make(hertz, settings_.dampingRatio, h);
-    const Softness staticSoft = rigidExp ? Softness{rigidBeta / h, 1.0, 0.0} : Softness::make(std::min(2.0 * hertz, 0.25 / h), settings_.dampingRatio, h);
+    const Softness soft = Softness::make(hertz, settings_.dampingRatio, h);
+    const Softness staticSoft = Softness::make(std::min(2.0 * hertz, 0.25 / h), settings_.dampingRatio, h);
 
     // A row of n touching bodies needs up to n passes; 64 bounds the cost.
     // Joints: rigid ones are corrected at up to half the substep rate
@@ -370,20 +367,6 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // pass then only stops approaches. Otherwise each contact's push (up to
     // pushMaxVelocity) adds up along the crowd and flings its edge out at
     // tens of m/s. Ordinary scenes have no crowded cell and are unchanged.
-    static const double loadG = std::getenv("STEPWISE_LOADSTIFF") ? std::atof(std::getenv("STEPWISE_LOADSTIFF")) : 0.0;
-    static const double loadMax = std::getenv("STEPWISE_LOADMAX") ? std::atof(std::getenv("STEPWISE_LOADMAX")) : 1e9;
-    if (loadG > 0.0) {
-        for (ContactConstraint& c : constraints_) {
-            for (int i = 0; i < c.pointCount; ++i) {
-                ContactPoint& p = c.points[i];
-                const double load = std::clamp(p.normalImpulse / (p.normalMass * loadG * h + 1e-300), 1.0, loadMax);
-                const Softness ps = Softness::make((c.touchesStatic ? std::min(2.0 * hertz, 0.25 / h) : hertz) * std::sqrt(load), settings_.dampingRatio, h);
-                p.expBias = ps.biasRate;
-                p.expMassScale = ps.massScale;
-                p.expImpulseScale = ps.impulseScale;
-            }
-        }
-    }
     bool reverse = false;
     for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse) {
         if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, true);
@@ -425,27 +408,6 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
     }
 
-    static const int ngs = std::getenv("STEPWISE_NGS") ? std::atoi(std::getenv("STEPWISE_NGS")) : 0;
-    static const double ngsBeta = std::getenv("STEPWISE_NGS_BETA") ? std::atof(std::getenv("STEPWISE_NGS_BETA")) : 0.2;
-    if (ngs > 0) {
-        static const bool shock = std::getenv("STEPWISE_SHOCK") != nullptr;
-        static const bool orderOnly = std::getenv("STEPWISE_ORDER") != nullptr;
-        const Vec2 up = shock && !orderOnly ? Vec2{0.0, 1.0} : Vec2{};
-        std::vector<std::uint32_t> order(constraints_.size());
-        for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
-        if (shock) {
-            const auto height = [&](std::uint32_t k) { return details_[k].point[0].y; };
-            std::stable_sort(order.begin(), order.end(), [&](std::uint32_t l, std::uint32_t r) { return height(l) < height(r); });
-        }
-        for (int it = 0; it < ngs; ++it) solvePositions(constraints_, order, bodies_, up, ngsBeta, kLinearSlop, 0.2);
-        for (std::size_t i = 0; i < n; ++i) {
-            const std::uint32_t s = solverIndex_[i];
-            if (s == 0) continue;
-            const std::size_t body = std::size_t(colliders_[i].body);
-            x[body] = stepStart_[i] + bodies_[s].dp;
-            angles_[i] = stepStartAngle_[i] + std::atan2(bodies_[s].dq.s, bodies_[s].dq.c);
-        }
-    }
     for (std::size_t i = 0; i < n; ++i) {
         const std::uint32_t s = solverIndex_[i];
         if (s == 0) continue;

@@ -185,15 +185,9 @@ void solveContacts(std::span<ContactConstraint> contacts, std::span<SolverBody> 
             if (separation > 0.0) {
                 t.bias = separation * invH;
             } else if (useBias) {
-                if (p.expMassScale > 0.0) {
-                    t.bias = std::max(p.expBias * separation, -pushMaxVelocity);
-                    t.massScale = p.expMassScale;
-                    t.impulseScale = p.expImpulseScale;
-                } else {
                 t.bias = std::max(s.biasRate * separation, -pushMaxVelocity);
                 t.massScale = s.massScale;
                 t.impulseScale = s.impulseScale;
-                }
             }
             return t;
         };
@@ -278,34 +272,6 @@ void solveContacts(std::span<ContactConstraint> contacts, std::span<SolverBody> 
         a.w = wA;
         b.v = vB;
         b.w = wB;
-    }
-}
-
-void solvePositions(std::span<ContactConstraint> contacts, std::span<const std::uint32_t> order,
-                    std::span<SolverBody> bodies, Vec2 up, double baumgarte, double slop, double maxCorrection) {
-    for (const std::uint32_t k : order) {
-        ContactConstraint& c = contacts[k];
-        SolverBody& a = bodies[c.bodyA];
-        SolverBody& b = bodies[c.bodyB];
-        // Shock propagation: a contact that holds one body up moves only the
-        // upper body; the lower one was corrected already (bottom-up order).
-        const double upness = dot(c.normal, up);
-        const double freezeA = upness > 0.5 ? 0.0 : 1.0, freezeB = upness < -0.5 ? 0.0 : 1.0;
-        const double mA = a.invMass * freezeA, mB = b.invMass * freezeB;
-        const double iA = a.invInertia * freezeA, iB = b.invInertia * freezeB;
-        for (int i = 0; i < c.pointCount; ++i) {
-            const ContactPoint& p = c.points[i];
-            const double separation = currentSeparation(a, b, c.normal, p);
-            const double correction = std::clamp(baumgarte * (separation + slop), -maxCorrection, 0.0);
-            if (correction == 0.0) continue;
-            const double k = mA + mB + iA * p.rnA * p.rnA + iB * p.rnB * p.rnB;
-            if (k <= 0.0) continue;
-            const double impulse = -correction / k;  // kg m
-            a.dp -= (mA * impulse) * c.normal;
-            b.dp += (mB * impulse) * c.normal;
-            if (iA > 0.0) a.dq = Rot::fromAngle(std::atan2(a.dq.s, a.dq.c) - iA * p.rnA * impulse);
-            if (iB > 0.0) b.dq = Rot::fromAngle(std::atan2(b.dq.s, b.dq.c) + iB * p.rnB * impulse);
-        }
     }
 }
 

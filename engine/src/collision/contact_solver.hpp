@@ -46,7 +46,6 @@ struct ContactPoint {
     double adjustedSeparation = 0.0;  ///< separation minus (dnB - dnA), metres
     double normalMass = 0.0, tangentMass = 0.0;        ///< kg
     double normalImpulse = 0.0, tangentImpulse = 0.0;  ///< accumulated, N*s
-    double expBias = 0.0, expMassScale = 0.0, expImpulseScale = 0.0;  // EXPERIMENT: per-point softness
 };
 
 /// The 2x2 normal system of a two-point manifold, for the block solve.
@@ -116,12 +115,5 @@ void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodi
 void solveContacts(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h,
                    const Softness& soft, const Softness& staticSoft, double pushMaxVelocity, bool useBias,
                    bool reverse);
-
-/// Non-linear Gauss-Seidel position pass (Box2D 2.x's position solver): moves
-/// each overlapping pair apart by `baumgarte` times its overlap beyond
-/// `slop` (metres), at most `maxCorrection` metres a point, changing the
-/// bodies' displacement (dp, dq) only, never their velocity.
-void solvePositions(std::span<ContactConstraint> contacts, std::span<const std::uint32_t> order,
-                    std::span<SolverBody> bodies, Vec2 up, double baumgarte, double slop, double maxCorrection);
 
 } // namespace stepwise::collision
