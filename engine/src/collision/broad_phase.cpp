@@ -13,8 +13,9 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uin
     case BroadPhaseKind::SweepAndPrune:
         sweepAndPrune(boxes, movable, pairs);
         // A crowd (bodies on top of each other) makes n^2/2 pairs; the grid
-        // bounds them per body, so hand such a step to it.
-        if (pairs.size() > kDenseNeighbours * boxes.size() + 4096) {
+        // bounds them per body, so hand such a step to it (16 pairs a box:
+        // far above any ordinary scene's few).
+        if (pairs.size() > 16 * boxes.size() + 4096) {
             pairs.clear();
             uniformGrid(boxes, movable, pairs);
         }
