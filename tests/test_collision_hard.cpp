@@ -134,9 +134,10 @@ TEST(CollisionHard, CrowdAtOnePointIsBoundedAndSpreadsWithoutExploding) {
     // Pushed apart (2,000 circles of 0.5 m need a disc of radius ~11 m).
     // Crowded bodies take the push as a position correction (split
     // impulse); the rim, in ordinary cells, still gets velocity pushes that
-    // add up: measured 35 m/s at most (87 m/s before the split impulse).
+    // add up: measured 17.7 m/s with 4 partners in Z-order (35 m/s with 16
+    // partners by x, 87 m/s before the split impulse).
     EXPECT_GT(spread, 5.0);
-    EXPECT_LT(fastest, 40.0);
+    EXPECT_LT(fastest, 25.0);
     // Spread in two dimensions, not along one line.
     double spreadX = 0.0, spreadY = 0.0;
     for (std::size_t b = 0; b < w->bodyCount(); ++b) {
