@@ -4,7 +4,7 @@
 // engines, from their final positions with Stepwise's narrow phase, so
 // Box2D's polygon skin does not flatter or penalise it.
 //
-//   collision_vs_box2d [--quick] [--sweep] [--adversarial] [--crowd N] [--out DIR] [--write-levels DIR] [--scene NAME]
+//   collision_vs_box2d [--quick] [--sweep] [--adversarial] [--crowd N [--steps S]] [--out DIR] [--write-levels DIR] [--scene NAME]
 //
 // --quick runs a fifth of the simulated time, once; otherwise each engine
 // runs three times, alternating, and the fastest run counts. --scene runs
@@ -13,7 +13,7 @@
 // default set and prints one line.
 // --adversarial times issue 13's scenes (fast crowds, one huge shape, free
 // fall) as ratios against the crowd at rest; --crowd N runs N circles
-// started at one point (wrap in /usr/bin/time -v for the peak memory).
+// started at one point for S steps (default 60; wrap in /usr/bin/time -v for the peak memory).
 // --sweep runs every setting (substeps x iterations) of both engines and, with
 // --out DIR, writes the work-precision plot DIR/collisions_work_precision.png.
 
@@ -492,7 +492,7 @@ int runSweep(const std::vector<bench::NamedScene>& scenes, bool quick, const std
 /// Adversarial scenes of issue 13: ms/step of each, as ratios against the
 /// same crowd at rest in the same run. `crowd` > 0 instead runs only N
 /// circles started at one point for 60 steps (for /usr/bin/time -v).
-int runAdversarial(int crowd) {
+int runAdversarial(int crowd, int crowdSteps) {
     const auto circle = [](Scene& s, Vec2 p, Vec2 v, double r, bool isStatic) {
         const Entity e = s.registry.create();
         s.registry.emplace<Position>(e, Position{p});
@@ -520,14 +520,51 @@ int runAdversarial(int crowd) {
         return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / steps;
     };
     if (crowd > 0) {
+        // One world: the first step timed alone, then each later step, with
+        // the pair count, the fastest body and the crowd's radius, so the
+        // spread can be followed (and a non-finite value is caught).
         Scene s = world({0.0, 0.0});
         for (int i = 0; i < crowd; ++i) circle(s, {0.0, 0.0}, {}, 0.25, false);
-        const auto start = std::chrono::steady_clock::now();
-        const double first = msPerStep(s, 0, 1);
-        const double sixty = msPerStep(s, 0, 60);
-        std::printf("%d circles at one point: first step %.1f ms, 60 steps %.1f ms/step (total %.1f s)\n", crowd, first,
-                    sixty, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-        return 0;
+        Result<World> w = World::build(s);
+        if (!w) {
+            std::cerr << w.error() << "\n";
+            return 2;
+        }
+        w->setProfiling(false);
+        const collision::CollisionSystem& contacts = *w->impl().collision;
+        double firstMs = 0.0, laterMs = 0.0, worstLaterMs = 0.0, fastest = 0.0;
+        std::size_t mostPairs = 0;
+        bool finite = true;
+        for (int step = 0; step < crowdSteps; ++step) {
+            const auto start = std::chrono::steady_clock::now();
+            if (!w->step()) {
+                std::printf("step %d failed\n", step + 1);
+                return 1;
+            }
+            const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            if (step == 0) firstMs = ms;
+            else {
+                laterMs += ms;
+                worstLaterMs = std::max(worstLaterMs, ms);
+            }
+            mostPairs = std::max(mostPairs, contacts.manifoldCount());
+            double speed = 0.0, radius = 0.0;
+            for (std::size_t b = 0; b < w->bodyCount(); ++b) {
+                const Vec2 p = w->bodyPosition(b), v = w->bodyVelocity(b);
+                finite = finite && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(v.x) && std::isfinite(v.y);
+                speed = std::max(speed, length(v));
+                radius = std::max(radius, length(p));
+            }
+            fastest = std::max(fastest, speed);
+            if (step == 0 || (step + 1) % 10 == 0 || step + 1 == crowdSteps)
+                std::printf("  step %3d: %8.1f ms, %zu pairs, %zu manifolds, fastest %.2f m/s, radius %.2f m\n", step + 1,
+                            ms, contacts.candidatePairCount(), contacts.manifoldCount(), speed, radius);
+        }
+        std::printf("%d circles at one point: first step %.1f ms, steps 2-%d %.1f ms/step (worst %.1f), "
+                    "most manifolds %zu (%.1f per body), fastest %.2f m/s, %s\n",
+                    crowd, firstMs, crowdSteps, crowdSteps > 1 ? laterMs / (crowdSteps - 1) : 0.0, worstLaterMs,
+                    mostPairs, double(mostPairs) / crowd, fastest, finite ? "all finite" : "NON-FINITE values");
+        return finite ? 0 : 1;
     }
     const auto spaced = [&](double speed, double hugeRadius) {
         Scene s = world({0.0, 0.0});
@@ -558,7 +595,7 @@ int runAdversarial(int crowd) {
 
 int main(int argc, char** argv) {
     bool quick = false, sweep = false, adversarial = false;
-    int crowd = 0;
+    int crowd = 0, crowdSteps = 60;
     std::string outDir, levelsDir, only;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
@@ -566,6 +603,7 @@ int main(int argc, char** argv) {
         else if (arg == "--sweep") sweep = true;
         else if (arg == "--adversarial") adversarial = true;
         else if (arg == "--crowd" && i + 1 < argc) crowd = std::atoi(argv[++i]);
+        else if (arg == "--steps" && i + 1 < argc && std::atoi(argv[i + 1]) > 0) crowdSteps = std::atoi(argv[++i]);
         else if (arg == "--out" && i + 1 < argc) outDir = argv[++i];
         else if (arg == "--write-levels" && i + 1 < argc) levelsDir = argv[++i];
         else if (arg == "--scene" && i + 1 < argc) only = argv[++i];
@@ -573,11 +611,11 @@ int main(int argc, char** argv) {
             g_broadPhase = argv[++i];
         else {
             std::cerr << "collision_vs_box2d: error: unknown argument \"" << arg
-                      << "\"; usage: collision_vs_box2d [--quick] [--sweep] [--adversarial] [--crowd N] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain|polygons]\n";
+                      << "\"; usage: collision_vs_box2d [--quick] [--sweep] [--adversarial] [--crowd N [--steps S]] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain|polygons]\n";
             return 2;
         }
     }
-    if (adversarial || crowd > 0) return runAdversarial(crowd);
+    if (adversarial || crowd > 0) return runAdversarial(crowd, crowdSteps);
     if (only == "polygons") {
         // The polygon pile: ms per step, alternating engines, fastest of three.
         const Scene pile = polygonPileScene(400);

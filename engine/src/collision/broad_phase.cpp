@@ -13,8 +13,9 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uin
     case BroadPhaseKind::SweepAndPrune:
         sweepAndPrune(boxes, movable, pairs);
         // A crowd (bodies on top of each other) makes n^2/2 pairs; the grid
-        // bounds them per body, so hand such a step to it.
-        if (pairs.size() > kDenseNeighbours * boxes.size() + 4096) {
+        // bounds them per body, so hand such a step to it (16 pairs a box:
+        // far above any ordinary scene's few).
+        if (pairs.size() > 16 * boxes.size() + 4096) {
             pairs.clear();
             uniformGrid(boxes, movable, pairs);
         }
@@ -132,19 +133,40 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
         // A crowd (thousands of bodies started at one point) puts everything
         // in one cell: all pairs would be n^2/2 (10,000 bodies: 50 million,
         // out of memory). Past kDenseCell entries, each box pairs only with
-        // its next kDenseNeighbours in the cell's order by centre x: the
-        // pairs, and so memory and time, grow linearly, and the contacts
-        // still push the crowd apart until the cells thin out. An ordinary
-        // scene never has such a cell (a cell is two typical boxes wide).
+        // its next kDenseNeighbours in the cell's Z-order (Morton code of the
+        // box centre within the cell, ties by index): the pairs, and so
+        // memory and time, grow linearly, and each box meets boxes near it
+        // in both directions (an order by x alone pairs a spread crowd
+        // across thin vertical strips). The contacts push the crowd apart
+        // until the cells thin out. An ordinary scene never has such a cell
+        // (a cell is two typical boxes wide).
         std::size_t reach = end - begin;
         if (end - begin > kDenseCell) {
-            std::sort(cellKeys_.begin() + std::ptrdiff_t(begin), cellKeys_.begin() + std::ptrdiff_t(end),
-                      [&](std::uint64_t l, std::uint64_t r) {
-                          const Aabb& bl = boxes[std::uint32_t(l)];
-                          const Aabb& br = boxes[std::uint32_t(r)];
-                          const double xl = bl.lower.x + bl.upper.x, xr = br.lower.x + br.upper.x;
-                          return xl != xr ? xl < xr : std::uint32_t(l) < std::uint32_t(r);
-                      });
+            const double originX = lo.x + double(cx) * cell, originY = lo.y + double(cy) * cell;
+            const auto morton = [&](std::uint64_t entry) {
+                const Aabb& b = boxes[std::uint32_t(entry)];
+                // Centre within the cell, quantised to 16 bits per axis.
+                const auto quantise = [&](double centre, double origin) {
+                    const double f = std::clamp((centre - origin) / cell, 0.0, 1.0);
+                    return std::uint32_t(f * 65535.0);
+                };
+                const auto spread = [](std::uint32_t v) {  // interleave: bit i -> bit 2i
+                    std::uint64_t x = v;
+                    x = (x | (x << 8)) & 0x00FF00FFull;
+                    x = (x | (x << 4)) & 0x0F0F0F0Full;
+                    x = (x | (x << 2)) & 0x33333333ull;
+                    x = (x | (x << 1)) & 0x55555555ull;
+                    return x;
+                };
+                const std::uint64_t code = spread(quantise(0.5 * (b.lower.x + b.upper.x), originX)) |
+                                           (spread(quantise(0.5 * (b.lower.y + b.upper.y), originY)) << 1);
+                return (code << 32) | (entry & 0xFFFFFFFFull);
+            };
+            mortonKeys_.resize(end - begin);
+            for (std::size_t i = begin; i < end; ++i) mortonKeys_[i - begin] = morton(cellKeys_[i]);
+            std::sort(mortonKeys_.begin(), mortonKeys_.end());
+            for (std::size_t i = begin; i < end; ++i)
+                cellKeys_[i] = (cellKeys_[i] & ~0xFFFFFFFFull) | (mortonKeys_[i - begin] & 0xFFFFFFFFull);
             reach = kDenseNeighbours;
             for (std::size_t i = begin; i < end; ++i) crowded_[std::uint32_t(cellKeys_[i])] = 1;
         }

@@ -48,9 +48,10 @@ private:
 
     BroadPhaseKind kind_;
     /// Grid cells with more entries than this are a crowd: each box there
-    /// pairs only with its next kDenseNeighbours boxes (by centre x).
+    /// pairs only with its next kDenseNeighbours boxes (in Z-order of the
+    /// centres), so it has about twice that many pairs.
     static constexpr std::size_t kDenseCell = 64;
-    static constexpr std::size_t kDenseNeighbours = 16;
+    static constexpr std::size_t kDenseNeighbours = 4;
     struct SortedBox {
         double lowerX, upperX, lowerY, upperY;
         std::uint32_t index;
@@ -59,6 +60,7 @@ private:
     std::vector<std::uint32_t> order_;  // SAP: proxies sorted by lower.x (kept between steps: nearly sorted)
     std::vector<SortedBox> sorted_;     // SAP: the boxes in that order, packed for the sweep
     std::vector<std::uint64_t> cellKeys_;  // grid: (cell, proxy) entries
+    std::vector<std::uint64_t> mortonKeys_;  // grid, crowded cell: (Z-order code, proxy)
     std::vector<double> extents_, median_;  // grid: each box's larger side, and a copy for the median (m)
     std::vector<std::uint32_t> large_;
     std::size_t overlapTests_ = 0;
