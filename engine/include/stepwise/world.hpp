@@ -121,7 +121,7 @@ struct WorldLayout {
 /// Everything a step reads that an earlier step wrote: a World restored
 /// from a snapshot steps bit for bit as the World that took it did. The
 /// editor's step-back history is made of these. Add any new state carried
-/// between steps (sleep timers, joint impulses, ...) here and in
+/// between steps (sleep timers, ...) here and in
 /// saveState/restoreState, and its entity-keyed form to SolverState.
 struct WorldState {
     std::shared_ptr<const WorldLayout> layout;

@@ -21,8 +21,9 @@
 //                            when its kernel is fused and no contact solve
 //                            ran after it)
 //
-// Determinism: a step reads the bodies' state, the time and, with contacts,
-// the warm-start cache (the impulses the previous step ended with). Nothing
+// Determinism: a step reads the bodies' state, the time and, with contacts
+// and joints, the warm-start cache and the joints' accumulated impulses (the
+// impulses the previous step ended with). Nothing
 // else is carried: no cached accelerations (Verlet recomputes a(x0, v0)),
 // the boid grid is rebuilt per evaluation, the broad phase returns sorted
 // pairs whatever its kept sweep order, and no summation depends on addresses
