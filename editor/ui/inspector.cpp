@@ -45,7 +45,7 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
         // A range (0, max] (dt, a tolerance) is dragged on a log scale: its
         // useful values span decades.
         if (f.range.minExclusive && f.range.min == 0.0 && hi)
-            return ImGui::DragScalar(label, ImGuiDataType_Double, &v, 0.01f, lo, hi, "%.3g",
+            return ImGui::DragScalar(label, ImGuiDataType_Double, &v, 0.01f, lo, hi, "%.6g",
                                      ImGuiSliderFlags_Logarithmic);
         return ImGui::DragScalar(label, ImGuiDataType_Double, &v, speedFor(v), lo, hi, "%.6g");
     }
