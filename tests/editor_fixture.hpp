@@ -35,13 +35,19 @@ struct TempDir : stepwise::test::TempDir {
     TempDir() : stepwise::test::TempDir("stepwise-editor-test") {}
 };
 
-/// Editor with a level open, a 800x600 viewport, config in a temp folder.
-struct Fixture {
+/// Editor with levels/<level> open, its config in a temporary folder.
+struct LevelOpen {
     TempDir tmp;
     Editor ed;
-    explicit Fixture(const std::string& level) {
+    explicit LevelOpen(const std::string& level) {
         ed.configDir = tmp.path / "config";
         EXPECT_TRUE(ed.open(kLevels / level)) << ed.errorModal;
+    }
+};
+
+/// The same with a 800x600 viewport framing the level, and mouse gestures.
+struct Fixture : LevelOpen {
+    explicit Fixture(const std::string& level) : LevelOpen(level) {
         ed.setViewportSize(800, 600);
         ed.fitView();
     }
