@@ -12,7 +12,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
 #include "stepwise/world.hpp"
-#include "world/world_impl.hpp"
+#include "world/world_internals.hpp"
 #include "report/scenes.hpp"
 
 #include <benchmark/benchmark.h>
@@ -130,11 +130,11 @@ void BM_OdeintRk4(benchmark::State& state, Problem p) {
     namespace odeint = boost::numeric::odeint;
     const std::size_t n = std::size_t(state.range(0));
     World& w = sharedWorld(p, n);
-    const detail::ForceModel& model = w.impl().model;
+    const detail::ForceModel& model = internals(w).model;
     const std::size_t m = 2 * model.n;
     std::vector<double> y(2 * m);
-    std::copy(w.impl().xs(), w.impl().xs() + m, y.begin());
-    std::copy(w.impl().vs(), w.impl().vs() + m, y.begin() + long(m));
+    std::copy(internals(w).xs(), internals(w).xs() + m, y.begin());
+    std::copy(internals(w).vs(), internals(w).vs() + m, y.begin() + long(m));
     odeint::runge_kutta4<std::vector<double>> stepper;
     auto sys = [&model, m](const std::vector<double>& s, std::vector<double>& dsdt, double) {
         std::copy(s.begin() + long(m), s.end(), dsdt.begin());
@@ -267,11 +267,11 @@ void BM_Attractors(benchmark::State& state, double theta) {
         state.SkipWithError(built.error().c_str());
         return;
     }
-    detail::ForceModel& model = built->impl().model;
+    detail::ForceModel& model = internals(*built).model;
     model.treeMinAttractors = 0;
     std::vector<double> a(2 * n);
     for (auto _ : state) {
-        model.accelerations(built->impl().xs(), built->impl().vs(), a.data());
+        model.accelerations(internals(*built).xs(), internals(*built).vs(), a.data());
         benchmark::DoNotOptimize(a.data());
     }
     perParticle(state, n);
@@ -337,7 +337,7 @@ void BM_OdeintDopri5Kepler(benchmark::State& state) {
     namespace odeint = boost::numeric::odeint;
     const double tolerance = std::pow(10.0, -double(state.range(0)));
     Result<World> w = World::build(keplerScene(tolerance));
-    const detail::ForceModel& model = w->impl().model;
+    const detail::ForceModel& model = internals(*w).model;
     auto sys = [&model](const std::vector<double>& s, std::vector<double>& dsdt, double) {
         dsdt[0] = s[2];
         dsdt[1] = s[3];

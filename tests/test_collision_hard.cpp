@@ -8,7 +8,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
-#include "world/world_impl.hpp"
+#include "world/world_internals.hpp"
 
 #include <gtest/gtest.h>
 
@@ -63,7 +63,7 @@ Scene spacedCrowd(Vec2 v, int side = 100) {
     return s;
 }
 
-const collision::CollisionSystem& contactsOf(const World& w) { return *w.impl().collision; }
+const collision::CollisionSystem& contactsOf(const World& w) { return *internals(w).collision; }
 
 } // namespace
 

@@ -12,6 +12,7 @@
 
 #include "stepwise/scene_io.hpp"
 
+#include "golden_image.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -73,21 +74,13 @@ TEST_P(EditorScreenshot, MatchesGolden) {
     EXPECT_EQ(actual->width, 1280);
     EXPECT_EQ(actual->height, 800);
     const fs::path golden = kSource / "screenshots" / (std::string("editor_") + c.name + ".png");
-    if (const char* u = std::getenv("STEPWISE_UPDATE_GOLDENS"); u && std::string(u) == "1") {
+    if (stepwise::test::updatingGoldens()) {
         ASSERT_TRUE(writeFileAtomically(golden, readFile(actualPath)));
         GTEST_SKIP() << "wrote " << golden;
     }
-    Result<Image> expected = readPng(golden.string());
-    ASSERT_TRUE(expected) << expected.error();
-    const ScreenshotSettings settings;
-    const ImageDiff diff = compareImages(*expected, *actual, settings.channelTolerance);
-    ASSERT_TRUE(diff.sameSize);
-    if (diff.fraction() > settings.maxDifferingFraction) {
-        const fs::path diffPath = kOut / (std::string("editor_") + c.name + "-diff.png");
-        (void)writeFileAtomically(diffPath, encodePng(diff.visual));
-        FAIL() << diff.differing << " of " << diff.total << " pixels differ (box " << diff.x0 << "," << diff.y0 << " - "
-               << diff.x1 << "," << diff.y1 << "); actual " << actualPath << ", diff " << diffPath;
-    }
+    const ::testing::AssertionResult same =
+        stepwise::test::matchesGolden(*actual, golden, kOut, std::string("editor_") + c.name);
+    ASSERT_TRUE(same);
     fs::remove(actualPath);
 }
 

@@ -3,14 +3,7 @@
 // while paused keeps the warm start; the step-back history holds states,
 // not scenes; "Save simulation state" resumes exactly.
 
-#include "app/editor.hpp"
-
-#include "stepwise/components.hpp"
-#include "stepwise/scene_io.hpp"
-
-#include "test_support.hpp"
-
-#include <gtest/gtest.h>
+#include "editor_fixture.hpp"
 
 #include <malloc.h>
 #include <unistd.h>
@@ -27,19 +20,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kLevels = fs::path(STEPWISE_SOURCE_DIR) / "levels";
+using editor_test::kLevels;
+using editor_test::TempDir;
 
-struct TempDir : stepwise::test::TempDir {
-    TempDir() : stepwise::test::TempDir("stepwise-editor-state") {}
-};
-
-struct Fixture {
-    TempDir tmp;
-    Editor ed;
-    explicit Fixture(const std::string& level) {
-        ed.configDir = tmp.path / "config";
-        EXPECT_TRUE(ed.open(kLevels / level)) << ed.errorModal;
-    }
+/// An editor with the level open (no viewport: these tests step and save).
+struct Fixture : editor_test::LevelOpen {
+    using LevelOpen::LevelOpen;
     void step(int n) {
         for (int i = 0; i < n; ++i) ed.stepForward();
     }

@@ -5,7 +5,7 @@
 #include "physics_scenes.hpp"
 #include "report/scenes.hpp"
 
-#include "world/world_impl.hpp"
+#include "world/world_internals.hpp"
 
 #include <gtest/gtest.h>
 
@@ -119,11 +119,11 @@ TEST(Forces, BoidGridMatchesBruteForce) {
         s.registry.emplace<Boid>(e, boid);
     }
     World w = buildOrDie(s);
-    const detail::ForceModel& model = w.impl().model;
+    const detail::ForceModel& model = internals(w).model;
     const std::size_t m = 2 * model.n;
     std::vector<double> grid(m, 0.0), brute(m, 0.0);
-    model.boids.accumulate(w.impl().xs(), w.impl().vs(), grid.data());
-    model.boids.accumulateBruteForce(w.impl().xs(), w.impl().vs(), brute.data());
+    model.boids.accumulate(internals(w).xs(), internals(w).vs(), grid.data());
+    model.boids.accumulateBruteForce(internals(w).xs(), internals(w).vs(), brute.data());
     int withNeighbours = 0;
     for (std::size_t i = 0; i < m; ++i) {
         EXPECT_NEAR(grid[i], brute[i], 1e-12) << i;
@@ -201,9 +201,9 @@ TEST(Forces, AnalyticJacobiansMatchFiniteDifferences) {
     addSpring(s, "s2", "a", "b", 20.0, 0.0, 1.5);  // compressed: the tension term is negative
     addSpring(s, "s3", "b", "c", 10.0, 0.0, 0.5);
     World w = buildOrDie(s);
-    const detail::ForceModel& f = w.impl().model;
+    const detail::ForceModel& f = internals(w).model;
     const std::size_t m = 2 * f.n;
-    std::vector<double> x(w.impl().xs(), w.impl().xs() + m), v(w.impl().vs(), w.impl().vs() + m);
+    std::vector<double> x(internals(w).xs(), internals(w).xs() + m), v(internals(w).vs(), internals(w).vs() + m);
     DenseSink sink(f);
     f.jacobian(x.data(), v.data(), sink);
     auto force = [&](const std::vector<double>& xx, const std::vector<double>& vv) {
@@ -264,8 +264,8 @@ TEST(BarnesHut, TenThousandAttractorsAfterFiveStepsWithinOnePercentOfTheDistance
     const std::size_t n = 10000;
     World exact = buildOrDie(report::attractorDisc(n, 0.0));
     World tree = buildOrDie(report::attractorDisc(n, 0.5));
-    ASSERT_TRUE(tree.impl().model.usesTree());
-    ASSERT_FALSE(exact.impl().model.usesTree());
+    ASSERT_TRUE(internals(tree).model.usesTree());
+    ASSERT_FALSE(internals(exact).model.usesTree());
     const std::vector<Vec2> start = positions(exact);
     for (int i = 0; i < 5; ++i) {
         ASSERT_TRUE(exact.step().ok());
@@ -293,7 +293,7 @@ TEST(BarnesHut, BelowTheCrossoverAndAtThetaZeroTheSumIsExact) {
     const std::size_t n = detail::ForceModel::kTreeMinAttractors - 1;
     World a = buildOrDie(report::attractorDisc(n, 0.0));
     World b = buildOrDie(report::attractorDisc(n, 0.9));
-    EXPECT_FALSE(b.impl().model.usesTree());
+    EXPECT_FALSE(internals(b).model.usesTree());
     for (int i = 0; i < 3; ++i) {
         ASSERT_TRUE(a.step().ok());
         ASSERT_TRUE(b.step().ok());

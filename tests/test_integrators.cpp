@@ -5,7 +5,7 @@
 
 #include "integrators/integrator.hpp"
 #include "stepwise/integrators.hpp"
-#include "world/world_impl.hpp"
+#include "world/world_internals.hpp"
 
 #include <gtest/gtest.h>
 
@@ -342,10 +342,10 @@ TEST(FusedKernels, EveryInstructionSetMatchesTheUnfusedFormulasBitForBit) {
             for (bool gravity : {false, true})
                 for (bool drag : {false, true}) {
                     World w = buildOrDie(localForceScene(integrator, gravity, drag));
-                    const detail::ForceModel& f = w.impl().model;
+                    const detail::ForceModel& f = internals(w).model;
                     ASSERT_TRUE(f.localOnly());
-                    std::vector<double> x(w.impl().xs(), w.impl().xs() + 2 * f.n);
-                    std::vector<double> v(w.impl().vs(), w.impl().vs() + 2 * f.n);
+                    std::vector<double> x(internals(w).xs(), internals(w).xs() + 2 * f.n);
+                    std::vector<double> v(internals(w).vs(), internals(w).vs() + 2 * f.n);
                     const double h = w.settings().dt / 2.0;
                     for (int step = 0; step < 40; ++step) {
                         ASSERT_TRUE(w.step().ok());
@@ -354,9 +354,9 @@ TEST(FusedKernels, EveryInstructionSetMatchesTheUnfusedFormulasBitForBit) {
                     }
                     for (std::size_t i = 0; i < 2 * f.n; ++i) {
                         // Bit patterns, so that -0 against +0 would fail too.
-                        EXPECT_EQ(std::bit_cast<std::uint64_t>(w.impl().xs()[i]), std::bit_cast<std::uint64_t>(x[i])) << simdName(level) << " " << integrator << " g" << gravity
+                        EXPECT_EQ(std::bit_cast<std::uint64_t>(internals(w).xs()[i]), std::bit_cast<std::uint64_t>(x[i])) << simdName(level) << " " << integrator << " g" << gravity
                                                           << " drag" << drag << " x[" << i << "]";
-                        EXPECT_EQ(std::bit_cast<std::uint64_t>(w.impl().vs()[i]), std::bit_cast<std::uint64_t>(v[i])) << simdName(level) << " " << integrator << " g" << gravity
+                        EXPECT_EQ(std::bit_cast<std::uint64_t>(internals(w).vs()[i]), std::bit_cast<std::uint64_t>(v[i])) << simdName(level) << " " << integrator << " g" << gravity
                                                           << " drag" << drag << " v[" << i << "]";
                     }
                 }

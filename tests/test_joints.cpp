@@ -4,7 +4,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
-#include "world/world_impl.hpp"
+#include "world/world_internals.hpp"
 
 #include "test_support.hpp"
 
@@ -613,8 +613,8 @@ TEST(JointSweep, DISABLED_Sweep) {
             Scene scene = load(chainLevel(last > 1 ? 10 : 20, 0.5, 1.0, last, substeps));
             scene.world.solverIterations = iters;
             World w = build(scene);
-            w.impl().collision->jointSettings().hertz = hz;
-            w.impl().collision->jointSettings().dampingRatio = zeta;
+            internals(w).collision->jointSettings().hertz = hz;
+            internals(w).collision->jointSettings().dampingRatio = zeta;
             const double worst = largestSeparationOver(w, 300);
             std::printf("substeps %d iterations %d hz %g zeta %g last %g kg: largest %.4f m, end %.4f m\n", substeps,
                         iters, hz, zeta, last, worst, largestSeparation(w));

@@ -3,10 +3,14 @@
 
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
+#include "stepwise/world_fields.hpp"
 
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
 
 #include <csignal>
 #include <cstring>
@@ -232,9 +236,9 @@ TEST(SceneErrors, UnknownComponentNamesEntityAndSuggests) {
               "t.json: error: /wrld: unknown top-level key \"wrld\"; did you mean \"world\"? Known keys: version, "
               "world, view, entities, solver_state");
     EXPECT_EQ(refusal(R"({"world": {"integrator": "rk5"}, "entities": []})"),
-              "t.json: error: /world/integrator: unknown integrator \"rk5\"; did you mean \"rk4\"? Known integrators: "
-              "explicit_euler, semi_implicit_euler, midpoint, trapezoid, rk4, velocity_verlet, implicit_euler, "
-              "implicit_midpoint, dopri5");
+              "t.json: error: /world/integrator: expected one of explicit_euler, semi_implicit_euler, midpoint, "
+              "trapezoid, rk4, velocity_verlet, implicit_euler, implicit_midpoint, dopri5, got \"rk5\"; did you mean "
+              "\"rk4\"?");
 }
 
 TEST(SceneErrors, SpringToMissingEntity) {
@@ -371,4 +375,68 @@ TEST(SceneFile, SaveIntoMissingFolderFailsCleanly) {
     Result<void> r = saveSceneFile(scene, "/nonexistent-dir/level.json");
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error(), "/nonexistent-dir/level.json: error: cannot write: No such file or directory");
+}
+
+// ---- World settings table -------------------------------------------------------------
+
+TEST(WorldFields, SchemaWorldObjectIsTheTable) {
+    // The schema's world properties are the table's rows: same keys in the
+    // same order, same kind, same bounds (solver_iterations was 1..1000 in the
+    // loader and 1..200 in the editor's World panel before the table).
+    const auto schema = nlohmann::json::parse(sceneJsonSchema());
+    const auto& properties = schema["properties"]["world"]["properties"];
+    ASSERT_EQ(properties.size(), worldFieldTable().size());
+    for (const WorldFieldInfo& info : worldFieldTable()) {
+        const std::string key(info.field.key);
+        ASSERT_TRUE(properties.contains(key)) << key;
+        const auto& p = properties[key];
+        const NumberRange& r = info.field.range;
+        switch (info.field.kind) {
+        case FieldKind::Integer:
+        case FieldKind::Number:
+        case FieldKind::OptionalNumber:
+            EXPECT_EQ(p["type"], info.field.kind == FieldKind::Integer ? "integer" : "number") << key;
+            if (std::isfinite(r.min)) EXPECT_EQ(p[r.minExclusive ? "exclusiveMinimum" : "minimum"].get<double>(), r.min) << key;
+            else EXPECT_FALSE(p.contains("minimum") || p.contains("exclusiveMinimum")) << key;
+            if (std::isfinite(r.max)) EXPECT_EQ(p["maximum"].get<double>(), r.max) << key;
+            else EXPECT_FALSE(p.contains("maximum")) << key;
+            break;
+        case FieldKind::String:
+            EXPECT_EQ(p["enum"].size(), info.field.choices.size()) << key;
+            break;
+        default: break;
+        }
+    }
+    EXPECT_EQ(properties["solver_iterations"]["maximum"], 1000);
+    EXPECT_EQ(properties["substeps"]["minimum"], 1);
+    EXPECT_EQ(properties["dt"]["exclusiveMinimum"], 0);
+}
+
+TEST(WorldFields, EveryOutOfRangeSettingIsRefusedAtItsPointer) {
+    // Each numeric row's bounds, one step outside, as the loader sees them.
+    for (const WorldFieldInfo& info : worldFieldTable()) {
+        const NumberRange& r = info.field.range;
+        if (!std::isfinite(r.max)) continue;
+        const std::string key(info.field.key);
+        const std::string text = R"({"world": {")" + key + R"(": )" + formatNumber(r.max + 1) + R"(}, "entities": []})";
+        Result<Scene> scene = parseScene(text, "t.json");
+        ASSERT_FALSE(scene) << key;
+        EXPECT_EQ(scene.error(), "t.json: error: /world/" + key + ": expected " +
+                                     r.describe(info.field.kind == FieldKind::Integer) + ", got " +
+                                     formatNumber(r.max + 1));
+    }
+}
+
+TEST(WorldFields, SaveWritesGivenSettingsOnlyAndReadsThemBack) {
+    Result<Scene> scene = parseScene(R"({"world": {"substeps": 7, "solver_iterations": 600, "theta": 0.25}, "entities": []})", "t.json");
+    ASSERT_TRUE(scene) << scene.error();
+    EXPECT_EQ(scene->world.substeps, 7);
+    EXPECT_EQ(scene->world.solverIterations, 600);
+    const std::string text = sceneToJsonText(*scene);
+    EXPECT_NE(text.find("\"solver_iterations\": 600"), std::string::npos) << text;
+    EXPECT_EQ(text.find("adaptive_step"), std::string::npos) << text;  // not given, not written
+    EXPECT_EQ(text.find("restitution_threshold"), std::string::npos) << text;
+    Result<Scene> again = parseScene(text, "t.json");
+    ASSERT_TRUE(again) << again.error();
+    EXPECT_EQ(again->world, scene->world);
 }

@@ -12,6 +12,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
+#include "golden_image.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -46,42 +47,11 @@ OffscreenRenderer& headless() {
     return *renderer;
 }
 
-bool updating() {
-    const char* v = std::getenv("STEPWISE_UPDATE_GOLDENS");
-    return v && std::string(v) == "1";
-}
-
 using stepwise::test::readFile;
 
-/// Compares against the golden; on failure writes actual + diff images and
-/// returns a message with their paths, the count and the bounding box.
+/// The shared harness, failures written next to the build.
 ::testing::AssertionResult matchesGolden(const Image& actual, const fs::path& golden, const std::string& stem) {
-    const ScreenshotSettings settings;
-    Result<Image> expected = readPng(golden.string());
-    if (!expected)
-        return ::testing::AssertionFailure()
-               << expected.error() << "\n  (no golden? regenerate: cmake --build build --target update-goldens)";
-    const ImageDiff diff = compareImages(*expected, actual, settings.channelTolerance);
-    const bool ok = diff.sameSize && diff.fraction() <= settings.maxDifferingFraction;
-    if (ok) return ::testing::AssertionSuccess();
-    fs::create_directories(kFailures);
-    const fs::path actualPath = kFailures / (stem + "-actual.png");
-    const fs::path diffPath = kFailures / (stem + "-diff.png");
-    (void)writeFileAtomically(actualPath, encodePng(actual));
-    if (diff.sameSize) (void)writeFileAtomically(diffPath, encodePng(diff.visual));
-    auto failure = ::testing::AssertionFailure();
-    if (!diff.sameSize) {
-        failure << "size differs: golden " << expected->width << "x" << expected->height << ", actual "
-                << actual.width << "x" << actual.height;
-    } else {
-        failure << diff.differing << " of " << diff.total << " pixels differ by more than "
-                << settings.channelTolerance << "/255 (" << 100.0 * diff.fraction() << "%, allowed "
-                << 100.0 * settings.maxDifferingFraction << "%), within x " << diff.x0 << ".." << diff.x1
-                << ", y " << diff.y0 << ".." << diff.y1 << " (top-left origin); largest delta " << diff.maxDelta;
-    }
-    failure << "\n  golden: " << golden.string() << "\n  actual: " << actualPath.string();
-    if (diff.sameSize) failure << "\n  diff:   " << diffPath.string() << " (differing pixels in magenta)";
-    return failure;
+    return stepwise::test::matchesGolden(actual, golden, kFailures, stem);
 }
 
 std::vector<std::string> levelStems() {
@@ -99,7 +69,7 @@ TEST_P(LevelScreenshot, MatchesGolden) {
     Result<Screenshot> shot = renderLevelScreenshot(headless(), level);
     ASSERT_TRUE(shot.ok()) << shot.error();
     if (!shot->note.empty()) std::printf("%s: drawn at step 0: %s\n", stem.c_str(), shot->note.c_str());
-    if (updating()) {
+    if (stepwise::test::updatingGoldens()) {
         Result<void> written = writeFileAtomically(golden, encodePng(shot->image));
         ASSERT_TRUE(written.ok()) << written.error();
         std::printf("updated %s\n", golden.string().c_str());

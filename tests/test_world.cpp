@@ -5,7 +5,7 @@
 #include "physics_scenes.hpp"
 
 #include "stepwise/scene_io.hpp"
-#include "world/world_impl.hpp"
+#include "world/world_internals.hpp"
 
 #include <gtest/gtest.h>
 

@@ -25,7 +25,9 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
-#include "world/world_impl.hpp"
+#include "world/world_internals.hpp"
+
+#include "collision/box2d_bodies.hpp"
 
 #include <box2d/box2d.h>
 
@@ -154,8 +156,8 @@ Outcome runStepwise(const Scene& initial, int steps, std::size_t topIndex) {
     }
     World& world = built.value();
     world.setProfiling(false);
-    if (!g_broadPhase.empty() && world.impl().collision)
-        world.impl().collision->setBroadPhase(g_broadPhase == "sap" ? collision::BroadPhaseKind::SweepAndPrune
+    if (!g_broadPhase.empty() && internals(world).collision)
+        internals(world).collision->setBroadPhase(g_broadPhase == "sap" ? collision::BroadPhaseKind::SweepAndPrune
                                                                     : collision::BroadPhaseKind::UniformGrid);
     const auto start = std::chrono::steady_clock::now();
     if (const AdvanceResult r = advance(world, std::uint64_t(steps)); !r.ok()) {
@@ -192,33 +194,7 @@ Outcome runBox2d(const Scene& scene, int steps, std::size_t topIndex, int subste
     const Registry& r = scene.registry;
     for (Entity e : r.entities()) {
         if (!(r.has<Radius>(e) || r.has<Box>(e))) continue;
-        const bool isStatic = r.has<Static>(e) && r.tryGet<Static>(e)->value;
-        b2BodyDef def;
-        def.type = isStatic ? b2_staticBody : b2_dynamicBody;
-        const Vec2 p = r.tryGet<Position>(e)->value;
-        def.position.Set(float(p.x), float(p.y));
-        if (const Velocity* v = r.tryGet<Velocity>(e)) def.linearVelocity.Set(float(v->value.x), float(v->value.y));
-        if (const Angle* a = r.tryGet<Angle>(e)) def.angle = float(a->value);
-        const double mass = r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
-        // Box2D's linear damping c is drag per unit mass: dv/dt = -c v.
-        if (const Drag* d = r.tryGet<Drag>(e)) def.linearDamping = float(d->value / mass);
-        b2Body* body = world.CreateBody(&def);
-        b2FixtureDef fd;
-        fd.friction = float(r.has<Friction>(e) ? r.tryGet<Friction>(e)->value : 0.2);
-        fd.restitution = float(r.has<Restitution>(e) ? r.tryGet<Restitution>(e)->value : 0.0);
-        b2CircleShape circle;
-        b2PolygonShape polygon;
-        if (const Radius* c = r.tryGet<Radius>(e)) {
-            circle.m_radius = float(c->value);
-            fd.shape = &circle;
-            fd.density = float(mass / (M_PI * c->value * c->value));
-        } else {
-            const Box* b = r.tryGet<Box>(e);
-            polygon.SetAsBox(float(b->width / 2), float(b->height / 2));
-            fd.shape = &polygon;
-            fd.density = float(mass / (b->width * b->height));
-        }
-        body->CreateFixture(&fd);
+        b2Body* body = bench::createBox2dBody(world, r, e);
         bodies.push_back(body);
     }
     const float dt = float(scene.world.dt);
@@ -367,28 +343,7 @@ PileOutcome runPolygonPileBox2d(const Scene& scene, int steps) {
     world.SetAllowSleeping(false);
     const Registry& r = scene.registry;
     for (Entity e : r.entities()) {
-        const bool isStatic = r.has<Static>(e) && r.tryGet<Static>(e)->value;
-        b2BodyDef def;
-        def.type = isStatic ? b2_staticBody : b2_dynamicBody;
-        const Vec2 p = r.tryGet<Position>(e)->value;
-        def.position.Set(float(p.x), float(p.y));
-        if (const Angle* a = r.tryGet<Angle>(e)) def.angle = float(a->value);
-        b2Body* body = world.CreateBody(&def);
-        b2FixtureDef fd;
-        fd.friction = float(r.has<Friction>(e) ? r.tryGet<Friction>(e)->value : 0.2);
-        b2PolygonShape shape;
-        if (const Box* b = r.tryGet<Box>(e)) {
-            shape.SetAsBox(float(b->width / 2), float(b->height / 2));
-            fd.density = 1.0f;
-        } else {
-            const Polygon& poly = *r.tryGet<Polygon>(e);
-            b2Vec2 v[b2_maxPolygonVertices];
-            for (std::size_t k = 0; k < poly.vertices.size(); ++k) v[k].Set(float(poly.vertices[k].x), float(poly.vertices[k].y));
-            shape.Set(v, int(poly.vertices.size()));
-            fd.density = float(1.0 / polygonMassProperties(poly.vertices).area);  // 1 kg, as Stepwise's default
-        }
-        fd.shape = &shape;
-        body->CreateFixture(&fd);
+        bench::createBox2dBody(world, r, e);
     }
     const float dt = float(scene.world.dt);
     const auto start = std::chrono::steady_clock::now();

@@ -16,6 +16,8 @@
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
 
+#include "collision/box2d_bodies.hpp"
+
 #include <box2d/box2d.h>
 
 #include <algorithm>
@@ -38,7 +40,6 @@ struct Outcome {
     double finalSeparation = 0.0;    ///< metres, largest at the last step
 };
 
-bool isStatic(const Registry& r, Entity e) { return r.has<Static>(e) && r.tryGet<Static>(e)->value; }
 
 Outcome runStepwise(const Scene& scene, int steps) {
     Result<World> built = World::build(scene);
@@ -76,29 +77,7 @@ Outcome runBox2d(const Scene& scene, int steps) {
     for (Entity e : r.entities()) {
         const Position* p = r.tryGet<Position>(e);
         if (!p) continue;
-        b2BodyDef def;
-        def.type = isStatic(r, e) ? b2_staticBody : b2_dynamicBody;
-        def.position.Set(float(p->value.x), float(p->value.y));
-        if (const Velocity* v = r.tryGet<Velocity>(e)) def.linearVelocity.Set(float(v->value.x), float(v->value.y));
-        if (const Angle* a = r.tryGet<Angle>(e)) def.angle = float(a->value);
-        if (const AngularVelocity* w = r.tryGet<AngularVelocity>(e)) def.angularVelocity = float(w->value);
-        b2Body* body = world.CreateBody(&def);
-        const double mass = r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
-        b2FixtureDef fd;
-        fd.friction = float(r.has<Friction>(e) ? r.tryGet<Friction>(e)->value : 0.2);
-        fd.restitution = float(r.has<Restitution>(e) ? r.tryGet<Restitution>(e)->value : 0.0);
-        b2CircleShape circle;
-        b2PolygonShape polygon;
-        if (const Radius* c = r.tryGet<Radius>(e)) {
-            circle.m_radius = float(c->value);
-            fd.shape = &circle;
-            fd.density = float(mass / (M_PI * c->value * c->value));
-        } else if (const Box* b = r.tryGet<Box>(e)) {
-            polygon.SetAsBox(float(b->width / 2), float(b->height / 2));
-            fd.shape = &polygon;
-            fd.density = float(mass / (b->width * b->height));
-        }
-        if (fd.shape) body->CreateFixture(&fd);
+        b2Body* body = bench::createBox2dBody(world, r, e);
         bodyOf.emplace(e.index, body);
     }
     std::vector<b2Joint*> joints;

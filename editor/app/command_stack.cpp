@@ -52,6 +52,13 @@ std::string encodeEntity(const Registry& reg, Entity e) {
             const void* field = f.address(const_cast<void*>(component));
             switch (f.kind) {
             case FieldKind::Number: put(out, *static_cast<const double*>(field)); break;
+            case FieldKind::Integer: put(out, *static_cast<const int*>(field)); break;
+            case FieldKind::VectorList: {
+                const auto& list = *static_cast<const std::vector<Vec2>*>(field);
+                put(out, std::uint32_t(list.size()));
+                for (const Vec2 p : list) put(out, p);
+                break;
+            }
             case FieldKind::OptionalNumber: putOptional<double>(out, field); break;
             case FieldKind::Vector: put(out, *static_cast<const Vec2*>(field)); break;
             case FieldKind::OptionalVector: putOptional<Vec2>(out, field); break;
@@ -83,6 +90,13 @@ void decodeEntity(const std::string& in, Registry& reg, Entity e) {
             void* field = f.address(component);
             switch (f.kind) {
             case FieldKind::Number: *static_cast<double*>(field) = take<double>(in, at); break;
+            case FieldKind::Integer: *static_cast<int*>(field) = take<int>(in, at); break;
+            case FieldKind::VectorList: {
+                auto& list = *static_cast<std::vector<Vec2>*>(field);
+                list.resize(take<std::uint32_t>(in, at));
+                for (Vec2& p : list) p = take<Vec2>(in, at);
+                break;
+            }
             case FieldKind::OptionalNumber: takeOptional<double>(in, at, field); break;
             case FieldKind::Vector: *static_cast<Vec2*>(field) = take<Vec2>(in, at); break;
             case FieldKind::OptionalVector: takeOptional<Vec2>(in, at, field); break;

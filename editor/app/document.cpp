@@ -35,8 +35,8 @@ void Document::reset(Scene fresh) {
 
 Result<void> Document::saveAs(const Scene& what, const std::filesystem::path& file) {
     if (file.empty()) return Error{"no file name given"};
-    if (std::string problem = checkSceneRelations(what); !problem.empty())
-        return Error{"not saved: the level is not valid: " + problem};
+    if (const std::optional<Error> problem = checkSceneRelations(what))
+        return Error{"not saved: the level is not valid: " + problem->message};
     Result<void> saved = saveSceneFile(what, file);
     if (!saved) return saved;
     path = file;

@@ -98,8 +98,8 @@ bool Editor::save() {
 }
 
 bool Editor::saveStateAs(const std::filesystem::path& file) {
-    if (std::string problem = checkSceneRelations(doc.scene); !problem.empty()) {
-        errorModal = "Cannot save the state: " + problem;
+    if (const std::optional<Error> problem = checkSceneRelations(doc.scene)) {
+        errorModal = "Cannot save the state: " + problem->message;
         return false;
     }
     // The running state with the solver's warm start (`solver_state`), so

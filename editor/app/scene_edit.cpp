@@ -18,6 +18,7 @@ void copyField(const FieldInfo& field, const void* src, void* dst) {
     void* to = field.address(dst);
     switch (field.kind) {
     case FieldKind::Number: *static_cast<double*>(to) = *static_cast<const double*>(from); break;
+    case FieldKind::Integer: *static_cast<int*>(to) = *static_cast<const int*>(from); break;
     case FieldKind::OptionalNumber:
         *static_cast<std::optional<double>*>(to) = *static_cast<const std::optional<double>*>(from);
         break;
@@ -39,6 +40,7 @@ FieldValue readField(const FieldInfo& field, const void* component) {
     const void* at = field.address(const_cast<void*>(component));
     switch (field.kind) {
     case FieldKind::Number: return *static_cast<const double*>(at);
+    case FieldKind::Integer: return *static_cast<const int*>(at);
     case FieldKind::OptionalNumber: return *static_cast<const std::optional<double>*>(at);
     case FieldKind::Vector: return *static_cast<const Vec2*>(at);
     case FieldKind::OptionalVector: return *static_cast<const std::optional<Vec2>*>(at);
@@ -60,6 +62,7 @@ void writeField(const FieldInfo& field, void* component, const FieldValue& value
             // programmer error in the caller and is ignored here.
             const bool matches =
                 (std::is_same_v<V, double> && field.kind == FieldKind::Number) ||
+                (std::is_same_v<V, int> && field.kind == FieldKind::Integer) ||
                 (std::is_same_v<V, std::optional<double>> && field.kind == FieldKind::OptionalNumber) ||
                 (std::is_same_v<V, Vec2> && field.kind == FieldKind::Vector) ||
                 (std::is_same_v<V, std::optional<Vec2>> && field.kind == FieldKind::OptionalVector) ||
@@ -73,28 +76,41 @@ void writeField(const FieldInfo& field, void* component, const FieldValue& value
         value);
 }
 
-std::string checkField(const FieldInfo& field, const FieldValue& value) {
-    auto number = [&](double v) -> std::string {
-        if (!std::isfinite(v)) return std::string(field.key) + ": expected a finite number";
-        if (!field.range.contains(v)) return std::string(field.key) + ": expected " + field.range.describe();
-        return {};
-    };
-    if (const double* d = std::get_if<double>(&value)) return number(*d);
-    if (const auto* od = std::get_if<std::optional<double>>(&value)) return *od ? number(**od) : std::string();
-    if (const Vec2* v = std::get_if<Vec2>(&value))
-        return isFinite(*v) ? std::string() : std::string(field.key) + ": expected finite numbers";
-    if (const auto* ov = std::get_if<std::optional<Vec2>>(&value))
-        return !*ov || isFinite(**ov) ? std::string() : std::string(field.key) + ": expected finite numbers";
-    if (const auto* list = std::get_if<std::vector<Vec2>>(&value)) {
-        for (const Vec2& p : *list)
-            if (!isFinite(p)) return std::string(field.key) + ": expected finite numbers";
-        return {};
-    }
-    if (const Rgb* c = std::get_if<Rgb>(&value))
-        return c->r >= 0 && c->r <= 1 && c->g >= 0 && c->g <= 1 && c->b >= 0 && c->b <= 1
-                   ? std::string()
-                   : std::string(field.key) + ": colour channels must be in 0..1";
-    return {};
+bool valueFitsKind(const FieldInfo& field, const FieldValue& value) {
+    return std::visit(
+        [&](const auto& v) {
+            using V = std::decay_t<decltype(v)>;
+            switch (field.kind) {
+            case FieldKind::Number: return std::is_same_v<V, double>;
+            case FieldKind::Integer: return std::is_same_v<V, int>;
+            case FieldKind::OptionalNumber: return std::is_same_v<V, std::optional<double>>;
+            case FieldKind::Vector: return std::is_same_v<V, Vec2>;
+            case FieldKind::OptionalVector: return std::is_same_v<V, std::optional<Vec2>>;
+            case FieldKind::Color: return std::is_same_v<V, Rgb>;
+            case FieldKind::Bool: return std::is_same_v<V, bool>;
+            case FieldKind::VectorList: return std::is_same_v<V, std::vector<Vec2>>;
+            case FieldKind::String: return std::is_same_v<V, std::string>;
+            case FieldKind::EntityRef: return std::is_same_v<V, Entity>;
+            }
+            return false;
+        },
+        value);
+}
+
+std::optional<Error> checkField(const FieldInfo& field, const FieldValue& value) {
+    if (!valueFitsKind(field, value)) return Error{std::string(field.key) + ": a value of the wrong type for this field"};
+    // The loader's own check (fieldValueProblem), so a value refused in a
+    // file is refused here in the same words.
+    const std::optional<std::string> problem =
+        std::visit([&](const auto& v) { return fieldValueProblem(field, &v); }, value);
+    if (!problem) return std::nullopt;
+    return Error{std::string(field.key) + ": " + *problem};
+}
+
+std::optional<Error> setWorldField(Scene& scene, const WorldFieldInfo& info, const FieldValue& value) {
+    if (std::optional<Error> why = checkField(info.field, value)) return Error{"world." + why->message};
+    writeField(info.field, &scene.world, value);
+    return std::nullopt;
 }
 
 namespace {
@@ -137,7 +153,7 @@ std::string describeRefusal(const Scene& scene, const std::string& problem, cons
     return "\"" + who + "\"" + (where.empty() ? std::string() : " " + where) + ": " + message;
 }
 
-std::string checkEdited(Scene& scene, const std::vector<Entity>& entities, const std::string& context) {
+std::optional<Error> checkEdited(Scene& scene, const std::vector<Entity>& entities, const std::string& context) {
     Registry& reg = scene.registry;
     for (Entity e : entities) {
         if (!reg.alive(e)) continue;
@@ -145,15 +161,15 @@ std::string checkEdited(Scene& scene, const std::vector<Entity>& entities, const
             void* c = info.get(reg, e);
             if (!c) continue;
             for (const FieldInfo& f : info.fields)
-                if (std::string why = checkField(f, readField(f, c)); !why.empty())
-                    return "\"" + displayName(reg, e) + "\" " + fieldPath(info, f.key) + why.substr(f.key.size());
+                if (std::optional<Error> why = checkField(f, readField(f, c)))
+                    return Error{"\"" + displayName(reg, e) + "\" " + fieldPath(info, f.key) + why->message.substr(f.key.size())};
             if (info.finish)
-                if (std::string why = info.finish(c); !why.empty())
-                    return "\"" + displayName(reg, e) + "\" " + finishMessage(info, why);
+                if (std::optional<Error> why = info.finish(c))
+                    return Error{"\"" + displayName(reg, e) + "\" " + finishMessage(info, why->message)};
         }
     }
-    if (std::string problem = checkSceneRelations(scene); !problem.empty()) return describeRefusal(scene, problem, context);
-    return {};
+    if (std::optional<Error> problem = checkSceneRelations(scene)) return Error{describeRefusal(scene, problem->message, context)};
+    return std::nullopt;
 }
 
 std::size_t setFieldOnAll(Scene& scene, const ComponentInfo& component, const FieldInfo& field,
@@ -172,9 +188,9 @@ std::size_t setFieldOnAll(Scene& scene, const ComponentInfo& component, const Fi
     for (const auto& [e, v] : old) touched.push_back(e);
     // Springs and joints that point at a touched entity are checked too.
     for (Entity s : attachedTo(scene.registry, touched)) touched.push_back(s);
-    if (std::string why = checkEdited(scene, touched, fieldPath(component, field.key)); !why.empty()) {
+    if (std::optional<Error> why = checkEdited(scene, touched, fieldPath(component, field.key))) {
         for (const auto& [e, v] : old) writeField(field, component.get(scene.registry, e), v);
-        if (problem) *problem = why;
+        if (problem) *problem = why->message;
         return 0;
     }
     return old.size();
@@ -188,9 +204,9 @@ std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, cons
             component.emplaceDefault(scene.registry, e);
             added.push_back(e);
         }
-    if (std::string why = checkEdited(scene, added, std::string(component.name)); !why.empty()) {
+    if (std::optional<Error> why = checkEdited(scene, added, std::string(component.name))) {
         for (Entity e : added) component.remove(scene.registry, e);
-        if (problem) *problem = why;
+        if (problem) *problem = why->message;
         return 0;
     }
     return added.size();
@@ -208,8 +224,8 @@ std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component,
     for (Entity e : from) component.remove(trial.registry, e);
     std::vector<Entity> touched = from;
     for (Entity s : attachedTo(trial.registry, from)) touched.push_back(s);
-    if (std::string why = checkEdited(trial, touched, std::string(component.name)); !why.empty()) {
-        if (problem) *problem = why;
+    if (std::optional<Error> why = checkEdited(trial, touched, std::string(component.name))) {
+        if (problem) *problem = why->message;
         return 0;
     }
     std::size_t n = 0;

@@ -9,6 +9,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene.hpp"
 #include "stepwise/scene_io.hpp"
+#include "stepwise/world_fields.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -30,20 +31,29 @@ void copyEntity(const Registry& src, Entity from, Registry& dst, Entity to);
 
 /// A field's value, by kind (FieldKind -> alternative).
 using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string, Entity,
-                                std::vector<Vec2>>;
+                                std::vector<Vec2>, int>;
 FieldValue readField(const FieldInfo& field, const void* component);
 void writeField(const FieldInfo& field, void* component, const FieldValue& value);
-/// "" when `value` is acceptable for `field` (finite, in range), else why not.
-std::string checkField(const FieldInfo& field, const FieldValue& value);
+/// True when `value` holds the C++ type of `field`'s kind.
+bool valueFitsKind(const FieldInfo& field, const FieldValue& value);
+/// Nothing when `value` is acceptable for `field` (finite, in range, one of
+/// the choices), else an Error "KEY: why" in the loader's words
+/// (fieldValueProblem).
+std::optional<Error> checkField(const FieldInfo& field, const FieldValue& value);
+
+/// Sets one world setting (a row of worldFieldTable()) after the loader's
+/// check: nothing when set, else an Error "world.KEY: why" and the scene is
+/// unchanged. The World panel's edits go through here.
+std::optional<Error> setWorldField(Scene& scene, const WorldFieldInfo& info, const FieldValue& value);
 
 /// The checks the loader makes, on entities edited in memory: every field of
 /// every component (finite, in range), each component's own check
 /// (`finish`, which e.g. normalises a plane's normal) and the relations
-/// between entities (checkSceneRelations). "" when a file could hold the
-/// scene, else the refusal naming the entity and the field:
+/// between entities (checkSceneRelations). Nothing when a file could hold
+/// the scene, else the refusal naming the entity and the field:
 /// `"circle" box: an entity has at most one shape (radius, box or plane), got 2`.
 /// `context` ("box") names the field when the loader's message names none.
-std::string checkEdited(Scene& scene, const std::vector<Entity>& entities, const std::string& context);
+std::optional<Error> checkEdited(Scene& scene, const std::vector<Entity>& entities, const std::string& context);
 /// A checkSceneRelations message ("/entities/20/spring/a: ...") with the
 /// entity's name for the index: `"spring" spring.a: ...`.
 std::string describeRefusal(const Scene& scene, const std::string& problem, const std::string& context = {});

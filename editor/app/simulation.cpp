@@ -374,14 +374,14 @@ void Simulation::advance(Scene& scene, double frameSeconds) {
     if (state_ != SimState::Playing) return;
     const double dt = scene.world.dt > 0.0 ? scene.world.dt : 1.0 / 60.0;
     accumulator_ += std::max(0.0, frameSeconds) * timeScale;
-    const auto t0 = std::chrono::steady_clock::now();
+    const double t0 = clockMs();
     int taken = 0;
     // A small tolerance so a 1/60 s frame at dt = 1/60 is exactly one step
     // despite rounding in the accumulator.
     behind_ = false;
     runSteps(scene, maxStepsPerFrame + 1, [&] {
         if (!(accumulator_ >= dt * (1.0 - 1e-9) && state_ == SimState::Playing)) return false;
-        const double spentMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        const double spentMs = clockMs() - t0;
         if (taken == maxStepsPerFrame || (taken > 0 && spentMs > physicsBudgetMs)) {
             // Behind: drop the time rather than fall further behind. A slow
             // frame must not buy more steps for the next one (each step
@@ -395,7 +395,7 @@ void Simulation::advance(Scene& scene, double frameSeconds) {
         ++taken;
         return true;
     });
-    frameStepMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    frameStepMs_ = clockMs() - t0;
 }
 
 } // namespace stepwise::editor

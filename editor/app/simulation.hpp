@@ -24,6 +24,7 @@
 #include "stepwise/world.hpp"
 
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <functional>
 #include <cstdint>
@@ -88,6 +89,12 @@ public:
     /// Wall time, ms, a frame may spend on steps beyond its first: half a
     /// 60 Hz frame, so drawing keeps the other half.
     double physicsBudgetMs = 8.0;
+    /// The clock advance() holds to physicsBudgetMs: milliseconds on a
+    /// monotonic clock (steady_clock). Tests put a fake here so a step count
+    /// does not depend on how busy the machine is.
+    std::function<double()> clockMs = [] {
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    };
     /// The last frame dropped simulated time (slow motion).
     bool behind() const { return behind_; }
     /// Pause when this body starts touching something (null: off).

@@ -16,7 +16,7 @@
 #include "stepwise/scene.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
-#include "world/world_impl.hpp"
+#include "world/world_internals.hpp"
 
 #include <boost/numeric/odeint/stepper/euler.hpp>
 #include <boost/numeric/odeint/stepper/modified_midpoint.hpp>
@@ -252,13 +252,7 @@ double runOdeintFirstOrderSystem(const detail::ForceModel& model, const std::vec
     std::copy(v0.begin(), v0.end(), y.begin() + long(m));
     Stepper stepper;
     OdeSystem sys{&model, m};
-    const auto t0 = Clock::now();
-    double t = 0.0;
-    for (long i = 0; i < steps; ++i) {
-        stepper.do_step(sys, y, t, dt);
-        t += dt;
-    }
-    const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    const double seconds = timedFixedSteps(stepper, sys, y, dt, steps);
     xOut.assign(y.begin(), y.begin() + long(m));
     return seconds;
 }
@@ -272,13 +266,7 @@ double runOdeintVerlet(const detail::ForceModel& model, const std::vector<double
     auto sys = [&model](const State& x, const State& v, State& a, double) {
         model.accelerations(x.data(), v.data(), a.data());
     };
-    const auto t0 = Clock::now();
-    double t = 0.0;
-    for (long i = 0; i < steps; ++i) {
-        stepper.do_step(sys, y, t, dt);
-        t += dt;
-    }
-    const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    const double seconds = timedFixedSteps(stepper, sys, y, dt, steps);
     xOut = y.first;
     return seconds;
 }
@@ -293,13 +281,7 @@ double runOdeintSymplecticEuler(const detail::ForceModel& model, const std::vect
     auto momentum = [&model, &zero](const State& q, State& dpdt) {
         model.accelerations(q.data(), zero.data(), dpdt.data());
     };
-    const auto t0 = Clock::now();
-    double t = 0.0;
-    for (long i = 0; i < steps; ++i) {
-        stepper.do_step(std::make_pair(coor, momentum), y, t, dt);
-        t += dt;
-    }
-    const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    const double seconds = timedFixedSteps(stepper, std::make_pair(coor, momentum), y, dt, steps);
     xOut = y.first;
     return seconds;
 }
@@ -402,10 +384,10 @@ BarnesHutSummary barnesHut(bool quick, std::vector<AccuracyRow>& rows, std::ostr
     log << "bench accuracy: barnes_hut (" << out.n << " attractors)\n" << std::flush;
     const Scene exactScene = attractorDisc(out.n, 0.0);
     World exact = buildWorld(exactScene, "semi_implicit_euler", 0.01);
-    const detail::ForceModel& exactModel = exact.impl().model;
+    const detail::ForceModel& exactModel = internals(exact).model;
     const std::size_t m = 2 * out.n;
-    const double* x = exact.impl().xs();
-    const double* v = exact.impl().vs();
+    const double* x = internals(exact).xs();
+    const double* v = internals(exact).vs();
     std::vector<double> reference(m), a(m);
     auto timeEvaluation = [&](const detail::ForceModel& model, std::vector<double>& acc, int repeats) {
         double best = std::numeric_limits<double>::infinity();
@@ -626,9 +608,9 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
 
         // Peers: same model, same initial state.
         World proto = buildWorld(p.scene, "rk4", 1.0);
-        const detail::ForceModel model = proto.impl().model;
-        const std::vector<double> x0(proto.impl().xs(), proto.impl().xs() + 2 * model.n);
-        const std::vector<double> v0(proto.impl().vs(), proto.impl().vs() + 2 * model.n);
+        const detail::ForceModel model = internals(proto).model;
+        const std::vector<double> x0(internals(proto).xs(), internals(proto).xs() + 2 * model.n);
+        const std::vector<double> v0(internals(proto).vs(), internals(proto).vs() + 2 * model.n);
         using Runner = std::function<double(double, long, std::vector<double>&)>;
         std::vector<std::pair<std::string, Runner>> peers = {
             {"odeint_euler",

@@ -44,13 +44,7 @@ double runOdeintImplicitEulerDense(std::size_t m, const double* x0, const double
             for (std::size_t c = 0; c < 2 * m; ++c) out(r, c) = J[r * 2 * m + c];
     };
     odeint::implicit_euler<double> stepper;
-    const auto t0 = ThreadCpuClock::now();
-    double t = 0.0;
-    for (long i = 0; i < steps; ++i) {
-        stepper.do_step(std::make_pair(deriv, jacobi), y, t, dt);
-        t += dt;
-    }
-    const double seconds = std::chrono::duration<double>(ThreadCpuClock::now() - t0).count();
+    const double seconds = timedFixedSteps(stepper, std::make_pair(deriv, jacobi), y, dt, steps);
     for (std::size_t i = 0; i < m; ++i) xOut[i] = y[i];
     return seconds;
 }

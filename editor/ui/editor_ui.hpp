@@ -118,6 +118,10 @@ void drawEditorUi(UiState& ui, editor::Editor& ed);
 
 /// The inspector panel (inspector.cpp): driven by the component table.
 void drawInspector(UiState& ui, editor::Editor& ed);
+/// The World panel's widget for world setting `key` (inspector.cpp), driven
+/// by the world-settings table: range, unit and description from the table,
+/// the edit checked as the loader checks it (editor::setWorldField).
+bool worldFieldWidget(UiState& ui, editor::Editor& ed, std::string_view key);
 
 /// `text` with the typographic quotes and dashes the current font has no
 /// glyph for replaced by ASCII (else ImGui draws '?').

@@ -10,6 +10,7 @@
 
 #include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
+#include "stepwise/world_fields.hpp"
 
 #include <imgui_stdlib.h>
 
@@ -38,7 +39,22 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
     case FieldKind::Number: {
         double& v = std::get<double>(value);
         if (typeNow) ImGui::SetKeyboardFocusHere();
+        // A range (0, max] (dt, a tolerance) is dragged on a log scale: its
+        // useful values span decades.
+        if (f.range.minExclusive && f.range.min == 0.0 && hi)
+            return ImGui::DragScalar(label, ImGuiDataType_Double, &v, 0.01f, lo, hi, "%.6g",
+                                     ImGuiSliderFlags_Logarithmic);
         return ImGui::DragScalar(label, ImGuiDataType_Double, &v, speedFor(v), lo, hi, "%.6g");
+    }
+    case FieldKind::Integer: {
+        // Only world settings are integers today; 0 there is "not given"
+        // (the engine chooses), shown as "auto" until dragged.
+        int& v = std::get<int>(value);
+        if (typeNow) ImGui::SetKeyboardFocusHere();
+        const int intLo = lo ? int(*lo) : 0, intHi = hi ? int(*hi) : 0;
+        if (!ImGui::DragInt(label, &v, 0.1f, intLo, intHi, v == 0 ? "auto" : "%d")) return false;
+        if (lo && hi) v = std::clamp(v, intLo, intHi);
+        return true;
     }
     case FieldKind::OptionalNumber: {
         auto& v = std::get<std::optional<double>>(value);
@@ -159,7 +175,46 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
     return false;
 }
 
+/// "key [unit]", the label of a field's widget.
+std::string fieldLabel(std::string_view key, std::string_view unit) {
+    std::string label(key);
+    if (!unit.empty()) label += " [" + std::string(unit) + "]";
+    return label;
+}
+
 } // namespace
+
+bool worldFieldWidget(UiState& ui, Editor& ed, std::string_view key) {
+    const WorldFieldInfo* info = findWorldField(key);
+    if (!info) return false;
+    const FieldInfo& f = info->field;
+    FieldValue value = editor::readField(f, &ed.doc.scene.world);
+    const std::string label = fieldLabel(f.key, f.unit);
+    const bool changed = fieldWidget(f, value, label.c_str(), ed.doc.scene.registry, false);
+    if (ImGui::IsItemHovered() && !f.description.empty())
+        ImGui::SetTooltip("%.*s%s%s", int(f.description.size()), f.description.data(),
+                          f.kind == FieldKind::Number || f.kind == FieldKind::Integer ? "\nrange: " : "",
+                          f.kind == FieldKind::Number || f.kind == FieldKind::Integer
+                              ? f.range.describe(f.kind == FieldKind::Integer).c_str()
+                              : "");
+    if (changed) {
+        // One merge key per widget activation: a drag is one undo step.
+        const ImGuiID id = ImGui::GetID(label.c_str());
+        if (ImGui::IsItemActivated() || ui.activeWidget != id) {
+            ui.activeWidget = id;
+            ui.activeKey = ed.newMergeKey();
+        }
+        std::optional<Error> problem;
+        if (!ed.applyEdit("world: " + std::string(f.key), [&](Scene& s) {
+                problem = editor::setWorldField(s, *info, value);
+                return !problem;
+            }, ui.activeKey) &&
+            problem)
+            ed.status = "refused: " + problem->message;
+    }
+    if (ImGui::IsItemDeactivated()) ed.endEdit();
+    return changed;
+}
 
 void drawInspector(UiState& ui, Editor& ed) {
     if (!beginPanel("Inspector", &ui.showInspector)) {
@@ -212,8 +267,7 @@ void drawInspector(UiState& ui, Editor& ed) {
                 for (Entity e : selection)
                     if (const void* other = info.getConst(reg, e); other && e != first)
                         mixed = mixed || !(editor::readField(f, other) == value);
-                std::string label = f.key.empty() ? std::string(info.name) : std::string(f.key);
-                if (!f.unit.empty()) label += " [" + std::string(f.unit) + "]";
+                std::string label = fieldLabel(f.key.empty() ? info.name : f.key, f.unit);
                 if (mixed) label += " (mixed)";
                 ImGui::PushID(f.key.empty() ? "value" : f.key.data());
                 const ImGuiID id = ImGui::GetID(label.c_str());

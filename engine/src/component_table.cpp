@@ -5,7 +5,10 @@
 
 #include "stepwise/components.hpp"
 
+#include "field_builder.hpp"
+
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -21,50 +24,16 @@ constexpr NumberRange kPositive{0.0, kInf, true};
 constexpr NumberRange kNonNegative{0.0, kInf, false};
 constexpr NumberRange kUnit{0.0, 1.0, false};
 
-template <class>
-struct MemberTraits;
-template <class C, class M>
-struct MemberTraits<M C::*> {
-    using Class = C;
-    using Type = M;
-};
-
 template <auto Member>
-void* addressOf(void* component) {
-    using C = typename MemberTraits<decltype(Member)>::Class;
-    return &(static_cast<C*>(component)->*Member);
-}
-
-/// Field kind follows from the member's C++ type, so the table cannot say
-/// "Number" for a Vec2.
-template <class M>
-constexpr FieldKind kindOf() {
-    if constexpr (std::is_same_v<M, double>) return FieldKind::Number;
-    else if constexpr (std::is_same_v<M, std::optional<double>>) return FieldKind::OptionalNumber;
-    else if constexpr (std::is_same_v<M, Vec2>) return FieldKind::Vector;
-    else if constexpr (std::is_same_v<M, std::optional<Vec2>>) return FieldKind::OptionalVector;
-    else if constexpr (std::is_same_v<M, Rgb>) return FieldKind::Color;
-    else if constexpr (std::is_same_v<M, bool>) return FieldKind::Bool;
-    else if constexpr (std::is_same_v<M, Entity>) return FieldKind::EntityRef;
-    else if constexpr (std::is_same_v<M, std::vector<Vec2>>) return FieldKind::VectorList;
-    else {
-        static_assert(std::is_same_v<M, std::string>, "unsupported field type");
-        return FieldKind::String;
-    }
-}
-
-template <auto Member>
-FieldInfo field(std::string_view key, NumberRange range, std::string_view unit,
-                std::string_view description) {
-    using M = typename MemberTraits<decltype(Member)>::Type;
-    return FieldInfo{key, kindOf<M>(), range, unit, description, &addressOf<Member>};
+FieldInfo field(std::string_view key, NumberRange range, std::string_view unit, std::string_view description) {
+    return detail::makeField<Member>(key, range, unit, description);
 }
 
 /// Fills the type-erased registry operations for component struct T.
 template <class T>
 ComponentInfo row(std::string_view name, std::string_view description, bool inlineValue,
                   std::vector<std::string_view> requires_, std::vector<FieldInfo> fields,
-                  std::string (*finish)(void*) = nullptr) {
+                  std::optional<Error> (*finish)(void*) = nullptr) {
     ComponentInfo info;
     info.name = name;
     info.description = description;
@@ -87,12 +56,12 @@ std::string describeNumber(double v) {
     return s.str();
 }
 
-std::string finishPlane(void* component) {
+std::optional<Error> finishPlane(void* component) {
     auto& plane = *static_cast<Plane*>(component);
     // hypot, not sqrt(x*x + y*y): a normal of 1e200 would overflow to inf
     // and normalise to (0, 0).
     const double len = std::hypot(plane.normal.x, plane.normal.y);
-    if (!(len > 1e-12)) return "normal: expected a non-zero vector, got {\"x\": 0, \"y\": 0}";
+    if (!(len > 1e-12)) return Error{"normal: expected a non-zero vector, got {\"x\": 0, \"y\": 0}"};
     // A normal that is already unit length up to rounding is kept bit for
     // bit. Dividing it by its own rounded length would move its last bits on
     // every load, so load -> save -> load -> save would not give the same
@@ -102,8 +71,8 @@ std::string finishPlane(void* component) {
     // same half-plane after normalising n by scaling d with it.
     const double offset = plane.offset / len;
     if (!std::isfinite(offset))
-        return "offset: expected an offset that stays finite once the normal is normalised (offset / |normal|), "
-               "got " + describeNumber(plane.offset) + " with |normal| = " + describeNumber(len);
+        return Error{"offset: expected an offset that stays finite once the normal is normalised (offset / |normal|), "
+               "got " + describeNumber(plane.offset) + " with |normal| = " + describeNumber(len)};
     plane.normal = plane.normal / len;
     plane.offset = offset;
     return {};
@@ -113,27 +82,27 @@ std::string finishPlane(void* component) {
 /// the kinetic energy m*v^2/2 overflow a double; the first step diverges.
 constexpr double kMaxSpeed = 1e150;
 
-std::string finishVelocity(void* component) {
+std::optional<Error> finishVelocity(void* component) {
     const Vec2 v = static_cast<Velocity*>(component)->value;
     if (std::abs(v.x) > kMaxSpeed || std::abs(v.y) > kMaxSpeed)
-        return ": expected a speed up to 1e150 m/s in each axis (beyond it the kinetic energy m*v^2/2 overflows), "
-               "got {\"x\": " + describeNumber(v.x) + ", \"y\": " + describeNumber(v.y) + "}";
+        return Error{": expected a speed up to 1e150 m/s in each axis (beyond it the kinetic energy m*v^2/2 overflows), "
+               "got {\"x\": " + describeNumber(v.x) + ", \"y\": " + describeNumber(v.y) + "}"};
     return {};
 }
 
-std::string finishPolygon(void* component) {
+std::optional<Error> finishPolygon(void* component) {
     const std::string problem = polygonProblem(static_cast<Polygon*>(component)->vertices);
     if (problem.empty()) return {};
     // polygonProblem says "INDEX: why" or ": why"; the field is "vertices".
-    return problem[0] == ':' ? "vertices" + problem : "vertices/" + problem;
+    return Error{problem[0] == ':' ? "vertices" + problem : "vertices/" + problem};
 }
 
-std::string finishSpring(void* component) {
+std::optional<Error> finishSpring(void* component) {
     auto& spring = *static_cast<Spring*>(component);
-    if (spring.a.isNull()) return "a: expected the name of an entity, got nothing";
+    if (spring.a.isNull()) return Error{"a: expected the name of an entity, got nothing"};
     if (spring.b.isNull() == !spring.anchor.has_value()) {
-        return spring.b.isNull() ? ": expected either \"b\" (an entity name) or \"anchor\" (a point), got neither"
-                                 : ": expected either \"b\" or \"anchor\", got both";
+        return Error{spring.b.isNull() ? ": expected either \"b\" (an entity name) or \"anchor\" (a point), got neither"
+                                 : ": expected either \"b\" or \"anchor\", got both"};
     }
     // a == b is checked with the names at hand: checkSceneRelations.
     return {};
@@ -141,26 +110,26 @@ std::string finishSpring(void* component) {
 
 constexpr std::string_view kJointTypes[] = {"hinge", "slider", "weld", "distance", "rope"};
 
-std::string finishJoint(void* component) {
+std::optional<Error> finishJoint(void* component) {
     auto& joint = *static_cast<Joint*>(component);
     if (joint.type.empty())
-        return "type: expected one of hinge, slider, weld, distance, rope, got nothing";
+        return Error{"type: expected one of hinge, slider, weld, distance, rope, got nothing"};
     if (std::find(std::begin(kJointTypes), std::end(kJointTypes), joint.type) == std::end(kJointTypes)) {
         std::string message = "type: expected one of hinge, slider, weld, distance, rope, got \"" + joint.type + "\"";
         if (auto guess = closestName(joint.type, kJointTypes)) message += "; did you mean \"" + std::string(*guess) + "\"?";
-        return message;
+        return Error{message};
     }
-    if (joint.a.isNull()) return "a: expected the name of a body, got nothing";
+    if (joint.a.isNull()) return Error{"a: expected the name of a body, got nothing"};
     if (joint.lower && joint.upper && *joint.lower > *joint.upper)
-        return "lower: expected at most upper (" + describeNumber(*joint.upper) + "), got " + describeNumber(*joint.lower);
+        return Error{"lower: expected at most upper (" + describeNumber(*joint.upper) + "), got " + describeNumber(*joint.lower)};
     return {};
 }
 
-std::string finishBoid(void* component) {
+std::optional<Error> finishBoid(void* component) {
     auto& boid = *static_cast<Boid*>(component);
     if (boid.separationRadius > boid.neighborRadius)
-        return "separation_radius: expected at most neighbor_radius (" +
-               std::to_string(boid.neighborRadius) + "), got " + std::to_string(boid.separationRadius);
+        return Error{"separation_radius: expected at most neighbor_radius (" +
+               std::to_string(boid.neighborRadius) + "), got " + std::to_string(boid.separationRadius)};
     return {};
 }
 
@@ -282,20 +251,78 @@ std::size_t editDistance(std::string_view a, std::string_view b) {
 
 std::span<const std::string_view> jointTypeNames() { return kJointTypes; }
 
-std::string NumberRange::describe() const {
+std::string NumberRange::describe(bool integer) const {
     std::ostringstream out;
     auto num = [](double v) {
         std::ostringstream s;
         s << v;
         return s.str();
     };
+    const char* what = integer ? "an integer" : "a number";
     const bool hasMin = std::isfinite(min), hasMax = std::isfinite(max);
-    if (hasMin && hasMax && !minExclusive) out << "a number in [" << num(min) << ", " << num(max) << "]";
-    else if (hasMin && hasMax) out << "a number in (" << num(min) << ", " << num(max) << "]";
-    else if (hasMin) out << "a number " << (minExclusive ? "> " : ">= ") << num(min);
-    else if (hasMax) out << "a number <= " << num(max);
-    else out << "a finite number";
+    if (hasMin && hasMax && !minExclusive) out << what << " in [" << num(min) << ", " << num(max) << "]";
+    else if (hasMin && hasMax) out << what << " in (" << num(min) << ", " << num(max) << "]";
+    else if (hasMin) out << what << (minExclusive ? " > " : " >= ") << num(min);
+    else if (hasMax) out << what << " <= " << num(max);
+    else out << (integer ? "an integer" : "a finite number");
     return out.str();
+}
+
+std::string formatNumber(double value) {
+    char buffer[32];
+    const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+    return error == std::errc() ? std::string(buffer, end) : std::string("?");
+}
+
+std::optional<std::string> fieldValueProblem(const FieldInfo& field, const void* member) {
+    auto number = [&](double v, bool integer) -> std::optional<std::string> {
+        if (!std::isfinite(v)) return "expected a finite number, got " + formatNumber(v);
+        if (!field.range.contains(v) || (integer && v != std::floor(v)))
+            return "expected " + field.range.describe(integer) + ", got " + formatNumber(v);
+        return std::nullopt;
+    };
+    auto vector = [](Vec2 v) -> std::optional<std::string> {
+        if (isFinite(v)) return std::nullopt;
+        return "expected finite numbers, got {\"x\": " + formatNumber(v.x) + ", \"y\": " + formatNumber(v.y) + "}";
+    };
+    switch (field.kind) {
+    case FieldKind::Number: return number(*static_cast<const double*>(member), false);
+    case FieldKind::Integer: return number(*static_cast<const int*>(member), true);
+    case FieldKind::OptionalNumber: {
+        const auto& v = *static_cast<const std::optional<double>*>(member);
+        return v ? number(*v, false) : std::nullopt;
+    }
+    case FieldKind::Vector: return vector(*static_cast<const Vec2*>(member));
+    case FieldKind::OptionalVector: {
+        const auto& v = *static_cast<const std::optional<Vec2>*>(member);
+        return v ? vector(*v) : std::nullopt;
+    }
+    case FieldKind::VectorList:
+        for (const Vec2 p : *static_cast<const std::vector<Vec2>*>(member))
+            if (auto problem = vector(p)) return problem;
+        return std::nullopt;
+    case FieldKind::Color: {
+        const Rgb c = *static_cast<const Rgb*>(member);
+        for (const double channel : {c.r, c.g, c.b})
+            if (auto problem = number(channel, false)) return "colour channels: " + *problem;
+        return std::nullopt;
+    }
+    case FieldKind::String: {
+        const auto& value = *static_cast<const std::string*>(member);
+        if (field.choices.empty() ||
+            std::find(field.choices.begin(), field.choices.end(), value) != field.choices.end())
+            return std::nullopt;
+        std::string message = "expected one of ";
+        for (std::size_t i = 0; i < field.choices.size(); ++i)
+            message += (i ? ", " : "") + std::string(field.choices[i]);
+        message += ", got \"" + value + "\"";
+        if (auto guess = closestName(value, field.choices)) message += "; did you mean \"" + std::string(*guess) + "\"?";
+        return message;
+    }
+    case FieldKind::Bool:
+    case FieldKind::EntityRef: return std::nullopt;
+    }
+    return std::nullopt;
 }
 
 std::span<const ComponentInfo> componentTable() {

@@ -199,7 +199,9 @@ namespace {
 /// into one folder, and a scan per file would make that quadratic.
 void removeStaleTemporaries(const fs::path& path) {
     const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
-    const std::string prefix = "." + path.filename().string() + ".tmp-";
+    // Appended, not "." + name + ...: GCC 12 warns falsely (-Wrestrict) on that once inlined.
+    std::string prefix = ".";
+    prefix.append(path.filename().string()).append(".tmp-");
     const auto now = fs::file_time_type::clock::now();
     std::error_code ec;
     for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
@@ -216,8 +218,11 @@ void removeStaleTemporaries(const fs::path& path) {
 } // namespace
 
 Result<void> saveSceneFile(const Scene& scene, const fs::path& path) {
-    if (std::string problem = checkSceneRelations(scene); !problem.empty())
-        return Error{path.string() + ": error: not saved, the scene is invalid: " + problem};
+    if (const std::optional<Error> problem = checkSceneRelations(scene)) {
+        std::string message = path.string();
+        message.append(": error: not saved, the scene is invalid: ").append(problem->message);
+        return Error{std::move(message)};
+    }
     Result<void> written = writeFileAtomically(path, sceneToJsonText(scene));
     if (written) removeStaleTemporaries(path);
     return written;

@@ -6,7 +6,7 @@
 
 #include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
-#include "stepwise/integrators.hpp"
+#include "stepwise/world_fields.hpp"
 
 #include "json_reader.hpp"
 
@@ -78,8 +78,13 @@ std::string joinNames(std::span<const std::string_view> names) {
     throw Refusal{std::move(pointer), std::move(message)};
 }
 
-double readNumber(const Json& v, const std::string& pointer, const NumberRange& range) {
-    if (!v.is_number()) refuse(pointer, "expected " + range.describe() + ", got " + describeFound(v));
+/// A JSON number in `range`. `expected` (default: `range`) is what a value
+/// of the wrong type is told to be: a field's own range, when the range
+/// itself is checked later by fieldValueProblem.
+double readNumber(const Json& v, const std::string& pointer, const NumberRange& range,
+                  const std::optional<NumberRange>& expected = std::nullopt, bool integer = false) {
+    if (!v.is_number())
+        refuse(pointer, "expected " + expected.value_or(range).describe(integer) + ", got " + describeFound(v));
     const double d = v.get<double>();
     if (!std::isfinite(d)) refuse(pointer, "expected a finite number, got " + describeFound(v));
     if (!range.contains(d)) refuse(pointer, "expected " + range.describe() + ", got " + describeFound(v));
@@ -145,10 +150,21 @@ struct EntityNames {
 void readField(const FieldInfo& field, const Json& v, void* component, const std::string& pointer,
                const EntityNames& names) {
     void* member = field.address(component);
+    // The JSON type is checked here; the value (range, choices) by
+    // fieldValueProblem below, the check the editor makes too.
     switch (field.kind) {
-    case FieldKind::Number: *static_cast<double*>(member) = readNumber(v, pointer, field.range); break;
+    case FieldKind::Number: *static_cast<double*>(member) = readNumber(v, pointer, NumberRange{}, field.range); break;
+    case FieldKind::Integer: {
+        const double d = readNumber(v, pointer, NumberRange{}, field.range, true);
+        // Whole and within int: range-checked below like any value; else
+        // refused here in the same words.
+        if (d != std::floor(d) || std::abs(d) > double(std::numeric_limits<int>::max()))
+            refuse(pointer, "expected " + field.range.describe(true) + ", got " + formatNumber(d));
+        *static_cast<int*>(member) = int(d);
+        break;
+    }
     case FieldKind::OptionalNumber:
-        *static_cast<std::optional<double>*>(member) = readNumber(v, pointer, field.range);
+        *static_cast<std::optional<double>*>(member) = readNumber(v, pointer, NumberRange{}, field.range);
         break;
     case FieldKind::Vector: *static_cast<Vec2*>(member) = readVector(v, pointer); break;
     case FieldKind::OptionalVector:
@@ -182,6 +198,7 @@ void readField(const FieldInfo& field, const Json& v, void* component, const std
         break;
     }
     }
+    if (auto problem = fieldValueProblem(field, member)) refuse(pointer, *problem);
 }
 
 Json vectorJson(Vec2 v) {
@@ -197,6 +214,7 @@ Json fieldJson(const FieldInfo& field, const void* component, const Registry& re
     const void* member = field.address(const_cast<void*>(component));
     switch (field.kind) {
     case FieldKind::Number: return *static_cast<const double*>(member);
+    case FieldKind::Integer: return *static_cast<const int*>(member);
     case FieldKind::OptionalNumber: {
         const auto& o = *static_cast<const std::optional<double>*>(member);
         return o ? Json(*o) : Json(Json::value_t::discarded);
@@ -271,8 +289,8 @@ void readComponent(const ComponentInfo& info, const Json& value, Registry& regis
         }
     }
     if (info.finish) {
-        const std::string problem = info.finish(component);
-        if (!problem.empty()) {
+        if (const std::optional<Error> refused = info.finish(component)) {
+            const std::string& problem = refused->message;
             const auto colon = problem.find(':');
             // WHERE may go deeper than one field ("vertices/3").
             std::string at = pointer;
@@ -310,38 +328,21 @@ void readEntity(const Json& entityJson, std::size_t index, Registry& registry, E
     }
 }
 
+/// The `world` object, field by field from the world-settings table.
 void readWorld(const Json& v, WorldSettings& world) {
     const std::string pointer = "/world";
     if (!v.is_object()) refuse(pointer, "expected an object, got " + describeFound(v));
-    static constexpr std::array<std::string_view, 11> kKeys{
-        "gravity", "G", "integrator", "dt", "substeps", "time", "solver_iterations", "restitution_threshold",
-        "tolerance", "theta", "adaptive_step"};
+    static const EntityNames kNoNames;  // world settings name no entity
     for (const auto& [key, value] : v.items()) {
         const std::string at = child(pointer, key);
-        if (key == "gravity") world.gravity = readVector(value, at);
-        else if (key == "G") world.G = readNumber(value, at, NumberRange{});
-        else if (key == "dt") world.dt = readNumber(value, at, NumberRange{0.0, 10.0, true});
-        else if (key == "substeps") world.substeps = int(readInteger(value, at, 1, 1000));
-        else if (key == "time") world.time = readNumber(value, at, NumberRange{});
-        else if (key == "solver_iterations") world.solverIterations = int(readInteger(value, at, 1, 1000));
-        else if (key == "restitution_threshold") world.restitutionThreshold = readNumber(value, at, NumberRange{0.0, 1e6});
-        else if (key == "tolerance") world.tolerance = readNumber(value, at, NumberRange{0.0, 1.0, true});
-        else if (key == "theta") world.theta = readNumber(value, at, NumberRange{0.0, 1.0});
-        else if (key == "adaptive_step") world.adaptiveStep = readNumber(value, at, NumberRange{0.0, 10.0});
-        else if (key == "integrator") {
-            std::string name = readString(value, at);
-            if (!isIntegratorName(name)) {
-                std::string message = "unknown integrator \"" + name + "\"";
-                if (auto guess = closestName(name, integratorNames()))
-                    message += "; did you mean \"" + std::string(*guess) + "\"?";
-                refuse(at, message + " Known integrators: " + joinNames(integratorNames()));
-            }
-            world.integrator = std::move(name);
-        } else {
+        const WorldFieldInfo* info = findWorldField(key);
+        if (!info) {
+            const std::vector<std::string_view> known = worldFieldNames();
             std::string message = "unknown world setting \"" + key + "\"";
-            if (auto guess = closestName(key, kKeys)) message += "; did you mean \"" + std::string(*guess) + "\"?";
-            refuse(at, message + " Known settings: " + joinNames(kKeys));
+            if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
+            refuse(at, message + " Known settings: " + joinNames(known));
         }
+        readField(info->field, value, &world, at, kNoNames);
     }
 }
 
@@ -614,7 +615,11 @@ std::string checkJoint(const Registry& registry, std::size_t index, const Joint&
 
 } // namespace
 
-std::string checkSceneRelations(const Scene& scene) {
+namespace {
+
+/// checkSceneRelations' walk: "" when fine (internal; the public function
+/// returns the message as an Error).
+std::string relationsProblem(const Scene& scene) {
     const Registry& registry = scene.registry;
     const auto& entities = registry.entities();
     std::map<std::string, std::size_t> indexByName;
@@ -676,6 +681,14 @@ std::string checkSceneRelations(const Scene& scene) {
                    "\" to itself";
     }
     return {};
+}
+
+} // namespace
+
+std::optional<Error> checkSceneRelations(const Scene& scene) {
+    std::string problem = relationsProblem(scene);
+    if (problem.empty()) return std::nullopt;
+    return Error{std::move(problem)};
 }
 
 namespace {
@@ -740,7 +753,8 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
             scene.solverState = readSolverState(*it, scene.registry);
         // Free the DOM before the relation checks: peak memory is one copy.
         root = Json();
-        if (std::string problem = checkSceneRelations(scene); !problem.empty()) {
+        if (const std::optional<Error> refused = checkSceneRelations(scene)) {
+            const std::string& problem = refused->message;
             const auto split = problem.find(": ");
             refuse(problem.substr(0, split), problem.substr(split + 2));
         }
@@ -901,19 +915,11 @@ std::string sceneToJsonText(const Scene& scene) {
     Json root = Json::object();
     root["version"] = scene.version;
     Json world = Json::object();
-    world["gravity"] = vectorJson(scene.world.gravity);
-    world["G"] = scene.world.G;
-    world["integrator"] = scene.world.integrator;
-    world["dt"] = scene.world.dt;
     // Settings the file did not give stay absent (0 / no value), so a level
     // that leaves them to the engine keeps doing so after a save.
-    if (scene.world.substeps > 0) world["substeps"] = scene.world.substeps;
-    world["time"] = scene.world.time;
-    if (scene.world.solverIterations > 0) world["solver_iterations"] = scene.world.solverIterations;
-    if (scene.world.restitutionThreshold) world["restitution_threshold"] = *scene.world.restitutionThreshold;
-    world["tolerance"] = scene.world.tolerance;
-    world["theta"] = scene.world.theta;
-    if (scene.world.adaptiveStep > 0.0) world["adaptive_step"] = scene.world.adaptiveStep;
+    for (const WorldFieldInfo& info : worldFieldTable())
+        if (!info.isUnset(scene.world))
+            world[std::string(info.field.key)] = fieldJson(info.field, &scene.world, scene.registry);
     root["world"] = std::move(world);
     if (scene.view) {
         Json view = Json::object();

@@ -2,8 +2,8 @@
 // schema can never disagree with the loader about names, kinds or ranges.
 
 #include "stepwise/component_table.hpp"
-#include "stepwise/integrators.hpp"
 #include "stepwise/scene_io.hpp"
+#include "stepwise/world_fields.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -31,6 +31,11 @@ Json fieldSchema(const FieldInfo& f) {
     switch (f.kind) {
     case FieldKind::Number:
     case FieldKind::OptionalNumber: return numberSchema(f.range, f.description);
+    case FieldKind::Integer:
+        j = Json{{"type", "integer"}};
+        if (std::isfinite(f.range.min)) j[f.range.minExclusive ? "exclusiveMinimum" : "minimum"] = long(f.range.min);
+        if (std::isfinite(f.range.max)) j["maximum"] = long(f.range.max);
+        break;
     case FieldKind::Vector:
     case FieldKind::OptionalVector: j = ref("vector"); break;
     case FieldKind::Color: j = ref("color"); break;
@@ -98,39 +103,24 @@ std::string sceneJsonSchema() {
                           {"properties", components},
                           {"additionalProperties", false}};
 
-    Json integrators = Json::array();
-    for (std::string_view n : integratorNames()) integrators.push_back(n);
-    Json world = Json{{"type", "object"},
-                      {"additionalProperties", false},
-                      {"properties",
-                       Json{{"gravity", ref("vector")},
-                            {"G", Json{{"type", "number"}, {"description", "gravitational constant for attractors"}}},
-                            {"integrator", Json{{"enum", integrators}}},
-                            {"dt", Json{{"type", "number"}, {"exclusiveMinimum", 0}, {"maximum", 10}}},
-                            {"substeps", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}},
-                            {"time", Json{{"type", "number"}}},
-                            {"solver_iterations", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}},
-                            {"tolerance",
-                             Json{{"type", "number"},
-                                  {"exclusiveMinimum", 0},
-                                  {"maximum", 1},
-                                  {"description", "local error per internal step of dopri5 (relative to 1 + |value|)"}}},
-                            {"theta",
-                             Json{{"type", "number"},
-                                  {"minimum", 0},
-                                  {"maximum", 1},
-                                  {"description", "Barnes-Hut opening angle for attractors; 0 = exact pairwise sums"}}},
-                            {"adaptive_step",
-                             Json{{"type", "number"},
-                                  {"minimum", 0},
-                                  {"maximum", 10},
-                                  {"description", "dopri5's proposed next internal step (s), saved for exact resume"}}},
-                            {"restitution_threshold",
-                             Json{{"type", "number"},
-                                  {"minimum", 0},
-                                  {"maximum", 1e6},
-                                  {"description", "m/s: slower impacts do not bounce; absent: derived from gravity and "
-                                                  "the substep (zero gravity: every approach bounces)"}}}}}};
+    // The world object from the world-settings table: the loader reads the
+    // same rows, so the two cannot disagree about keys or ranges.
+    Json worldProperties = Json::object();
+    const WorldSettings defaults;
+    for (const WorldFieldInfo& info : worldFieldTable()) {
+        Json property = fieldSchema(info.field);
+        if (!info.field.unit.empty())
+            property["description"] = std::string(info.field.description) + " [" + std::string(info.field.unit) + "]";
+        // Defaults of the scalar settings a file may leave out (the optional
+        // ones have none: the engine chooses).
+        const void* member = info.field.address(const_cast<WorldSettings*>(&defaults));
+        if (!info.optional) {
+            if (info.field.kind == FieldKind::Number) property["default"] = *static_cast<const double*>(member);
+            if (info.field.kind == FieldKind::String) property["default"] = *static_cast<const std::string*>(member);
+        }
+        worldProperties[std::string(info.field.key)] = std::move(property);
+    }
+    Json world = Json{{"type", "object"}, {"additionalProperties", false}, {"properties", worldProperties}};
     Json view = Json{{"type", "object"},
                      {"description", "camera: centre in metres, zoom in pixels per metre at 720 px image height"},
                      {"additionalProperties", false},

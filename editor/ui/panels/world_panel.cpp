@@ -18,47 +18,11 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
     if (!ui.showWorld) return;
     placePanel(ui, "World", r.worldPos, r.worldSize);
     if (beginPanel("World", &ui.showWorld)) {
-        WorldSettings ws = ed.doc.scene.world;
-        auto edited = [&](const char* label) {
-            // One merge key per widget activation: a drag is one undo step.
-            const ImGuiID id = ImGui::GetID(label);
-            if (ImGui::IsItemActivated() || ui.activeWidget != id) {
-                ui.activeWidget = id;
-                ui.activeKey = ed.newMergeKey();
-            }
-            ed.applyEdit(std::string("world: ") + label, [&](Scene& s) {
-                s.world = ws;
-                return true;
-            }, ui.activeKey);
-        };
-        auto done = [&] {
-            if (ImGui::IsItemDeactivated()) ed.endEdit();
-        };
+        const WorldSettings& ws = ed.doc.scene.world;
+        // Each setting's widget, range and check come from the world-settings
+        // table (worldFieldWidget); this panel only lays them out.
         ImGui::PushItemWidth(-110 * ui.scale);
-        double g[2] = {ws.gravity.x, ws.gravity.y};
-        if (ImGui::DragScalarN("gravity [m/s2]", ImGuiDataType_Double, g, 2, 0.05f, nullptr, nullptr, "%.4g")) {
-            ws.gravity = {g[0], g[1]};
-            if (isFinite(ws.gravity)) edited("gravity");
-        }
-        done();
-        if (ImGui::DragScalar("G [N m2/kg2]", ImGuiDataType_Double, &ws.G, 0.01f, nullptr, nullptr, "%.6g") &&
-            std::isfinite(ws.G))
-            edited("G");
-        done();
-        if (ImGui::BeginCombo("integrator", ws.integrator.c_str())) {
-            for (std::string_view name : integratorNames()) {
-                const std::string n(name);
-                if (ImGui::Selectable(n.c_str(), n == ws.integrator)) {
-                    ws.integrator = n;
-                    ui.activeWidget = 0;
-                    ed.applyEdit("integrator " + n, [&](Scene& s) {
-                        s.world.integrator = n;
-                        return true;
-                    });
-                }
-            }
-            ImGui::EndCombo();
-        }
+        for (const char* key : {"gravity", "G", "integrator"}) worldFieldWidget(ui, ed, key);
         const World* world = panelWorld(ui, ed);
         if (world) {
             const std::vector<StiffnessHint> hints = world->stiffnessHints();
@@ -76,30 +40,11 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
             ImGui::TextColored(kGold, "not simulable: %s", ui.previewError.c_str());
             ImGui::PopTextWrapPos();
         }
-        const double dtMin = 1e-6, dtMax = 1.0;
-        if (ImGui::DragScalar("dt [s]", ImGuiDataType_Double, &ws.dt, 0.0001f, &dtMin, &dtMax, "%.6g")) edited("dt");
-        done();
-        // 0: the level gives none and the engine chooses (shown as "auto");
-        // dragging gives it a value, which the level then keeps.
-        if (ImGui::DragInt("substeps", &ws.substeps, 0.1f, 1, 1000, ws.substeps == 0 ? "auto" : "%d")) {
-            ws.substeps = std::clamp(ws.substeps, 1, 1000);
-            edited("substeps");
-        }
-        done();
-        if (ImGui::DragInt("solver iterations", &ws.solverIterations, 0.1f, 1, 200,
-                           ws.solverIterations == 0 ? "auto" : "%d")) {
-            ws.solverIterations = std::clamp(ws.solverIterations, 1, 200);
-            edited("solver iterations");
-        }
-        done();
+        for (const char* key : {"dt", "substeps", "solver_iterations"}) worldFieldWidget(ui, ed, key);
         // Error control (dopri5) and Barnes–Hut (attractors): shown when the
         // scene uses them.
         if (ws.integrator == "dopri5") {
-            const double tolMin = 1e-14, tolMax = 1e-1;
-            if (ImGui::DragScalar("tolerance", ImGuiDataType_Double, &ws.tolerance, 0.01f, &tolMin, &tolMax, "%.1e",
-                                  ImGuiSliderFlags_Logarithmic))
-                edited("tolerance");
-            done();
+            worldFieldWidget(ui, ed, "tolerance");
             if (world) {
                 const StepStats& st = world->lastStats();
                 ImGui::TextColored(kDim, "internal steps %d, rejected %d (last frame)", st.internalSteps,
@@ -114,14 +59,7 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
         if (world)
             for (std::string_view system : world->activeSystems()) attractors = attractors || system == "attractors";
         if (attractors) {
-            const double thetaMin = 0.0, thetaMax = 1.0;
-            if (ImGui::DragScalar("theta (Barnes-Hut)", ImGuiDataType_Double, &ws.theta, 0.005f, &thetaMin, &thetaMax,
-                                  "%.3g"))
-                edited("theta");
-            done();
-            if (ImGui::IsItemHovered())
-                ImGui::SetTooltip("opening angle: 0 sums every pair exactly; larger is faster and less exact. "
-                                  "Small scenes are summed exactly whatever theta says (it is faster there)");
+            worldFieldWidget(ui, ed, "theta");
         }
         if (world) {
             // A pile the level's substeps cannot hold: said before playing.

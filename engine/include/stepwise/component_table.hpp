@@ -8,6 +8,7 @@
 
 #include "stepwise/entity.hpp"
 #include "stepwise/registry.hpp"
+#include "stepwise/result.hpp"
 
 #include <limits>
 #include <optional>
@@ -21,6 +22,9 @@ namespace stepwise {
 /// What a field holds; decides how it is read, written, checked and edited.
 enum class FieldKind {
     Number,          ///< double
+    /// int, a JSON integer; `range` bounds it (world settings such as
+    /// substeps: components have none today)
+    Integer,
     OptionalNumber,  ///< std::optional<double>; absent in JSON = nullopt
     Vector,          ///< Vec2, JSON {"x","y"}
     OptionalVector,  ///< std::optional<Vec2>
@@ -46,8 +50,9 @@ struct NumberRange {
     bool contains(double v) const {
         return (minExclusive ? v > min : v >= min) && v <= max;
     }
-    /// "a number > 0", "a number in [0, 1]", "a number >= 0", "a number".
-    std::string describe() const;
+    /// "a number > 0", "a number in [0, 1]", "a number >= 0", "a finite
+    /// number"; with `integer`, "an integer in [1, 1000]" and so on.
+    std::string describe(bool integer = false) const;
 };
 
 struct FieldInfo {
@@ -61,6 +66,20 @@ struct FieldInfo {
     /// schema lists them as an enum and the inspector offers them in a combo.
     std::span<const std::string_view> choices = {};
 };
+
+/// The one check of a field's value, made by the loader (once it has read a
+/// value of the right JSON type) and by the editor (checkField, the World
+/// panel), so both refuse the same value with the same words. `member`
+/// points at a value of the field's C++ type (FieldKind). Nothing when the
+/// value is acceptable, else what was expected and found, without the
+/// field's name (callers say where): "expected an integer in [1, 1000], got
+/// 5000", "expected one of hinge, slider, ..., got \"hing\"; did you mean
+/// \"hinge\"?". Cross-field rules are the component's `finish`.
+std::optional<std::string> fieldValueProblem(const FieldInfo& field, const void* member);
+
+/// A number as messages show it: the shortest text that reads back to the
+/// same double ("0.1", "5000", "1e-07").
+std::string formatNumber(double value);
 
 /// One row of the table.
 struct ComponentInfo {
@@ -80,8 +99,8 @@ struct ComponentInfo {
     void* (*emplaceDefault)(Registry&, Entity) = nullptr;
     bool (*remove)(Registry&, Entity) = nullptr;
     /// Cross-field check and normalisation after the fields are read.
-    /// Returns "" when fine, else "FIELD: message" (FIELD may be empty).
-    std::string (*finish)(void* component) = nullptr;
+    /// Nothing when fine, else an Error "FIELD: message" (FIELD may be empty).
+    std::optional<Error> (*finish)(void* component) = nullptr;
     /// The loader's message for a `finish` refusal also names the entity
     /// ("entity 3 (\"wedge\"): ..."): for shapes, whose problems are about
     /// the body as a whole.

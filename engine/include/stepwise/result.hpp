@@ -5,6 +5,7 @@
 /// and what (the Jolt `Result::SetError` pattern).
 
 #include <cassert>
+#include <optional>
 #include <string>
 #include <utility>
 #include <variant>
@@ -13,6 +14,8 @@ namespace stepwise {
 
 struct Error {
     std::string message;
+
+    friend bool operator==(const Error&, const Error&) = default;
 };
 
 template <class T>

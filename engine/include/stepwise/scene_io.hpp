@@ -101,9 +101,9 @@ Result<void> saveSceneFile(const Scene& scene, const std::filesystem::path& path
 
 /// Checks the relations between entities that no single component can check:
 /// unique names, spring ends that exist and are bodies, one shape per body.
-/// Returns "" or "/json/pointer: message". parseScene runs it; the editor
-/// runs it before saving.
-std::string checkSceneRelations(const Scene& scene);
+/// Nothing when they hold, else an Error "/json/pointer: message".
+/// parseScene runs it; the editor runs it before saving.
+std::optional<Error> checkSceneRelations(const Scene& scene);
 
 struct Joint;
 /// Fills what a joint takes from the bodies' poses as they are now (the

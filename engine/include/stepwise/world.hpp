@@ -266,10 +266,13 @@ public:
     /// all; the benchmarks use this to time the integrators alone. (Addition.)
     void setProfiling(bool on);
 
+private:
+    // Tests, benchmarks and the accuracy report reach the internals through
+    // engine/src/world/world_internals.hpp, not through this class's API.
+    friend struct WorldInternalAccess;
     WorldImpl& impl() { return *impl_; }
     const WorldImpl& impl() const { return *impl_; }
 
-private:
     explicit World(std::unique_ptr<WorldImpl> impl);
     std::unique_ptr<WorldImpl> impl_;
 };

@@ -404,27 +404,6 @@ std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind, const ForceModel
     return nullptr;
 }
 
-std::optional<IntegratorKind> integratorKind(std::string_view name) {
-    for (int k = 0; k <= int(IntegratorKind::Dopri5); ++k)
-        if (integratorName(IntegratorKind(k)) == name) return IntegratorKind(k);
-    return std::nullopt;
-}
-
-std::string_view integratorName(IntegratorKind kind) {
-    switch (kind) {
-        case IntegratorKind::ExplicitEuler: return "explicit_euler";
-        case IntegratorKind::SemiImplicitEuler: return "semi_implicit_euler";
-        case IntegratorKind::Midpoint: return "midpoint";
-        case IntegratorKind::Trapezoid: return "trapezoid";
-        case IntegratorKind::Rk4: return "rk4";
-        case IntegratorKind::VelocityVerlet: return "velocity_verlet";
-        case IntegratorKind::ImplicitEuler: return "implicit_euler";
-        case IntegratorKind::ImplicitMidpoint: return "implicit_midpoint";
-        case IntegratorKind::Dopri5: return "dopri5";
-    }
-    return "?";
-}
-
 SimdLevel simdLevel() { return simdLevelInUse().load(std::memory_order_relaxed); }
 
 SimdLevel setSimdLevel(SimdLevel level) {

@@ -1,0 +1,57 @@
+#pragma once
+// One Box2D 2.4.1 body from one Stepwise body, for the comparisons
+// (collision_vs_box2d, joints_vs_box2d): the same pose, velocity, spin,
+// material, drag, shape and mass, so both engines start from the same state.
+
+#include "stepwise/components.hpp"
+#include "stepwise/registry.hpp"
+
+#include <box2d/box2d.h>
+
+#include <cmath>
+
+namespace stepwise::bench {
+
+inline bool isStaticBody(const Registry& r, Entity e) { return r.has<Static>(e) && r.tryGet<Static>(e)->value; }
+
+/// Creates `e`'s body in `world` (static when Static, else dynamic), with a
+/// fixture for its radius, box or polygon (none when it has no shape). Mass
+/// as Stepwise's: `mass`, else 1 kg, spread over the shape's area; friction
+/// and restitution as the components say, else Stepwise's defaults 0.2 and
+/// 0. Drag b (force -b v) becomes Box2D's linear damping b/m (dv/dt = -c v).
+inline b2Body* createBox2dBody(b2World& world, const Registry& r, Entity e) {
+    b2BodyDef def;
+    def.type = isStaticBody(r, e) ? b2_staticBody : b2_dynamicBody;
+    if (const Position* p = r.tryGet<Position>(e)) def.position.Set(float(p->value.x), float(p->value.y));
+    if (const Velocity* v = r.tryGet<Velocity>(e)) def.linearVelocity.Set(float(v->value.x), float(v->value.y));
+    if (const Angle* a = r.tryGet<Angle>(e)) def.angle = float(a->value);
+    if (const AngularVelocity* w = r.tryGet<AngularVelocity>(e)) def.angularVelocity = float(w->value);
+    const double mass = r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
+    if (const Drag* d = r.tryGet<Drag>(e)) def.linearDamping = float(d->value / mass);
+    b2Body* body = world.CreateBody(&def);
+    b2FixtureDef fd;
+    fd.friction = float(r.has<Friction>(e) ? r.tryGet<Friction>(e)->value : 0.2);
+    fd.restitution = float(r.has<Restitution>(e) ? r.tryGet<Restitution>(e)->value : 0.0);
+    b2CircleShape circle;
+    b2PolygonShape polygon;
+    if (const Radius* c = r.tryGet<Radius>(e)) {
+        circle.m_radius = float(c->value);
+        fd.shape = &circle;
+        fd.density = float(mass / (M_PI * c->value * c->value));
+    } else if (const Box* b = r.tryGet<Box>(e)) {
+        polygon.SetAsBox(float(b->width / 2), float(b->height / 2));
+        fd.shape = &polygon;
+        fd.density = float(mass / (b->width * b->height));
+    } else if (const Polygon* poly = r.tryGet<Polygon>(e)) {
+        b2Vec2 v[b2_maxPolygonVertices];
+        for (std::size_t k = 0; k < poly->vertices.size(); ++k)
+            v[k].Set(float(poly->vertices[k].x), float(poly->vertices[k].y));
+        polygon.Set(v, int(poly->vertices.size()));
+        fd.shape = &polygon;
+        fd.density = float(mass / polygonMassProperties(poly->vertices).area);
+    }
+    if (fd.shape) body->CreateFixture(&fd);
+    return body;
+}
+
+} // namespace stepwise::bench

@@ -1,0 +1,81 @@
+// The world-settings table. See world_fields.hpp.
+
+#include "stepwise/world_fields.hpp"
+
+#include "stepwise/integrators.hpp"
+
+#include "field_builder.hpp"
+
+
+namespace stepwise {
+
+namespace {
+
+
+std::vector<WorldFieldInfo> buildTable() {
+    using detail::makeField;
+    FieldInfo integrator = makeField<&WorldSettings::integrator>(
+        "integrator", {}, "", "time integrator (docs/physics.md compares them)");
+    integrator.choices = integratorNames();
+    // Ranges: dt up to 10 s and counts up to 1000 are far past any useful
+    // level; they only keep a typo (dt 1e9, 1e9 substeps) from freezing a run.
+    return {
+        {makeField<&WorldSettings::gravity>("gravity", {}, "m/s^2", "applied to every dynamic body")},
+        {makeField<&WorldSettings::G>("G", {}, "N*m^2/kg^2", "gravitational constant for attractors")},
+        {integrator},
+        {makeField<&WorldSettings::dt>("dt", {0.0, 10.0, true}, "s", "seconds per step")},
+        {makeField<&WorldSettings::substeps>("substeps", {1.0, 1000.0}, "",
+                                             "each step is substeps steps of dt/substeps; absent: chosen from "
+                                             "the scene (the deepest pile it can hold)"),
+         true},
+        {makeField<&WorldSettings::time>("time", {}, "s", "simulated seconds so far")},
+        {makeField<&WorldSettings::solverIterations>("solver_iterations", {1.0, 1000.0}, "",
+                                                     "contact solver velocity iterations per substep; absent: 8, "
+                                                     "or chosen with substeps when that is absent too"),
+         true},
+        {makeField<&WorldSettings::restitutionThreshold>(
+            "restitution_threshold", {0.0, 1e6}, "m/s",
+            "slower impacts do not bounce; absent: derived from gravity and the substep (zero gravity: every "
+            "approach bounces)")},
+        {makeField<&WorldSettings::tolerance>("tolerance", {0.0, 1.0, true}, "",
+                                              "local error per internal step of dopri5 (relative to 1 + |value|)")},
+        {makeField<&WorldSettings::theta>("theta", {0.0, 1.0}, "",
+                                          "Barnes-Hut opening angle for attractors; 0 = exact pairwise sums, larger is faster "
+                                          "and less exact (small scenes are summed exactly whatever theta says)")},
+        {makeField<&WorldSettings::adaptiveStep>("adaptive_step", {0.0, 10.0}, "s",
+                                                 "dopri5's proposed next internal step, saved for exact resume; "
+                                                 "absent: none yet"),
+         true},
+    };
+}
+
+} // namespace
+
+bool WorldFieldInfo::isUnset(const WorldSettings& settings) const {
+    const void* member = field.address(const_cast<WorldSettings*>(&settings));
+    switch (field.kind) {
+    case FieldKind::OptionalNumber: return !static_cast<const std::optional<double>*>(member)->has_value();
+    case FieldKind::Integer: return optional && *static_cast<const int*>(member) == 0;
+    case FieldKind::Number: return optional && *static_cast<const double*>(member) == 0.0;
+    default: return false;
+    }
+}
+
+std::span<const WorldFieldInfo> worldFieldTable() {
+    static const std::vector<WorldFieldInfo> table = buildTable();
+    return table;
+}
+
+const WorldFieldInfo* findWorldField(std::string_view key) {
+    for (const WorldFieldInfo& info : worldFieldTable())
+        if (info.field.key == key) return &info;
+    return nullptr;
+}
+
+std::vector<std::string_view> worldFieldNames() {
+    std::vector<std::string_view> names;
+    for (const WorldFieldInfo& info : worldFieldTable()) names.push_back(info.field.key);
+    return names;
+}
+
+} // namespace stepwise

@@ -1,0 +1,154 @@
+// Table-driven scene edits (editor/app/scene_edit): the inspector's and the
+// World panel's edit paths, checked with the loader's own words.
+
+#include "editor_fixture.hpp"
+
+#include "stepwise/world_fields.hpp"
+
+using namespace stepwise;
+using namespace stepwise::editor;
+using namespace stepwise::editor_test;
+using stepwise::test::readFile;
+
+TEST(Inspector, MultiSelectionEditAppliesToAllAndIsOneUndoStep) {
+    Fixture f("spring_chain.json");
+    const ComponentInfo* mass = findComponent("mass");
+    ASSERT_NE(mass, nullptr);
+    const std::vector<Entity> sel{f.named("link0"), f.named("link1"), f.named("link4")};
+    f.ed.select(sel);
+    const std::string before = textOf(f.ed.doc.scene);
+    const std::uint64_t key = f.ed.newMergeKey();
+    // A slider drag: three values, one command.
+    for (double v : {0.5, 0.7, 2.5})
+        ASSERT_TRUE(f.ed.applyEdit("edit mass", [&](Scene& s) {
+            return setFieldOnAll(s, *mass, mass->fields[0], v, f.ed.selection) > 0;
+        }, key));
+    f.ed.endEdit();
+    for (Entity e : sel) EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Mass>(e)->value, 2.5);
+    EXPECT_NE(f.ed.doc.scene.registry.tryGet<Mass>(f.named("link2"))->value, 2.5);
+    ASSERT_TRUE(f.ed.undo());
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+    // Out of range: refused, nothing changes.
+    std::string problem;
+    EXPECT_EQ(setFieldOnAll(f.ed.doc.scene, *mass, mass->fields[0], -1.0, sel, &problem), 0u);
+    EXPECT_NE(problem.find("mass"), std::string::npos) << problem;
+    // Add and remove a component on the whole selection.
+    const ComponentInfo* drag = findComponent("restitution");
+    ASSERT_NE(drag, nullptr);
+    ASSERT_TRUE(f.ed.applyEdit("add", [&](Scene& s) { return addComponentToAll(s, *drag, sel) > 0; }));
+    for (Entity e : sel) EXPECT_TRUE(drag->has(f.ed.doc.scene.registry, e));
+    ASSERT_TRUE(f.ed.applyEdit("remove", [&](Scene& s) { return removeComponentFromAll(s, *drag, sel) > 0; }));
+    for (Entity e : sel) EXPECT_FALSE(drag->has(f.ed.doc.scene.registry, e));
+}
+
+TEST(Inspector, CopyEntityIsTableDrivenAndExact) {
+    Result<Scene> s = loadSceneFile(kLevels / "render_showcase.json");
+    ASSERT_TRUE(s) << s.error();
+    // Copy every entity into a fresh scene with the same world: same bytes.
+    Scene copy;
+    copy.version = s->version;
+    copy.world = s->world;
+    copy.view = s->view;
+    for (Entity e : s->registry.entities()) copyEntity(s->registry, e, copy.registry, copy.registry.create());
+    EXPECT_EQ(textOf(copy), textOf(*s));
+}
+
+TEST(PolygonTool, ConvexHullIsCounterClockwiseWithoutCollinearPoints) {
+    const std::vector<Vec2> hull = convexHull({{0, 0}, {1, 0}, {2, 0}, {2, 2}, {1, 1}, {0, 2}, {0, 0}, {1, 2}});
+    ASSERT_EQ(hull.size(), 4u);
+    EXPECT_EQ(polygonProblem(hull), "");
+    EXPECT_EQ(convexHull({{0, 0}, {1, 1}, {2, 2}}).size(), 2u);
+}
+
+TEST(Inspector, RefusesAtEditTimeWhatTheLoaderRefusesNamingEntityAndField) {
+    Fixture f("default.json");
+    const std::string before = textOf(f.ed.doc.scene);
+    const Entity bob = f.named("bob");
+    ASSERT_TRUE(f.ed.doc.scene.registry.has<Radius>(bob));
+    std::string problem;
+    // A second shape.
+    EXPECT_FALSE(f.ed.applyEdit("add box", [&](Scene& s) { return addComponentToAll(s, *findComponent("box"), {bob}, &problem) > 0; }));
+    EXPECT_EQ(problem, "\"bob\" box: an entity has at most one shape (radius, box, polygon or plane), got 2");
+    // A speed whose kinetic energy overflows.
+    const ComponentInfo* velocity = findComponent("velocity");
+    EXPECT_FALSE(f.ed.applyEdit("v", [&](Scene& s) {
+        return setFieldOnAll(s, *velocity, velocity->fields[0], Vec2{1e308, 0.0}, {bob}, &problem) > 0;
+    }));
+    EXPECT_EQ(problem.rfind("\"bob\" velocity: expected a speed up to 1e150 m/s", 0), 0u) << problem;
+    // The same numbers are refused by the loader.
+    EXPECT_FALSE(parseScene(R"({"entities": [{"position": {"x": 0, "y": 0}, "velocity": {"x": 1e308, "y": 0}}]})", "t.json"));
+    // A duplicate name.
+    EXPECT_FALSE(rename(f, bob, "floor", &problem));
+    EXPECT_NE(problem.find("duplicate name \"floor\""), std::string::npos) << problem;
+    // Removing the position of a body that has a velocity.
+    EXPECT_FALSE(f.ed.applyEdit("rm", [&](Scene& s) {
+        return removeComponentFromAll(s, *findComponent("position"), {bob}, &problem) > 0;
+    }));
+    EXPECT_EQ(problem.rfind("\"bob\"", 0), 0u) << problem;
+    EXPECT_NE(problem.find("needs \"position\""), std::string::npos) << problem;
+    // Mass out of range names the entity and the field.
+    const ComponentInfo* mass = findComponent("mass");
+    EXPECT_FALSE(f.ed.applyEdit("m", [&](Scene& s) { return setFieldOnAll(s, *mass, mass->fields[0], -1.0, {bob}, &problem) > 0; }));
+    EXPECT_EQ(problem, "\"bob\" mass: expected a number > 0, got -1");  // the loader's words
+    // Nothing of it reached the scene.
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+}
+
+TEST(WorldSettingsEdit, OutOfRangeRefusedWithTheLoadersWords) {
+    // The same value, through a file and through the World panel's edit
+    // path: the same message after "where" (/world/KEY in a file,
+    // world.KEY in the editor), and the scene left as it was.
+    struct Case {
+        const char* key;
+        const char* json;
+        FieldValue value;
+    };
+    const Case cases[] = {
+        {"solver_iterations", "5000", 5000},  // the UI allowed only 1..200 before the table
+        {"substeps", "0", 0},
+        {"dt", "-1", -1.0},
+        {"theta", "1.5", 1.5},
+        {"tolerance", "0", 0.0},
+        {"restitution_threshold", "-2", std::optional<double>(-2.0)},
+        {"integrator", "\"rk5\"", std::string("rk5")},
+    };
+    for (const Case& c : cases) {
+        const std::string key = c.key;
+        Result<Scene> loaded = parseScene(R"({"world": {")" + key + "\": " + c.json + R"(}, "entities": []})", "t.json");
+        ASSERT_FALSE(loaded) << key;
+        const std::string loaderPrefix = "t.json: error: /world/" + key + ": ";
+        ASSERT_EQ(loaded.error().rfind(loaderPrefix, 0), 0u) << loaded.error();
+
+        Fixture f("default.json");
+        const WorldSettings before = f.ed.doc.scene.world;
+        std::optional<Error> refused;
+        EXPECT_FALSE(f.ed.applyEdit("world", [&](Scene& s) {
+            refused = setWorldField(s, *findWorldField(key), c.value);
+            return !refused;
+        }));
+        ASSERT_TRUE(refused) << key;
+        const std::string editorPrefix = "world." + key + ": ";
+        ASSERT_EQ(refused->message.rfind(editorPrefix, 0), 0u) << refused->message;
+        EXPECT_EQ(refused->message.substr(editorPrefix.size()), loaded.error().substr(loaderPrefix.size())) << key;
+        EXPECT_EQ(f.ed.doc.scene.world, before) << key;
+    }
+}
+
+TEST(WorldSettingsEdit, AcceptsWhatTheLoaderAccepts) {
+    // 600 solver iterations load from a file; the World panel took at most
+    // 200 before it read the table.
+    Fixture f("default.json");
+    std::optional<Error> refused;
+    EXPECT_TRUE(f.ed.applyEdit("world", [&](Scene& s) {
+        refused = setWorldField(s, *findWorldField("solver_iterations"), 600);
+        return !refused;
+    })) << refused->message;
+    EXPECT_EQ(f.ed.doc.scene.world.solverIterations, 600);
+    Result<Scene> again = parseScene(textOf(f.ed.doc.scene), "t.json");
+    ASSERT_TRUE(again) << again.error();
+    EXPECT_EQ(again->world.solverIterations, 600);
+    // A value of the wrong type for the field is refused, not written.
+    EXPECT_EQ(setWorldField(f.ed.doc.scene, *findWorldField("solver_iterations"), 7.0),
+              Error{"world.solver_iterations: a value of the wrong type for this field"});
+    EXPECT_EQ(f.ed.doc.scene.world.solverIterations, 600);
+}

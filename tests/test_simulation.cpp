@@ -1,0 +1,178 @@
+// The simulation controller (editor/app/simulation): play, step back,
+// reset, time scale and the frame budget.
+
+#include "editor_fixture.hpp"
+
+using namespace stepwise;
+using namespace stepwise::editor;
+using namespace stepwise::editor_test;
+using stepwise::test::readFile;
+
+TEST(Simulation, ResetReturnsToTheEditedSceneAndStepBackIsExact) {
+    Fixture f("spring_chain.json");
+    // An edit before playing is part of the level.
+    ASSERT_TRUE(f.ed.applyEdit("gravity", [](Scene& s) {
+        s.world.gravity.y = -5.0;
+        return true;
+    }));
+    const std::string edited = textOf(f.ed.doc.scene);
+    f.ed.stepForward();
+    ASSERT_EQ(f.ed.sim.state(), SimState::Paused) << f.ed.sim.message();
+    const std::string afterOne = textOf(f.ed.doc.scene);
+    EXPECT_NE(afterOne, edited);
+    f.ed.stepForward();
+    f.ed.stepForward();
+    f.ed.stepBack();
+    f.ed.stepBack();
+    EXPECT_EQ(textOf(f.ed.doc.scene), afterOne);
+    f.ed.stepBack();
+    EXPECT_EQ(textOf(f.ed.doc.scene), edited);
+    // Play, then edit while paused: the edit applies to the state ...
+    f.ed.togglePlay();
+    for (int i = 0; i < 10; ++i) f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 10u);
+    f.ed.togglePlay();
+    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
+        s.registry.tryGet<Mass>(f.named("link3"))->value = 9.0;
+        return true;
+    }));
+    f.ed.stepForward();
+    // ... and reset discards it with the simulated state.
+    f.ed.resetSimulation();
+    EXPECT_EQ(f.ed.sim.state(), SimState::Editing);
+    EXPECT_EQ(textOf(f.ed.doc.scene), edited);
+    // The edit from before Play is still undoable.
+    ASSERT_TRUE(f.ed.undo());
+    EXPECT_EQ(f.ed.doc.scene.world.gravity.y, -9.81);
+}
+
+TEST(Simulation, SteppingThroughTheEditorMatchesTheWorld) {
+    Fixture f("orbit.json");
+    Result<World> w = World::build(f.ed.doc.scene);
+    ASSERT_TRUE(w) << w.error();
+    for (int i = 0; i < 30; ++i) ASSERT_TRUE(w->step());
+    Scene expected = f.ed.doc.scene;
+    w->writeBack(expected);
+    // A step back restores the World's saved state in place, so stepping
+    // on gives the same bits (with contacts too: test_editor_state).
+    for (int i = 0; i < 20; ++i) f.ed.stepForward();
+    for (int i = 0; i < 5; ++i) f.ed.stepBack();
+    for (int i = 0; i < 15; ++i) f.ed.stepForward();
+    EXPECT_EQ(textOf(f.ed.doc.scene), textOf(expected));
+}
+
+TEST(Simulation, AMouseSpringDragBuildsTheWorldOnceAndPullsTheBody) {
+    Fixture f("spring_chain.json");  // link11, the free end, starts at (6, 0)
+    f.ed.tool = Tool::Select;
+    f.ed.togglePlay();
+    f.ed.update(1.0 / 60.0);
+    const std::uint64_t buildsBefore = f.ed.sim.worldBuilds();
+    const Entity link = findByName(f.ed.doc.scene.registry, "link11");
+    const Vec2 grab = f.ed.doc.scene.registry.tryGet<Position>(link)->value;
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseDown, grab));
+    ASSERT_TRUE(f.ed.sim.mouseSpring);
+    // The cursor moves every frame; the anchor follows without a rebuild.
+    const Vec2 target{6.0, 3.0};
+    for (int i = 1; i <= 60; ++i) {
+        f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseMove, grab + (target - grab) * std::min(1.0, i / 20.0)));
+        f.ed.update(1.0 / 60.0);
+    }
+    EXPECT_EQ(f.ed.sim.worldBuilds(), buildsBefore + 1);  // once, when the drag began
+    // Pulled up against gravity toward the cursor, from below y = 0.
+    const Vec2 held = f.ed.doc.scene.registry.tryGet<Position>(link)->value;
+    EXPECT_GT(held.y, 1.0) << held.x << ", " << held.y;
+    f.ed.handleViewportEvent(f.mouse(InputEvent::Type::MouseUp, target));
+    EXPECT_FALSE(f.ed.sim.mouseSpring);
+    f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.worldBuilds(), buildsBefore + 2);  // released: rebuilt without it
+}
+
+TEST(Simulation, DisabledSystemIsLeftOutOfTheWorld) {
+    Fixture f("spring_chain.json");
+    f.ed.sim.disabledSystems.insert("springs");
+    f.ed.stepForward();
+    ASSERT_NE(f.ed.sim.world(), nullptr) << f.ed.sim.message();
+    const auto active = f.ed.sim.world()->activeSystems();
+    EXPECT_EQ(std::find(active.begin(), active.end(), "springs"), active.end());
+    EXPECT_NE(std::find(active.begin(), active.end(), "gravity"), active.end());
+    // The document keeps its springs.
+    EXPECT_GT(f.ed.doc.scene.registry.count<Spring>(), 0u);
+}
+
+TEST(Simulation, DivergencePausesAndNamesEntityAndQuantity) {
+    Fixture f("orbit.json");
+    ASSERT_TRUE(f.ed.applyEdit("blow up", [&](Scene& s) {
+        // G so large that the pull on the planet (first body) overflows to inf in the first step.
+        s.world.G = 1e308;
+        return true;
+    }));
+    f.ed.togglePlay();
+    for (int i = 0; i < 5 && f.ed.sim.state() == SimState::Playing; ++i) f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.state(), SimState::Paused);
+    EXPECT_TRUE(f.ed.sim.diverged());
+    EXPECT_NE(f.ed.sim.message().find("planet"), std::string::npos) << f.ed.sim.message();
+    EXPECT_NE(f.ed.sim.message().find("became"), std::string::npos) << f.ed.sim.message();
+}
+
+TEST(Simulation, TimeScaleSetsStepsPerFrame) {
+    Fixture f("orbit.json");  // dt = 1/240
+    // A clock that never moves: every step fits the frame's budget however
+    // slow this machine is right now (with the wall clock, a busy machine
+    // got fewer steps).
+    f.ed.sim.clockMs = [] { return 0.0; };
+    f.ed.sim.timeScale = 0.5;
+    f.ed.togglePlay();
+    for (int i = 0; i < 10; ++i) f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 20u);  // 10 frames * (1/60 * 0.5) / (1/240)
+    EXPECT_FALSE(f.ed.sim.behind());
+}
+
+TEST(Simulation, StepsPastTheFrameBudgetAreDropped) {
+    Fixture f("orbit.json");  // dt = 1/240: a 1/60 s frame is due 4 steps
+    // A fake clock 3 ms later at every read (advance reads it once at the
+    // frame's start and once before each step): with the 8 ms budget the
+    // frame takes its first step (always), a second at 6 ms spent, and stops
+    // at 9 ms with 2 of its 4 steps dropped.
+    double now = 0.0;
+    f.ed.sim.clockMs = [&] { return now += 3.0; };
+    f.ed.sim.physicsBudgetMs = 8.0;
+    f.ed.togglePlay();
+    f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 2u);
+    EXPECT_TRUE(f.ed.sim.behind());
+}
+
+TEST(Simulation, ASlowFrameDropsTimeInsteadOfTakingMoreSteps) {
+    Fixture f("orbit.json");  // dt = 1/240: a 1/60 s frame is due 4 steps
+    f.ed.togglePlay();
+    f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 4u);
+    EXPECT_FALSE(f.ed.sim.behind());
+    // A budget already spent after the first step (as on a frame where one
+    // step takes longer than the budget): one step per frame, the rest of
+    // the frame's time dropped, and the editor says it is behind.
+    f.ed.sim.physicsBudgetMs = -1.0;
+    for (int i = 0; i < 5; ++i) f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 9u);
+    EXPECT_TRUE(f.ed.sim.behind());
+    // The dropped time is not owed later: back on budget, 4 per frame again.
+    f.ed.sim.physicsBudgetMs = 1e9;
+    f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 13u);
+    EXPECT_FALSE(f.ed.sim.behind());
+}
+
+TEST(Simulation, StepCounterIsClearedByResetNewAndOpen) {
+    Fixture f("default.json");
+    for (int i = 0; i < 5; ++i) f.ed.stepForward();
+    ASSERT_EQ(f.ed.sim.steps(), 5u);
+    f.ed.resetSimulation();
+    EXPECT_EQ(f.ed.sim.steps(), 0u);
+    for (int i = 0; i < 3; ++i) f.ed.stepForward();
+    f.ed.newDocument();
+    EXPECT_EQ(f.ed.sim.steps(), 0u);
+    ASSERT_TRUE(f.ed.open(kLevels / "orbit.json"));
+    for (int i = 0; i < 2; ++i) f.ed.stepForward();
+    ASSERT_TRUE(f.ed.open(kLevels / "default.json"));
+    EXPECT_EQ(f.ed.sim.steps(), 0u);
+}
