@@ -486,7 +486,7 @@ int runAdversarial(int crowd, int crowdSteps) {
             return 2;
         }
         w->setProfiling(false);
-        const collision::CollisionSystem& contacts = *w->impl().collision;
+        const collision::CollisionSystem& contacts = *internals(*w).collision;
         double firstMs = 0.0, laterMs = 0.0, worstLaterMs = 0.0, fastest = 0.0;
         std::size_t mostPairs = 0;
         bool finite = true;
