@@ -15,6 +15,7 @@
 #include "stepwise/scene_io.hpp"
 
 #include <GL/osmesa.h>
+#include <nlohmann/json.hpp>
 #include <SDL.h>
 
 #include <algorithm>
@@ -97,7 +98,11 @@ void writeDebugState(const std::string& path, ui::Session& session, std::uint64_
         << ",\n  \"steps\": " << ed.sim.steps() << ",\n  \"entities\": " << ed.doc.scene.registry.size()
         << ",\n  \"dirty\": " << (ed.dirty() ? "true" : "false") << ",\n  \"viewport\": [" << p.x << ", " << p.y << ", "
         << z.x << ", " << z.y << "],\n  \"camera\": [" << ed.view.camera.center.x << ", " << ed.view.camera.center.y
-        << ", " << ed.view.camera.zoom << "],\n  \"selection\": " << ed.selection.size() << ",\n  \"positions\": [";
+        << ", " << ed.view.camera.zoom << "],\n  \"selection\": " << ed.selection.size();
+    const ui::Session::DialogState d = session.dialogState();
+    out << ",\n  \"modal\": " << nlohmann::json(d.modal).dump() << ",\n  \"status\": " << nlohmann::json(d.status).dump()
+        << ",\n  \"open_folder\": " << nlohmann::json(d.openFolder).dump() << ",\n  \"open_files\": " << d.openFiles
+        << ",\n  \"save_as_suggestion\": " << nlohmann::json(d.saveAsSuggestion).dump() << ",\n  \"positions\": [";
     int n = 0;
     for (Entity e : ed.doc.scene.registry.entities()) {
         const Position* pos = ed.doc.scene.registry.tryGet<Position>(e);

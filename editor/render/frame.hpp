@@ -28,11 +28,12 @@ enum class Overlay : std::uint32_t {
     Velocity = 1u << 0,       ///< an arrow per body
     VelocityField = 1u << 1,  ///< kernel-weighted velocity of nearby bodies on a grid
     ForceField = 1u << 2,     ///< World::probeForce on a grid (needs a World)
-    Force = 1u << 3,          ///< net force per body, World::bodyForces (needs a World)
+    Force = 1u << 3,          ///< applied force per body (gravity, springs, ...), World::bodyForces (needs a World)
     Contacts = 1u << 4,       ///< World::contacts(): points, normals, impulses
     Aabb = 1u << 5,           ///< bounding boxes and the occupied cells of a uniform grid
     Trails = 1u << 6,         ///< positions over the last N recorded steps
     Joints = 1u << 7,         ///< World::joints(): reaction force at each joint's anchor
+    NetForce = 1u << 8,       ///< net force per body over the last step, contacts included, World::netForces
 };
 
 struct OverlaySet {
@@ -40,12 +41,14 @@ struct OverlaySet {
     bool has(Overlay o) const { return (bits & std::uint32_t(o)) != 0; }
     void add(Overlay o) { bits |= std::uint32_t(o); }
     bool needsWorld() const {
-        return has(Overlay::ForceField) || has(Overlay::Force) || has(Overlay::Contacts) || has(Overlay::Joints);
+        return has(Overlay::ForceField) || has(Overlay::Force) || has(Overlay::NetForce) || has(Overlay::Contacts) ||
+               has(Overlay::Joints);
     }
 };
 
 /// Command-line names, in drawing-legend order: "velocity", "velocity-field",
-/// "force-field", "force", "contacts", "aabb", "trails", "joints".
+/// "force-field", "force" (applied), "net-force", "contacts", "aabb",
+/// "trails", "joints".
 const std::vector<std::pair<std::string_view, Overlay>>& overlayNames();
 
 /// Parses "velocity,force-field" (or "all", or "" for none). The error names
@@ -93,13 +96,18 @@ private:
 /// Reference magnitudes for arrows: an arrow of magnitude `ref` is drawn
 /// `referencePixels` long; lengths grow as log2(1 + m/ref) so a field
 /// spanning orders of magnitude stays legible (3*ref is twice as long,
-/// 7*ref three times). 0 means "choose from the data" (a 1-2-5 number near
-/// the median magnitude). Fix them for a frame sequence so arrows compare.
+/// 7*ref three times). 0 means "choose from the data": a 1-2-5 number near
+/// the median magnitude, except for forces (see `force`). Fix them for a
+/// frame sequence so arrows compare.
 struct ArrowScales {
     double velocity = 0.0;       ///< m/s
     double velocityField = 0.0;  ///< m/s
-    double force = 0.0;          ///< N
-    double forceField = 0.0;     ///< N per kg (= m/s^2)
+    /// N, applied and net force alike (so their arrows compare). Chosen
+    /// from the applied forces' low end (10th percentile), so the weakest
+    /// force that acts, gravity next to a strong attractor, draws at about
+    /// the reference length and stronger ones grow logarithmically.
+    double force = 0.0;
+    double forceField = 0.0;     ///< N per kg (= m/s^2); chosen like `force`
     double impulse = 0.0;        ///< N*s
     double jointForce = 0.0;     ///< N (joints overlay)
 };
@@ -142,6 +150,7 @@ struct DrawData {
     std::vector<Batch> batches;   ///< in drawing order
     ArrowScales scales;           ///< the references used (auto ones resolved)
     std::vector<std::string> notes;  ///< e.g. "force-field: no World (scene has shapes)"
+    std::vector<std::string> legend; ///< the legend's arrow rows, e.g. "applied force = 20 N"
     std::size_t instanceCount() const;
 };
 
