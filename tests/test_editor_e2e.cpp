@@ -292,7 +292,7 @@ TEST(EditorWindow, FromAnotherFolderRenameThenPlayAndSaveAsAsksBeforeReplacing) 
     ASSERT_TRUE(parsed) << parsed.error();
     const Entity link5 = editor::findByName(parsed->registry, "link5");
     ASSERT_FALSE(link5.isNull());
-    const Vec2 body = cam.toPixels(parsed->registry.get<Position>(link5).value);
+    const Vec2 body = cam.toPixels(parsed->registry.tryGet<Position>(link5)->value);
     ASSERT_TRUE(xdo("key 1"));
     ASSERT_TRUE(xdo("mousemove " + at(vx + body.x, vy + body.y) + " click 1"));
     ASSERT_TRUE(waitFor([&] { return readState(state)["selection"] == 1; }, 10s)) << readState(state).dump();
@@ -317,7 +317,7 @@ TEST(EditorWindow, FromAnotherFolderRenameThenPlayAndSaveAsAsksBeforeReplacing) 
     ASSERT_TRUE(xdo("key ctrl+s"));
     ASSERT_TRUE(waitFor([&] { return readState(state)["dirty"] == false; }, 10s)) << readState(state).dump();
     // Saved: the level with link5 called bob, and both springs naming bob.
-    parsed->registry.get<Name>(link5).value = "bob";
+    parsed->registry.tryGet<Name>(link5)->value = "bob";
     EXPECT_EQ(readFile(level), sceneToJsonText(*parsed));
     const std::string saved = readFile(level);
     EXPECT_EQ(saved.find("\"link5\""), std::string::npos);

@@ -1122,7 +1122,11 @@ void dialogs(UiState& ui, Editor& ed) {
         ImGui::SetNextWindowPos(center, ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
         ImGui::SetNextWindowSize(ImVec2(520 * ui.scale, 0), ImGuiCond_Appearing);
         if (ImGui::BeginPopupModal(name)) {
-            if (ImGui::IsWindowAppearing()) ImGui::SetKeyboardFocusHere();  // type the path at once
+            // Type the path at once: the field takes the keyboard whenever
+            // nothing else in the dialog is active (asked on the appearing
+            // frame alone, the request is lost: an auto-sized window is
+            // hidden on that frame).
+            if (!ImGui::IsAnyItemActive()) ImGui::SetKeyboardFocusHere();
             ImGui::SetNextItemWidth(-1);
             const bool enter =
                 ImGui::InputText("##saveas", &ui.saveAsPath, ImGuiInputTextFlags_EnterReturnsTrue);
