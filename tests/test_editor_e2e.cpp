@@ -30,6 +30,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <sstream>
 #include <thread>
 
@@ -124,6 +125,37 @@ nlohmann::json readState(const fs::path& p) {
     }
 }
 
+/// An Xvfb of 1280x800 on a free display, stopped (by its process id) on
+/// scope exit; `env` runs the editor on it with its settings under `tmp`.
+struct XDisplay {
+    std::string name;   ///< ":N"
+    std::unique_ptr<Child> server;
+    std::vector<std::string> env;
+    std::string error;  ///< why it could not be started ("" when it runs)
+    explicit XDisplay(const fs::path& tmp) {
+        const int display = freeDisplay();
+        if (display <= 0) {
+            error = "no free X display number";
+            return;
+        }
+        name = ":" + std::to_string(display);
+        server = std::make_unique<Child>(std::vector<std::string>{"Xvfb", name, "-screen", "0", "1280x800x24",
+                                                                  "-nolisten", "tcp"},
+                                         std::vector<std::string>{}, tmp / "xvfb.log");
+        if (server->pid <= 0 ||
+            !waitFor([&] { return fs::exists("/tmp/.X11-unix/X" + std::to_string(display)); }, 10s)) {
+            error = "Xvfb did not start: " + readFile(tmp / "xvfb.log");
+            return;
+        }
+        env = {"DISPLAY=" + name, "LIBGL_ALWAYS_SOFTWARE=1", "XDG_CONFIG_HOME=" + (tmp / "config").string()};
+    }
+    /// Runs `xdotool ARGS` on this display; true when it succeeded.
+    bool xdo(const std::string& args) const {
+        const std::string cmd = "DISPLAY=" + name + " xdotool " + args + " > /dev/null 2>&1";
+        return std::system(cmd.c_str()) == 0;
+    }
+};
+
 } // namespace
 
 TEST(EditorWindow, PlayPlaceUndoSaveThroughXvfbAndXdotool) {
@@ -135,24 +167,14 @@ TEST(EditorWindow, PlayPlaceUndoSaveThroughXvfbAndXdotool) {
     fs::copy_file(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "spring_chain.json", level);
     const std::string original = readFile(level);
 
-    const int display = freeDisplay();
-    ASSERT_GT(display, 0) << "no free X display number";
-    const std::string disp = ":" + std::to_string(display);
-    Child xvfb({"Xvfb", disp, "-screen", "0", "1280x800x24", "-nolisten", "tcp"}, {}, tmp / "xvfb.log");
-    ASSERT_GT(xvfb.pid, 0);
-    ASSERT_TRUE(waitFor([&] { return fs::exists("/tmp/.X11-unix/X" + std::to_string(display)); }, 10s))
-        << readFile(tmp / "xvfb.log");
-
-    const std::vector<std::string> env{"DISPLAY=" + disp, "LIBGL_ALWAYS_SOFTWARE=1",
-                                       "XDG_CONFIG_HOME=" + (tmp / "config").string()};
+    const XDisplay x(tmp);
+    ASSERT_TRUE(x.error.empty()) << x.error;
+    const std::vector<std::string>& env = x.env;
     Child editor({STEPWISE_BINARY, "edit", level.string(), "--size", "1280x800", "--builtin-font", "--font-size", "13",
                   "--debug-state", state.string()},
                  env, tmp / "editor.log");
     ASSERT_GT(editor.pid, 0);
-    auto xdo = [&](const std::string& args) {
-        const std::string cmd = "DISPLAY=" + disp + " xdotool " + args + " > /dev/null 2>&1";
-        return std::system(cmd.c_str()) == 0;
-    };
+    auto xdo = [&](const std::string& args) { return x.xdo(args); };
     ASSERT_TRUE(waitFor([&] { return !readState(state).is_null(); }, 30s)) << readFile(tmp / "editor.log");
     nlohmann::json s0 = readState(state);
     const auto vp = s0["viewport"];
@@ -230,19 +252,10 @@ TEST(EditorWindow, FromAnotherFolderRenameThenPlayAndSaveAsAsksBeforeReplacing) 
     fs::copy_file(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "default.json", other);
     const std::string original = readFile(level), otherText = readFile(other);
 
-    const int display = freeDisplay();
-    ASSERT_GT(display, 0) << "no free X display number";
-    const std::string disp = ":" + std::to_string(display);
-    Child xvfb({"Xvfb", disp, "-screen", "0", "1280x800x24", "-nolisten", "tcp"}, {}, tmp / "xvfb.log");
-    ASSERT_GT(xvfb.pid, 0);
-    ASSERT_TRUE(waitFor([&] { return fs::exists("/tmp/.X11-unix/X" + std::to_string(display)); }, 10s))
-        << readFile(tmp / "xvfb.log");
-    const std::vector<std::string> env{"DISPLAY=" + disp, "LIBGL_ALWAYS_SOFTWARE=1",
-                                       "XDG_CONFIG_HOME=" + (tmp / "config").string()};
-    auto xdo = [&](const std::string& args) {
-        const std::string cmd = "DISPLAY=" + disp + " xdotool " + args + " > /dev/null 2>&1";
-        return std::system(cmd.c_str()) == 0;
-    };
+    const XDisplay x(tmp);
+    ASSERT_TRUE(x.error.empty()) << x.error;
+    const std::vector<std::string>& env = x.env;
+    auto xdo = [&](const std::string& args) { return x.xdo(args); };
     auto at = [](double x, double y) { return std::to_string(int(x)) + " " + std::to_string(int(y)); };
 
     // Started in an empty folder with no level: an untitled document.

@@ -941,6 +941,9 @@ void Builder::bodyArrows() {
                 const Vec2 from = origins[i];
                 if (!thin.keep(from, selected_.count(in_.world->bodyEntity(i)) != 0)) continue;
                 const double len = arrowLength(m, ref, arrowRef_, maxPx);
+                // Under a pixel there is nothing to see (a resting body's net
+                // force), and a settled pile would send an instance per body.
+                if (len < 1.0) continue;
                 arrow(from, from + forces[i] / m * len, dense_ ? 1.0 : 2.0, colour);
             }
         };
