@@ -14,7 +14,10 @@
 #                    speed is measured first and its steps are cut to fit,
 #                    and the table says how many it ran (default: no cap)
 #   --binary PATH    the stepwise executable (default build/stepwise)
-#   LEVEL...         default: every levels/*.json
+#   LEVEL...         default: every levels/*.json (joints: bridge, car,
+#                    chain, ragdoll; polygons: car, polygons) and
+#                    tests/data/joints_every_type.json (the slider, distance
+#                    and rope joints no shipped level uses)
 #
 # Output: one Markdown table row per level (steps run, ms/step including
 # start-up, peak RSS at the start and at the end in MiB, growth, result).
@@ -29,7 +32,7 @@ while (($#)); do
     --steps) steps=$2; shift 2 ;;
     --max-minutes) max_minutes=$2; shift 2 ;;
     --binary) binary=$2; shift 2 ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
     *) levels+=("$1"); shift ;;
   esac
 done
@@ -37,6 +40,7 @@ if ((${#levels[@]} == 0)); then
   for f in "$root"/levels/*.json; do
     [[ $(basename "$f") == scene.schema.json ]] || levels+=("$f")
   done
+  levels+=("$root/tests/data/joints_every_type.json")
 fi
 [[ -x $binary ]] || { echo "soak: $binary is not built (cmake --build build)" >&2; exit 2; }
 

@@ -404,6 +404,12 @@ TEST_F(Cli, RenderBadArgumentsExitTwoNameTheArgumentAndWriteNothing) {
     }
 }
 
+/// Runs `command` as the unprivileged user nobody when this process is
+/// root (root may write any file, so a read-only file means nothing to it).
+std::string asUnprivileged(const std::string& command) {
+    return ::geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups " + command : command;
+}
+
 TEST_F(Cli, BenchBadArgumentsExitTwoNamingTheArgument) {
     Outcome o = stepwise("bench");
     EXPECT_EQ(o.exitCode, 2);
@@ -430,6 +436,25 @@ TEST_F(Cli, BenchBadArgumentsExitTwoNamingTheArgument) {
     EXPECT_EQ(o.exitCode, 2);
     EXPECT_EQ(o.err, "stepwise: error: --out: cannot create the folder " + notAFolder.string() + ": Not a directory\n");
     EXPECT_FALSE(fs::exists(dir_ / "r"));
+    // A report file the user may not replace (0444, as an unprivileged
+    // user): refused before measuring, in the words of every other output,
+    // and kept. It was overwritten after the whole run.
+    fs::permissions(dir_, fs::perms::all);
+    const fs::path reportDir = dir_ / "report";
+    fs::create_directory(reportDir);
+    fs::permissions(reportDir, fs::perms::all);
+    const fs::path md = reportDir / "accuracy.md";
+    { std::ofstream(md) << "kept\n"; }
+    fs::permissions(md, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+    const fs::path errFile = dir_ / "err.txt";
+    const int status = std::system((asUnprivileged(std::string(STEPWISE_BINARY) + " bench accuracy --quick --out " +
+                                                   reportDir.string()) +
+                                    " >/dev/null 2>" + errFile.string())
+                                       .c_str());
+    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
+    EXPECT_EQ(readFile(errFile), md.string() + ": error: cannot write: Permission denied\n");
+    EXPECT_EQ(readFile(md), "kept\n");
+    EXPECT_EQ(std::distance(fs::directory_iterator(reportDir), fs::directory_iterator()), 1) << "nothing else written";
 }
 
 TEST_F(Cli, RenderAndBenchHaveHelp) {
@@ -580,11 +605,6 @@ TEST_F(Cli, ARenderSequenceThatDivergesWritesNoFrame) {
     EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1) << "only the level";
 }
 
-/// Runs `command` as the unprivileged user nobody when this process is
-/// root (root may write any file, so a read-only file means nothing to it).
-std::string asUnprivileged(const std::string& command) {
-    return ::geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups " + command : command;
-}
 
 // A read-only output (0444, as an unprivileged user) was replaced through
 // the atomic rename, which needs only the folder's permission.
@@ -601,6 +621,30 @@ TEST_F(Cli, AReadOnlyOutputIsRefusedAndKept) {
     EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
     EXPECT_EQ(readFile(errFile), out.string() + ": error: cannot write: Permission denied\n");
     EXPECT_EQ(readFile(out), "read-only\n");
+}
+
+// `edit --screenshot` checked only that the folder existed: a read-only
+// screenshot was replaced at the end through the rename, after the whole
+// script had run. Now it is refused before the first frame, in the words of
+// every other unwritable output, and kept.
+TEST_F(Cli, EditRefusesAnUnwritableScreenshotBeforeItStarts) {
+    fs::permissions(dir_, fs::perms::all);
+    const fs::path file = write("forces.json", kForces);
+    const fs::path png = write("shot.png", "read-only\n");
+    fs::permissions(png, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+    const fs::path errFile = dir_ / "err.txt";
+    const int status = std::system((asUnprivileged(std::string(STEPWISE_BINARY) + " edit " + file.string() +
+                                                   " --builtin-font --size 320x240 --screenshot " + png.string()) +
+                                    " >/dev/null 2>" + errFile.string())
+                                       .c_str());
+    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
+    EXPECT_EQ(readFile(errFile), png.string() + ": error: cannot write: Permission denied\n");
+    EXPECT_EQ(readFile(png), "read-only\n");
+    const fs::path missing = dir_ / "missing" / "shot.png";
+    Outcome o = stepwise("edit " + file.string() + " --builtin-font --size 320x240 --screenshot " + missing.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, missing.string() + ": error: cannot write: No such file or directory\n");
+    EXPECT_FALSE(fs::exists(dir_ / "missing"));
 }
 
 // The trace was held in memory to the end: 1e6 steps made a 95 MB file and

@@ -5,6 +5,8 @@
 #include "app/editor.hpp"
 #include "app/scene_edit.hpp"
 #include "app/script.hpp"
+#include "app/script_actions.hpp"
+#include "app/tools/tools.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
@@ -20,6 +22,7 @@
 #include <chrono>
 #include <csignal>
 #include <random>
+#include <set>
 #include <thread>
 
 #include <filesystem>
@@ -742,6 +745,119 @@ saveas /tmp/x.json
     Result<std::vector<ScriptCommand>> badKey = parseScript("key Hyper+Q\n", "c.txt");
     ASSERT_FALSE(badKey);
     EXPECT_NE(badKey.error().find("Hyper"), std::string::npos);
+}
+
+// ---- one table of tools, one of script actions ------------------------------
+
+namespace {
+
+/// The scripted runner's side, recorded: frames drawn, panels, tabs, shots.
+struct RecordingHost final : ScriptHost {
+    int frames = 0;
+    std::vector<std::string> calls, errors;
+    void frame() override { ++frames; }
+    bool showWindow(const std::string& name, bool on) override {
+        calls.push_back("window " + name + (on ? " on" : " off"));
+        return name == "debug";
+    }
+    bool showDebugTab(const std::string& name) override {
+        calls.push_back("tab " + name);
+        return name == "plots";
+    }
+    Result<void> screenshot(const std::string& path) override {
+        calls.push_back("screenshot " + path);
+        return {};
+    }
+    void reportError(const std::string& message) override { errors.push_back(message); }
+};
+
+/// Parses one script line and runs it as the headless runner does.
+bool runLine(Editor& ed, RecordingHost& host, const std::string& line) {
+    Result<std::vector<ScriptCommand>> parsed = parseScript(line + "\n", "t.txt");
+    EXPECT_TRUE(parsed) << parsed.error();
+    if (!parsed) return false;
+    EXPECT_EQ(parsed->size(), 1u);
+    return runScriptAction(ed, host, parsed->front(), "t.txt");
+}
+
+} // namespace
+
+TEST(ToolTable, EveryToolHasOneKeyOneScriptNameAndALeftClickHandler) {
+    std::set<std::string_view> names;
+    for (std::size_t i = 0; i < kToolCount; ++i) {
+        const ToolInfo& info = toolTable()[i];
+        EXPECT_EQ(info.tool, Tool(i));
+        EXPECT_TRUE(names.insert(info.scriptName).second) << info.scriptName;
+        EXPECT_EQ(toolFromScriptName(info.scriptName), info.tool);
+        EXPECT_EQ(toolForKey(toolKey(info.tool)), info.tool);
+        EXPECT_EQ(toolName(info.tool), info.label);
+        EXPECT_NE(info.press, nullptr);
+    }
+    EXPECT_EQ(toolKey(Tool::Select), Key::Num1);
+    EXPECT_EQ(toolKey(Tool::Polygon), Key::Num0);
+    EXPECT_EQ(toolFromScriptName("wall"), std::nullopt) << "the script calls the Wall tool plane";
+    EXPECT_EQ(toolScriptNames("|"), "select|rotate|circle|box|plane|spring|attractor|boids|joint|polygon");
+    EXPECT_EQ(toolHelpNames(), "select, rotate, circle, box, wall, spring, attractor, boid brush, joint, polygon");
+}
+
+TEST(ToolTable, KeysAndTheScriptPickEveryTool) {
+    Editor ed;
+    RecordingHost host;
+    for (const ToolInfo& info : toolTable()) {
+        ed.tool = Tool::Select;
+        EXPECT_TRUE(ed.handleShortcut(toolKey(info.tool), kModNone));
+        EXPECT_EQ(ed.tool, info.tool) << info.scriptName;
+        ed.tool = Tool::Select;
+        EXPECT_TRUE(runLine(ed, host, "tool " + std::string(info.scriptName)));
+        EXPECT_EQ(ed.tool, info.tool) << info.scriptName;
+    }
+    EXPECT_TRUE(host.errors.empty());
+}
+
+// The usage line listed eight of the ten tools (no joint, no polygon).
+TEST(ScriptActions, UsageAndUnknownToolListEveryTool) {
+    Result<std::vector<ScriptCommand>> bare = parseScript("tool\n", "u.txt");
+    ASSERT_FALSE(bare);
+    EXPECT_EQ(bare.error(), "u.txt:1: expected: tool select|rotate|circle|box|plane|spring|attractor|boids|joint|polygon");
+    Editor ed;
+    RecordingHost host;
+    EXPECT_FALSE(runLine(ed, host, "tool wall"));
+    ASSERT_EQ(host.errors.size(), 1u);
+    EXPECT_EQ(host.errors[0], "t.txt:1: tool: unknown tool \"wall\" (select, rotate, circle, box, plane, spring, "
+                              "attractor, boids, joint, polygon)");
+}
+
+TEST(ScriptActions, TheParserChecksArgumentsAgainstTheTable) {
+    for (const ScriptAction& a : scriptActions()) {
+        EXPECT_EQ(findScriptAction(a.name), &a);
+        // One argument too many is refused with the action's usage.
+        std::string line = a.name;
+        for (std::size_t i = 0; i <= a.maxArgs && a.maxArgs < 1000; ++i) line += " x";
+        if (a.maxArgs >= 1000) continue;
+        Result<std::vector<ScriptCommand>> r = parseScript(line + "\n", "a.txt");
+        ASSERT_FALSE(r) << line;
+        EXPECT_EQ(r.error(), "a.txt:1: expected: " + a.usage) << line;
+    }
+    EXPECT_EQ(findScriptAction("teleport"), nullptr);
+    Result<std::vector<ScriptCommand>> steps = parseScript("step 0\n", "s.txt");
+    ASSERT_FALSE(steps);
+    EXPECT_EQ(steps.error(), "s.txt:1: N must be 1..100000");
+}
+
+TEST(ScriptActions, PanelsTabsAndShotsGoToTheHostAndAFailureStopsWithTheLine) {
+    Editor ed;
+    RecordingHost host;
+    EXPECT_TRUE(runLine(ed, host, "window debug off"));
+    EXPECT_TRUE(runLine(ed, host, "tab plots"));
+    const int framesBefore = host.frames;
+    EXPECT_TRUE(runLine(ed, host, "screenshot /tmp/shot.png"));
+    EXPECT_EQ(host.frames, framesBefore + 1) << "a screenshot draws its own frame, then none after it";
+    EXPECT_EQ(host.calls, (std::vector<std::string>{"window debug off", "tab plots", "screenshot /tmp/shot.png"}));
+    EXPECT_FALSE(runLine(ed, host, "window sidebar on"));
+    EXPECT_FALSE(runLine(ed, host, "select nobody"));
+    EXPECT_EQ(host.errors, (std::vector<std::string>{
+                               "t.txt:1: window: expected inspector|world|tools|entities|debug|help on|off",
+                               "t.txt:1: select: no entity named \"nobody\""}));
 }
 
 // ---- polygon tool (issue 15) ------------------------------------------------

@@ -472,6 +472,133 @@ TEST(JointPhysics, ReactionForceOfAHangingBodyIsItsWeight) {
     EXPECT_NEAR(w.joints()[0].force.y, -3.0 * 9.81, 1e-3);
 }
 
+// Anchors are in the body's frame, measured from its `position` (the frame
+// of a polygon's vertices), not from its centre of mass. A triangle whose
+// position is one of its vertices, hinged to the world there, is a physical
+// pendulum about that vertex. Before the fix the engine took the anchor
+// from the centroid: the triangle hung from its centroid, did not swing,
+// and its pivot vertex sank 1.33 m.
+TEST(JointPhysics, HingeAtAPolygonVertexIsAPhysicalPendulumAboutThatVertex) {
+    // Vertices (0,0), (-1,-2), (1,-2) about position (0,0): centroid
+    // (0,-4/3), d = 4/3 m below the pivot. I about the centroid is
+    // m (a^2 + b^2 + c^2) / 36 with sides 2, sqrt5, sqrt5: 7m/18; about the
+    // pivot 7m/18 + m d^2 = 13m/6.
+    const double g = 9.81, d = 4.0 / 3.0, theta0 = 0.4;
+    const Scene scene = load("{" + world(8) + R"(, "entities": [
+        {"name": "tri", "position": {"x": 0, "y": 0}, "angle": )" + num(theta0) + R"(, "mass": 3,
+         "polygon": {"vertices": [{"x": 0, "y": 0}, {"x": -1, "y": -2}, {"x": 1, "y": -2}]}},
+        {"name": "pin", "joint": {"type": "hinge", "a": "tri", "anchor": {"x": 0, "y": 0}}}]})");
+    World w = build(scene);
+    const double T0 = 2.0 * kPi * std::sqrt((13.0 / 6.0) / (g * d));
+    const double T = T0 * (1.0 + theta0 * theta0 / 16.0 + 11.0 * std::pow(theta0, 4) / 3072.0);
+    std::vector<double> crossings;  // upward zero crossings of the angle
+    double prevAngle = theta0, prevT = 0.0, pivotDrift = 0.0;
+    for (int i = 0; i < 60 * 20 && crossings.size() < 5; ++i) {
+        ASSERT_TRUE(w.step());
+        const double angle = w.saveState().colliderAngle.at(0), t = w.time();
+        if (prevAngle < 0.0 && angle >= 0.0) crossings.push_back(prevT + (t - prevT) * (-prevAngle) / (angle - prevAngle));
+        prevAngle = angle;
+        prevT = t;
+        // The body's position is the pivot vertex: it stays on the pin.
+        pivotDrift = std::max(pivotDrift, length(w.bodyPosition(0)));
+    }
+    ASSERT_GE(crossings.size(), 3u) << "the triangle does not swing";
+    const double measured = (crossings.back() - crossings.front()) / double(crossings.size() - 1);
+    std::printf("triangle pendulum about a vertex: period %.5f s, expected %.5f s (ratio %.6f); pivot drift %.2e m\n",
+                measured, T, measured / T, pivotDrift);
+    EXPECT_NEAR(measured / T, 1.0, 2e-4);  // measured 2e-6
+    EXPECT_LT(pivotDrift, 1e-3);  // 0.1% of the pendulum; measured 9e-6 m
+}
+
+// Two triangles, each with its position at a vertex off its centroid, the
+// second hinged by that vertex to a vertex of the first: the joined
+// vertices stay together (within 1% of a 2 m side) as the pair swings.
+TEST(JointPhysics, HingedPolygonsKeepTheirVerticesTogether) {
+    const Scene scene = load("{" + world(8) + R"(, "entities": [
+        {"name": "upper", "position": {"x": 0, "y": 0}, "angle": 1.0,
+         "polygon": {"vertices": [{"x": 0, "y": 0}, {"x": -1, "y": -2}, {"x": 1, "y": -2}]}},
+        {"name": "lower", "position": {"x": 0, "y": 0}, "angle": 0.0,
+         "polygon": {"vertices": [{"x": 0, "y": 0}, {"x": -0.5, "y": -1}, {"x": 0.5, "y": -1}]}},
+        {"name": "top", "joint": {"type": "hinge", "a": "upper", "anchor": {"x": 0, "y": 0}}},
+        {"name": "knee", "joint": {"type": "hinge", "a": "lower", "b": "upper", "local_a": {"x": 0, "y": 0},
+                                   "local_b": {"x": 1, "y": -2}}}]})");
+    // The lower triangle starts away from the upper one's vertex: move it
+    // there so the joint starts closed.
+    Scene placed = scene;
+    const Vec2 vertex = collision::rotate(collision::Rot::fromAngle(1.0), Vec2{1.0, -2.0});
+    placed.registry.tryGet<Position>(named(placed, "lower"))->value = vertex;
+    World w = build(placed);
+    double worst = 0.0;
+    for (int i = 0; i < 300; ++i) {
+        ASSERT_TRUE(w.step());
+        // World position of the upper triangle's vertex (1,-2) and of the
+        // lower one's position (its vertex (0,0)).
+        const WorldState s = w.saveState();
+        const Vec2 upperVertex = w.bodyPosition(0) + collision::rotate(collision::Rot::fromAngle(s.colliderAngle.at(0)), Vec2{1.0, -2.0});
+        worst = std::max(worst, length(w.bodyPosition(1) - upperVertex));
+        EXPECT_LT(w.joints()[1].separation, 0.02);
+    }
+    std::printf("hinged triangles: joined vertices at most %.2e m apart\n", worst);
+    EXPECT_LT(worst, 0.02);
+}
+
+// levels/car.json (issue 15: "a motorised car with hinged wheels driving
+// over polygon terrain"): every piece of its terrain is a polygon, and in
+// 10 s the car drives over all of it, upright, wheels on their axles and
+// never sunk into the ground.
+TEST(JointLevels, TheCarDrivesOverItsPolygonTerrain) {
+    Result<Scene> loaded = loadSceneFile(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "car.json");
+    ASSERT_TRUE(loaded) << loaded.error();
+    const Scene& scene = *loaded;
+    int terrain = 0;
+    double terrainEnd = -std::numeric_limits<double>::infinity(), highest = 0.0;
+    for (Entity e : scene.registry.entities()) {
+        const Static* fixed = scene.registry.tryGet<Static>(e);
+        if (!fixed || !fixed->value) continue;
+        const Polygon* poly = scene.registry.tryGet<Polygon>(e);
+        ASSERT_TRUE(poly) << "terrain piece " << scene.registry.tryGet<Name>(e)->value << " is not a polygon";
+        ++terrain;
+        for (const Vec2& v : poly->vertices) {
+            const Vec2 p = scene.registry.tryGet<Position>(e)->value + v;
+            if (p.y > 1.0) terrainEnd = std::max(terrainEnd, p.x);  // right end of the last rise
+            highest = std::max(highest, p.y);
+        }
+    }
+    EXPECT_GE(terrain, 8);
+    const Entity car = named(scene, "car"), rear = named(scene, "rear wheel"), front = named(scene, "front wheel");
+    const Joint* axle = scene.registry.tryGet<Joint>(named(scene, "rear axle"));
+    ASSERT_TRUE(axle);
+    const double link = length(axle->localA);  // chassis centre to axle, m
+    World w = build(scene);
+    std::size_t carBody = 0;
+    for (std::size_t b = 0; b < w.bodyCount(); ++b)
+        if (w.bodyEntity(b) == car) carBody = b;
+    const double startX = w.bodyPosition(carBody).x;
+    double worstSeparation = 0.0, worstTilt = 0.0, deepest = 0.0, topY = -1.0;
+    for (int i = 0; i < 600; ++i) {
+        ASSERT_TRUE(w.step());
+        worstSeparation = std::max(worstSeparation, largestSeparation(w));
+        Scene now = scene;
+        w.writeBack(now);
+        worstTilt = std::max(worstTilt, std::abs(now.registry.tryGet<Angle>(car) ? now.registry.tryGet<Angle>(car)->value : 0.0));
+        topY = std::max(topY, w.bodyPosition(carBody).y);
+        for (const ContactRecord& c : w.contacts())
+            if (c.a == rear || c.a == front || c.b == rear || c.b == front) deepest = std::max(deepest, c.depth);
+    }
+    const double travelled = w.bodyPosition(carBody).x - startX;
+    std::printf("car: %d polygon pieces; drove %.2f m in 10 s (past the last rise at x = %.1f m: %s); chassis top "
+                "%.2f m; largest axle separation %.2f mm (%.2f%% of the %.3f m link); tilt at most %.2f rad; wheels "
+                "at most %.1f mm into the ground\n",
+                terrain, travelled, terrainEnd, w.bodyPosition(carBody).x > terrainEnd ? "yes" : "no", topY,
+                1e3 * worstSeparation, 100.0 * worstSeparation / link, link, worstTilt, 1e3 * deepest);
+    EXPECT_GT(travelled, 30.0);                           // measured 37.4 m
+    EXPECT_GT(w.bodyPosition(carBody).x, terrainEnd);     // over every slope and bump
+    EXPECT_GT(topY, highest);                             // it climbed the top plateau
+    EXPECT_LT(worstSeparation, 0.01 * link);              // wheels stay on their axles (measured 0.38%)
+    EXPECT_LT(worstTilt, 0.6);                            // never tips over
+    EXPECT_LT(deepest, 0.01);                             // never sinks into it (measured 4.8 mm)
+}
+
 } // namespace
 namespace {
 

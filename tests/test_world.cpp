@@ -141,6 +141,41 @@ TEST(World, DivergenceNamesStepEntityAndQuantityAndKeepsState) {
     EXPECT_EQ(w2.bodyPosition(0), (Vec2{0.0, 0.0}));
 }
 
+// A step that diverges leaves the whole carried state as it was, the
+// solver's too: before, the failed step's contact cache and joint impulses
+// stayed in place and warmed the next step (a retry after an edit, a reload
+// keeping the warm start), so the World was not "as before that step".
+TEST(World, DivergenceLeavesTheWarmStartAndJointImpulsesAsTheyWere) {
+    // A ball resting on a floor (contact impulses), a swinging pendulum
+    // (joint impulses), and a shapeless body at 1e308 m/s that overflows in
+    // its fourth step of 0.5 s.
+    Result<Scene> scene = parseScene(R"({"world": {"dt": 0.5, "substeps": 2},
+        "entities": [{"name": "floor", "position": {"x": 0, "y": -1}, "static": true, "box": {"width": 10, "height": 1}},
+                     {"name": "ball", "position": {"x": 0, "y": 0}, "radius": 0.5},
+                     {"name": "bob", "position": {"x": 6, "y": 0}, "radius": 0.2},
+                     {"name": "pin", "joint": {"type": "hinge", "a": "bob", "anchor": {"x": 5, "y": 0}}},
+                     {"name": "rocket", "position": {"x": 0, "y": 50}, "velocity": {"x": 1, "y": 0}}]})",
+                                     "diverge.json");
+    ASSERT_TRUE(scene) << scene.error();
+    // Past what a file may hold (1e150 m/s), so set in memory.
+    scene->registry.tryGet<Velocity>(scene->registry.entities().back())->value = {1e308, 0.0};
+    World w = buildOrDie(*scene);
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(w.step().ok());
+    const WorldState before = w.saveState();
+    ASSERT_FALSE(before.contacts.empty());
+    ASSERT_EQ(before.joints.size(), 1u);
+    Result<void> r = w.step();
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().find("\"rocket\""), std::string::npos) << r.error();
+    const WorldState after = w.saveState();
+    EXPECT_EQ(after.x, before.x);
+    EXPECT_EQ(after.v, before.v);
+    EXPECT_EQ(after.colliderAngle, before.colliderAngle);
+    EXPECT_EQ(after.colliderSpin, before.colliderSpin);
+    EXPECT_EQ(after.contacts, before.contacts);
+    EXPECT_EQ(after.joints, before.joints);
+}
+
 std::string stepAndSave(Scene scene, int steps, int times) {
     // `times` rounds of: build, step `steps`, write back, save, load.
     for (int round = 0; round < times; ++round) {

@@ -131,7 +131,7 @@ std::size_t CommandStack::Delta::bytes() const {
     if (slots) n += slots->first.bytes() + slots->second.bytes();
     if (solver)
         for (const std::optional<SolverState>* s : {&solver->first, &solver->second})
-            if (*s) n += (*s)->contacts.capacity() * sizeof(ContactImpulse);
+            if (*s) n += (*s)->contacts.capacity() * sizeof(ContactImpulse) + (*s)->joints.capacity() * sizeof(JointImpulse);
     return n;
 }
 

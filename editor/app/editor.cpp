@@ -11,28 +11,6 @@
 
 namespace stepwise::editor {
 
-std::string_view toolName(Tool t) {
-    switch (t) {
-    case Tool::Select: return "Select";
-    case Tool::Rotate: return "Rotate";
-    case Tool::Circle: return "Circle";
-    case Tool::Box: return "Box";
-    case Tool::Plane: return "Wall";
-    case Tool::Spring: return "Spring";
-    case Tool::Attractor: return "Attractor";
-    case Tool::Boids: return "Boids";
-    case Tool::Joint: return "Joint";
-    case Tool::Polygon: return "Polygon";
-    case Tool::Count: break;
-    }
-    return "?";
-}
-
-// Keys 1..9 pick the first nine tools and 0 the tenth, as on a keyboard's row.
-Key toolKey(Tool t) {
-    return std::uint16_t(t) < 9 ? Key(std::uint16_t(Key::Num1) + std::uint16_t(t)) : Key::Num0;
-}
-
 Editor::Editor() : configDir(configDirectory()) {
     doc.reset(makeNewScene());
     overlays.add(render::Overlay::Velocity);
@@ -437,10 +415,8 @@ bool Editor::handleShortcut(Key key, std::uint8_t mods) {
     case Key::G: snap = !snap; note(snap ? "snap on" : "snap off"); return true;
     default: break;
     }
-    if (key >= Key::Num0 && key <= Key::Num9 &&
-        (key == Key::Num0 ? std::uint16_t(Tool::Count) > 9
-                          : std::uint16_t(key) - std::uint16_t(Key::Num1) < std::uint16_t(Tool::Count))) {
-        tool = key == Key::Num0 ? Tool(9) : Tool(std::uint16_t(key) - std::uint16_t(Key::Num1));
+    if (const std::optional<Tool> picked = toolForKey(key)) {
+        tool = *picked;
         springStart_ = {};
         polygonClicks_.clear();
         note(std::string("tool: ") + std::string(toolName(tool)));
@@ -472,26 +448,9 @@ std::optional<std::pair<Vec2, Vec2>> Editor::selectionRect() const {
     return std::make_pair(dragStartPx_, mouse_);
 }
 
-void Editor::placeAt(Vec2 world) {
-    const Vec2 at = snapped(world);
-    Entity created;
-    const std::string label = std::string("place ") + std::string(toolName(tool));
-    const bool done = applyEdit(label, [&](Scene& s) {
-        switch (tool) {
-        case Tool::Circle: created = addCircle(s, at); break;
-        case Tool::Box: created = addBox(s, at); break;
-        case Tool::Attractor: created = addAttractor(s, at); break;
-        default: return false;
-        }
-        return true;
-    });
-    if (done) selection = {created};
-}
-
 void Editor::handleViewportEvent(const InputEvent& e) {
     using T = InputEvent::Type;
     const Vec2 px{e.x, e.y};
-    const Registry& reg = doc.scene.registry;
     switch (e.type) {
     case T::Wheel:
         view.zoomAt(px, e.wheel);
@@ -519,135 +478,7 @@ void Editor::handleViewportEvent(const InputEvent& e) {
             else finishReferencePick(hit);
             return;
         }
-        switch (tool) {
-        case Tool::Select:
-        case Tool::Rotate: {
-            if (hit.isNull() && tool == Tool::Rotate && !selection.empty() && !additive_) {
-                hit = selection.front();  // rotate the selection about its first entity from anywhere
-            } else if (hit.isNull()) {
-                if (!additive_) selection.clear();
-                drag_ = Drag::BoxSelect;
-                return;
-            }
-            const bool selected = std::find(selection.begin(), selection.end(), hit) != selection.end();
-            if (additive_) {
-                if (selected) std::erase(selection, hit);
-                else selection.push_back(hit);
-                return;
-            }
-            if (!selected) selection = {hit};
-            dragPrimary_ = hit;
-            dragKey_ = newMergeKey();
-            if (sim.state() == SimState::Playing && tool == Tool::Select && reg.has<Position>(hit) &&
-                !(reg.has<Static>(hit) && reg.tryGet<Static>(hit)->value)) {
-                // Playing: a mouse spring, not an edit.
-                drag_ = Drag::MouseSpring;
-                sim.mouseSpring = std::make_pair(hit, world);
-                return;
-            }
-            dragStart_.clear();
-            angleStart_.clear();
-            planeStart_.clear();
-            for (Entity s : selection) {
-                if (const Position* p = reg.tryGet<Position>(s)) dragStart_.push_back({s, p->value});
-                if (const Plane* pl = reg.tryGet<Plane>(s)) planeStart_.push_back({s, pl->offset});
-                if (reg.has<Box>(s) || reg.has<Polygon>(s) || reg.has<Angle>(s)) {
-                    const Angle* a = reg.tryGet<Angle>(s);
-                    angleStart_.push_back({s, a ? a->value : 0.0});
-                }
-            }
-            drag_ = tool == Tool::Rotate ? Drag::Rotate : Drag::Move;
-            return;
-        }
-        case Tool::Circle:
-        case Tool::Box:
-        case Tool::Attractor: placeAt(world); return;
-        case Tool::Plane: drag_ = Drag::Plane; return;
-        case Tool::Spring: {
-            if (springStart_.isNull()) {
-                if (!hit.isNull() && isBody(reg, hit)) {
-                    springStart_ = hit;
-                    note("spring: click a second body, or empty space for an anchor (Esc cancels)");
-                } else {
-                    note("spring: click a body first");
-                }
-                return;
-            }
-            const Entity a = springStart_;
-            springStart_ = {};
-            Entity created;
-            const bool toBody = !hit.isNull() && hit != a && isBody(reg, hit);
-            const Vec2 anchor = snapped(world);
-            if (applyEdit("place spring", [&](Scene& s) {
-                    created = toBody ? addSpring(s, a, hit) : addAnchoredSpring(s, a, anchor);
-                    return true;
-                }))
-                selection = {created};
-            return;
-        }
-        case Tool::Joint: {
-            // First click: body a. Second click: body b, or empty space for
-            // the world; the second click's point is the anchor (for
-            // distance and rope, b's end: a's end is its centre).
-            if (springStart_.isNull()) {
-                if (!hit.isNull() && isBody(reg, hit)) {
-                    springStart_ = hit;
-                    note("joint: click a second body, or empty space to join to the world (Esc cancels)");
-                } else {
-                    note("joint: click a body first");
-                }
-                return;
-            }
-            const Entity a = springStart_;
-            springStart_ = {};
-            const Entity b = !hit.isNull() && hit != a && isBody(reg, hit) ? hit : Entity{};
-            Entity created;
-            std::string problem;
-            if (applyEdit("place " + jointType + " joint", [&](Scene& s) {
-                    created = addJoint(s, jointType, a, b, snapped(world), &problem);
-                    return !created.isNull();
-                }))
-                selection = {created};
-            else if (!problem.empty())
-                note("joint refused: " + problem);
-            return;
-        }
-        case Tool::Boids: {
-            drag_ = Drag::Boids;
-            dragKey_ = newMergeKey();
-            lastBoid_ = snapped(world);
-            Entity created;
-            applyEdit("boid brush", [&](Scene& s) {
-                created = addBoid(s, lastBoid_, {1.0, 0.0});
-                return true;
-            }, dragKey_);
-            return;
-        }
-        case Tool::Polygon: {
-            const Vec2 at = snapped(world);
-            if (polygonSides >= 3) {
-                drag_ = Drag::RegularPolygon;
-                dragStartWorld_ = at;
-                return;
-            }
-            // A click on the first vertex closes the outline.
-            if (polygonClicks_.size() >= 3 && length(px - view.toPixels(polygonClicks_.front())) <= 8.0) {
-                finishPolygon();
-                return;
-            }
-            std::vector<Vec2> next = polygonClicks_;
-            next.push_back(at);
-            if (convexHull(next).size() > 8) {
-                note("polygon: at most 8 vertices; press Enter to make it");
-                return;
-            }
-            polygonClicks_ = std::move(next);
-            note("polygon: " + std::to_string(polygonClicks_.size()) +
-                 " clicked; click more, then Enter, a right click or the first vertex (Esc cancels)");
-            return;
-        }
-        case Tool::Count: return;
-        }
+        if (tool < Tool::Count) (this->*toolTable()[std::size_t(tool)].press)(ToolPress{px, world, hit});
         return;
     }
     case T::MouseMove: {
@@ -660,51 +491,9 @@ void Editor::handleViewportEvent(const InputEvent& e) {
         case Drag::MouseSpring:
             if (sim.mouseSpring) sim.mouseSpring->second = world;
             return;
-        case Drag::Move: {
-            Vec2 offset = world - dragStartWorld_;
-            // Snap the grabbed entity's position to the grid; the rest keep
-            // their offsets to it.
-            for (const auto& [ent, start] : dragStart_)
-                if (ent == dragPrimary_) offset = snapped(start + offset) - start;
-            if (offset == Vec2{}) return;
-            applyEdit("move", [&](Scene& s) {
-                for (const auto& [ent, start] : dragStart_)
-                    if (Position* p = s.registry.tryGet<Position>(ent)) p->value = start + offset;
-                for (const auto& [ent, off0] : planeStart_)
-                    if (Plane* pl = s.registry.tryGet<Plane>(ent)) pl->offset = off0 + dot(pl->normal, offset);
-                return true;
-            }, dragKey_);
-            return;
-        }
-        case Drag::Rotate: {
-            const Position* p = reg.tryGet<Position>(dragPrimary_);
-            if (!p) return;
-            const Vec2 a = dragStartWorld_ - p->value, b = world - p->value;
-            double delta = std::atan2(cross(a, b), dot(a, b));
-            if (snap) delta = std::round(delta / (std::numbers::pi / 12.0)) * (std::numbers::pi / 12.0);  // 15 degrees
-            applyEdit("rotate", [&](Scene& s) {
-                for (const auto& [ent, start] : angleStart_) s.registry.emplace(ent, Angle{start + delta});
-                return !angleStart_.empty();
-            }, dragKey_);
-            return;
-        }
-        case Drag::Boids: {
-            const Vec2 at = snapped(world);
-            const Vec2 d = at - lastBoid_;
-            const double l = length(d);
-            if (l < 0.6) return;  // brush spacing, metres
-            // Deterministic jitter (LCG) so a brush stroke is not a line.
-            boidSeed_ = boidSeed_ * 1664525u + 1013904223u;
-            const double jitter = (double(boidSeed_ >> 8) / double(1u << 24) - 0.5) * 0.4;
-            const Vec2 dir = d / l;
-            const Vec2 pos = at + Vec2{-dir.y, dir.x} * jitter;
-            lastBoid_ = at;
-            applyEdit("boid brush", [&](Scene& s) {
-                addBoid(s, pos, dir * 2.0);
-                return true;
-            }, dragKey_);
-            return;
-        }
+        case Drag::Move: dragMove(world); return;
+        case Drag::Rotate: dragRotate(world); return;
+        case Drag::Boids: dragBoids(world); return;
         default: return;
         }
     }
@@ -718,41 +507,11 @@ void Editor::handleViewportEvent(const InputEvent& e) {
             sim.mouseSpring.reset();
             sim.sceneChanged();
         } else if (finished == Drag::BoxSelect) {
-            if (length(px - dragStartPx_) < 3.0) return;  // a click on empty space: selection already cleared
-            std::vector<Entity> inside = entitiesInRect(doc.scene, dragStartWorld_, view.toWorld(px));
-            if (additive_) {
-                for (Entity ent : inside)
-                    if (std::find(selection.begin(), selection.end(), ent) == selection.end()) selection.push_back(ent);
-            } else {
-                selection = std::move(inside);
-            }
+            releaseBoxSelect(px);
         } else if (finished == Drag::RegularPolygon) {
-            const std::vector<Vec2> outline = regularOutline();
-            if (outline.empty()) {
-                note("polygon: drag out its size from the centre");
-                return;
-            }
-            Entity created;
-            std::string problem;
-            if (applyEdit("place polygon", [&](Scene& s) {
-                    created = addPolygon(s, outline, &problem);
-                    return !created.isNull();
-                }))
-                selection = {created};
-            else if (!problem.empty())
-                note("refused: " + problem);
+            releaseRegularPolygon();
         } else if (finished == Drag::Plane) {
-            const Vec2 world = view.toWorld(px);
-            const Vec2 through = snapped(dragStartWorld_);
-            // Dragging points the normal (the side bodies stay on); a click
-            // makes a floor.
-            const Vec2 normal = length(px - dragStartPx_) > 5.0 ? world - dragStartWorld_ : Vec2{0.0, 1.0};
-            Entity created;
-            if (applyEdit("place wall", [&](Scene& s) {
-                    created = addPlane(s, through, normal);
-                    return true;
-                }))
-                selection = {created};
+            releaseWall(px);
         }
         return;
     }
@@ -808,48 +567,6 @@ bool Editor::recover(const std::filesystem::path& recoveryFile) {
 void Editor::discardRecovery() {
     std::error_code ec;
     std::filesystem::remove(doc.recoveryPath(configDir), ec);
-}
-
-std::vector<Vec2> Editor::polygonPreview() const {
-    if (tool != Tool::Polygon) return {};
-    const Vec2 cursor = snapped(view.toWorld(mouse_));
-    if (polygonSides >= 3) return drag_ == Drag::RegularPolygon ? regularOutline() : std::vector<Vec2>{};
-    if (polygonClicks_.empty()) return {};
-    // The hull with the cursor as the next vertex, unless that breaks the limit.
-    std::vector<Vec2> points = polygonClicks_;
-    points.push_back(cursor);
-    std::vector<Vec2> hull = convexHull(points);
-    if (hull.size() > 8 || hull.size() < 3) hull = convexHull(polygonClicks_);
-    return hull;
-}
-
-std::vector<Vec2> Editor::regularOutline() const {
-    const Vec2 arm = snapped(view.toWorld(mouse_)) - dragStartWorld_;
-    const double radius = length(arm);
-    if (!(radius > 1e-3) || polygonSides < 3) return {};  // a click, not a drag
-    std::vector<Vec2> outline = regularPolygon(polygonSides, radius, std::atan2(arm.y, arm.x));
-    for (Vec2& v : outline) v += dragStartWorld_;
-    return outline;
-}
-
-bool Editor::finishPolygon() {
-    const std::vector<Vec2> hull = convexHull(polygonClicks_);
-    polygonClicks_.clear();
-    std::string problem;
-    Entity created;
-    if (hull.size() < 3) {
-        note("polygon: needs 3 vertices that are not on one line");
-        return false;
-    }
-    if (!applyEdit("place polygon", [&](Scene& s) {
-            created = addPolygon(s, hull, &problem);
-            return !created.isNull();
-        })) {
-        note("refused: " + problem);
-        return false;
-    }
-    selection = {created};
-    return true;
 }
 
 render::FrameInput Editor::frameInput() const {

@@ -9,9 +9,10 @@
 #include "app/document.hpp"
 #include "app/events.hpp"
 #include "app/simulation.hpp"
+#include "app/tools/tools.hpp"
 #include "app/view_camera.hpp"
 
-#include "render/frame.hpp"
+#include "view/frame_input.hpp"
 
 #include "stepwise/component_table.hpp"
 
@@ -22,11 +23,6 @@
 #include <vector>
 
 namespace stepwise::editor {
-
-enum class Tool : std::uint8_t { Select, Rotate, Circle, Box, Plane, Spring, Attractor, Boids, Joint, Polygon, Count };
-std::string_view toolName(Tool t);
-/// Shortcut key of each tool ("1" .. "8").
-Key toolKey(Tool t);
 
 /// Actions the model cannot finish alone: they need a dialog.
 enum class UiRequest : std::uint8_t { None, OpenDialog, SaveAsDialog, ConfirmDiscard, Help };
@@ -189,6 +185,26 @@ private:
     bool mouseKnown_ = false;  ///< the cursor has been over the viewport
     double pickRadius() const;
     void placeAt(Vec2 world);
+
+    // Tool handlers (editor/app/tools/): a left press with each tool (the
+    // table in tools.cpp picks one), then the drags and releases it starts.
+    friend const std::array<ToolInfo, kToolCount>& toolTable();
+    void pressSelectOrRotate(const ToolPress& press);  // select_tools.cpp
+    void dragMove(Vec2 world);
+    void dragRotate(Vec2 world);
+    void releaseBoxSelect(Vec2 px);
+    void pressPlace(const ToolPress& press);           // place_tools.cpp
+    void pressWall(const ToolPress& press);
+    void releaseWall(Vec2 px);
+    void pressSpring(const ToolPress& press);          // link_tools.cpp
+    void pressJoint(const ToolPress& press);
+    /// Spring and joint tools: while no first end is chosen, takes `hit` as
+    /// it when it is a body (or says to click one) and returns true.
+    bool takeFirstEnd(Entity hit, std::string_view toolWord, std::string_view otherwise);
+    void pressBoids(const ToolPress& press);           // boids_tool.cpp
+    void dragBoids(Vec2 world);
+    void pressPolygon(const ToolPress& press);         // polygon_tool.cpp
+    void releaseRegularPolygon();
     /// The regular polygon the current drag describes (world metres), or
     /// empty for a drag shorter than a millimetre.
     std::vector<Vec2> regularOutline() const;

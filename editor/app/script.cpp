@@ -1,9 +1,10 @@
 #include "app/script.hpp"
 
+#include "app/script_actions.hpp"
+
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
-#include <set>
 #include <sstream>
 
 namespace stepwise::editor {
@@ -33,14 +34,14 @@ std::vector<std::string> splitWords(const std::string& line, std::string& quoted
     return words;
 }
 
-bool toNumber(const std::string& s, double& out) {
+} // namespace
+
+bool parseScriptNumber(const std::string& s, double& out) {
     if (s.empty()) return false;
     char* end = nullptr;
     out = std::strtod(s.c_str(), &end);
     return end == s.c_str() + s.size() && std::isfinite(out);
 }
-
-} // namespace
 
 Result<std::pair<Key, std::uint8_t>> parseChord(std::string_view chord) {
     std::uint8_t mods = kModNone;
@@ -67,9 +68,6 @@ Result<std::vector<ScriptCommand>> parseScript(std::string_view text, std::strin
     std::vector<ScriptCommand> out;
     std::istringstream in{std::string(text)};
     int lineNo = 0;
-    static const std::set<std::string, std::less<>> kActions{
-        "play", "pause", "step", "stepback", "reset", "undo", "redo", "tool", "select", "overlay", "system",
-        "snap", "timescale", "breakon", "fit", "new", "open", "save", "saveas", "savestate", "screenshot", "window", "tab"};
     for (std::string line; std::getline(in, line);) {
         ++lineNo;
         if (const auto hash = line.find('#'); hash != std::string::npos && line.find('"') == std::string::npos)
@@ -92,7 +90,7 @@ Result<std::vector<ScriptCommand>> parseScript(std::string_view text, std::strin
                 ++i;
             }
             if (i + 2 > w.size()) return false;
-            if (!toNumber(w[i], p.value.x) || !toNumber(w[i + 1], p.value.y)) return false;
+            if (!parseScriptNumber(w[i], p.value.x) || !parseScriptNumber(w[i + 1], p.value.y)) return false;
             i += 2;
             return true;
         };
@@ -124,7 +122,7 @@ Result<std::vector<ScriptCommand>> parseScript(std::string_view text, std::strin
             if (!point(i, c.a)) return fail("expected: drag [world] X0 Y0 X1 Y1 [MOVES] [right|middle]");
             const bool world = c.a.world;
             c.b.world = world;
-            if (i + 2 > w.size() || !toNumber(w[i], c.b.value.x) || !toNumber(w[i + 1], c.b.value.y))
+            if (i + 2 > w.size() || !parseScriptNumber(w[i], c.b.value.x) || !parseScriptNumber(w[i + 1], c.b.value.y))
                 return fail("expected: drag [world] X0 Y0 X1 Y1 [MOVES] [right|middle]");
             i += 2;
             c.count = 8;
@@ -134,13 +132,13 @@ Result<std::vector<ScriptCommand>> parseScript(std::string_view text, std::strin
                 else if (w[i] == "middle") c.button = MouseButton::Middle;
                 else if (w[i] == "shift") c.mods |= kModShift;
                 else if (w[i] == "ctrl") c.mods |= kModCtrl;
-                else if (toNumber(w[i], n) && n >= 1 && n <= 1000) c.count = int(n);
+                else if (parseScriptNumber(w[i], n) && n >= 1 && n <= 1000) c.count = int(n);
                 else return fail("unexpected \"" + w[i] + "\" (expected a move count 1..1000, right, middle, shift or ctrl)");
             }
             c.hasPoint = true;
         } else if (verb == "wheel") {
             c.kind = ScriptCommand::Kind::Wheel;
-            if (w.size() < 2 || !toNumber(w[1], c.number)) return fail("expected: wheel NOTCHES [[world] X Y]");
+            if (w.size() < 2 || !parseScriptNumber(w[1], c.number)) return fail("expected: wheel NOTCHES [[world] X Y]");
             std::size_t i = 2;
             if (i < w.size()) {
                 if (!point(i, c.a)) return fail("expected: wheel NOTCHES [[world] X Y]");
@@ -152,43 +150,23 @@ Result<std::vector<ScriptCommand>> parseScript(std::string_view text, std::strin
             c.text = quoted;
         } else if (verb == "wait") {
             double n = 0;
-            if (w.size() != 2 || !toNumber(w[1], n) || n < 0 || n > 1e6) return fail("expected: wait FRAMES (0..1000000)");
+            if (w.size() != 2 || !parseScriptNumber(w[1], n) || n < 0 || n > 1e6) return fail("expected: wait FRAMES (0..1000000)");
             c.kind = ScriptCommand::Kind::Wait;
             c.count = int(n);
-        } else if (kActions.count(verb)) {
+        } else if (const ScriptAction* action = findScriptAction(verb)) {
             c.kind = ScriptCommand::Kind::Action;
             c.text = verb;
             c.args.assign(w.begin() + 1, w.end());
             const std::size_t n = c.args.size();
-            auto needs = [&](std::size_t lo, std::size_t hi, const char* usage) -> std::optional<Error> {
-                if (n < lo || n > hi) return fail(std::string("expected: ") + usage);
-                return std::nullopt;
-            };
-            std::optional<Error> bad;
-            if (verb == "step" || verb == "stepback") {
-                bad = needs(0, 1, (verb + " [N]").c_str());
-                double k = 1;
-                if (!bad && n == 1 && (!toNumber(c.args[0], k) || k < 1 || k > 100000)) bad = fail("N must be 1..100000");
-                c.count = int(k);
-            } else if (verb == "tool") bad = needs(1, 1, "tool select|rotate|circle|box|plane|spring|attractor|boids");
-            else if (verb == "select") bad = needs(1, 1000, "select NAME... | select none | select all");
-            else if (verb == "overlay" || verb == "system" || verb == "window")
-                bad = needs(2, 2, (verb + " NAME on|off").c_str());
-            else if (verb == "tab") bad = needs(1, 1, "tab contacts|plots|profile|history");
-            else if (verb == "snap") bad = needs(1, 1, "snap on|off");
-            else if (verb == "timescale") {
-                bad = needs(1, 1, "timescale X");
-                if (!bad && (!toNumber(c.args[0], c.number) || c.number < 0)) bad = fail("timescale: expected a number >= 0");
-            } else if (verb == "breakon") bad = needs(1, 1, "breakon NAME|none");
-            else if (verb == "open" || verb == "saveas" || verb == "savestate" || verb == "screenshot")
-                bad = needs(1, 1, (verb + " PATH").c_str());
-            else bad = needs(0, 0, verb.c_str());
-            if (bad) return *bad;
+            if (n < action->minArgs || n > action->maxArgs) return fail("expected: " + action->usage);
+            if (action->parse)
+                if (Result<void> parsed = action->parse(c); !parsed) return fail(parsed.error());
         } else {
+            std::string actions;
+            for (const ScriptAction& a : scriptActions()) actions += (actions.empty() ? "" : ", ") + a.name;
             return fail("unknown command \"" + verb +
-                        "\" (expected key, keydown, keyup, move, click, drag, wheel, text, wait, or an action: play, "
-                        "pause, step, stepback, reset, undo, redo, tool, select, overlay, system, snap, timescale, "
-                        "breakon, fit, new, open, save, saveas, savestate, screenshot, window, tab)");
+                        "\" (expected key, keydown, keyup, move, click, drag, wheel, text, wait, or an action: " +
+                        actions + ")");
         }
         out.push_back(std::move(c));
     }

@@ -12,7 +12,7 @@
 ///   wheel NOTCHES [X Y]           text "hello"
 ///   wait N                        (N frames; every command takes at least one)
 ///   play | pause | step [N] | stepback [N] | reset | undo | redo
-///   tool select|rotate|circle|box|plane|spring|attractor|boids
+///   tool select|rotate|circle|box|plane|spring|attractor|boids|joint|polygon (toolScriptNames)
 ///   select NAME...  | select none   overlay NAME on|off   system NAME on|off
 ///   snap on|off     timescale X     breakon NAME|none     fit
 ///   new | open PATH | save | saveas PATH | savestate PATH | screenshot PATH
@@ -53,6 +53,9 @@ struct ScriptCommand {
 
 /// Parses a whole script. `name` prefixes messages ("demo.txt:3: ...").
 Result<std::vector<ScriptCommand>> parseScript(std::string_view text, std::string_view name);
+
+/// A finite number written whole ("1.5", "-2", "1e3"); false otherwise.
+bool parseScriptNumber(const std::string& text, double& out);
 
 /// "Ctrl+Shift+Z" -> key and modifiers.
 Result<std::pair<Key, std::uint8_t>> parseChord(std::string_view chord);

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <vector>
 
 namespace stepwise::cli {
 
@@ -41,6 +42,16 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
             // An existing file of that name is ENOTDIR ("Not a directory").
             reportError("--out: cannot create the folder " + *out + ": " +
                         (ec ? ec.message() : std::string("not a directory")));
+            exitCode = kExitBadInput;
+            return;
+        }
+        // Each file the report replaces, also before measuring: a read-only
+        // accuracy.md is refused now, not after the run.
+        std::vector<OutputFile> outputs;
+        for (const char* name : {"accuracy.csv", "accuracy.md", "accuracy.png"})
+            outputs.push_back({"--out", (options->out / name).string()});
+        if (std::string problem = checkOutputs({}, outputs); !problem.empty()) {
+            std::cerr << problem << "\n";
             exitCode = kExitBadInput;
             return;
         }

@@ -6,6 +6,7 @@
 // coordinates in the shaders would lose sub-pixel precision past ~1e4 m).
 
 #include "frame.hpp"
+#include "scene_bounds.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/world.hpp"
@@ -130,46 +131,6 @@ std::string formatLength(double metres) {
     if (metres < 1.0) return formatNumber(metres * 100.0) + " cm";
     if (metres >= 1000.0) return formatNumber(metres / 1000.0) + " km";
     return formatNumber(metres) + " m";
-}
-
-struct Bounds {
-    Vec2 lo{1e300, 1e300};
-    Vec2 hi{-1e300, -1e300};
-    bool empty() const { return lo.x > hi.x; }
-    void add(Vec2 p, double r = 0.0) {
-        lo = {std::min(lo.x, p.x - r), std::min(lo.y, p.y - r)};
-        hi = {std::max(hi.x, p.x + r), std::max(hi.y, p.y + r)};
-    }
-};
-
-/// The axis-aligned box around an entity's shape, metres: its centre and
-/// half extents (the centre is the position except for a polygon, whose
-/// outline need not be centred on it).
-struct ShapeBox {
-    Vec2 centre, half;
-};
-std::optional<ShapeBox> shapeBox(const Scene& scene, Entity e) {
-    const Position* p = scene.registry.tryGet<Position>(e);
-    if (!p) return std::nullopt;
-    if (const Radius* r = scene.registry.tryGet<Radius>(e)) return ShapeBox{p->value, Vec2{r->value, r->value}};
-    const Angle* a = scene.registry.tryGet<Angle>(e);
-    const double angle = a ? a->value : 0.0;
-    if (const Box* b = scene.registry.tryGet<Box>(e)) {
-        const double c = std::abs(std::cos(angle)), s = std::abs(std::sin(angle));
-        return ShapeBox{p->value, Vec2{0.5 * (c * b->width + s * b->height), 0.5 * (s * b->width + c * b->height)}};
-    }
-    if (const Polygon* poly = scene.registry.tryGet<Polygon>(e); poly && !poly->vertices.empty()) {
-        const double c = std::cos(angle), s = std::sin(angle);
-        Bounds bounds;
-        for (const Vec2 v : poly->vertices) bounds.add(p->value + Vec2{c * v.x - s * v.y, s * v.x + c * v.y});
-        return ShapeBox{0.5 * (bounds.lo + bounds.hi), 0.5 * (bounds.hi - bounds.lo)};
-    }
-    return std::nullopt;
-}
-
-bool isStatic(const Scene& scene, Entity e) {
-    const Static* s = scene.registry.tryGet<Static>(e);
-    return s && s->value;
 }
 
 class Builder {
@@ -1105,109 +1066,6 @@ void Builder::hud() {
 } // namespace
 
 // ---------------------------------------------------------------------------
-
-const std::vector<std::pair<std::string_view, Overlay>>& overlayNames() {
-    static const std::vector<std::pair<std::string_view, Overlay>> names = {
-        {"velocity", Overlay::Velocity}, {"velocity-field", Overlay::VelocityField},
-        {"force-field", Overlay::ForceField}, {"force", Overlay::Force}, {"net-force", Overlay::NetForce},
-        {"contacts", Overlay::Contacts}, {"aabb", Overlay::Aabb},
-        {"trails", Overlay::Trails}, {"joints", Overlay::Joints},
-    };
-    return names;
-}
-
-Result<OverlaySet> parseOverlayList(std::string_view list) {
-    OverlaySet set;
-    std::size_t start = 0;
-    while (start <= list.size()) {
-        std::size_t comma = list.find(',', start);
-        if (comma == std::string_view::npos) comma = list.size();
-        std::string_view item = list.substr(start, comma - start);
-        while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
-        while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
-        if (item == "all") {
-            for (const auto& [name, o] : overlayNames()) set.add(o);
-        } else if (item == "none" || (item.empty() && list.find_first_not_of(' ') == std::string_view::npos)) {
-        } else {
-            bool found = false;
-            for (const auto& [name, o] : overlayNames())
-                if (name == item) { set.add(o); found = true; }
-            if (!found) {
-                std::string known;
-                for (const auto& [name, o] : overlayNames()) known += std::string(known.empty() ? "" : ", ") + std::string(name);
-                return Error{"unknown overlay \"" + std::string(item) + "\"; known overlays: " + known + ", all, none"};
-            }
-        }
-        start = comma + 1;
-    }
-    return set;
-}
-
-Camera fitCamera(const Scene& scene, int widthPx, int heightPx) {
-    Bounds b;
-    const Registry& reg = scene.registry;
-    for (Entity e : reg.entities()) {
-        if (const Position* p = reg.tryGet<Position>(e)) {
-            if (reg.has<Spring>(e)) continue;
-            if (const auto shape = shapeBox(scene, e)) {
-                b.add(shape->centre - shape->half);
-                b.add(shape->centre + shape->half);
-            } else {
-                b.add(p->value, 0.25);
-            }
-        }
-        if (const Spring* s = reg.tryGet<Spring>(e); s && s->anchor) b.add(*s->anchor, 0.25);
-    }
-    // Planes are infinite: show the part nearest the rest of the scene, and
-    // a metre of the solid side so the hatching reads.
-    const Vec2 middle = b.empty() ? Vec2{} : 0.5 * (b.lo + b.hi);
-    reg.each<Plane>([&](Entity, const Plane& p) {
-        const Vec2 q = middle - (dot(p.normal, middle) - p.offset) * p.normal;
-        b.add(q - p.normal * 1.0);
-        b.add(q);
-    });
-    Camera cam;
-    if (b.empty()) return cam;
-    const Vec2 size{std::max(b.hi.x - b.lo.x, 2.0), std::max(b.hi.y - b.lo.y, 2.0)};
-    cam.center = 0.5 * (b.lo + b.hi);
-    // 12% margin each side.
-    const double ppm = std::min(double(widthPx) / (size.x * 1.24), double(heightPx) / (size.y * 1.24));
-    cam.zoom = ppm * 720.0 / double(heightPx);
-    return cam;
-}
-
-Camera sceneCamera(const Scene& scene, int widthPx, int heightPx) {
-    if (scene.view) return Camera{scene.view->center, scene.view->zoom};
-    return fitCamera(scene, widthPx, heightPx);
-}
-
-TrailRecorder::Trail& TrailRecorder::trailFor(Entity e) {
-    if (e.index >= slotOfIndex_.size()) slotOfIndex_.resize(std::size_t(e.index) + 1, 0);
-    std::uint32_t& slot = slotOfIndex_[e.index];
-    if (slot == 0 || trails_[slot - 1].entity != e) {
-        trails_.push_back({e, {}});
-        slot = std::uint32_t(trails_.size());
-    }
-    return trails_[slot - 1];
-}
-
-void TrailRecorder::record(const World& world) {
-    for (std::size_t i = 0; i < world.bodyCount(); ++i) {
-        Trail& t = trailFor(world.bodyEntity(i));
-        t.points.push_back(world.bodyPosition(i));
-        if (t.points.size() > capacity_) t.points.pop_front();
-    }
-}
-
-void TrailRecorder::record(const Scene& scene) {
-    for (Entity e : scene.registry.entities()) {
-        const Position* p = scene.registry.tryGet<Position>(e);
-        if (!p || isStatic(scene, e) || scene.registry.has<Spring>(e)) continue;
-        Trail& t = trailFor(e);
-        t.points.push_back(p->value);
-        if (t.points.size() > capacity_) t.points.pop_front();
-    }
-}
 
 std::size_t floatsPerInstance(BatchKind kind) {
     switch (kind) {

@@ -14,6 +14,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
 #include "stepwise/scene.hpp"
+#include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
 #include "world/world_impl.hpp"
 
@@ -27,10 +28,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -536,8 +539,14 @@ std::string writeGnuplot(const std::vector<Problem>& problems, const std::vector
     const std::filesystem::path scriptPath = dir / "accuracy.gp";
     std::ofstream(scriptPath) << script.str();
     const std::string command = "gnuplot '" + scriptPath.string() + "' 2>'" + (dir / "gnuplot.log").string() + "'";
-    if (std::system(command.c_str()) != 0)
-        return "gnuplot failed (is gnuplot-nox installed?); see " + (dir / "gnuplot.log").string();
+    if (std::system(command.c_str()) != 0) {
+        // The staging folder goes away: the message carries the log's start.
+        std::ifstream logFile(dir / "gnuplot.log");
+        std::string first(400, '\0');
+        logFile.read(first.data(), std::streamsize(first.size()));
+        first.resize(std::size_t(logFile.gcount()));
+        return "gnuplot failed (is gnuplot-nox installed?): " + first;
+    }
     return {};
 }
 
@@ -670,22 +679,24 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
 
     const BarnesHutSummary tree = barnesHut(quick, rows, log);
 
-    // CSV.
+    // Nothing is written until everything is ready: the CSV and the
+    // Markdown are built in memory, the plot is drawn in a private staging
+    // folder, and then each output replaces its file atomically. A run that
+    // fails (or is killed) leaves the previous report whole.
+    std::ostringstream csv;
+    std::ostringstream md;
     {
-        std::ofstream csv(options.out / "accuracy.csv");
         csv << "problem,method,dt,steps,error_m,seconds_per_step,reference,parameter\n";
         for (const AccuracyRow& r : rows)
             csv << r.problem << "," << r.method << "," << num(r.dt, 17) << "," << r.steps << ","
                 << (std::isfinite(r.error) ? num(r.error, 6) : "inf") << ","
                 << (r.secondsPerStep > 0 ? num(r.secondsPerStep, 6) : "") << ",\""
                 << r.reference << "\"," << num(r.parameter, 6) << "\n";
-        if (!csv) return "cannot write " + (options.out / "accuracy.csv").string();
     }
 
     // Markdown: per problem, each method's observed order (slope between
     // the two finest dt), and the CPU cost to reach 1e-3 m and 1e-6 m.
     {
-        std::ofstream md(options.out / "accuracy.md");
         md << "# Speed against error\n\n"
            << "Error: largest final position error over the bodies, metres, against the reference. Cost: CPU "
               "seconds per step (best of repeats, one thread). `odeint_*` rows: Boost.Odeint steppers on the "
@@ -752,11 +763,24 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
            << "x untraced), tree " << num(tree.treeTraced, 3) << " s (" << num(tree.treeTraced / tree.treeFiveSteps, 3)
            << "x).\n\n";
         md << "![work-precision](accuracy.png)\n";
-        if (!md) return "cannot write " + (options.out / "accuracy.md").string();
     }
-    if (std::string problem = writeGnuplot(problems, rows, options.out, tree.exactSecondsPerEvaluation);
-        !problem.empty())
-        return problem;
+    std::string staging = (options.out / ".accuracy-XXXXXX").string();
+    if (!::mkdtemp(staging.data())) return "cannot write in " + options.out.string() + ": " + std::strerror(errno);
+    const std::filesystem::path stagingDir(staging);
+    std::string problem = writeGnuplot(problems, rows, stagingDir, tree.exactSecondsPerEvaluation);
+    if (problem.empty()) {
+        if (Result<void> w = writeFileAtomically(options.out / "accuracy.csv", csv.str()); !w) problem = w.error();
+    }
+    if (problem.empty()) {
+        if (Result<void> w = writeFileAtomically(options.out / "accuracy.md", md.str()); !w) problem = w.error();
+    }
+    if (problem.empty()) {
+        // Same folder, same filesystem: rename() replaces the old plot whole.
+        std::filesystem::rename(stagingDir / "accuracy.png", options.out / "accuracy.png", ec);
+        if (ec) problem = (options.out / "accuracy.png").string() + ": error: cannot write: " + ec.message();
+    }
+    std::filesystem::remove_all(stagingDir, ec);
+    if (!problem.empty()) return problem;
     if (rowsOut) *rowsOut = std::move(rows);
     return {};
 }

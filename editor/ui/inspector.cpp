@@ -4,7 +4,7 @@
 // An edit applies to every selected entity that has the component, as one
 // undo step per widget drag.
 
-#include "ui/editor_ui.hpp"
+#include "ui/panels/panels.hpp"
 
 #include "app/scene_edit.hpp"
 
@@ -23,9 +23,6 @@ using editor::Editor;
 using editor::FieldValue;
 
 namespace {
-
-const ImVec4 kDim{0.60f, 0.63f, 0.68f, 1.0f};
-const ImVec4 kRed{0.95f, 0.42f, 0.38f, 1.0f};
 
 /// Drag speed: about 0.5% of the value per pixel, at least 0.001.
 float speedFor(double v) { return float(std::max(1e-3, std::abs(v) * 0.005)); }

@@ -13,12 +13,15 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
 #include <tuple>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace stepwise {
 
@@ -342,61 +345,105 @@ void readWorld(const Json& v, WorldSettings& world) {
     }
 }
 
+/// Whether the entity has a shape, so contacts (and their warm start) can
+/// name it.
+bool collides(const Registry& registry, Entity e) {
+    return registry.has<Radius>(e) || registry.has<Box>(e) || registry.has<Polygon>(e) || registry.has<Plane>(e);
+}
+
+/// Reads one `solver_state` entry: an object with the given keys, each read
+/// by `readField(key, value, pointer)`; `required` keys must be present.
+template <std::size_t N, typename ReadField>
+void readEntry(const Json& entry, const std::string& at, std::string_view what,
+               const std::array<std::string_view, N>& keys, std::size_t required, ReadField readField) {
+    if (!entry.is_object()) refuse(at, "expected " + std::string(what) + " {" + joinNames(keys) + "}, got " + describeFound(entry));
+    std::array<bool, N> seen{};
+    for (const auto& [field, fv] : entry.items()) {
+        const auto k = std::find(keys.begin(), keys.end(), field);
+        if (k == keys.end())
+            refuse(child(at, field), "unknown key \"" + field + "\" in " + std::string(what) + ". Known keys: " + joinNames(keys));
+        seen[std::size_t(k - keys.begin())] = true;
+        readField(field, fv, child(at, field));
+    }
+    for (std::size_t k = 0; k < required; ++k)
+        if (!seen[k]) refuse(at, "missing \"" + std::string(keys[k]) + "\"");
+}
+
 /// `solver_state` (an addition): the warm start a resumed run needs. Read
 /// after the entities, since its entries name them. An entity is named by
 /// its `name`, or by its index in `entities` when it has none.
 SolverState readSolverState(const Json& v, const Registry& registry) {
     const std::string pointer = "/solver_state";
-    if (!v.is_object()) refuse(pointer, "expected an object {\"contacts\": [...]}, got " + describeFound(v));
+    if (!v.is_object())
+        refuse(pointer, "expected an object {\"contacts\": [...], \"joints\": [...]}, got " + describeFound(v));
     const auto& entities = registry.entities();
     std::map<std::string, Entity, std::less<>> byName;
     for (const Entity e : entities)
         if (const Name* n = registry.tryGet<Name>(e)) byName.emplace(n->value, e);
     auto entityAt = [&](const Json& ref, const std::string& at) -> Entity {
-        Entity e;
         if (ref.is_string()) {
             const auto it = byName.find(ref.get<std::string>());
             if (it == byName.end()) refuse(at, "no entity is named " + ref.dump());
-            e = it->second;
-        } else if (ref.is_number_integer() || ref.is_number_unsigned()) {
-            const long index = readInteger(ref, at, 0, long(entities.size()) - 1);
-            e = entities[std::size_t(index)];
-        } else {
-            refuse(at, "expected an entity name or index, got " + describeFound(ref));
+            return it->second;
         }
-        if (!registry.has<Radius>(e) && !registry.has<Box>(e) && !registry.has<Plane>(e))
-            refuse(at, "entity " + ref.dump() + " has no shape (radius, box or plane), so it has no contacts");
+        if (ref.is_number_integer() || ref.is_number_unsigned())
+            return entities[std::size_t(readInteger(ref, at, 0, long(entities.size()) - 1))];
+        refuse(at, "expected an entity name or index, got " + describeFound(ref));
+    };
+    auto shapeAt = [&](const Json& ref, const std::string& at) {
+        const Entity e = entityAt(ref, at);
+        if (!collides(registry, e))
+            refuse(at, "entity " + ref.dump() + " has no shape (radius, box, polygon or plane), so it has no contacts");
         return e;
     };
+    static constexpr std::array<std::string_view, 5> kContactKeys{"a", "b", "feature", "normal_impulse",
+                                                                  "tangent_impulse"};
+    // "joint" is required; an impulse left out is +0.
+    static constexpr std::array<std::string_view, 7> kJointKeys{
+        "joint", "linear_impulse", "angular_impulse", "axial_impulse", "motor_impulse", "lower_impulse", "upper_impulse"};
     SolverState state;
     for (const auto& [key, value] : v.items()) {
         const std::string at = child(pointer, key);
-        if (key != "contacts") refuse(at, "unknown key \"" + key + "\" in solver_state. Known keys: contacts");
-        if (!value.is_array()) refuse(at, "expected an array of contacts, got " + describeFound(value));
-        state.contacts.reserve(value.size());
-        for (std::size_t i = 0; i < value.size(); ++i) {
-            const Json& c = value[i];
-            const std::string ci = child(at, i);
-            if (!c.is_object())
-                refuse(ci, "expected {\"a\", \"b\", \"feature\", \"normal_impulse\", \"tangent_impulse\"}, got " +
-                               describeFound(c));
-            ContactImpulse impulse;
-            bool seen[5] = {false, false, false, false, false};
-            for (const auto& [field, fv] : c.items()) {
-                const std::string fa = child(ci, field);
-                if (field == "a") impulse.a = entityAt(fv, fa), seen[0] = true;
-                else if (field == "b") impulse.b = entityAt(fv, fa), seen[1] = true;
-                else if (field == "feature") impulse.feature = std::uint32_t(readInteger(fv, fa, 0, 0xFFFF)), seen[2] = true;
-                else if (field == "normal_impulse") impulse.normalImpulse = readNumber(fv, fa, NumberRange{}), seen[3] = true;
-                else if (field == "tangent_impulse") impulse.tangentImpulse = readNumber(fv, fa, NumberRange{}), seen[4] = true;
-                else
-                    refuse(fa, "unknown key \"" + field +
-                                   "\" in a contact. Known keys: a, b, feature, normal_impulse, tangent_impulse");
+        if (key != "contacts" && key != "joints")
+            refuse(at, "unknown key \"" + key + "\" in solver_state. Known keys: contacts, joints");
+        if (!value.is_array()) refuse(at, "expected an array of " + key + ", got " + describeFound(value));
+        if (key == "contacts") {
+            state.contacts.reserve(value.size());
+            for (std::size_t i = 0; i < value.size(); ++i) {
+                ContactImpulse c;
+                readEntry(value[i], child(at, i), "a contact", kContactKeys, kContactKeys.size(),
+                          [&](const std::string& field, const Json& fv, const std::string& fa) {
+                              if (field == "a") c.a = shapeAt(fv, fa);
+                              else if (field == "b") c.b = shapeAt(fv, fa);
+                              else if (field == "feature") c.feature = std::uint32_t(readInteger(fv, fa, 0, 0xFFFF));
+                              else if (field == "normal_impulse") c.normalImpulse = readNumber(fv, fa, NumberRange{});
+                              else c.tangentImpulse = readNumber(fv, fa, NumberRange{});
+                          });
+                state.contacts.push_back(c);
             }
-            static constexpr const char* kRequired[5] = {"a", "b", "feature", "normal_impulse", "tangent_impulse"};
-            for (int k = 0; k < 5; ++k)
-                if (!seen[k]) refuse(ci, std::string("missing \"") + kRequired[k] + "\"");
-            state.contacts.push_back(impulse);
+            continue;
+        }
+        state.joints.reserve(value.size());
+        std::unordered_set<Entity> seenJoints;
+        for (std::size_t i = 0; i < value.size(); ++i) {
+            JointImpulse j;
+            // Limits and a rope only push one way: their impulses are >= 0.
+            const NumberRange oneSided{0.0, std::numeric_limits<double>::infinity(), false};
+            readEntry(value[i], child(at, i), "a joint", kJointKeys, 1,
+                      [&](const std::string& field, const Json& fv, const std::string& fa) {
+                          if (field == "joint") {
+                              j.joint = entityAt(fv, fa);
+                              if (!registry.has<Joint>(j.joint)) refuse(fa, "entity " + fv.dump() + " is not a joint");
+                              if (!seenJoints.insert(j.joint).second)
+                                  refuse(fa, "joint " + fv.dump() + " has an entry already");
+                          } else if (field == "linear_impulse") j.linear = readVector(fv, fa);
+                          else if (field == "angular_impulse") j.angular = readNumber(fv, fa, NumberRange{});
+                          else if (field == "axial_impulse") j.axial = readNumber(fv, fa, NumberRange{});
+                          else if (field == "motor_impulse") j.motor = readNumber(fv, fa, NumberRange{});
+                          else if (field == "lower_impulse") j.lower = readNumber(fv, fa, oneSided);
+                          else j.upper = readNumber(fv, fa, oneSided);
+                      });
+            state.joints.push_back(j);
         }
     }
     return state;
@@ -793,36 +840,59 @@ Result<Scene> parseScene(std::string_view text, std::string_view sourceName, con
 namespace {
 
 /// Appends `"solver_state": {...}` as the last key of the written root
-/// object (`out` ends with its closing brace). One line per contact: a
-/// settled pile has thousands. Numbers read back to the same double, so a
-/// resumed run is bit-identical. Entries naming an entity no longer in the
-/// scene, or no longer a shape, are dropped.
+/// object (`out` ends with its closing brace). One line per contact or
+/// joint: a settled pile has thousands. Numbers read back to the same
+/// double, so a resumed run is bit-identical. Entries naming an entity no
+/// longer in the scene, or no longer a shape (a joint), are dropped; a
+/// joint's impulses that are +0 are left out (absent reads as +0).
 void appendSolverState(const SolverState& state, const Registry& registry, std::string& out) {
     std::unordered_map<Entity, std::size_t> indexOf;
     const auto& entities = registry.entities();
     for (std::size_t i = 0; i < entities.size(); ++i) indexOf.emplace(entities[i], i);
-    auto ref = [&](Entity e) -> std::optional<std::string> {
+    // Gone, or no longer what the entry needs (edited since): the loader
+    // would refuse the entry, and there is nothing it could warm anyway.
+    auto ref = [&](Entity e, bool usable) -> std::optional<std::string> {
         const auto it = indexOf.find(e);
-        // Gone, or no longer a shape (edited since): the loader would
-        // refuse the entry, and no contact of it can be warmed anyway.
-        if (it == indexOf.end() || !(registry.has<Radius>(e) || registry.has<Box>(e) || registry.has<Plane>(e)))
-            return std::nullopt;
+        if (it == indexOf.end() || !usable) return std::nullopt;
         if (const Name* n = registry.tryGet<Name>(e); n && !n->value.empty()) return Json(n->value).dump();
         return std::to_string(it->second);
     };
+    const auto number = [](double v) { return Json(v).dump(); };
     out.erase(out.size() - 2);  // "\n}"
     out += ",\n  \"solver_state\": {\n    \"contacts\": [";
     bool first = true;
     for (const ContactImpulse& c : state.contacts) {
-        const std::optional<std::string> a = ref(c.a), b = ref(c.b);
+        const std::optional<std::string> a = ref(c.a, collides(registry, c.a)), b = ref(c.b, collides(registry, c.b));
         if (!a || !b) continue;
         out += first ? "\n      " : ",\n      ";
         first = false;
         out += "{\"a\": " + *a + ", \"b\": " + *b + ", \"feature\": " + std::to_string(c.feature) +
-               ", \"normal_impulse\": " + Json(c.normalImpulse).dump() +
-               ", \"tangent_impulse\": " + Json(c.tangentImpulse).dump() + "}";
+               ", \"normal_impulse\": " + number(c.normalImpulse) + ", \"tangent_impulse\": " + number(c.tangentImpulse) +
+               "}";
     }
-    out += first ? "]\n  }\n}" : "\n    ]\n  }\n}";
+    out += first ? "]" : "\n    ]";
+    if (!state.joints.empty()) {
+        const auto plusZero = [](double v) { return v == 0.0 && !std::signbit(v); };
+        out += ",\n    \"joints\": [";
+        first = true;
+        for (const JointImpulse& j : state.joints) {
+            const std::optional<std::string> joint = ref(j.joint, registry.has<Joint>(j.joint));
+            if (!joint) continue;
+            out += first ? "\n      " : ",\n      ";
+            first = false;
+            out += "{\"joint\": " + *joint;
+            if (!plusZero(j.linear.x) || !plusZero(j.linear.y))
+                out += ", \"linear_impulse\": {\"x\": " + number(j.linear.x) + ", \"y\": " + number(j.linear.y) + "}";
+            const std::pair<const char*, double> scalars[] = {{"angular_impulse", j.angular}, {"axial_impulse", j.axial},
+                                                              {"motor_impulse", j.motor},     {"lower_impulse", j.lower},
+                                                              {"upper_impulse", j.upper}};
+            for (const auto& [key, value] : scalars)
+                if (!plusZero(value)) out += ", \"" + std::string(key) + "\": " + number(value);
+            out += "}";
+        }
+        out += first ? "]" : "\n    ]";
+    }
+    out += "\n  }\n}";
 }
 
 } // namespace

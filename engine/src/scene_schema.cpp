@@ -150,12 +150,35 @@ std::string sceneJsonSchema() {
                             {"feature", Json{{"type", "integer"}, {"minimum", 0}, {"maximum", 65535}}},
                             {"normal_impulse", Json{{"type", "number"}, {"description", "N*s"}}},
                             {"tangent_impulse", Json{{"type", "number"}, {"description", "N*s"}}}}}};
+    const auto impulse = [](const char* description) {
+        return Json{{"type", "number"}, {"description", description}};
+    };
+    const auto oneSided = [](const char* description) {
+        return Json{{"type", "number"}, {"minimum", 0}, {"description", description}};
+    };
+    Json joint = Json{
+        {"type", "object"},
+        {"description", "accumulated impulses of one joint at the end of the last step (warm start); an impulse "
+                        "left out is 0, and a joint without an entry starts from zero"},
+        {"additionalProperties", false},
+        {"required", Json::array({"joint"})},
+        {"properties",
+         Json{{"joint", entityRef},
+              {"linear_impulse", Json{{"$ref", "#/$defs/vector"},
+                                      {"description", "hinge, weld: the shared point, N*s; slider: (across the axis "
+                                                      "N*s, relative rotation N*m*s)"}}},
+              {"angular_impulse", impulse("weld: relative rotation, N*m*s")},
+              {"axial_impulse", impulse("distance: along the anchors' line, N*s")},
+              {"motor_impulse", impulse("hinge motor N*m*s, slider motor N*s")},
+              {"lower_impulse", oneSided("hinge, slider: lower limit")},
+              {"upper_impulse", oneSided("hinge, slider: upper limit; rope: its pull, N*s")}}}};
     Json solverState = Json{
         {"type", "object"},
         {"description", "what the solver carries between steps, written with a running state (stepwise run --out, the "
                         "editor's Save simulation state) so that a resumed run is bit-identical; absent: a cold start"},
         {"additionalProperties", false},
-        {"properties", Json{{"contacts", Json{{"type", "array"}, {"items", contact}}}}}};
+        {"properties", Json{{"contacts", Json{{"type", "array"}, {"items", contact}}},
+                            {"joints", Json{{"type", "array"}, {"items", joint}}}}}};
 
     Json schema = Json::object();
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema";

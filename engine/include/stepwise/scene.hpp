@@ -71,6 +71,24 @@ struct ContactImpulse {
     friend bool operator==(const ContactImpulse&, const ContactImpulse&) = default;
 };
 
+/// The accumulated impulses of one joint at the end of a step: its warm
+/// start for the next step. Which fields a joint uses depends on its type;
+/// the others stay +0 (a World zeroes any it is given for rows the joint
+/// does not have, such as a motor impulse on a hinge without a motor).
+struct JointImpulse {
+    Entity joint;                ///< the joint's own entity
+    /// hinge and weld: the point constraint, N*s; slider: (across the axis
+    /// N*s, relative rotation N*m*s)
+    Vec2 linear;
+    double angular = 0.0;        ///< weld: relative rotation, N*m*s
+    double axial = 0.0;          ///< distance: along the anchors' line, N*s
+    double motor = 0.0;          ///< hinge N*m*s, slider N*s
+    double lower = 0.0;          ///< hinge, slider: lower limit (>= 0)
+    double upper = 0.0;          ///< hinge, slider: upper limit; rope: its pull (>= 0)
+
+    friend bool operator==(const JointImpulse&, const JointImpulse&) = default;
+};
+
 /// What the solver carries from one step to the next beyond what the
 /// entities hold (positions, velocities, angles, spins). A World built from
 /// a scene with this state steps exactly as the World that wrote it: the
@@ -79,8 +97,9 @@ struct ContactImpulse {
 /// keyed by entity the same way.
 struct SolverState {
     std::vector<ContactImpulse> contacts;  ///< warm start, sorted by the solver's key
+    std::vector<JointImpulse> joints;      ///< joints' warm start, in scene order
 
-    bool empty() const { return contacts.empty(); }
+    bool empty() const { return contacts.empty() && joints.empty(); }
     friend bool operator==(const SolverState&, const SolverState&) = default;
 };
 

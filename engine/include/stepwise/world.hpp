@@ -114,6 +114,7 @@ struct WorldLayout {
     std::vector<Entity> spinBodies;  ///< dynamic bodies without a shape that turn
     std::vector<Entity> colliders;   ///< every shape, in collider order
     std::vector<std::uint8_t> colliderMoves;  ///< per collider: 1 when it is a dynamic body's
+    std::vector<Entity> joints;      ///< every joint's entity, in solver (scene) order
     friend bool operator==(const WorldLayout&, const WorldLayout&) = default;
 };
 
@@ -131,9 +132,10 @@ struct WorldState {
     std::vector<double> spinAngle;             ///< spinBodies, rad
     std::vector<double> colliderAngle, colliderSpin;  ///< colliders, rad and rad/s
     std::vector<CachedImpulse> contacts;       ///< the warm-start cache
+    std::vector<JointImpulse> joints;          ///< every joint's accumulated impulses, in layout.joints order
     /// Heap bytes held (the layout, shared, not counted).
     std::size_t bytes() const;
-    /// The warm-start cache keyed by entities (as World::solverState()).
+    /// The warm start keyed by entities (as World::solverState()).
     SolverState solverState() const;
     /// Writes the bodies' state and the time into `scene`, as
     /// World::writeBack did when the snapshot was taken.

@@ -177,6 +177,8 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
         stepStart_[i] = centres_[i];
         startV_[i] = c.body >= 0 ? v[std::size_t(c.body)] : Vec2{};
     }
+    jointImpulsesBefore_.resize(joints_.size());
+    for (std::size_t k = 0; k < joints_.size(); ++k) jointImpulsesBefore_[k] = joints::impulsesOf(joints_[k]);
     // Solver bodies start the step where they are: no displacement yet.
     for (std::size_t i = 0; i < n; ++i) {
         const std::uint32_t s = solverIndex_[i];
@@ -411,7 +413,17 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     timings_.solveMs += msSince(start);
 }
 
+void CollisionSystem::undoSolverState() {
+    cache_.swap(previousCache_);
+    cacheCursor_ = 0;
+    for (std::size_t k = 0; k < joints_.size() && k < jointImpulsesBefore_.size(); ++k)
+        joints::setImpulses(joints_[k], jointImpulsesBefore_[k]);
+}
+
 void CollisionSystem::endStep() {
+    // The cache this step started from is kept (swapped, not copied) so a
+    // divergence can put it back.
+    previousCache_.swap(cache_);
     cache_.clear();
     records_.clear();
     for (std::size_t k = 0; k < constraints_.size(); ++k) {

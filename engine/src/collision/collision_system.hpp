@@ -76,6 +76,10 @@ public:
     /// Whether any collider has a shape (a system may hold only joints).
     bool hasShapes() const { return !finite_.empty() || !planes_.empty(); }
     joints::JointSettings& jointSettings() { return jointSettings_; }
+    /// The joints in solver (scene) order; their accumulated impulses are
+    /// the joints' warm start, saved and restored with the contacts' cache.
+    std::span<const joints::JointConstraint> jointConstraints() const { return joints_; }
+    std::span<joints::JointConstraint> jointConstraints() { return joints_; }
     /// Joints of the last step, for the debugging views.
     std::span<const JointRecord> jointRecords() const { return jointRecords_; }
     const SolverSettings& settings() const { return settings_; }
@@ -119,6 +123,11 @@ public:
         angles_.assign(angles.begin(), angles.end());
         angularVelocities_.assign(angularVelocities.begin(), angularVelocities.end());
     }
+    /// Undoes what the last beginStep..endStep did to the carried solver
+    /// state (after a divergence): the warm-start cache and the joints'
+    /// impulses go back to what they were, so the failed step's (perhaps
+    /// non-finite) impulses never warm a later step.
+    void undoSolverState();
     std::span<const double> angles() const { return angles_; }
     std::span<const double> angularVelocities() const { return angularVelocities_; }
 
@@ -166,6 +175,8 @@ private:
     std::vector<ContactConstraint> constraints_;
     std::vector<ContactDetail> details_;  // parallel to constraints_
     std::vector<CachedImpulse> cache_;
+    std::vector<CachedImpulse> previousCache_;     // the cache the last step started from (undoSolverState)
+    std::vector<JointImpulse> jointImpulsesBefore_;  // the joints' impulses at the last beginStep
     std::size_t cacheCursor_ = 0;  // where the previous manifold's cache search ended
     std::vector<Vec2> unconstrainedV_;
     std::vector<ContactRecord> records_;

@@ -233,6 +233,20 @@ void solveSlider(JointConstraint& j, const SolverBody& a, const SolverBody& b, P
 
 } // namespace
 
+JointImpulse impulsesOf(const JointConstraint& j) {
+    return {j.entity, j.linearImpulse, j.angularImpulse, j.axialImpulse, j.motorImpulse, j.lowerImpulse, j.upperImpulse};
+}
+
+void setImpulses(JointConstraint& j, const JointImpulse& in) {
+    const bool hingeLike = j.kind == JointKind::Hinge || j.kind == JointKind::Slider;
+    j.linearImpulse = hingeLike || j.kind == JointKind::Weld ? in.linear : Vec2{};
+    j.angularImpulse = j.kind == JointKind::Weld ? in.angular : 0.0;
+    j.axialImpulse = j.kind == JointKind::Distance ? in.axial : 0.0;
+    j.motorImpulse = hingeLike && j.motor ? in.motor : 0.0;
+    j.lowerImpulse = hingeLike && j.hasLower ? in.lower : 0.0;
+    j.upperImpulse = (hingeLike && j.hasUpper) || j.kind == JointKind::Rope ? in.upper : 0.0;
+}
+
 void prepareJoints(std::span<JointConstraint> joints, std::span<const SolverBody> bodies,
                    std::span<const Vec2> centres, std::span<const double> angles) {
     for (JointConstraint& j : joints) {

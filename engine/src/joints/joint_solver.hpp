@@ -17,6 +17,7 @@
 #include "collision/contact_solver.hpp"
 
 #include "stepwise/entity.hpp"
+#include "stepwise/scene.hpp"
 #include "stepwise/vec2.hpp"
 
 #include <cstdint>
@@ -82,6 +83,13 @@ struct JointSettings {
     /// chain above, 2 measured 5.3 mm and 5 measured 9.4 mm.
     double dampingRatio = 1.0;
 };
+
+/// The joint's accumulated impulses (its warm start), keyed by its entity.
+JointImpulse impulsesOf(const JointConstraint& joint);
+/// Sets them, zeroing the rows the joint does not have (a motor impulse on
+/// a hinge without a motor, a limit it lacks, a row of another type), which
+/// the warm start would otherwise apply every substep with nothing to undo it.
+void setImpulses(JointConstraint& joint, const JointImpulse& impulses);
 
 /// Computes the step-start anchors, centres and angles. `centres` and
 /// `angles` are per collider (step start).

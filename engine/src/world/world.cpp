@@ -412,6 +412,8 @@ Result<World> World::build(const Scene& scene) {
             layout->colliders.push_back(w.collision->collider(c).entity);
             layout->colliderMoves.push_back(w.collision->collider(c).body >= 0 ? 1 : 0);
         }
+    if (w.collision)
+        for (const joints::JointConstraint& j : w.collision->jointConstraints()) layout->joints.push_back(j.entity);
     w.layout = std::move(layout);
 
     World world(std::move(impl));
@@ -466,6 +468,7 @@ Result<void> World::step() {
             if (contacts) {
                 contacts->endStep();
                 contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
+                contacts->undoSolverState();
             }
             return Error{w.describeSolveFailure(*failed, w.stats.step + 1)};
         }
@@ -511,7 +514,10 @@ Result<void> World::step() {
             std::copy(w.backupV.begin(), w.backupV.end(), w.v[w.current].begin());
         }
         std::copy(w.angleBackup.begin(), w.angleBackup.end(), w.angle.begin());
-        if (contacts) contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
+        if (contacts) {
+            contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
+            contacts->undoSolverState();
+        }
         w.integrator->setProposedStep(w.settings.adaptiveStep);
         return Error{message};
     }
@@ -607,22 +613,40 @@ void WorldState::writeBack(Scene& scene) const {
 }
 
 namespace {
-SolverState entityKeyed(const WorldLayout& layout, std::span<const CachedImpulse> cache) {
+/// Bitwise +0 (not -0): a joint whose impulses are all this needs no entry.
+bool isPlusZero(double v) { return v == 0.0 && !std::signbit(v); }
+bool carriesNothing(const JointImpulse& j) {
+    return isPlusZero(j.linear.x) && isPlusZero(j.linear.y) && isPlusZero(j.angular) && isPlusZero(j.axial) &&
+           isPlusZero(j.motor) && isPlusZero(j.lower) && isPlusZero(j.upper);
+}
+
+SolverState entityKeyed(const WorldLayout& layout, std::span<const CachedImpulse> cache,
+                        std::span<const JointImpulse> jointImpulses) {
     SolverState state;
     state.contacts.reserve(cache.size());
     for (const CachedImpulse& c : cache)
         state.contacts.push_back(
             {layout.colliders[c.colliderA()], layout.colliders[c.colliderB()], c.feature(), c.normal, c.tangent});
+    // A joint that carries nothing is left out: absent means all +0.
+    for (const JointImpulse& j : jointImpulses)
+        if (!carriesNothing(j)) state.joints.push_back(j);
     return state;
+}
+
+std::vector<JointImpulse> jointImpulsesOf(const collision::CollisionSystem& system) {
+    std::vector<JointImpulse> out;
+    out.reserve(system.jointConstraints().size());
+    for (const joints::JointConstraint& j : system.jointConstraints()) out.push_back(joints::impulsesOf(j));
+    return out;
 }
 } // namespace
 
-SolverState WorldState::solverState() const { return entityKeyed(*layout, contacts); }
+SolverState WorldState::solverState() const { return entityKeyed(*layout, contacts, joints); }
 
 SolverState World::solverState() const {
     const WorldImpl& w = *impl_;
     if (!w.collision) return {};
-    return entityKeyed(*w.layout, w.collision->warmStartCache());
+    return entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision));
 }
 
 void World::setSolverState(const SolverState& state) {
@@ -642,12 +666,20 @@ void World::setSolverState(const SolverState& state) {
     // engine wrote): entries with equal keys then stay in the order the
     // warm start reads them.
     w.collision->setWarmStartCache(std::move(cache));
+    // Joints: an entry sets its joint's impulses, a joint without one
+    // starts from zero (as a state that carried nothing was written).
+    std::unordered_map<Entity, const JointImpulse*> given;
+    for (const JointImpulse& j : state.joints) given[j.joint] = &j;
+    for (joints::JointConstraint& j : w.collision->jointConstraints()) {
+        const auto it = given.find(j.entity);
+        joints::setImpulses(j, it != given.end() ? *it->second : JointImpulse{j.entity});
+    }
 }
 
 std::size_t WorldState::bytes() const {
     return sizeof(double) * (x.capacity() + v.capacity() + spinAngle.capacity() + colliderAngle.capacity() +
                              colliderSpin.capacity()) +
-           sizeof(CachedImpulse) * contacts.capacity();
+           sizeof(CachedImpulse) * contacts.capacity() + sizeof(JointImpulse) * joints.capacity();
 }
 
 WorldState World::saveState() const {
@@ -664,13 +696,14 @@ WorldState World::saveState() const {
         s.colliderAngle.assign(w.collision->angles().begin(), w.collision->angles().end());
         s.colliderSpin.assign(w.collision->angularVelocities().begin(), w.collision->angularVelocities().end());
         s.contacts = w.collision->warmStartCache();
+        s.joints = jointImpulsesOf(*w.collision);
     }
     return s;
 }
 
 Result<void> World::restoreState(const WorldState& s) {
     WorldImpl& w = *impl_;
-    if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout))
+    if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout) || s.joints.size() != w.layout->joints.size())
         return Error{"the snapshot was taken from a world with other bodies or shapes"};
     std::copy(s.x.begin(), s.x.end(), w.x[w.current].begin());
     std::copy(s.v.begin(), s.v.end(), w.v[w.current].begin());
@@ -678,6 +711,8 @@ Result<void> World::restoreState(const WorldState& s) {
     if (w.collision) {
         w.collision->restoreRotation(s.colliderAngle, s.colliderSpin);
         w.collision->setWarmStartCache(s.contacts);
+        const std::span<joints::JointConstraint> joints = w.collision->jointConstraints();
+        for (std::size_t k = 0; k < joints.size(); ++k) joints::setImpulses(joints[k], s.joints[k]);
         w.collision->clearContactRecords();  // they described the step this state replaces
     }
     w.stats.contactCount = 0;

@@ -137,6 +137,11 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
             }
             je.collider = filter[k];
             je.solverBody = system->solverBodyOf(std::size_t(filter[k]));
+            // The file's anchor is measured from the body's position (the
+            // frame of a polygon's vertices); the solver turns a dynamic
+            // body about its centre of mass, so the anchor is taken from
+            // there. (A fixed end stays about its position: fixedCentre.)
+            je.local = je.local - system->collider(std::size_t(filter[k])).centreOfMass;
         }
         if (fixed[0] && fixed[1]) {
             if (problem) *problem = labelOf(reg, i) + ": joint joins two static bodies; at least one end must be dynamic";

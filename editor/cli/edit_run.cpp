@@ -1,0 +1,101 @@
+#include "cli/edit_run.hpp"
+
+#include "cli/cli_common.hpp"
+
+#include "app/scene_edit.hpp"
+
+#include "stepwise/components.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <sstream>
+
+namespace stepwise::cli {
+
+Scene benchScene(int bodies) {
+    Scene s;
+    s.view = View{{0.0, 10.0}, 30.0};
+    const int columns = int(std::ceil(std::sqrt(double(bodies) * 1.6)));
+    editor::addPlane(s, {0.0, 0.0}, {0.0, 1.0});
+    editor::addPlane(s, {-0.3 * columns - 1.0, 0.0}, {1.0, 0.0});
+    editor::addPlane(s, {0.3 * columns + 1.0, 0.0}, {-1.0, 0.0});
+    std::uint32_t seed = 7u;
+    for (int i = 0; i < bodies; ++i) {
+        const int cx = i % columns, cy = i / columns;
+        seed = seed * 1664525u + 1013904223u;
+        const double jitter = (double(seed >> 8) / double(1u << 24) - 0.5) * 0.05;
+        const Entity e = s.registry.create();
+        s.registry.emplace(e, Name{"c" + std::to_string(i)});
+        s.registry.emplace(e, Position{{-0.3 * columns + 0.6 * cx + jitter + 0.3, 0.5 + 0.6 * cy}});
+        s.registry.emplace(e, Velocity{{jitter * 20.0, 0.0}});
+        s.registry.emplace(e, Mass{1.0});
+        s.registry.emplace(e, Radius{0.25});
+        s.registry.emplace(e, Color{Rgb{0.3 + 0.6 * double(cx) / columns, 0.5, 0.9 - 0.5 * double(cy % 20) / 20.0}});
+    }
+    return s;
+}
+
+void writeDebugState(const std::string& path, ui::Session& session, std::uint64_t frame) {
+    editor::Editor& ed = session.editor();
+    std::ostringstream out;
+    out.precision(17);
+    const char* mode = ed.sim.state() == editor::SimState::Playing ? "playing"
+                       : ed.sim.state() == editor::SimState::Paused ? "paused" : "editing";
+    const ImVec2 p = session.viewportPos(), z = session.viewportSize();
+    out << "{\n  \"frame\": " << frame << ",\n  \"mode\": \"" << mode << "\",\n  \"time\": " << ed.doc.scene.world.time
+        << ",\n  \"steps\": " << ed.sim.steps() << ",\n  \"entities\": " << ed.doc.scene.registry.size()
+        << ",\n  \"dirty\": " << (ed.dirty() ? "true" : "false") << ",\n  \"viewport\": [" << p.x << ", " << p.y << ", "
+        << z.x << ", " << z.y << "],\n  \"camera\": [" << ed.view.camera.center.x << ", " << ed.view.camera.center.y
+        << ", " << ed.view.camera.zoom << "],\n  \"selection\": " << ed.selection.size();
+    const ui::Session::DialogState d = session.dialogState();
+    out << ",\n  \"modal\": " << nlohmann::json(d.modal).dump() << ",\n  \"status\": " << nlohmann::json(d.status).dump()
+        << ",\n  \"open_folder\": " << nlohmann::json(d.openFolder).dump() << ",\n  \"open_files\": " << d.openFiles
+        << ",\n  \"save_as_suggestion\": " << nlohmann::json(d.saveAsSuggestion).dump() << ",\n  \"positions\": [";
+    int n = 0;
+    for (Entity e : ed.doc.scene.registry.entities()) {
+        const Position* pos = ed.doc.scene.registry.tryGet<Position>(e);
+        if (!pos || ed.doc.scene.registry.has<Spring>(e)) continue;
+        out << (n ? ", " : "") << "[" << pos->value.x << ", " << pos->value.y << "]";
+        if (++n == 64) break;
+    }
+    out << "]\n}\n";
+    (void)writeFileAtomically(path, out.str());
+}
+
+void FrameTimes::add(double frameMs, const ui::UiState::FrameParts& parts) {
+    ms.push_back(frameMs);
+    sum.uiMs += parts.uiMs;
+    sum.stepMs += parts.stepMs;
+    sum.sceneMs += parts.sceneMs;
+    sum.drawUiMs += parts.drawUiMs;
+    sum.presentMs += parts.presentMs;
+    sum.steps += parts.steps;
+    last = parts;
+}
+
+void FrameTimes::report(const char* what, std::size_t bodies) const {
+    if (ms.empty()) return;
+    std::vector<double> sorted = ms;
+    std::sort(sorted.begin(), sorted.end());
+    const double n = double(sorted.size());
+    const double mean = std::accumulate(sorted.begin(), sorted.end(), 0.0) / n;
+    std::printf("edit bench (%s): %zu entities, %zu frames: mean %.2f ms, median %.2f ms, p95 %.2f ms, max %.2f ms "
+                "(%.1f fps at the mean)\n",
+                what, bodies, sorted.size(), mean, sorted[sorted.size() / 2], sorted[sorted.size() * 95 / 100],
+                sorted.back(), 1000.0 / mean);
+    // Where a frame goes. "present" is the previous frame's buffer
+    // swap (Session::frame): waiting for llvmpipe to finish drawing it,
+    // then (under Xvfb) the copy to the X server. The rest is events.
+    const double parts = (sum.uiMs + sum.stepMs + sum.sceneMs + sum.drawUiMs + sum.presentMs) / n;
+    std::printf("  per frame: ui build %.2f ms, physics %.2f ms (%.2f steps), viewport render %.2f ms, "
+                "ui draw %.2f ms, present %.2f ms, rest %.2f ms\n",
+                sum.uiMs / n, sum.stepMs / n, double(sum.steps) / n, sum.sceneMs / n, sum.drawUiMs / n,
+                sum.presentMs / n, std::max(0.0, mean - parts));
+    std::printf("  viewport, last frame: %zu instances in %d draw calls\n", last.instances, last.drawCalls);
+}
+
+} // namespace stepwise::cli

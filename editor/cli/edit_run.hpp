@@ -1,0 +1,62 @@
+#pragma once
+/// \file edit_run.hpp
+/// What `stepwise edit`'s two ways of running share: the options, the
+/// --bench-bodies level, the --debug-state file and the frame-time report.
+/// The window loop is platform/sdl_window.cpp, the headless scripted runner
+/// cli/edit_scripted.cpp; edit_command.cpp parses the options and picks one.
+
+#include "ui/session.hpp"
+
+#include "stepwise/scene.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace stepwise::cli {
+
+struct EditOptions {
+    std::string level;
+    std::string script;
+    std::string screenshot;
+    std::string size = "1280x800";
+    float fontSize = 0.0f;
+    bool builtinFont = false;
+    std::string configDir;
+    int benchFrames = 0;
+    int benchBodies = 0;
+    std::string debugState;
+    bool headless = false;
+    bool showTimings = false;
+    bool noVsync = false;
+    std::string overlays;
+};
+
+constexpr double kFrameSeconds = 1.0 / 60.0;  // scripted frames: fixed, so runs are deterministic
+
+/// A synthetic level for --bench-bodies: N circles (0.25 m, 1 kg) in a
+/// box of three planes under gravity, jittered so they do not stack in
+/// perfect columns. Named c0, c1, ... directly: generating 100,000 bodies
+/// through the palette's one-at-a-time naming would be quadratic.
+Scene benchScene(int bodies);
+
+/// Writes the editor's state (mode, time, steps, viewport, camera, the first
+/// 64 positions) as JSON, atomically, for tests that watch a running editor.
+void writeDebugState(const std::string& path, ui::Session& session, std::uint64_t frame);
+
+struct FrameTimes {
+    std::vector<double> ms;
+    ui::UiState::FrameParts sum;  ///< the parts summed over the recorded frames
+    ui::UiState::FrameParts last; ///< the last recorded frame's parts
+
+    void add(double frameMs, const ui::UiState::FrameParts& parts);
+    /// Prints the mean, median, p95 and max frame time and where a frame goes.
+    void report(const char* what, std::size_t bodies) const;
+};
+
+/// Headless (OSMesa): replays --script, then --bench-frames, then writes
+/// --screenshot. Returns the process exit code.
+int runScripted(const EditOptions& o, int width, int height);
+
+} // namespace stepwise::cli

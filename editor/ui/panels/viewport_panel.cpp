@@ -1,0 +1,129 @@
+// The Viewport panel: the simulation toolbar above the scene, which Session draws into the panel's rectangle.
+
+#include "ui/panels/panels.hpp"
+
+#include "app/scene_edit.hpp"
+
+#include "stepwise/components.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace stepwise::ui {
+
+using editor::Editor;
+using editor::SimState;
+
+namespace {
+
+void simToolbar(UiState& ui, Editor& ed) {
+    const SimState s = ed.sim.state();
+    if (ImGui::Button(s == SimState::Playing ? "Pause" : "Play")) ed.togglePlay();
+    ImGui::SameLine();
+    if (ImGui::Button("Step")) ed.stepForward();
+    ImGui::SameLine();
+    ImGui::BeginDisabled(ed.sim.historySize() == 0);
+    if (ImGui::Button("Back")) ed.stepBack();
+    ImGui::EndDisabled();
+    ImGui::SameLine();
+    ImGui::BeginDisabled(!ed.sim.running());
+    if (ImGui::Button("Reset")) ed.resetSimulation();
+    ImGui::EndDisabled();
+    ImGui::SameLine();
+    float scale = float(ed.sim.timeScale);
+    // The value is written beside the slider: inside it, the handle sat on
+    // top of the digits.
+    ImGui::SetNextItemWidth(80 * ui.scale);
+    if (ImGui::SliderFloat("##timescale", &scale, 0.05f, 4.0f, "", ImGuiSliderFlags_Logarithmic))
+        ed.sim.timeScale = scale;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Simulated seconds per real second (Ctrl+click to type)");
+    ImGui::SameLine(0, 4 * ui.scale);
+    ImGui::Text("time x%.2f", ed.sim.timeScale);
+    ImGui::SameLine();
+    bool breakOn = !ed.sim.breakOnContact.isNull();
+    const bool canBreak = ed.selection.size() == 1;
+    ImGui::BeginDisabled(!canBreak && !breakOn);
+    if (ImGui::Checkbox("Break on contact", &breakOn))
+        ed.sim.breakOnContact = breakOn && canBreak ? ed.selection[0] : Entity{};
+    ImGui::EndDisabled();
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+        ImGui::SetTooltip("Pause at the step where the selected body first touches something");
+    ImGui::SameLine();
+    ImGui::TextColored(kDim, "t = %.3f s  step %llu  history %zu", ed.doc.scene.world.time,
+                       static_cast<unsigned long long>(ed.sim.steps()), ed.sim.historySize());
+}
+
+} // namespace
+
+void viewportPanel(UiState& ui, Editor& ed, const PanelRects& r) {
+    placePanel(ui, "Viewport", r.viewportPos, r.viewportSize);
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+    // The scene is drawn into the window before ImGui (Session::frame), so
+    // this panel has no background of its own, and it stays behind every
+    // other panel: one that went behind it would be drawn over the scene.
+    const bool open = ImGui::Begin("Viewport", nullptr, ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse |
+                                                             ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoBackground |
+                                                             ImGuiWindowFlags_NoBringToFrontOnFocus);
+    ImGui::PopStyleVar();
+    if (open) {
+        // The toolbar band gets the background the window does not draw:
+        // its size is known after the toolbar, so the fill goes into a
+        // channel drawn under the toolbar's widgets.
+        ImDrawList* dl = ImGui::GetWindowDrawList();
+        dl->ChannelsSplit(2);
+        dl->ChannelsSetCurrent(1);
+        const ImVec2 band = ImGui::GetCursorScreenPos();
+        ImGui::SetCursorPos(ImVec2(ImGui::GetCursorPosX() + 6 * ui.scale, ImGui::GetCursorPosY() + 4 * ui.scale));
+        simToolbar(ui, ed);
+        ImGui::SetCursorPosY(ImGui::GetCursorPosY() + 2 * ui.scale);
+        ImVec2 avail = ImGui::GetContentRegionAvail();
+        avail.x = std::max(16.0f, std::floor(avail.x));
+        avail.y = std::max(16.0f, std::floor(avail.y));
+        const ImVec2 pos = ImGui::GetCursorScreenPos();
+        dl->ChannelsSetCurrent(0);
+        dl->AddRectFilled(band, ImVec2(band.x + ImGui::GetWindowWidth(), std::floor(pos.y)), ImGui::GetColorU32(ImGuiCol_WindowBg));
+        dl->ChannelsMerge();
+        ui.viewportPos = ImVec2(std::floor(pos.x), std::floor(pos.y));
+        ui.viewportSize = avail;
+        // An invisible button owns the mouse over the image, so a drag there
+        // is a tool's drag and never moves the window.
+        ImGui::InvisibleButton("##scene", avail,
+                               ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight |
+                                   ImGuiButtonFlags_MouseButtonMiddle);
+        ui.viewportHovered = ImGui::IsItemHovered() || ImGui::IsItemActive();
+        const ImVec2 o = ui.viewportPos;
+        // Mode frame: green while playing, gold when paused.
+        if (ed.sim.running())
+            dl->AddRect(o, ImVec2(o.x + avail.x, o.y + avail.y),
+                        ImGui::GetColorU32(ed.sim.state() == SimState::Playing ? kGreen : kGold), 0, 0, 2.0f * ui.scale);
+        if (auto rect = ed.selectionRect()) {
+            const ImVec2 a(o.x + float(rect->first.x), o.y + float(rect->first.y));
+            const ImVec2 b(o.x + float(rect->second.x), o.y + float(rect->second.y));
+            dl->AddRectFilled(a, b, IM_COL32(90, 160, 240, 40));
+            dl->AddRect(a, b, IM_COL32(90, 160, 240, 200));
+        }
+        if (!ed.springStart().isNull())
+            if (const Position* p = ed.doc.scene.registry.tryGet<Position>(ed.springStart())) {
+                const Vec2 a = ed.view.toPixels(p->value), b = ed.mouseViewport();
+                dl->AddLine(ImVec2(o.x + float(a.x), o.y + float(a.y)), ImVec2(o.x + float(b.x), o.y + float(b.y)),
+                            ImGui::GetColorU32(kGold), 1.5f * ui.scale);
+            }
+        // Cursor readout, bottom right of the viewport.
+        const Vec2 w = ed.view.toWorld(ed.mouseViewport());
+        char text[96];
+        std::snprintf(text, sizeof text, "%s  x %.3f  y %.3f m%s", std::string(editor::toolName(ed.tool)).c_str(), w.x, w.y,
+                      ed.snap ? "  [snap]" : "");
+        const ImVec2 ts = ImGui::CalcTextSize(text);
+        dl->AddText(ImVec2(o.x + avail.x - ts.x - 8 * ui.scale, o.y + avail.y - ts.y - 6 * ui.scale),
+                    ImGui::GetColorU32(kDim), text);
+        if (!ed.sim.message().empty() && ed.sim.running()) {
+            const ImVec4 col = ed.sim.diverged() ? kRed : kGold;
+            dl->AddText(ImVec2(o.x + 10 * ui.scale, o.y + avail.y - ts.y - 6 * ui.scale), ImGui::GetColorU32(col),
+                        ed.sim.message().c_str());
+        }
+    }
+    ImGui::End();
+}
+
+} // namespace stepwise::ui

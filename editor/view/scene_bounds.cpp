@@ -1,0 +1,33 @@
+#include "scene_bounds.hpp"
+
+#include "stepwise/components.hpp"
+
+#include <cmath>
+
+namespace stepwise::render {
+
+std::optional<ShapeBox> shapeBox(const Scene& scene, Entity e) {
+    const Position* p = scene.registry.tryGet<Position>(e);
+    if (!p) return std::nullopt;
+    if (const Radius* r = scene.registry.tryGet<Radius>(e)) return ShapeBox{p->value, Vec2{r->value, r->value}};
+    const Angle* a = scene.registry.tryGet<Angle>(e);
+    const double angle = a ? a->value : 0.0;
+    if (const Box* b = scene.registry.tryGet<Box>(e)) {
+        const double c = std::abs(std::cos(angle)), s = std::abs(std::sin(angle));
+        return ShapeBox{p->value, Vec2{0.5 * (c * b->width + s * b->height), 0.5 * (s * b->width + c * b->height)}};
+    }
+    if (const Polygon* poly = scene.registry.tryGet<Polygon>(e); poly && !poly->vertices.empty()) {
+        const double c = std::cos(angle), s = std::sin(angle);
+        Bounds bounds;
+        for (const Vec2 v : poly->vertices) bounds.add(p->value + Vec2{c * v.x - s * v.y, s * v.x + c * v.y});
+        return ShapeBox{0.5 * (bounds.lo + bounds.hi), 0.5 * (bounds.hi - bounds.lo)};
+    }
+    return std::nullopt;
+}
+
+bool isStatic(const Scene& scene, Entity e) {
+    const Static* s = scene.registry.tryGet<Static>(e);
+    return s && s->value;
+}
+
+} // namespace stepwise::render
