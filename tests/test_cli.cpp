@@ -377,7 +377,7 @@ TEST_F(Cli, RenderBadArgumentsExitTwoNameTheArgumentAndWriteNothing) {
          "implicit_euler,implicit_midpoint,dopri5}"},
         {orbit + " --out " + png.string() + " --overlay velocity,bogus",
          "stepwise: error: --overlay: unknown overlay \"bogus\"; known overlays: velocity, velocity-field, "
-         "force-field, force, contacts, aabb, trails, joints, all, none"},
+         "force-field, force, net-force, contacts, aabb, trails, joints, all, none"},
         {orbit + " --out " + png.string() + " --camera 1,2",
          "stepwise: error: --camera: expected X,Y,ZOOM (metres, metres, pixels per metre at 720 px height), got "
          "\"1,2\""},

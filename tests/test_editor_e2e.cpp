@@ -30,6 +30,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <sstream>
 #include <thread>
 
@@ -46,7 +47,9 @@ using stepwise::test::readFile;
 /// A child process started with posix_spawnp; stopped (TERM, then KILL) on scope exit.
 struct Child {
     pid_t pid = -1;
-    Child(std::vector<std::string> argv, const std::vector<std::string>& extraEnv, const fs::path& log) {
+    /// `cwd`: the folder the child starts in (empty: this process's).
+    Child(std::vector<std::string> argv, const std::vector<std::string>& extraEnv, const fs::path& log,
+          const fs::path& cwd = {}) {
         std::vector<std::string> env;
         for (char** e = environ; *e; ++e) env.emplace_back(*e);
         for (const std::string& e : extraEnv) env.push_back(e);
@@ -59,6 +62,7 @@ struct Child {
         posix_spawn_file_actions_init(&actions);
         posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         posix_spawn_file_actions_adddup2(&actions, 1, 2);
+        if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(&actions, cwd.c_str());
         if (posix_spawnp(&pid, a[0], &actions, nullptr, a.data(), v.data()) != 0) pid = -1;
         posix_spawn_file_actions_destroy(&actions);
     }
@@ -121,6 +125,37 @@ nlohmann::json readState(const fs::path& p) {
     }
 }
 
+/// An Xvfb of 1280x800 on a free display, stopped (by its process id) on
+/// scope exit; `env` runs the editor on it with its settings under `tmp`.
+struct XDisplay {
+    std::string name;   ///< ":N"
+    std::unique_ptr<Child> server;
+    std::vector<std::string> env;
+    std::string error;  ///< why it could not be started ("" when it runs)
+    explicit XDisplay(const fs::path& tmp) {
+        const int display = freeDisplay();
+        if (display <= 0) {
+            error = "no free X display number";
+            return;
+        }
+        name = ":" + std::to_string(display);
+        server = std::make_unique<Child>(std::vector<std::string>{"Xvfb", name, "-screen", "0", "1280x800x24",
+                                                                  "-nolisten", "tcp"},
+                                         std::vector<std::string>{}, tmp / "xvfb.log");
+        if (server->pid <= 0 ||
+            !waitFor([&] { return fs::exists("/tmp/.X11-unix/X" + std::to_string(display)); }, 10s)) {
+            error = "Xvfb did not start: " + readFile(tmp / "xvfb.log");
+            return;
+        }
+        env = {"DISPLAY=" + name, "LIBGL_ALWAYS_SOFTWARE=1", "XDG_CONFIG_HOME=" + (tmp / "config").string()};
+    }
+    /// Runs `xdotool ARGS` on this display; true when it succeeded.
+    bool xdo(const std::string& args) const {
+        const std::string cmd = "DISPLAY=" + name + " xdotool " + args + " > /dev/null 2>&1";
+        return std::system(cmd.c_str()) == 0;
+    }
+};
+
 } // namespace
 
 TEST(EditorWindow, PlayPlaceUndoSaveThroughXvfbAndXdotool) {
@@ -132,24 +167,14 @@ TEST(EditorWindow, PlayPlaceUndoSaveThroughXvfbAndXdotool) {
     fs::copy_file(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "spring_chain.json", level);
     const std::string original = readFile(level);
 
-    const int display = freeDisplay();
-    ASSERT_GT(display, 0) << "no free X display number";
-    const std::string disp = ":" + std::to_string(display);
-    Child xvfb({"Xvfb", disp, "-screen", "0", "1280x800x24", "-nolisten", "tcp"}, {}, tmp / "xvfb.log");
-    ASSERT_GT(xvfb.pid, 0);
-    ASSERT_TRUE(waitFor([&] { return fs::exists("/tmp/.X11-unix/X" + std::to_string(display)); }, 10s))
-        << readFile(tmp / "xvfb.log");
-
-    const std::vector<std::string> env{"DISPLAY=" + disp, "LIBGL_ALWAYS_SOFTWARE=1",
-                                       "XDG_CONFIG_HOME=" + (tmp / "config").string()};
+    const XDisplay x(tmp);
+    ASSERT_TRUE(x.error.empty()) << x.error;
+    const std::vector<std::string>& env = x.env;
     Child editor({STEPWISE_BINARY, "edit", level.string(), "--size", "1280x800", "--builtin-font", "--font-size", "13",
                   "--debug-state", state.string()},
                  env, tmp / "editor.log");
     ASSERT_GT(editor.pid, 0);
-    auto xdo = [&](const std::string& args) {
-        const std::string cmd = "DISPLAY=" + disp + " xdotool " + args + " > /dev/null 2>&1";
-        return std::system(cmd.c_str()) == 0;
-    };
+    auto xdo = [&](const std::string& args) { return x.xdo(args); };
     ASSERT_TRUE(waitFor([&] { return !readState(state).is_null(); }, 30s)) << readFile(tmp / "editor.log");
     nlohmann::json s0 = readState(state);
     const auto vp = s0["viewport"];
@@ -206,3 +231,127 @@ TEST(EditorWindow, PlayPlaceUndoSaveThroughXvfbAndXdotool) {
     EXPECT_TRUE(editor.waitExit(15s)) << "the editor did not quit on Ctrl+Q";
     fs::remove_all(tmp);
 }
+
+// The inspector's name field with one body selected, in the default layout
+// at 1280x800 with the built-in 13 px font (as the scripted editor's
+// screenshots show it: the Inspector's first row).
+constexpr double kNameFieldX = 1050, kNameFieldY = 100;
+
+// Issue 12: started from another folder, the Open list is not empty and Save
+// as of an untitled level proposes a folder it can write; Save as onto an
+// existing file asks, and Cancel keeps the file; renaming a body that a
+// spring uses (typed into the inspector) keeps the spring: Play runs and
+// the save names the spring's end by the new name.
+TEST(EditorWindow, FromAnotherFolderRenameThenPlayAndSaveAsAsksBeforeReplacing) {
+    if (!have("Xvfb") || !have("xdotool")) GTEST_SKIP() << "needs Xvfb and xdotool (tests/setup-debian.sh installs them)";
+    const fs::path tmp = fs::temp_directory_path() / ("stepwise-e2e-folder-" + std::to_string(getpid()));
+    fs::remove_all(tmp);
+    fs::create_directories(tmp / "elsewhere");
+    const fs::path level = tmp / "level.json", other = tmp / "other.json", state = tmp / "state.json";
+    fs::copy_file(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "spring_chain.json", level);
+    fs::copy_file(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "default.json", other);
+    const std::string original = readFile(level), otherText = readFile(other);
+
+    const XDisplay x(tmp);
+    ASSERT_TRUE(x.error.empty()) << x.error;
+    const std::vector<std::string>& env = x.env;
+    auto xdo = [&](const std::string& args) { return x.xdo(args); };
+    auto at = [](double x, double y) { return std::to_string(int(x)) + " " + std::to_string(int(y)); };
+
+    // Started in an empty folder with no level: an untitled document.
+    {
+        Child editor({STEPWISE_BINARY, "edit", "--size", "1280x800", "--builtin-font", "--font-size", "13",
+                      "--debug-state", state.string()},
+                     env, tmp / "editor-untitled.log", tmp / "elsewhere");
+        ASSERT_GT(editor.pid, 0);
+        ASSERT_TRUE(waitFor([&] { return !readState(state).is_null(); }, 30s)) << readFile(tmp / "editor-untitled.log");
+        const nlohmann::json s = readState(state);
+        const auto vp = s["viewport"];
+        ASSERT_TRUE(xdo("mousemove " + at(double(vp[0]) + double(vp[2]) / 2, double(vp[1]) + 20)));
+        // The Open dialog lists the repository's levels, found from the
+        // executable's place, not from the working folder.
+        ASSERT_TRUE(xdo("key ctrl+o"));
+        ASSERT_TRUE(waitFor([&] { return readState(state)["modal"] == "Open level"; }, 10s)) << readState(state).dump();
+        const nlohmann::json open = readState(state);
+        EXPECT_TRUE(fs::equivalent(std::string(open["open_folder"]), fs::path(STEPWISE_SOURCE_DIR) / "levels"))
+            << open["open_folder"];
+        EXPECT_GT(int(open["open_files"]), 10);
+        // Save as proposes an absolute path in a folder that exists and can be written.
+        const fs::path proposed = std::string(open["save_as_suggestion"]);
+        EXPECT_TRUE(proposed.is_absolute()) << proposed;
+        EXPECT_TRUE(fs::is_directory(proposed.parent_path())) << proposed;
+        EXPECT_EQ(::access(proposed.parent_path().c_str(), W_OK), 0) << proposed;
+    }  // the editor is stopped (TERM) here
+    fs::remove(state);
+
+    Child editor({STEPWISE_BINARY, "edit", level.string(), "--size", "1280x800", "--builtin-font", "--font-size", "13",
+                  "--debug-state", state.string()},
+                 env, tmp / "editor.log", tmp / "elsewhere");
+    ASSERT_GT(editor.pid, 0);
+    ASSERT_TRUE(waitFor([&] { return !readState(state).is_null(); }, 30s)) << readFile(tmp / "editor.log");
+    const nlohmann::json s0 = readState(state);
+    const double vx = s0["viewport"][0], vy = s0["viewport"][1];
+    editor::ViewCamera cam;
+    cam.width = int(double(s0["viewport"][2]));
+    cam.height = int(double(s0["viewport"][3]));
+    cam.camera.center = {double(s0["camera"][0]), double(s0["camera"][1])};
+    cam.camera.zoom = double(s0["camera"][2]);
+    ASSERT_TRUE(xdo("mousemove " + at(vx + cam.width / 2.0, vy + 20)));
+    EXPECT_EQ(s0["open_folder"], tmp.string()) << "the document's own folder";
+
+    // Rename link5 (both chain springs spring4 and spring5 hold it) by
+    // clicking it and typing into the inspector's name field.
+    Result<Scene> parsed = parseScene(original, "original");
+    ASSERT_TRUE(parsed) << parsed.error();
+    const Entity link5 = editor::findByName(parsed->registry, "link5");
+    ASSERT_FALSE(link5.isNull());
+    const Vec2 body = cam.toPixels(parsed->registry.tryGet<Position>(link5)->value);
+    ASSERT_TRUE(xdo("key 1"));
+    ASSERT_TRUE(xdo("mousemove " + at(vx + body.x, vy + body.y) + " click 1"));
+    ASSERT_TRUE(waitFor([&] { return readState(state)["selection"] == 1; }, 10s)) << readState(state).dump();
+    ASSERT_TRUE(xdo("mousemove " + at(kNameFieldX, kNameFieldY) + " click 1"));
+    std::this_thread::sleep_for(300ms);
+    ASSERT_TRUE(xdo("key ctrl+a"));
+    ASSERT_TRUE(xdo("type --delay 30 bob"));
+    ASSERT_TRUE(xdo("key Return"));
+    ASSERT_TRUE(waitFor([&] { return readState(state)["dirty"] == true; }, 10s)) << readState(state).dump();
+    // Play runs (a spring that lost its end would be refused) and moves the chain.
+    ASSERT_TRUE(xdo("mousemove " + at(vx + cam.width / 2.0, vy + 20)));
+    ASSERT_TRUE(xdo("key space"));
+    ASSERT_TRUE(waitFor([&] {
+        const nlohmann::json s = readState(state);
+        return !s.is_null() && s["mode"] == "playing" && double(s["time"]) > 0.2;
+    }, 20s)) << readState(state).dump();
+    EXPECT_NE(readState(state)["positions"], s0["positions"]);
+    ASSERT_TRUE(xdo("key space"));
+    ASSERT_TRUE(waitFor([&] { return readState(state)["mode"] == "paused"; }, 10s));
+    ASSERT_TRUE(xdo("key r"));
+    ASSERT_TRUE(waitFor([&] { return readState(state)["mode"] == "editing"; }, 10s));
+    ASSERT_TRUE(xdo("key ctrl+s"));
+    ASSERT_TRUE(waitFor([&] { return readState(state)["dirty"] == false; }, 10s)) << readState(state).dump();
+    // Saved: the level with link5 called bob, and both springs naming bob.
+    parsed->registry.tryGet<Name>(link5)->value = "bob";
+    EXPECT_EQ(readFile(level), sceneToJsonText(*parsed));
+    const std::string saved = readFile(level);
+    EXPECT_EQ(saved.find("\"link5\""), std::string::npos);
+    EXPECT_NE(saved.find("\"a\": \"bob\""), std::string::npos);
+
+    // Save as onto other.json: asks, and Cancel keeps the file.
+    ASSERT_TRUE(xdo("key ctrl+shift+s"));
+    ASSERT_TRUE(waitFor([&] { return readState(state)["modal"] == "Save as"; }, 10s)) << readState(state).dump();
+    std::this_thread::sleep_for(300ms);
+    ASSERT_TRUE(xdo("key ctrl+a"));
+    ASSERT_TRUE(xdo("type --delay 20 " + other.string()));
+    ASSERT_TRUE(xdo("key Return"));
+    ASSERT_TRUE(waitFor([&] { return readState(state)["modal"] == "Replace file?"; }, 10s)) << readState(state).dump();
+    EXPECT_EQ(readFile(other), otherText) << "written before asking";
+    ASSERT_TRUE(xdo("key Escape"));
+    ASSERT_TRUE(waitFor([&] { return readState(state)["modal"] == ""; }, 10s)) << readState(state).dump();
+    EXPECT_EQ(readState(state)["status"], "not saved: " + other.string() + " was kept");
+    EXPECT_EQ(readFile(other), otherText);
+
+    ASSERT_TRUE(xdo("key ctrl+q"));
+    EXPECT_TRUE(editor.waitExit(15s)) << "the editor did not quit on Ctrl+Q";
+    fs::remove_all(tmp);
+}
+

@@ -4,6 +4,9 @@
 
 #include "stepwise/scene_io.hpp"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
@@ -89,6 +92,29 @@ std::filesystem::path dialogFolder(const std::filesystem::path& documentPath, co
         if (std::filesystem::is_directory(folder, ec)) return folder;
     }
     return levelsDir;
+}
+
+std::vector<std::string> levelFiles(const std::filesystem::path& folder) {
+    std::vector<std::string> out;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(folder, ec))
+        if (entry.path().extension() == ".json" && entry.path().filename() != "scene.schema.json")
+            out.push_back(entry.path().string());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+std::filesystem::path saveAsSuggestion(const std::filesystem::path& documentPath,
+                                       const std::filesystem::path& levelsDir,
+                                       const std::filesystem::path& workingDir) {
+    std::error_code ec;
+    if (!documentPath.empty()) return std::filesystem::absolute(documentPath, ec);
+    std::vector<std::filesystem::path> folders{levelsDir, workingDir};
+    if (const char* home = std::getenv("HOME"); home && *home) folders.emplace_back(home);
+    for (const std::filesystem::path& f : folders)
+        if (!f.empty() && std::filesystem::is_directory(f, ec) && ::access(f.c_str(), W_OK) == 0)
+            return std::filesystem::absolute(f, ec) / "untitled.json";
+    return std::filesystem::absolute(levelsDir, ec) / "untitled.json";
 }
 
 bool replacesAnotherFile(const std::filesystem::path& target, const std::filesystem::path& documentPath) {

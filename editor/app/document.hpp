@@ -66,6 +66,18 @@ std::filesystem::path findLevelsDirectory(const std::filesystem::path& exeDir, c
 /// folder, else `levelsDir`.
 std::filesystem::path dialogFolder(const std::filesystem::path& documentPath, const std::filesystem::path& levelsDir);
 
+/// The level files (*.json but the schema) in `folder`, sorted: the Open
+/// dialog's list.
+std::vector<std::string> levelFiles(const std::filesystem::path& folder);
+
+/// Where Save as proposes to write: the document's own path; for an untitled
+/// level, untitled.json in the first folder that exists and can be written
+/// of `levelsDir`, `workingDir` and the home folder (an installed levels
+/// folder is read-only), else in `levelsDir`. Absolute.
+std::filesystem::path saveAsSuggestion(const std::filesystem::path& documentPath,
+                                       const std::filesystem::path& levelsDir,
+                                       const std::filesystem::path& workingDir);
+
 /// True when saving to `target` would write over a file other than the
 /// document's own (`documentPath`): Save as asks first.
 bool replacesAnotherFile(const std::filesystem::path& target, const std::filesystem::path& documentPath);

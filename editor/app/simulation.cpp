@@ -311,6 +311,24 @@ bool Simulation::step(Scene& scene) {
     return stepOnce(scene);
 }
 
+namespace {
+/// Same bytes in every array a step reads (the layout aside).
+bool sameState(const WorldState& a, const WorldState& b) {
+    return a.time == b.time && a.adaptiveStep == b.adaptiveStep && a.steps == b.steps && a.x == b.x && a.v == b.v &&
+           a.spinAngle == b.spinAngle && a.colliderAngle == b.colliderAngle && a.colliderSpin == b.colliderSpin &&
+           a.contacts == b.contacts && a.joints == b.joints;
+}
+} // namespace
+
+bool Simulation::replayStepInto(World& world, const HistoryEntry& target) const {
+    // Only from an entry of the same build (no edit, system switch or new
+    // drag in between), and kept only when the replay lands on the target's
+    // bytes: a mouse spring whose anchor moved since, for one, would not.
+    if (history_.empty() || history_.back().scene != target.scene) return false;
+    if (!world.restoreState(history_.back().state) || !world.step()) return false;
+    return sameState(world.saveState(), target.state);
+}
+
 bool Simulation::stepBack(Scene& scene) {
     if (state_ == SimState::Editing || history_.empty()) return false;
     state_ = SimState::Paused;
@@ -341,7 +359,11 @@ bool Simulation::stepBack(Scene& scene) {
         builtMouseBody_ = springEntity.isNull() ? Entity{} : mouseSpring->first;
         stale_ = !world_;
     }
-    if (world_) (void)world_->restoreState(entry.state);  // refused only for another layout: then reload set it
+    // The restored state came out of the step before it: replay that step
+    // from the entry before, so the contacts, joint forces and net forces
+    // on screen are that step's (a restore alone carries none, and the
+    // contacts table would be empty until the next step).
+    if (world_ && !replayStepInto(*world_, entry)) (void)world_->restoreState(entry.state);  // refused only for another layout: then reload set it
     sceneAtBuild_ = world_ ? entry.scene : nullptr;
     gained_ = entry.gained;
     sceneCounts_ = stateComponentCounts(scene.registry);

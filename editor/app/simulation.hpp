@@ -155,6 +155,10 @@ private:
         /// then the state written back.
         Scene restore() const;
     };
+    /// Restores the entry before `target` into `world` and steps it once:
+    /// true when that lands on target's state exactly (then the World also
+    /// holds the contacts and joint records of the step that made it).
+    bool replayStepInto(World& world, const HistoryEntry& target) const;
     bool rebuild(const Scene& scene);
     /// Recompiles a changed scene into the live World (keeps the warm start).
     bool reload(const Scene& scene);

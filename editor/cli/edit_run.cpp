@@ -6,6 +6,8 @@
 
 #include "stepwise/components.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -48,7 +50,11 @@ void writeDebugState(const std::string& path, ui::Session& session, std::uint64_
         << ",\n  \"steps\": " << ed.sim.steps() << ",\n  \"entities\": " << ed.doc.scene.registry.size()
         << ",\n  \"dirty\": " << (ed.dirty() ? "true" : "false") << ",\n  \"viewport\": [" << p.x << ", " << p.y << ", "
         << z.x << ", " << z.y << "],\n  \"camera\": [" << ed.view.camera.center.x << ", " << ed.view.camera.center.y
-        << ", " << ed.view.camera.zoom << "],\n  \"selection\": " << ed.selection.size() << ",\n  \"positions\": [";
+        << ", " << ed.view.camera.zoom << "],\n  \"selection\": " << ed.selection.size();
+    const ui::Session::DialogState d = session.dialogState();
+    out << ",\n  \"modal\": " << nlohmann::json(d.modal).dump() << ",\n  \"status\": " << nlohmann::json(d.status).dump()
+        << ",\n  \"open_folder\": " << nlohmann::json(d.openFolder).dump() << ",\n  \"open_files\": " << d.openFiles
+        << ",\n  \"save_as_suggestion\": " << nlohmann::json(d.saveAsSuggestion).dump() << ",\n  \"positions\": [";
     int n = 0;
     for (Entity e : ed.doc.scene.registry.entities()) {
         const Position* pos = ed.doc.scene.registry.tryGet<Position>(e);

@@ -166,7 +166,7 @@ int render(const RenderOptions& o) {
             // --steps 0 draws the scene as it is; overlays that need the
             // simulation say so in the legend.
             std::cerr << "stepwise: note: " << o.level << ": no World (" << built.error()
-                      << "); force, force-field and contacts overlays are skipped\n";
+                      << "); force, net-force, force-field, contacts and joints overlays are skipped\n";
         }
     }
 
@@ -270,8 +270,9 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--width", o->width, "Image width, pixels")->check(CLI::Range(16, 16384));
     cmd->add_option("--height", o->height, "Image height, pixels")->check(CLI::Range(16, 16384));
     cmd->add_option("--overlay", o->overlays,
-                    "Comma-separated overlays: velocity, velocity-field, force-field, force, contacts, aabb, "
-                    "trails, or all");
+                    "Comma-separated overlays: velocity, velocity-field, force-field, force (applied: gravity, "
+                    "springs, ...), net-force (m dv/dt over the last step, contacts included), contacts, aabb, "
+                    "trails, joints, or all");
     cmd->add_option("--camera", o->camera,
                     "X,Y,ZOOM: centre in metres and pixels per metre at 720 px height (default: the level's "
                     "view, else fit the scene)");

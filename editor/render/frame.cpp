@@ -42,6 +42,7 @@ constexpr Rgba kAnchorColor = rgb(0x718096);
 constexpr Rgba kVelocity = rgb(0x4fd1c5);
 constexpr Rgba kVelocityField = rgb(0x38b2ac, 0.8f);
 constexpr Rgba kForce = rgb(0xf6ad55);
+constexpr Rgba kNetForce = rgb(0xf687b3);
 constexpr Rgba kForceField = rgb(0xa78bfa, 0.5f);
 constexpr Rgba kContactPoint = rgb(0xff6b6b);
 constexpr Rgba kContactNormal = rgb(0xffa8a8);
@@ -102,6 +103,23 @@ double autoReference(std::vector<double> magnitudes) {
     return niceCeil(*mid);
 }
 
+/// Reference magnitude for forces: the 10th percentile of the non-zero
+/// magnitudes, rounded up to a 1-2-5 number. Forces in one view span orders
+/// of magnitude (gravity beside an attractor's pull). Taken from the low end,
+/// the weakest force that acts draws at about the reference length and the
+/// strong ones are compressed by the logarithmic length; a median reference
+/// shrank gravity to dots next to an attractor.
+double lowReference(std::vector<double> magnitudes) {
+    std::erase_if(magnitudes, [](double m) { return !(m > 0.0) || !std::isfinite(m); });
+    if (magnitudes.empty()) return 1.0;
+    const double largest = *std::max_element(magnitudes.begin(), magnitudes.end());
+    // Rounding-level values (a field cancelling at a point) say nothing.
+    std::erase_if(magnitudes, [&](double m) { return m < 1e-9 * largest; });
+    auto low = magnitudes.begin() + std::ptrdiff_t(magnitudes.size() / 10);
+    std::nth_element(magnitudes.begin(), low, magnitudes.end());
+    return niceCeil(*low);
+}
+
 std::string formatNumber(double v) {
     char buffer[32];
     std::snprintf(buffer, sizeof buffer, "%g", v);
@@ -120,7 +138,11 @@ public:
     Builder(DrawData& out, const FrameInput& input, int w, int h)
         : out_(out), in_(input), scene_(*input.scene), w_(w), h_(h),
           ppm_(input.camera.pixelsPerMetre(h)),
-          textScale_(h / 700 + 1),
+          // 1.5 pixels per font unit from a 360 px image up to 700 (capitals
+          // about 10 px tall, like the editor's 13 px UI font): one unit was
+          // 7 px print in the editor's viewport and the 960x540 renders.
+          // From 700 px, whole units as before (2 at 720 and 1080).
+          textScale_(h < 360 ? 1.0 : h < 700 ? 1.5 : double(h / 700 + 1)),
           arrowRef_(0.06 * h) {
         for (Entity e : input.selection) selected_.insert(e);
         // Level of detail: with thousands of bodies, per-body lines get
@@ -252,7 +274,7 @@ private:
     double text(double x, double yTop, const std::string& s, Rgba col);
     double textWidth(const std::string& s) const {
         std::string copy = s;
-        return double(stb_easy_font_width(copy.data()) * textScale_);
+        return double(stb_easy_font_width(copy.data())) * textScale_;
     }
     double textHeight() const { return 7.0 * textScale_; }
 
@@ -284,7 +306,7 @@ private:
     const Scene& scene_;
     int w_, h_;
     double ppm_;        ///< pixels per metre at this image height
-    int textScale_;     ///< integer pixel scale of the bitmap font
+    double textScale_;  ///< pixels per unit of the bitmap font (its strokes are one unit)
     double arrowRef_;   ///< pixels drawn for a reference-magnitude arrow
 
     /// Level of detail for per-body and per-contact marks (arrows, trails,
@@ -357,8 +379,13 @@ double Builder::text(double x, double yTop, const std::string& s, Rgba col) {
     for (int q = 0; q < quads; ++q) {
         const float* v = reinterpret_cast<const float*>(buffer.data() + q * 64);
         // Vertices 0 and 2 are opposite corners (x, y, z at +0, +1, +2; stride 4 floats).
-        const double x0 = x + v[0] * s8, x1 = x + v[8] * s8;
-        const double y0 = yTop - v[1] * s8, y1 = yTop - v[9] * s8;
+        double x0 = x + v[0] * s8, x1 = x + v[8] * s8;
+        double y0 = yTop - v[1] * s8, y1 = yTop - v[9] * s8;
+        if (s8 != std::floor(s8)) {
+            // A fractional scale: whole-pixel edges, so every stroke is
+            // solid (1 or 2 px) rather than a blend of two half-lit rows.
+            x0 = std::round(x0), x1 = std::round(x1), y0 = std::round(y0), y1 = std::round(y1);
+        }
         const double p[6][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y0}, {x1, y1}, {x0, y1}};
         for (const auto& pt : p) push(d, {pt[0], pt[1], col.r, col.g, col.b, col.a});
     }
@@ -524,7 +551,7 @@ void Builder::fields() {
                 forces.push_back(in_.world->probeForce(p));
                 mags.push_back(length(forces.back()));
             }
-            const double ref = in_.scales.forceField > 0 ? in_.scales.forceField : autoReference(mags);
+            const double ref = in_.scales.forceField > 0 ? in_.scales.forceField : lowReference(mags);
             out_.scales.forceField = ref;
             for (std::size_t k = 0; k < points.size(); ++k) {
                 const double m = mags[k];
@@ -852,26 +879,47 @@ void Builder::aabbOutlines() {
 
 void Builder::bodyArrows() {
     const double maxPx = 3.2 * arrowRef_;
-    if (in_.overlays.has(Overlay::Force)) {
-        if (!in_.world) {
-            out_.notes.push_back("force: needs a World (not built)");
-        } else {
-            const std::vector<Vec2> forces = in_.world->bodyForces();
-            std::vector<double> mags;
-            for (Vec2 f : forces) mags.push_back(length(f));
-            const double ref = in_.scales.force > 0 ? in_.scales.force : autoReference(mags);
-            out_.scales.force = ref;
-            std::vector<Vec2> origins;
-            for (std::size_t i = 0; i < forces.size(); ++i) origins.push_back(toPx(in_.world->bodyPosition(i)));
+    const bool applied = in_.overlays.has(Overlay::Force), net = in_.overlays.has(Overlay::NetForce);
+    if ((applied || net) && !in_.world) {
+        out_.notes.push_back(std::string(applied ? "force" : "net-force") + ": needs a World (not built)");
+    } else if (applied || net) {
+        // One reference for both, from the applied forces (see ArrowScales::
+        // force), so a net arrow reads against the forces that act: a crate
+        // resting on the floor has an applied arrow of its weight and a net
+        // arrow of about nothing.
+        const std::vector<Vec2> appliedForces = in_.world->bodyForces();
+        std::vector<double> mags;
+        for (Vec2 f : appliedForces) mags.push_back(length(f));
+        const double ref = in_.scales.force > 0 ? in_.scales.force : lowReference(mags);
+        out_.scales.force = ref;
+        std::vector<Vec2> origins;
+        for (std::size_t i = 0; i < appliedForces.size(); ++i) origins.push_back(toPx(in_.world->bodyPosition(i)));
+        const auto draw = [&](const std::vector<Vec2>& forces, Rgba colour) {
             CellThinner thin(*this, origins);
             for (std::size_t i = 0; i < forces.size(); ++i) {
-                if (!(mags[i] > 0.0) || !std::isfinite(mags[i])) continue;
+                const double m = length(forces[i]);
+                if (!(m > 0.0) || !std::isfinite(m)) continue;
                 const Vec2 from = origins[i];
                 if (!thin.keep(from, selected_.count(in_.world->bodyEntity(i)) != 0)) continue;
-                const double len = arrowLength(mags[i], ref, arrowRef_, maxPx);
-                arrow(from, from + forces[i] / mags[i] * len, dense_ ? 1.0 : 2.0, kForce);
+                const double len = arrowLength(m, ref, arrowRef_, maxPx);
+                // Under a pixel there is nothing to see (a resting body's net
+                // force), and a settled pile would send an instance per body.
+                if (len < 1.0) continue;
+                arrow(from, from + forces[i] / m * len, dense_ ? 1.0 : 2.0, colour);
             }
-            legend_.push_back({"force", kForce, ref, "N"});
+        };
+        if (applied) {
+            draw(appliedForces, kForce);
+            legend_.push_back({"applied force", kForce, ref, "N"});
+        }
+        if (net) {
+            const std::vector<Vec2> netForces = in_.world->netForces();
+            if (netForces.empty()) {
+                out_.notes.push_back("net force: shown once a step is taken");
+            } else {
+                draw(netForces, kNetForce);
+                legend_.push_back({"net force (m dv/dt)", kNetForce, ref, "N"});
+            }
         }
     }
     if (in_.overlays.has(Overlay::Velocity)) {
@@ -970,8 +1018,10 @@ void Builder::hud() {
         int kind;  // 0 arrow, 1 swatch box, 2 line, 3 note
     };
     std::vector<Row> rows;
-    for (const LegendRow& r : legend_)
+    for (const LegendRow& r : legend_) {
         rows.push_back({r.label, "= " + formatNumber(r.reference) + " " + r.unit, r.colour, 0});
+        out_.legend.push_back(r.label + " " + rows.back().value);
+    }
     if (in_.overlays.has(Overlay::Aabb)) rows.push_back({"bounding boxes", "", kAabb, 1});
     if (in_.overlays.has(Overlay::Trails) && in_.trails)
         rows.push_back({"trails", std::to_string(in_.trails->capacity()) + " steps", rgb(0x9fb3c8, 0.8f), 2});

@@ -37,6 +37,7 @@ struct DrawData {
     std::vector<Batch> batches;   ///< in drawing order
     ArrowScales scales;           ///< the references used (auto ones resolved)
     std::vector<std::string> notes;  ///< e.g. "force-field: no World (scene has shapes)"
+    std::vector<std::string> legend; ///< the legend's arrow rows, e.g. "applied force = 20 N"
     std::size_t instanceCount() const;
 };
 

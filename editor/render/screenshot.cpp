@@ -36,8 +36,9 @@ Result<Screenshot> renderSceneScreenshot(OffscreenRenderer& renderer, Scene scen
         trails.record(scene);
         // Drawn as loaded; overlays that need the simulation are left out
         // rather than drawn as "unavailable" notes.
-        input.overlays.bits &= ~(std::uint32_t(Overlay::Force) | std::uint32_t(Overlay::ForceField) |
-                                 std::uint32_t(Overlay::Contacts) | std::uint32_t(Overlay::Joints));
+        input.overlays.bits &= ~(std::uint32_t(Overlay::Force) | std::uint32_t(Overlay::NetForce) |
+                                 std::uint32_t(Overlay::ForceField) | std::uint32_t(Overlay::Contacts) |
+                                 std::uint32_t(Overlay::Joints));
     }
     input.scene = &scene;
     input.world = world ? &*world : nullptr;

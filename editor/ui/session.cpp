@@ -3,6 +3,7 @@
 #include "ui/imgui_gl.hpp"
 
 #include <imgui.h>
+#include <imgui_internal.h>
 
 #include <algorithm>
 #include <chrono>
@@ -27,6 +28,23 @@ const char* kFontPaths[] = {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
                             "/usr/share/fonts/TTF/DejaVuSans.ttf"};
 
 } // namespace
+
+Session::DialogState Session::dialogState() const {
+    DialogState d;
+    ImGuiContext* previous = ImGui::GetCurrentContext();
+    ImGui::SetCurrentContext(imgui_);
+    if (const ImGuiWindow* modal = ImGui::GetTopMostPopupModal()) {
+        d.modal = modal->Name;
+        d.modal = d.modal.substr(0, d.modal.find("##"));
+    }
+    ImGui::SetCurrentContext(previous);
+    d.status = editor_.status;
+    d.openFolder = editor::dialogFolder(editor_.doc.path, ui_.levelsDir).string();
+    d.openFiles = editor::levelFiles(d.openFolder).size();
+    std::error_code cwd;
+    d.saveAsSuggestion = editor::saveAsSuggestion(editor_.doc.path, ui_.levelsDir, std::filesystem::current_path(cwd)).string();
+    return d;
+}
 
 Result<std::unique_ptr<Session>> Session::create(render::GetProcAddress getProc, const SessionOptions& options) {
     std::unique_ptr<Session> s(new Session());

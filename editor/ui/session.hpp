@@ -65,6 +65,16 @@ public:
     ImVec2 viewportPos() const { return ui_.viewportPos; }
     ImVec2 viewportSize() const { return ui_.viewportSize; }
 
+    /// What the dialogs show, for --debug-state (the end-to-end test drives
+    /// the real window by it): the open modal's title ("" for none), the
+    /// status line, the Open dialog's folder and its number of level files,
+    /// and the path Save as proposes.
+    struct DialogState {
+        std::string modal, status, openFolder, saveAsSuggestion;
+        std::size_t openFiles = 0;
+    };
+    DialogState dialogState() const;
+
     /// Saves settings (recent files, font size) and imgui.ini when persisting.
     void saveSettings();
     bool wantsQuit() const { return editor_.quitRequested(); }

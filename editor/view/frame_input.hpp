@@ -24,13 +24,18 @@ namespace stepwise::render {
 /// Reference magnitudes for arrows: an arrow of magnitude `ref` is drawn
 /// `referencePixels` long; lengths grow as log2(1 + m/ref) so a field
 /// spanning orders of magnitude stays legible (3*ref is twice as long,
-/// 7*ref three times). 0 means "choose from the data" (a 1-2-5 number near
-/// the median magnitude). Fix them for a frame sequence so arrows compare.
+/// 7*ref three times). 0 means "choose from the data": a 1-2-5 number near
+/// the median magnitude, except for forces (see `force`). Fix them for a
+/// frame sequence so arrows compare.
 struct ArrowScales {
     double velocity = 0.0;       ///< m/s
     double velocityField = 0.0;  ///< m/s
-    double force = 0.0;          ///< N
-    double forceField = 0.0;     ///< N per kg (= m/s^2)
+    /// N, applied and net force alike (so their arrows compare). Chosen
+    /// from the applied forces' low end (10th percentile), so the weakest
+    /// force that acts, gravity next to a strong attractor, draws at about
+    /// the reference length and stronger ones grow logarithmically.
+    double force = 0.0;
+    double forceField = 0.0;     ///< N per kg (= m/s^2); chosen like `force`
     double impulse = 0.0;        ///< N*s
     double jointForce = 0.0;     ///< N (joints overlay)
 };

@@ -7,7 +7,7 @@ namespace stepwise::render {
 const std::vector<std::pair<std::string_view, Overlay>>& overlayNames() {
     static const std::vector<std::pair<std::string_view, Overlay>> names = {
         {"velocity", Overlay::Velocity}, {"velocity-field", Overlay::VelocityField},
-        {"force-field", Overlay::ForceField}, {"force", Overlay::Force},
+        {"force-field", Overlay::ForceField}, {"force", Overlay::Force}, {"net-force", Overlay::NetForce},
         {"contacts", Overlay::Contacts}, {"aabb", Overlay::Aabb},
         {"trails", Overlay::Trails}, {"joints", Overlay::Joints},
     };

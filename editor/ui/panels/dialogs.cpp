@@ -15,20 +15,6 @@ namespace stepwise::ui {
 
 using editor::Editor;
 
-namespace {
-
-std::vector<std::string> listLevelFiles(const std::string& dir) {
-    std::vector<std::string> out;
-    std::error_code ec;
-    for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
-        if (entry.path().extension() == ".json" && entry.path().filename() != "scene.schema.json")
-            out.push_back(entry.path().string());
-    std::sort(out.begin(), out.end());
-    return out;
-}
-
-} // namespace
-
 void dialogs(UiState& ui, Editor& ed) {
     using editor::UiRequest;
     switch (ed.uiRequest) {
@@ -49,9 +35,10 @@ void dialogs(UiState& ui, Editor& ed) {
         ImGui::OpenPopup("Save as");
         // An absolute suggestion in a folder that exists, wherever the
         // editor was started from.
-        if (ui.saveAsPath.empty())
-            ui.saveAsPath = ed.doc.path.empty() ? (std::filesystem::path(ui.levelsDir) / "untitled.json").string()
-                                                : ed.doc.path.string();
+        if (ui.saveAsPath.empty()) {
+            std::error_code cwd;
+            ui.saveAsPath = editor::saveAsSuggestion(ed.doc.path, ui.levelsDir, std::filesystem::current_path(cwd)).string();
+        }
         ui.saveAsDialogRequested = false;
     }
     if (ui.saveStateRequested) {
@@ -84,7 +71,7 @@ void dialogs(UiState& ui, Editor& ed) {
         const std::string folder = editor::dialogFolder(ed.doc.path, ui.levelsDir).string();
         ImGui::TextColored(kDim, "Levels in %s", folder.c_str());
         ImGui::BeginChild("levels", ImVec2(0, 200 * ui.scale), true);
-        for (const std::string& f : listLevelFiles(folder))
+        for (const std::string& f : editor::levelFiles(folder))
             if (ImGui::Selectable(f.c_str(), f == ui.openPath, ImGuiSelectableFlags_AllowDoubleClick)) {
                 ui.openPath = f;
                 if (ImGui::IsMouseDoubleClicked(0)) {
@@ -108,6 +95,11 @@ void dialogs(UiState& ui, Editor& ed) {
         ImGui::SetNextWindowPos(center, ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
         ImGui::SetNextWindowSize(ImVec2(520 * ui.scale, 0), ImGuiCond_Appearing);
         if (ImGui::BeginPopupModal(name)) {
+            // Type the path at once: the field takes the keyboard whenever
+            // nothing else in the dialog is active (asked on the appearing
+            // frame alone, the request is lost: an auto-sized window is
+            // hidden on that frame).
+            if (!ImGui::IsAnyItemActive()) ImGui::SetKeyboardFocusHere();
             ImGui::SetNextItemWidth(-1);
             const bool enter =
                 ImGui::InputText("##saveas", &ui.saveAsPath, ImGuiInputTextFlags_EnterReturnsTrue);

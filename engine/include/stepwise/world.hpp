@@ -259,8 +259,17 @@ public:
     Entity bodyEntity(std::size_t body) const;
     Vec2 bodyPosition(std::size_t body) const;
     Vec2 bodyVelocity(std::size_t body) const;
-    /// Net force on each dynamic body at the current state, newtons.
+    /// Applied force on each dynamic body at the current state, newtons:
+    /// what the force systems (gravity, drag, springs, attractors, boids)
+    /// give, without the contact and joint constraints. A crate resting on
+    /// the floor shows m g here; netForces() shows what moves it.
     std::vector<Vec2> bodyForces() const;
+    /// Net force on each dynamic body over the last step, newtons: the
+    /// momentum change m (v - v_start) / dt, so the applied forces and the
+    /// contact and joint impulses together (a crate resting on the floor
+    /// shows about 0). Empty when no step was taken since the World was
+    /// built, reloaded or restored, or when the last step failed.
+    std::vector<Vec2> netForces() const;
 
     /// Per-stage timing on (default) or off. Off, a step reads no clock at
     /// all; the benchmarks use this to time the integrators alone. (Addition.)

@@ -432,6 +432,7 @@ Result<void> World::step() {
     const std::size_t m = 2 * f.n;
     const int substeps = w.settings.substeps;
     const double h = w.settings.dt / double(substeps);
+    w.stepStartKnown = false;  // set again once this step succeeds
     if (substeps > 1) {
         std::copy(w.x[w.current].begin(), w.x[w.current].end(), w.backupX.begin());
         std::copy(w.v[w.current].begin(), w.v[w.current].end(), w.backupV.begin());
@@ -522,6 +523,7 @@ Result<void> World::step() {
         return Error{message};
     }
     w.settings.time += w.settings.dt;
+    w.stepStartKnown = true;
     if (w.kind == detail::IntegratorKind::Dopri5) w.settings.adaptiveStep = w.integrator->proposedStep();
     ++w.stats.step;
     w.stats.forceEvaluations = evaluations;
@@ -715,6 +717,7 @@ Result<void> World::restoreState(const WorldState& s) {
         w.collision->clearContactRecords();  // they described the step this state replaces
     }
     w.stats.contactCount = 0;
+    w.stepStartKnown = false;  // the other buffer holds no step's start
     w.settings.time = s.time;
     w.settings.adaptiveStep = s.adaptiveStep;
     w.integrator->setProposedStep(s.adaptiveStep);
@@ -920,6 +923,19 @@ std::vector<Vec2> World::bodyForces() const {
     f.profiling = wasProfiling;
     std::vector<Vec2> forces(f.n);
     for (std::size_t b = 0; b < f.n; ++b) forces[b] = {f.mass[b] * a[2 * b], f.mass[b] * a[2 * b + 1]};
+    return forces;
+}
+
+std::vector<Vec2> World::netForces() const {
+    const WorldImpl& w = *impl_;
+    if (!w.stepStartKnown) return {};
+    const detail::ForceModel& f = w.model;
+    const double* v = w.vs();
+    const double* v0 = w.stepStartV();
+    const double dt = w.settings.dt;
+    std::vector<Vec2> forces(f.n);
+    for (std::size_t b = 0; b < f.n; ++b)
+        forces[b] = {f.mass[b] * (v[2 * b] - v0[2 * b]) / dt, f.mass[b] * (v[2 * b + 1] - v0[2 * b + 1]) / dt};
     return forces;
 }
 

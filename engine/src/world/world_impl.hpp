@@ -28,6 +28,12 @@ public:
     // Start-of-step copy, only needed with substeps > 1 (the intermediate
     // substeps overwrite both buffers).
     std::vector<double> backupX, backupV;
+    /// The last step succeeded and the velocities it started from are still
+    /// there (the other buffer with one substep, backupV with several): what
+    /// netForces() needs. Cleared by a failed step; a restore or reload
+    /// starts a World without it.
+    bool stepStartKnown = false;
+    const double* stepStartV() const { return settings.substeps > 1 ? backupV.data() : v[1 - current].data(); }
 
     // Bodies with angle and angular_velocity (angle += h * omega).
     std::vector<std::uint32_t> spinBody;  ///< dynamic body index
