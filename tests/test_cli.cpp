@@ -404,10 +404,17 @@ TEST_F(Cli, RenderBadArgumentsExitTwoNameTheArgumentAndWriteNothing) {
     }
 }
 
-/// Runs `command` as the unprivileged user nobody when this process is
-/// root (root may write any file, so a read-only file means nothing to it).
-std::string asUnprivileged(const std::string& command) {
-    return ::geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups " + command : command;
+/// Runs `stepwise ARGS` as the unprivileged user nobody when this process
+/// is root (root may write any file, so a read-only file means nothing to
+/// it). The shell that redirects stderr to `errFile` stays root.
+Outcome stepwiseUnprivileged(const std::string& args, const fs::path& errFile) {
+    const std::string asNobody = ::geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups " : "";
+    const int status =
+        std::system((asNobody + STEPWISE_BINARY + " " + args + " >/dev/null 2>" + errFile.string()).c_str());
+    Outcome o;
+    o.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    o.err = readFile(errFile);
+    return o;
 }
 
 TEST_F(Cli, BenchBadArgumentsExitTwoNamingTheArgument) {
@@ -447,12 +454,9 @@ TEST_F(Cli, BenchBadArgumentsExitTwoNamingTheArgument) {
     { std::ofstream(md) << "kept\n"; }
     fs::permissions(md, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
     const fs::path errFile = dir_ / "err.txt";
-    const int status = std::system((asUnprivileged(std::string(STEPWISE_BINARY) + " bench accuracy --quick --out " +
-                                                   reportDir.string()) +
-                                    " >/dev/null 2>" + errFile.string())
-                                       .c_str());
-    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
-    EXPECT_EQ(readFile(errFile), md.string() + ": error: cannot write: Permission denied\n");
+    const Outcome refused = stepwiseUnprivileged("bench accuracy --quick --out " + reportDir.string(), errFile);
+    EXPECT_EQ(refused.exitCode, 2);
+    EXPECT_EQ(refused.err, md.string() + ": error: cannot write: Permission denied\n");
     EXPECT_EQ(readFile(md), "kept\n");
     EXPECT_EQ(std::distance(fs::directory_iterator(reportDir), fs::directory_iterator()), 1) << "nothing else written";
 }
@@ -614,12 +618,9 @@ TEST_F(Cli, AReadOnlyOutputIsRefusedAndKept) {
     const fs::path out = write("o.json", "read-only\n");
     fs::permissions(out, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
     const fs::path errFile = dir_ / "err.txt";
-    const int status = std::system((asUnprivileged(std::string(STEPWISE_BINARY) + " run " + file.string() +
-                                                   " --steps 3 --out " + out.string()) +
-                                    " >/dev/null 2>" + errFile.string())
-                                       .c_str());
-    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
-    EXPECT_EQ(readFile(errFile), out.string() + ": error: cannot write: Permission denied\n");
+    const Outcome refused = stepwiseUnprivileged("run " + file.string() + " --steps 3 --out " + out.string(), errFile);
+    EXPECT_EQ(refused.exitCode, 2);
+    EXPECT_EQ(refused.err, out.string() + ": error: cannot write: Permission denied\n");
     EXPECT_EQ(readFile(out), "read-only\n");
 }
 
@@ -633,12 +634,9 @@ TEST_F(Cli, EditRefusesAnUnwritableScreenshotBeforeItStarts) {
     const fs::path png = write("shot.png", "read-only\n");
     fs::permissions(png, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
     const fs::path errFile = dir_ / "err.txt";
-    const int status = std::system((asUnprivileged(std::string(STEPWISE_BINARY) + " edit " + file.string() +
-                                                   " --builtin-font --size 320x240 --screenshot " + png.string()) +
-                                    " >/dev/null 2>" + errFile.string())
-                                       .c_str());
-    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
-    EXPECT_EQ(readFile(errFile), png.string() + ": error: cannot write: Permission denied\n");
+    const Outcome refused = stepwiseUnprivileged("edit " + file.string() + " --builtin-font --size 320x240 --screenshot " + png.string(), errFile);
+    EXPECT_EQ(refused.exitCode, 2);
+    EXPECT_EQ(refused.err, png.string() + ": error: cannot write: Permission denied\n");
     EXPECT_EQ(readFile(png), "read-only\n");
     const fs::path missing = dir_ / "missing" / "shot.png";
     Outcome o = stepwise("edit " + file.string() + " --builtin-font --size 320x240 --screenshot " + missing.string());
