@@ -3,6 +3,8 @@
 
 #include "editor_fixture.hpp"
 
+#include <map>
+
 #include "stepwise/world_fields.hpp"
 
 using namespace stepwise;
@@ -151,4 +153,23 @@ TEST(WorldSettingsEdit, AcceptsWhatTheLoaderAccepts) {
     EXPECT_EQ(setWorldField(f.ed.doc.scene, *findWorldField("solver_iterations"), 7.0),
               Error{"world.solver_iterations: a value of the wrong type for this field"});
     EXPECT_EQ(f.ed.doc.scene.world.solverIterations, 600);
+}
+
+// The entity list called polygons and joints "point" (car.json: the
+// terrain's thirteen polygons and the car's three joints), and its filter
+// could not find them by what they are.
+TEST(EntityList, EveryShapeAndLinkIsNamedForWhatItIs) {
+    LevelOpen car("car.json");
+    const Registry& reg = car.ed.doc.scene.registry;
+    std::map<std::string, std::string> kinds;
+    for (Entity e : reg.entities()) kinds[displayName(reg, e)] = std::string(entityKind(reg, e));
+    EXPECT_EQ(kinds["slope up"], "polygon");
+    EXPECT_EQ(kinds["rear axle"], "joint");
+    EXPECT_EQ(kinds["roof weld"], "joint");
+    EXPECT_EQ(kinds["rear wheel"], "circle");
+    EXPECT_EQ(kinds["car"], "box");
+    LevelOpen chain("spring_chain.json");
+    const Registry& springs = chain.ed.doc.scene.registry;
+    EXPECT_EQ(entityKind(springs, findByName(springs, "spring0")), "spring");
+    EXPECT_EQ(entityKind(springs, findByName(springs, "link0")), "point");
 }

@@ -280,6 +280,18 @@ std::string displayName(const Registry& registry, Entity e) {
     return "entity " + std::to_string(it - order.begin());
 }
 
+std::string_view entityKind(const Registry& registry, Entity e) {
+    if (registry.has<Spring>(e)) return "spring";
+    if (registry.has<Joint>(e)) return "joint";
+    if (registry.has<Plane>(e)) return "wall";
+    if (registry.has<Box>(e)) return "box";
+    if (registry.has<Radius>(e)) return "circle";
+    if (registry.has<Polygon>(e)) return "polygon";
+    if (registry.has<Attractor>(e)) return "attractor";
+    if (registry.has<Boid>(e)) return "boid";
+    return "point";
+}
+
 bool isBody(const Registry& registry, Entity e) { return registry.has<Position>(e) && !registry.has<Spring>(e); }
 
 namespace {

@@ -94,6 +94,10 @@ std::string uniqueName(const Registry& registry, const std::string& base);
 Entity findByName(const Registry& registry, std::string_view name);
 /// Name, or "entity N" (N its place in the scene order).
 std::string displayName(const Registry& registry, Entity e);
+/// What the entity is, for the entity list and its filter: "spring",
+/// "joint", "wall", "box", "circle", "polygon", "attractor", "boid", else
+/// "point".
+std::string_view entityKind(const Registry& registry, Entity e);
 
 /// True when the entity is a body: has a position and is not a spring.
 bool isBody(const Registry& registry, Entity e);

@@ -28,7 +28,8 @@ void entitiesPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                 const std::string name = editor::displayName(reg, e);
                 const Type* t = reg.tryGet<Type>(e);
                 if (name.find(ui.entityFilter) == std::string::npos &&
-                    !(t && t->value.find(ui.entityFilter) != std::string::npos))
+                    !(t && t->value.find(ui.entityFilter) != std::string::npos) &&
+                    editor::entityKind(reg, e).find(ui.entityFilter) == std::string_view::npos)
                     continue;
             }
             shown.push_back(e);
@@ -41,9 +42,7 @@ void entitiesPanel(UiState& ui, Editor& ed, const PanelRects& r) {
             for (int i = clipper.DisplayStart; i < clipper.DisplayEnd; ++i) {
                 const Entity e = shown[std::size_t(i)];
                 const bool selected = std::find(ed.selection.begin(), ed.selection.end(), e) != ed.selection.end();
-                const char* kind = reg.has<Spring>(e) ? "spring" : reg.has<Plane>(e) ? "wall"
-                                 : reg.has<Box>(e) ? "box" : reg.has<Radius>(e) ? "circle"
-                                 : reg.has<Attractor>(e) ? "attractor" : reg.has<Boid>(e) ? "boid" : "point";
+                const std::string kind(editor::entityKind(reg, e));
                 ImGui::PushID(int(e.index));
                 const std::string label = editor::displayName(reg, e);
                 if (ImGui::Selectable(label.c_str(), selected)) {
@@ -57,7 +56,7 @@ void entitiesPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                     }
                 }
                 ImGui::SameLine(ImGui::GetContentRegionAvail().x - 60 * ui.scale + ImGui::GetCursorPosX() * 0);
-                ImGui::TextColored(kDim, "%s", kind);
+                ImGui::TextColored(kDim, "%s", kind.c_str());
                 ImGui::PopID();
             }
         ImGui::EndChild();
