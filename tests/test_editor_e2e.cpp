@@ -106,9 +106,14 @@ bool waitFor(const std::function<bool()>& condition, std::chrono::milliseconds t
 }
 
 int freeDisplay() {
-    for (int n = 90; n < 200; ++n)
+    // Start the search at a number of this process's own: ctest -j runs the
+    // e2e tests side by side, and two that both took the first free number
+    // (:90) shared one X server and drove each other's windows.
+    for (int k = 0; k < 110; ++k) {
+        const int n = 90 + int((unsigned(::getpid()) + unsigned(k) * 7u) % 110u);
         if (!fs::exists("/tmp/.X" + std::to_string(n) + "-lock") && !fs::exists("/tmp/.X11-unix/X" + std::to_string(n)))
             return n;
+    }
     return -1;
 }
 
