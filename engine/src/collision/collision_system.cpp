@@ -304,6 +304,8 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
         }
     }
     prepareContacts(constraints_, details_, bodies_);
+    coloured_.build(constraints_, bodies_, settings_.simd);
+    indexImpacts(constraints_, bodies_.size(), impactScratch_);
     if (!joints_.empty()) joints::prepareJoints(joints_, bodies_, centres_, angles_);
     timings_.narrowPhaseMs = msSince(narrowStart);
 }
@@ -354,13 +356,14 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // In a crowd every pair approaches every other: the passes would run to
     // the bound over hundreds of thousands of contacts (measured: 60% of a
     // 2,000-body crowd's step). Two passes there; the push-apart does the rest.
-    propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, crowdBodies_.empty() ? 64 : 2);
+    propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, crowdBodies_.empty() ? 64 : 2,
+                     impactScratch_);
     crowdSaved_.resize(crowdBodies_.size());
     for (std::size_t k = 0; k < crowdBodies_.size(); ++k)
         crowdSaved_[k] = {bodies_[crowdBodies_[k]].v, bodies_[crowdBodies_[k]].w};
     if (settings_.warmStart) {
         if (jointed) joints::warmStartJoints(joints_, bodies_);
-        warmStart(constraints_, bodies_);
+        coloured_.warmStart(constraints_, bodies_);
     }
     // Bodies in a crowd (many on top of each other) take the biased
     // passes' push (and the warm start's) as a position correction only
@@ -372,7 +375,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     bool reverse = false;
     for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse) {
         if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, true);
-        solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
+        coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
     }
 
     offsetAngleBefore_.resize(offsetBodies_.size());
@@ -407,7 +410,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     }
     for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse) {
         if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, false);
-        solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
+        coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
     }
 
     for (std::size_t i = 0; i < n; ++i) {
@@ -431,6 +434,7 @@ void CollisionSystem::endStep() {
     // divergence can put it back.
     previousCache_.swap(cache_);
     cache_.clear();
+    coloured_.storeImpulses(constraints_);
     records_.clear();
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
         const ContactConstraint& c = constraints_[k];
