@@ -3,6 +3,7 @@
 #include "integrators/integrator.hpp"  // detail::simdLevel: the instruction set the integrators use
 
 #include <bit>
+#include <cstddef>
 #include <cstring>
 
 // The helpers below pass four-double vectors by value; they are always
@@ -42,31 +43,46 @@ static_assert(kContactLanes == 4, "the vector types below hold four lanes");
 
 /// Velocities of the four lanes' bodies, and their motion since the step began.
 struct BodyLanes {
-    D4 vx, vy, w, dpx, dpy, qc, qs;
+    D4 vx, vy, w, invMass, dpx, dpy, qc, qs;
 };
-[[gnu::always_inline]] inline BodyLanes gather(const SolverBody* bodies, const std::uint32_t* index) {
-    BodyLanes r;
-    for (int l = 0; l < kContactLanes; ++l) {
-        const SolverBody& b = bodies[index[l]];
-        r.vx[l] = b.v.x;
-        r.vy[l] = b.v.y;
-        r.w[l] = b.w;
-        r.dpx[l] = b.dp.x;
-        r.dpy[l] = b.dp.y;
-        r.qc[l] = b.dq.c;
-        r.qs[l] = b.dq.s;
-    }
-    return r;
+// SolverBody holds (v.x, v.y, w, invMass) and (dp.x, dp.y, dq.c, dq.s) as
+// four consecutive doubles each: one load per lane and a 4x4 transpose
+// (pure data movement, so it changes no bit) give the lanes.
+static_assert(offsetof(SolverBody, w) == 2 * sizeof(double) && offsetof(SolverBody, invMass) == 3 * sizeof(double) &&
+                  offsetof(SolverBody, dq) == offsetof(SolverBody, dp) + 2 * sizeof(double),
+              "gather() reads SolverBody as two runs of four doubles");
+[[gnu::always_inline]] inline void transpose(D4& r0, D4& r1, D4& r2, D4& r3) {
+    const D4 t0 = __builtin_shufflevector(r0, r1, 0, 4, 2, 6);
+    const D4 t1 = __builtin_shufflevector(r0, r1, 1, 5, 3, 7);
+    const D4 t2 = __builtin_shufflevector(r2, r3, 0, 4, 2, 6);
+    const D4 t3 = __builtin_shufflevector(r2, r3, 1, 5, 3, 7);
+    r0 = __builtin_shufflevector(t0, t2, 0, 1, 4, 5);
+    r1 = __builtin_shufflevector(t1, t3, 0, 1, 4, 5);
+    r2 = __builtin_shufflevector(t0, t2, 2, 3, 6, 7);
+    r3 = __builtin_shufflevector(t1, t3, 2, 3, 6, 7);
 }
-[[gnu::always_inline]] inline void scatter(SolverBody* bodies, const std::uint32_t* index, D4 vx, D4 vy, D4 w) {
-    // In lane order, as the one-at-a-time solve writes them; lanes on static
-    // body 0 write its zeros back.
-    for (int l = 0; l < kContactLanes; ++l) {
-        SolverBody& b = bodies[index[l]];
-        b.v.x = vx[l];
-        b.v.y = vy[l];
-        b.w = w[l];
-    }
+[[gnu::always_inline]] inline BodyLanes gather(const SolverBody* bodies, const std::uint32_t* index) {
+    const SolverBody& b0 = bodies[index[0]];
+    const SolverBody& b1 = bodies[index[1]];
+    const SolverBody& b2 = bodies[index[2]];
+    const SolverBody& b3 = bodies[index[3]];
+    D4 v0 = load(&b0.v.x), v1 = load(&b1.v.x), v2 = load(&b2.v.x), v3 = load(&b3.v.x);
+    D4 p0 = load(&b0.dp.x), p1 = load(&b1.dp.x), p2 = load(&b2.dp.x), p3 = load(&b3.dp.x);
+    transpose(v0, v1, v2, v3);  // vx, vy, w, invMass
+    transpose(p0, p1, p2, p3);  // dp.x, dp.y, dq.c, dq.s
+    return {v0, v1, v2, v3, p0, p1, p2, p3};
+}
+[[gnu::always_inline]] inline void scatter(SolverBody* bodies, const std::uint32_t* index, const D4& vx, const D4& vy,
+                                           const D4& w, const D4& invMass) {
+    // Back to one (v.x, v.y, w, invMass) row per lane (invMass as gathered,
+    // unchanged), stored in lane order as the one-at-a-time solve stores;
+    // lanes on static body 0 write its zeros back.
+    D4 r0 = vx, r1 = vy, r2 = w, r3 = invMass;
+    transpose(r0, r1, r2, r3);
+    store(&bodies[index[0]].v.x, r0);
+    store(&bodies[index[1]].v.x, r1);
+    store(&bodies[index[2]].v.x, r2);
+    store(&bodies[index[3]].v.x, r3);
 }
 
 struct PassArgs {
@@ -113,8 +129,8 @@ template <int Points>
         v.vBy = v.vBy + (mB * ti) * ty;
         v.wB = v.wB + (iB * -dnB) * ti;
     }
-    scatter(bodies, c.bodyA, v.vAx, v.vAy, v.wA);
-    scatter(bodies, c.bodyB, v.vBx, v.vBy, v.wB);
+    scatter(bodies, c.bodyA, v.vAx, v.vAy, v.wA, a.invMass);
+    scatter(bodies, c.bodyB, v.vBx, v.vBy, v.wB, b.invMass);
 }
 
 /// Bias and soft scaling of one point (solveContacts' targetOf).
@@ -192,15 +208,20 @@ template <int Points, bool UseBias>
             const D4 both1 = -(i11 * q1 + i12 * q2);
             const D4 both2 = -(i12 * q1 + i22 * q2);
             const M4 bothOk = (both1 >= zero) & (both2 >= zero);
-            const D4 first1 = -q1 / k11;
-            const M4 firstOk = (first1 >= zero) & (k12 * first1 + q2 >= zero);
-            const D4 second2 = -q2 / k22;
-            const M4 secondOk = (second2 >= zero) & (k12 * second2 + q1 >= zero);
-            const M4 noneOk = (q1 >= zero) & (q2 >= zero);
-            const D4 none1 = noneOk ? zero : a1 / t[0].massScale;
-            const D4 none2 = noneOk ? zero : a2 / t[0].massScale;
-            const D4 y1 = bothOk ? both1 : firstOk ? first1 : secondOk ? zero : none1;
-            const D4 y2 = bothOk ? both2 : firstOk ? zero : secondOk ? second2 : none2;
+            D4 y1 = both1, y2 = both2;
+            if (!allLanes(bothOk)) {
+                // Only lanes where both points cannot push need the other
+                // cases (and their divisions): settled stacks rarely do.
+                const D4 first1 = -q1 / k11;
+                const M4 firstOk = (first1 >= zero) & (k12 * first1 + q2 >= zero);
+                const D4 second2 = -q2 / k22;
+                const M4 secondOk = (second2 >= zero) & (k12 * second2 + q1 >= zero);
+                const M4 noneOk = (q1 >= zero) & (q2 >= zero);
+                const D4 none1 = noneOk ? zero : a1 / t[0].massScale;
+                const D4 none2 = noneOk ? zero : a2 / t[0].massScale;
+                y1 = bothOk ? both1 : firstOk ? first1 : secondOk ? zero : none1;
+                y2 = bothOk ? both2 : firstOk ? zero : secondOk ? second2 : none2;
+            }
             blockX1 = t[0].massScale * y1;
             blockX2 = t[0].massScale * y2;
             const D4 d1 = blockX1 - a1, d2 = blockX2 - a2;
@@ -253,8 +274,8 @@ template <int Points, bool UseBias>
         v.vBy = v.vBy + (mB * impulse) * ty;
         v.wB = v.wB - (iB * dnB) * impulse;
     }
-    scatter(bodies, c.bodyA, v.vAx, v.vAy, v.wA);
-    scatter(bodies, c.bodyB, v.vBx, v.vBy, v.wB);
+    scatter(bodies, c.bodyA, v.vAx, v.vAy, v.wA, a.invMass);
+    scatter(bodies, c.bodyB, v.vBx, v.vBy, v.wB, b.invMass);
 }
 
 // One colour: its one-point bundles, then its two-point bundles (any order
@@ -342,24 +363,17 @@ void fillLane(ContactBundle<Points>& bundle, int lane, const ContactConstraint& 
     }
 }
 
-/// A bundle whose lanes are all unused (static body 0 against itself, all zero).
-template <int Points>
-ContactBundle<Points> emptyBundle() {
-    ContactBundle<Points> b;
-    std::memset(&b, 0, sizeof b);
-    for (int l = 0; l < kContactLanes; ++l) b.source[l] = ~0u;
-    return b;
-}
-
-/// Bundles the contacts order[begin, end) (all with `Points` points).
+/// Bundles the contacts `order` (all with `Points` points) at the end of
+/// `out`; lanes left over stay unused (all zero: static body 0 against itself).
 template <int Points>
 void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32_t> order,
             std::span<const ContactConstraint> contacts, std::span<const SolverBody> bodies) {
-    for (std::size_t k = 0; k < order.size(); k += kContactLanes) {
-        out.push_back(emptyBundle<Points>());
-        for (std::size_t l = 0; l < kContactLanes && k + l < order.size(); ++l)
-            fillLane(out.back(), int(l), contacts[order[k + l]], order[k + l], bodies);
-    }
+    const std::size_t first = out.size(), count = (order.size() + kContactLanes - 1) / kContactLanes;
+    out.resize(first + count);  // value-initialised: all zero
+    for (std::size_t k = 0; k < order.size(); ++k)
+        fillLane(out[first + k / kContactLanes], int(k % kContactLanes), contacts[order[k]], order[k], bodies);
+    for (std::size_t k = order.size(); k < count * kContactLanes; ++k)
+        out[first + k / kContactLanes].source[k % kContactLanes] = ~0u;
 }
 
 template <int Points>
