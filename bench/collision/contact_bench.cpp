@@ -6,9 +6,10 @@
 //     (SolverSettings::simd off: the same bits, the scalar cost),
 //   - Box2D 2.4.1 (8 velocity and 3 position iterations, sleeping off), the
 //     peer measured in the same run, as in collision_vs_box2d.
-// Each benchmark iteration is one step; the iteration count is fixed at the
-// scene's step count, so a run is the whole scene. Not part of ctest: the
-// machine is shared, compare the ratios of one run.
+// Each benchmark iteration is one step (its time is ms per step); the
+// iteration count is fixed at the scene's step count, so a run is the whole
+// scene. Not part of ctest: the machine is shared, compare the ratios of one
+// run (the CPU column is steadier than wall time on a loaded machine).
 //
 //   build/bench/contact_bench --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 
@@ -53,8 +54,6 @@ void BM_Stepwise(benchmark::State& state, std::string name, bool simd) {
             return;
         }
     }
-    state.counters["ms_per_step"] =
-        benchmark::Counter(double(state.iterations()) * 1e-3, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 void BM_Box2d(benchmark::State& state, std::string name) {
@@ -66,8 +65,6 @@ void BM_Box2d(benchmark::State& state, std::string name) {
         if (r.has<Radius>(e) || r.has<Box>(e)) bench::createBox2dBody(world, r, e);
     const float dt = float(scene.world.dt);
     for (auto _ : state) world.Step(dt, 8, 3);
-    state.counters["ms_per_step"] =
-        benchmark::Counter(double(state.iterations()) * 1e-3, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 int registerAll() {

@@ -103,31 +103,36 @@ struct Velocities {
 // Each formula below is solveContacts' (contact_solver.cpp), with the same
 // operations in the same order; comments there say why.
 
+/// The inverse masses (1/kg) and inertias (1/(kg m^2)) of a bundle's two sides.
+struct Masses {
+    D4 mA, iA, mB, iB;
+};
+
+/// Impulse j (N*s) along (dx, dy) with lever arms armA, armB: applyImpulse
+/// of contact_solver.cpp. Friction passes the arms -dnA, -dnB, where
+/// solveContacts writes wA + iA dnA j: negation is exact, so the bits agree.
+[[gnu::always_inline]] inline void applyLanes(Velocities& v, const Masses& m, D4 dx, D4 dy, D4 armA, D4 armB, D4 j) {
+    v.vAx = v.vAx - (m.mA * j) * dx;
+    v.vAy = v.vAy - (m.mA * j) * dy;
+    v.wA = v.wA - (m.iA * armA) * j;
+    v.vBx = v.vBx + (m.mB * j) * dx;
+    v.vBy = v.vBy + (m.mB * j) * dy;
+    v.wB = v.wB + (m.iB * armB) * j;
+}
+
 template <int Points>
 [[gnu::always_inline]] inline void warmStartBundle(ContactBundle<Points>& c, SolverBody* bodies) {
     const BodyLanes a = gather(bodies, c.bodyA), b = gather(bodies, c.bodyB);
     Velocities v{a.vx, a.vy, a.w, b.vx, b.vy, b.w};
-    const D4 mA = load(c.invMassA), iA = load(c.invInertiaA), mB = load(c.invMassB), iB = load(c.invInertiaB);
+    const Masses m{load(c.invMassA), load(c.invInertiaA), load(c.invMassB), load(c.invInertiaB)};
     const D4 nx = load(c.nx), ny = load(c.ny);
     const D4 tx = ny, ty = -nx;
     for (int i = 0; i < Points; ++i) {
         const PointLanes& p = c.points[i];
         const D4 ni = load(p.normalImpulse), ti = load(p.tangentImpulse);
         const D4 rnA = load(p.rnA), rnB = load(p.rnB), dnA = load(p.dnA), dnB = load(p.dnB);
-        // applyImpulse(a, b, n, rnA, rnB, ni)
-        v.vAx = v.vAx - (mA * ni) * nx;
-        v.vAy = v.vAy - (mA * ni) * ny;
-        v.wA = v.wA - (iA * rnA) * ni;
-        v.vBx = v.vBx + (mB * ni) * nx;
-        v.vBy = v.vBy + (mB * ni) * ny;
-        v.wB = v.wB + (iB * rnB) * ni;
-        // applyImpulse(a, b, t, -dnA, -dnB, ti)
-        v.vAx = v.vAx - (mA * ti) * tx;
-        v.vAy = v.vAy - (mA * ti) * ty;
-        v.wA = v.wA - (iA * -dnA) * ti;
-        v.vBx = v.vBx + (mB * ti) * tx;
-        v.vBy = v.vBy + (mB * ti) * ty;
-        v.wB = v.wB + (iB * -dnB) * ti;
+        applyLanes(v, m, nx, ny, rnA, rnB, ni);
+        applyLanes(v, m, tx, ty, -dnA, -dnB, ti);
     }
     scatter(bodies, c.bodyA, v.vAx, v.vAy, v.wA, a.invMass);
     scatter(bodies, c.bodyB, v.vBx, v.vBy, v.wB, b.invMass);
@@ -139,8 +144,8 @@ struct Target {
 };
 
 /// One point's sequential normal update (solveContacts' else branch).
-[[gnu::always_inline]] inline void normalPoint(Velocities& v, PointLanes& p, const Target& t, D4 nx, D4 ny, D4 mA,
-                                               D4 iA, D4 mB, D4 iB) {
+[[gnu::always_inline]] inline void normalPoint(Velocities& v, PointLanes& p, const Target& t, D4 nx, D4 ny,
+                                               const Masses& m) {
     const D4 rnA = load(p.rnA), rnB = load(p.rnB);
     const D4 ni = load(p.normalImpulse);
     const D4 vn = (((v.vBx - v.vAx) * nx + (v.vBy - v.vAy) * ny) + v.wB * rnB) - v.wA * rnA;
@@ -148,12 +153,7 @@ struct Target {
     const D4 total = maxOf(ni + impulse, splat(0.0));
     impulse = total - ni;
     store(p.normalImpulse, total);
-    v.vAx = v.vAx - (mA * impulse) * nx;
-    v.vAy = v.vAy - (mA * impulse) * ny;
-    v.wA = v.wA - (iA * rnA) * impulse;
-    v.vBx = v.vBx + (mB * impulse) * nx;
-    v.vBy = v.vBy + (mB * impulse) * ny;
-    v.wB = v.wB + (iB * rnB) * impulse;
+    applyLanes(v, m, nx, ny, rnA, rnB, impulse);
 }
 
 template <int Points, bool UseBias>
@@ -161,7 +161,8 @@ template <int Points, bool UseBias>
     SolverBody* bodies = args.bodies;
     const BodyLanes a = gather(bodies, c.bodyA), b = gather(bodies, c.bodyB);
     Velocities v{a.vx, a.vy, a.w, b.vx, b.vy, b.w};
-    const D4 mA = load(c.invMassA), iA = load(c.invInertiaA), mB = load(c.invMassB), iB = load(c.invInertiaB);
+    const Masses m{load(c.invMassA), load(c.invInertiaA), load(c.invMassB), load(c.invInertiaB)};
+    const D4 mA = m.mA, iA = m.iA, mB = m.mB, iB = m.iB;
     const D4 nx = load(c.nx), ny = load(c.ny);
     const M4 isStatic = loadMask(c.touchesStatic);
     const D4 biasRate = isStatic ? splat(args.staticSoft.biasRate) : splat(args.soft.biasRate);
@@ -185,7 +186,7 @@ template <int Points, bool UseBias>
         }
     }
     if constexpr (Points == 1) {
-        normalPoint(v, c.points[0], t[0], nx, ny, mA, iA, mB, iB);
+        normalPoint(v, c.points[0], t[0], nx, ny, m);
     } else {
         const M4 useBlock = loadMask(c.block) & (t[0].massScale == t[1].massScale);
         Velocities blockV = v;
@@ -240,8 +241,8 @@ template <int Points, bool UseBias>
         } else {
             // Some lanes solve the points one after the other; the block
             // lanes keep their block result.
-            normalPoint(v, c.points[0], t[0], nx, ny, mA, iA, mB, iB);
-            normalPoint(v, c.points[1], t[1], nx, ny, mA, iA, mB, iB);
+            normalPoint(v, c.points[0], t[0], nx, ny, m);
+            normalPoint(v, c.points[1], t[1], nx, ny, m);
             if (anyLane(useBlock)) {
                 v.vAx = useBlock ? blockV.vAx : v.vAx;
                 v.vAy = useBlock ? blockV.vAy : v.vAy;
@@ -267,12 +268,7 @@ template <int Points, bool UseBias>
         const D4 total = minOf(maxOf(ti + impulse, -maxFriction), maxFriction);  // std::clamp
         impulse = total - ti;
         store(p.tangentImpulse, total);
-        v.vAx = v.vAx - (mA * impulse) * tx;
-        v.vAy = v.vAy - (mA * impulse) * ty;
-        v.wA = v.wA + (iA * dnA) * impulse;
-        v.vBx = v.vBx + (mB * impulse) * tx;
-        v.vBy = v.vBy + (mB * impulse) * ty;
-        v.wB = v.wB - (iB * dnB) * impulse;
+        applyLanes(v, m, tx, ty, -dnA, -dnB, impulse);
     }
     scatter(bodies, c.bodyA, v.vAx, v.vAy, v.wA, a.invMass);
     scatter(bodies, c.bodyB, v.vBx, v.vBy, v.wB, b.invMass);
