@@ -161,7 +161,10 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
         const auto from = cacheCursor_ < cache_.size() && cache_[cacheCursor_].key <= pairKey
                               ? cache_.begin() + std::ptrdiff_t(cacheCursor_)
                               : cache_.begin();
-        auto it = std::lower_bound(from, cache_.end(), CachedImpulse{pairKey, 0, 0});
+        // Usually a few entries on: step there, and search only past that.
+        auto it = from;
+        for (int step = 0; step < 8 && it != cache_.end() && it->key < pairKey; ++step) ++it;
+        if (it != cache_.end() && it->key < pairKey) it = std::lower_bound(it, cache_.end(), CachedImpulse{pairKey, 0, 0});
         cacheCursor_ = std::size_t(it - cache_.begin());
         bool found[2] = {false, false};  // the first entry of a key counts, as lower_bound finds it
         for (; it != cache_.end() && (it->key >> 16) == (pairKey >> 16); ++it) {
@@ -251,7 +254,12 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     // One sincos per collider per step, shared by the boxes and the narrow phase.
     std::vector<Rot>& rots = rotScratch_;
     rots.resize(n);
-    for (std::size_t i = 0; i < n; ++i) rots[i] = Rot::fromAngle(angles_[i]);
+    // Circles and planes never read theirs (narrow phase, boxes): no sincos
+    // for them.
+    for (std::size_t i = 0; i < n; ++i) {
+        const ShapeKind kind = colliders_[i].shape.kind;
+        rots[i] = kind == ShapeKind::Circle || kind == ShapeKind::Plane ? Rot{} : Rot::fromAngle(angles_[i]);
+    }
 
     boxes_.resize(finite_.size());
     movable_.resize(finite_.size());
