@@ -384,4 +384,18 @@ TEST(Collision, SimdBundlesGiveTheBitsOfTheOneAtATimeSolveOnEveryInstructionSet)
             return w;
         },
         180, "circles");
+    // A crowd started at one point: bodies with more contacts than there are
+    // colours, so the overflow (solved one at a time between the SIMD
+    // colours) takes part.
+    const auto crowd = [] {
+        MiniWorld w;
+        w.fixed(plane({0, 1}, -2.0), {});
+        for (int i = 0; i < 60; ++i)  // every pair touches: 59 contacts a body
+            w.dynamic(circle(0.3), {0.001 * (i % 8), 0.001 * (i / 8)}, {}, 1.0, 0.0, 0.3);
+        return w;
+    };
+    expectSimdMatchesOneAtATime(crowd, 30, "crowd");
+    MiniWorld w = crowd();
+    w.step(1.0 / 60.0);
+    EXPECT_GT(w.collision.colouredContacts().overflowCount(), 0u) << "the crowd should overflow the colours";
 }
