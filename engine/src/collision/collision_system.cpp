@@ -127,8 +127,10 @@ void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_
 void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m,
                                   std::span<const Vec2> centres) {
     if (m.pointCount == 0) return;
-    ContactConstraint c;
-    ContactDetail detail;
+    // Built in place (detect() reserved room for every manifold): a copy of
+    // both would double the bytes written per manifold.
+    ContactConstraint& c = constraints_.emplace_back();
+    ContactDetail& detail = details_.emplace_back();
     detail.colliderA = a;
     detail.colliderB = b;
     detail.restitution = std::max(colliders_[a].restitution, colliders_[b].restitution);
@@ -176,8 +178,6 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
             }
         }
     }
-    details_.push_back(detail);
-    constraints_.push_back(c);
 }
 
 void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v, double dt, int substeps) {
