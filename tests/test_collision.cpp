@@ -399,3 +399,22 @@ TEST(Collision, SimdBundlesGiveTheBitsOfTheOneAtATimeSolveOnEveryInstructionSet)
     w.step(1.0 / 60.0);
     EXPECT_GT(w.collision.colouredContacts().overflowCount(), 0u) << "the crowd should overflow the colours";
 }
+
+TEST(Collision, SmallRotationMatchesLibmWithinTwoUnitsInTheLastPlace) {
+    // rotationBy's series against std::sin and std::cos over its range
+    // (|x| < 1/16 rad) and past it (libm itself).
+    int worstSin = 0, worstCos = 0;
+    for (int i = -20000; i <= 20000; ++i) {
+        const double x = 0.07 * double(i) / 20000.0 + 1e-7 * double(i % 7);
+        const Rot q = rotationBy(x);
+        const auto ulps = [](double a, double b) {
+            return int(std::abs(std::bit_cast<std::int64_t>(a) - std::bit_cast<std::int64_t>(b)));
+        };
+        worstSin = std::max(worstSin, ulps(q.s, std::sin(x)));
+        worstCos = std::max(worstCos, ulps(q.c, std::cos(x)));
+    }
+    EXPECT_LE(worstSin, 2);
+    EXPECT_LE(worstCos, 2);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(rotationBy(0.0).s), 0u);  // no turn: exactly the identity
+    EXPECT_EQ(rotationBy(0.0).c, 1.0);
+}
