@@ -184,6 +184,10 @@ Result<World> World::build(const Scene& scene) {
         return Error{"world.theta: expected a number in [0, 1], got " + format(ws.theta)};
     if (!(ws.adaptiveStep >= 0.0) || !std::isfinite(ws.adaptiveStep))
         return Error{"world.adaptive_step: expected a finite number >= 0, got " + format(ws.adaptiveStep)};
+    if (!(ws.sleepVelocity >= 0.0) || !std::isfinite(ws.sleepVelocity))
+        return Error{"world.sleep_velocity: expected a finite number >= 0, got " + format(ws.sleepVelocity)};
+    if (!(ws.sleepTime >= 0.0) || !std::isfinite(ws.sleepTime))
+        return Error{"world.sleep_time: expected a finite number >= 0, got " + format(ws.sleepTime)};
 
     const Registry& reg = scene.registry;
     const std::vector<Entity>& order = reg.entities();
@@ -384,6 +388,31 @@ Result<World> World::build(const Scene& scene) {
     }
     w.angleBackup.resize(w.angle.size());
 
+    // Sleeping (world/islands.hpp). A dynamic attractor moves the field every
+    // body feels, so nothing is ever still for long: no sleeping then.
+    w.sleep.resize(n);
+    bool movingField = false;
+    for (const detail::AttractorData& a : f.attractors) movingField = movingField || a.body != kNoBody;
+    w.sleep.enabled = ws.sleep && !movingField;
+    w.sleep.velocity = ws.sleepVelocity;
+    w.sleep.time = ws.sleepTime;
+    w.colliderOfBody.assign(n, -1);
+    if (w.collision)
+        for (std::size_t c = 0; c < w.collision->colliderCount(); ++c)
+            if (const std::int32_t body = w.collision->collider(c).body; body >= 0) {
+                w.colliderOfBody[std::size_t(body)] = std::int32_t(c);
+                // A shapeless jointed body turns like a disc of kShapelessRadius.
+                w.sleep.extent[std::size_t(body)] = w.collision->collider(c).solverOnly ? detail::kShapelessRadius
+                                                                                          : w.collision->maxExtent(c);
+            }
+    // Boids steer by their neighbours and never rest; a shapeless body that
+    // turns (its spin is constant: nothing applies torque) would stop turning.
+    for (const std::uint32_t b : f.boids.body) w.sleep.restless[b] = 1;
+    for (std::size_t k = 0; k < w.spinBody.size(); ++k)
+        if (w.angularVelocity[k] != 0.0) w.sleep.restless[w.spinBody[k]] = 1;
+    if (w.collision)
+        w.collision->setSleepSource(&w.sleep.asleep, [impl = &w](std::uint32_t body) { impl->sleep.wake(body); });
+
     if (f.gravityOn) w.active.push_back("gravity");
     if (f.dragOn) w.active.push_back("drag");
     if (f.springsOn()) w.active.push_back("springs");
@@ -524,6 +553,8 @@ Result<void> World::step() {
     }
     w.settings.time += w.settings.dt;
     w.stepStartKnown = true;
+    w.updateSleep(substeps > 1 ? w.backupX.data() : w.x[1 - w.current].data(),
+                  substeps > 1 ? w.backupV.data() : w.v[1 - w.current].data());
     if (w.kind == detail::IntegratorKind::Dopri5) w.settings.adaptiveStep = w.integrator->proposedStep();
     ++w.stats.step;
     w.stats.forceEvaluations = evaluations;
@@ -622,8 +653,14 @@ bool carriesNothing(const JointImpulse& j) {
 }
 
 SolverState entityKeyed(const WorldLayout& layout, std::span<const CachedImpulse> cache,
-                        std::span<const JointImpulse> jointImpulses) {
+                        std::span<const JointImpulse> jointImpulses, std::span<const double> sleepTimer,
+                        std::span<const std::int32_t> sleepIsland) {
     SolverState state;
+    // An awake body whose timer is +0 carries nothing: no entry.
+    for (std::size_t b = 0; b < sleepTimer.size(); ++b)
+        if (sleepIsland[b] >= 0 || !isPlusZero(sleepTimer[b]))
+            state.bodies.push_back({layout.bodies[b], sleepTimer[b],
+                                    sleepIsland[b] >= 0 ? layout.bodies[std::size_t(sleepIsland[b])] : Entity{}});
     state.contacts.reserve(cache.size());
     for (const CachedImpulse& c : cache)
         state.contacts.push_back(
@@ -642,16 +679,37 @@ std::vector<JointImpulse> jointImpulsesOf(const collision::CollisionSystem& syst
 }
 } // namespace
 
-SolverState WorldState::solverState() const { return entityKeyed(*layout, contacts, joints); }
+SolverState WorldState::solverState() const {
+    return entityKeyed(*layout, contacts, joints, sleepTimer, sleepIsland);
+}
 
 SolverState World::solverState() const {
     const WorldImpl& w = *impl_;
-    if (!w.collision) return {};
-    return entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision));
+    if (!w.collision) return entityKeyed(*w.layout, {}, {}, w.sleep.timer, w.sleep.island);
+    return entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision), w.sleep.timer,
+                       w.sleep.island);
 }
 
 void World::setSolverState(const SolverState& state) {
     WorldImpl& w = *impl_;
+    // Sleep first: the contacts' cache is split by it.
+    {
+        std::unordered_map<Entity, std::uint32_t> bodyOf;
+        for (std::size_t b = 0; b < w.bodyEntity.size(); ++b) bodyOf.emplace(w.bodyEntity[b], std::uint32_t(b));
+        std::fill(w.sleep.timer.begin(), w.sleep.timer.end(), 0.0);
+        std::fill(w.sleep.island.begin(), w.sleep.island.end(), -1);
+        for (const BodySleep& s : state.bodies) {
+            const auto body = bodyOf.find(s.body);
+            if (body == bodyOf.end()) continue;  // no longer a dynamic body
+            w.sleep.timer[body->second] = s.sleepTime;
+            const auto label = s.island.isNull() ? bodyOf.end() : bodyOf.find(s.island);
+            // Asleep only where sleeping is on, and a body that may sleep.
+            if (label != bodyOf.end() && w.sleep.enabled && !w.sleep.restless[body->second])
+                w.sleep.island[body->second] = std::int32_t(label->second);
+        }
+        w.sleep.refresh();
+        w.sleepChanged();
+    }
     if (!w.collision) return;
     std::unordered_map<Entity, std::uint32_t> colliderOf;
     const std::vector<Entity>& colliders = w.layout->colliders;
@@ -679,7 +737,8 @@ void World::setSolverState(const SolverState& state) {
 
 std::size_t WorldState::bytes() const {
     return sizeof(double) * (x.capacity() + v.capacity() + spinAngle.capacity() + colliderAngle.capacity() +
-                             colliderSpin.capacity()) +
+                             colliderSpin.capacity() + sleepTimer.capacity()) +
+           sizeof(std::int32_t) * sleepIsland.capacity() +
            sizeof(CachedImpulse) * contacts.capacity() + sizeof(JointImpulse) * joints.capacity();
 }
 
@@ -693,6 +752,8 @@ WorldState World::saveState() const {
     s.x.assign(w.x[w.current].begin(), w.x[w.current].end());
     s.v.assign(w.v[w.current].begin(), w.v[w.current].end());
     s.spinAngle = w.angle;
+    s.sleepTimer = w.sleep.timer;
+    s.sleepIsland = w.sleep.island;
     if (w.collision) {
         s.colliderAngle.assign(w.collision->angles().begin(), w.collision->angles().end());
         s.colliderSpin.assign(w.collision->angularVelocities().begin(), w.collision->angularVelocities().end());
@@ -704,13 +765,21 @@ WorldState World::saveState() const {
 
 Result<void> World::restoreState(const WorldState& s) {
     WorldImpl& w = *impl_;
-    if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout) || s.joints.size() != w.layout->joints.size())
+    if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout) || s.joints.size() != w.layout->joints.size() ||
+        s.sleepTimer.size() != w.bodyEntity.size() || s.sleepIsland.size() != w.bodyEntity.size())
         return Error{"the snapshot was taken from a world with other bodies or shapes"};
     std::copy(s.x.begin(), s.x.end(), w.x[w.current].begin());
     std::copy(s.v.begin(), s.v.end(), w.v[w.current].begin());
     w.angle = s.spinAngle;
+    if (w.collision) w.collision->restoreRotation(s.colliderAngle, s.colliderSpin);
+    // Sleep after the rotations (the frozen shapes' boxes use them) and
+    // before the cache (it is split by it).
+    w.sleep.timer = s.sleepTimer;
+    w.sleep.island = s.sleepIsland;
+    if (!w.sleep.enabled) std::fill(w.sleep.island.begin(), w.sleep.island.end(), -1);
+    w.sleep.refresh();
+    w.sleepChanged();
     if (w.collision) {
-        w.collision->restoreRotation(s.colliderAngle, s.colliderSpin);
         w.collision->setWarmStartCache(s.contacts);
         const std::span<joints::JointConstraint> joints = w.collision->jointConstraints();
         for (std::size_t k = 0; k < joints.size(); ++k) joints::setImpulses(joints[k], s.joints[k]);
@@ -728,7 +797,10 @@ Result<void> World::restoreState(const WorldState& s) {
 Result<void> World::reload(const Scene& scene) {
     Result<World> next = build(scene);
     if (!next) return Error{next.error()};
-    if (!scene.solverState) next->setSolverState(solverState());
+    if (!scene.solverState) {
+        next->setSolverState(solverState());
+        next->impl_->wakeEdited(*impl_);  // an edit wakes the islands it touches
+    }
     next->impl_->stats.step = impl_->stats.step;
     next->impl_->profiling = impl_->profiling;
     impl_ = std::move(next->impl_);
@@ -760,6 +832,10 @@ const WorldSettings& World::settings() const { return impl_->settings; }
 Result<void> World::setIntegrator(std::string_view name) {
     const auto kind = detail::integratorKind(name);
     if (!kind) return Error{"unknown integrator \"" + std::string(name) + "\""};
+    if (*kind != impl_->kind) {
+        impl_->sleep.wakeAll();  // another integrator moves every body differently
+        impl_->sleepChanged();
+    }
     impl_->setIntegratorKind(*kind);
     return {};
 }
@@ -767,6 +843,10 @@ Result<void> World::setIntegrator(std::string_view name) {
 Result<void> World::setSpringAnchor(Entity spring, Vec2 anchor) {
     for (detail::SpringData& s : impl_->model.springs)
         if (s.entity == spring && s.b == detail::kNoBody) {
+            if (s.fx != anchor.x || s.fy != anchor.y) {
+                impl_->sleep.wake(s.a);  // the mouse spring pulls its body out of its island's sleep
+                impl_->sleepChanged();
+            }
             s.fx = anchor.x;
             s.fy = anchor.y;
             return {};
