@@ -427,7 +427,8 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
         }
         if (key == "bodies") {
             // Sleep timers and islands (an addition): "body" is required.
-            static constexpr std::array<std::string_view, 3> kBodyKeys{"body", "sleep_time", "island"};
+            static constexpr std::array<std::string_view, 5> kBodyKeys{"body", "sleep_time", "still_at", "still_angle",
+                                                                       "island"};
             std::unordered_set<Entity> seenBodies;
             const auto dynamicAt = [&](const Json& ref, const std::string& fa) {
                 const Entity e = entityAt(ref, fa);
@@ -446,6 +447,10 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
                                       refuse(fa, "body " + fv.dump() + " has an entry already");
                               } else if (field == "sleep_time") {
                                   b.sleepTime = readNumber(fv, fa, NumberRange{0.0, 1e300});
+                              } else if (field == "still_at") {
+                                  b.stillAt = readVector(fv, fa);
+                              } else if (field == "still_angle") {
+                                  b.stillAngle = readNumber(fv, fa, NumberRange{});
                               } else {
                                   b.island = dynamicAt(fv, fa);
                               }
@@ -950,6 +955,9 @@ void appendSolverState(const SolverState& state, const Registry& registry, std::
         out += anyBody ? ",\n      " : ",\n    \"bodies\": [\n      ";
         anyBody = true;
         out += "{\"body\": " + *body + ", \"sleep_time\": " + number(b.sleepTime);
+        if (b.stillAt)
+            out += ", \"still_at\": {\"x\": " + number(b.stillAt->x) + ", \"y\": " + number(b.stillAt->y) +
+                   "}, \"still_angle\": " + number(b.stillAngle);
         if (!b.island.isNull())
             if (const std::optional<std::string> island = ref(b.island, dynamic(b.island))) out += ", \"island\": " + *island;
         out += "}";

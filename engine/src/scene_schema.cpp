@@ -170,6 +170,9 @@ std::string sceneJsonSchema() {
         {"required", Json::array({"body"})},
         {"properties", Json{{"body", entityRef},
                             {"sleep_time", Json{{"type", "number"}, {"minimum", 0}, {"description", "s"}}},
+                            {"still_at", Json{{"$ref", "#/$defs/vector"},
+                                              {"description", "where its still window began, m"}}},
+                            {"still_angle", Json{{"type", "number"}, {"description", "its angle then, rad"}}},
                             {"island", entityRef}}}};
     Json solverState = Json{
         {"type", "object"},

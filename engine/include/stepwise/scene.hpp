@@ -100,11 +100,15 @@ struct JointImpulse {
 };
 
 /// One dynamic body's sleep state (an addition): how long it has been
-/// still, and the island it sleeps in. Bodies with a zero timer that are
-/// awake have no entry.
+/// still, where that began, and the island it sleeps in. Awake bodies with
+/// no still window have no entry.
 struct BodySleep {
     Entity body;
     double sleepTime = 0.0;  ///< seconds it has stayed under world.sleep_velocity
+    /// Where its still window began (position m, angle rad): a body that
+    /// drifts 0.1 sleep_velocity sleep_time from it starts again.
+    std::optional<Vec2> stillAt;
+    double stillAngle = 0.0;
     /// Asleep: the island's label, one of its bodies (the first in scene
     /// order); the island wakes as a whole. Null: awake.
     Entity island;

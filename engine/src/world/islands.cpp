@@ -1,12 +1,15 @@
 #include "world/islands.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 namespace stepwise::detail {
 
 void SleepIslands::resize(std::size_t bodies) {
     timer.assign(bodies, 0.0);
+    anchor.assign(3 * bodies, 0.0);
+    anchored.assign(bodies, 0);
     island.assign(bodies, -1);
     asleep.assign(bodies, 0);
     extent.assign(bodies, 0.0);
@@ -31,7 +34,7 @@ bool SleepIslands::wake(std::uint32_t body) {
     for (const std::uint32_t b : sleeping)
         if (island[b] == label) {
             island[b] = -1;
-            timer[b] = 0.0;
+            restart(b);
         }
     refresh();
     return true;
@@ -41,7 +44,7 @@ void SleepIslands::wakeAll() {
     if (sleeping.empty()) return;
     for (const std::uint32_t b : sleeping) {
         island[b] = -1;
-        timer[b] = 0.0;
+        restart(b);
     }
     refresh();
 }
@@ -57,14 +60,38 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t b) {
 }
 } // namespace
 
-bool SleepIslands::advanceTimers(std::span<const double> speed, double dt) {
+bool SleepIslands::advanceTimers(std::span<const double> speed, const double* x, std::span<const double> angle,
+                                 double dt) {
     if (!enabled) return false;
     bool ready = false;
+    const double limit = driftLimit();
+    // At least two steps past the window's start as well: with a frame
+    // longer than sleep_time (implicit Euler at dt = 100 s), one step's
+    // motion is no evidence that a body has come to rest.
+    readyAt = std::max(time, 2.0 * dt);
     for (std::size_t b = 0; b < timer.size(); ++b) {
         if (island[b] >= 0) continue;
-        if (restless[b] || !(speed[b] <= velocity)) timer[b] = 0.0;  // NaN speed counts as moving
-        else timer[b] += dt;
-        ready = ready || timer[b] >= time;
+        if (restless[b] || !(speed[b] <= velocity)) {  // NaN speed counts as moving
+            restart(b);
+            continue;
+        }
+        double* a = &anchor[3 * b];
+        const double px = x[2 * b], py = x[2 * b + 1], pa = angle[b];
+        // The window counts the time between still observations, so one
+        // still step never sleeps a body, however long dt is.
+        if (anchored[b]) {
+            const double drift = std::max(std::hypot(px - a[0], py - a[1]), extent[b] * std::abs(pa - a[2]));
+            if (drift <= limit) {
+                timer[b] += dt;
+                ready = ready || timer[b] >= readyAt;
+                continue;
+            }
+        }
+        a[0] = px;
+        a[1] = py;
+        a[2] = pa;
+        anchored[b] = 1;
+        timer[b] = 0.0;
     }
     return ready;
 }
@@ -92,7 +119,7 @@ std::vector<std::uint32_t> SleepIslands::fallAsleep(std::span<const std::pair<st
     // An island sleeps when its slowest-to-settle body has waited long enough.
     std::vector<std::uint8_t> blocked(n, 0);
     for (std::size_t b = 0; b < n; ++b)
-        if (island[b] < 0 && !(timer[b] >= time)) blocked[findRoot(parent, std::uint32_t(b))] = 1;
+        if (island[b] < 0 && !(timer[b] >= readyAt)) blocked[findRoot(parent, std::uint32_t(b))] = 1;
     for (const std::uint32_t b : touchesSleeper) blocked[findRoot(parent, b)] = 1;
     for (std::size_t b = 0; b < n; ++b) {
         if (island[b] >= 0) continue;

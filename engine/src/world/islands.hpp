@@ -34,7 +34,13 @@ struct SleepIslands {
     double time = 0.5;       ///< s, world.sleep_time
 
     // Per dynamic body (state-vector order).
-    std::vector<double> timer;          ///< s spent still (frozen while asleep)
+    std::vector<double> timer;          ///< s spent still since `anchor` (frozen while asleep)
+    /// Where the body was when its still window began: x, y (m) and angle
+    /// (rad), three per body; valid while anchored[b]. A body that drifts
+    /// further than driftLimit() from it starts its window again, so a body
+    /// gliding slowly through space (or rolling along a floor) never sleeps.
+    std::vector<double> anchor;
+    std::vector<std::uint8_t> anchored;
     std::vector<std::int32_t> island;   ///< -1 awake; else the island's label, its lowest body index
     std::vector<std::uint8_t> asleep;   ///< 1 while asleep (island >= 0): what the collision system reads
     std::vector<double> extent;         ///< m, the lever arm of the angular speed (farthest point)
@@ -42,6 +48,7 @@ struct SleepIslands {
 
     std::vector<std::uint32_t> sleeping;  ///< bodies asleep, ascending (rebuilt by refresh())
     bool changed = false;                 ///< the sleeping set changed since the collision system last looked
+    double readyAt = 0.5;                 ///< s a timer must reach: max(time, 2 dt) (advanceTimers)
 
     void resize(std::size_t bodies);
     bool anyAsleep() const { return !sleeping.empty(); }
@@ -54,7 +61,17 @@ struct SleepIslands {
     /// After a step: the timers of the awake bodies (speed[b] = |v| +
     /// extent |omega|, m/s; read for awake bodies only) advance by dt or
     /// reset. True when some timer reached `time`: then fallAsleep() is due.
-    bool advanceTimers(std::span<const double> speed, double dt);
+    /// `x`: positions (x0, y0, x1, ...), `angle`: per body, rad.
+    bool advanceTimers(std::span<const double> speed, const double* x, std::span<const double> angle, double dt);
+    /// m: how far a still body may drift from its anchor, a tenth of what
+    /// sleep_velocity covers in sleep_time (2.5 mm by default); a body
+    /// creeping slower than a tenth of sleep_velocity may still sleep.
+    double driftLimit() const { return 0.1 * velocity * time; }
+    /// Forgets body b's still window (it moved, was edited or woke).
+    void restart(std::size_t b) {
+        timer[b] = 0.0;
+        anchored[b] = 0;
+    }
     /// Builds the islands of the awake bodies from `edges` (pairs of
     /// bodies) and puts to sleep every island whose bodies have all been
     /// still for `time`. Returns the bodies that fell asleep, ascending.

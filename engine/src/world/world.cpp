@@ -652,15 +652,28 @@ bool carriesNothing(const JointImpulse& j) {
            isPlusZero(j.motor) && isPlusZero(j.lower) && isPlusZero(j.upper);
 }
 
+/// The bodies' sleep state, one array of each (WorldState's or the live one's).
+struct SleepArrays {
+    std::span<const double> timer;
+    std::span<const std::int32_t> island;
+    std::span<const double> anchor;
+    std::span<const std::uint8_t> anchored;
+};
+
 SolverState entityKeyed(const WorldLayout& layout, std::span<const CachedImpulse> cache,
-                        std::span<const JointImpulse> jointImpulses, std::span<const double> sleepTimer,
-                        std::span<const std::int32_t> sleepIsland) {
+                        std::span<const JointImpulse> jointImpulses, const SleepArrays& sleep) {
     SolverState state;
-    // An awake body whose timer is +0 carries nothing: no entry.
-    for (std::size_t b = 0; b < sleepTimer.size(); ++b)
-        if (sleepIsland[b] >= 0 || !isPlusZero(sleepTimer[b]))
-            state.bodies.push_back({layout.bodies[b], sleepTimer[b],
-                                    sleepIsland[b] >= 0 ? layout.bodies[std::size_t(sleepIsland[b])] : Entity{}});
+    // An awake body with no still window carries nothing: no entry.
+    for (std::size_t b = 0; b < sleep.timer.size(); ++b) {
+        if (sleep.island[b] < 0 && !sleep.anchored[b] && isPlusZero(sleep.timer[b])) continue;
+        BodySleep entry{layout.bodies[b], sleep.timer[b], std::nullopt, 0.0,
+                        sleep.island[b] >= 0 ? layout.bodies[std::size_t(sleep.island[b])] : Entity{}};
+        if (sleep.anchored[b]) {
+            entry.stillAt = Vec2{sleep.anchor[3 * b], sleep.anchor[3 * b + 1]};
+            entry.stillAngle = sleep.anchor[3 * b + 2];
+        }
+        state.bodies.push_back(entry);
+    }
     state.contacts.reserve(cache.size());
     for (const CachedImpulse& c : cache)
         state.contacts.push_back(
@@ -680,14 +693,14 @@ std::vector<JointImpulse> jointImpulsesOf(const collision::CollisionSystem& syst
 } // namespace
 
 SolverState WorldState::solverState() const {
-    return entityKeyed(*layout, contacts, joints, sleepTimer, sleepIsland);
+    return entityKeyed(*layout, contacts, joints, {sleepTimer, sleepIsland, sleepAnchor, sleepAnchored});
 }
 
 SolverState World::solverState() const {
     const WorldImpl& w = *impl_;
-    if (!w.collision) return entityKeyed(*w.layout, {}, {}, w.sleep.timer, w.sleep.island);
-    return entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision), w.sleep.timer,
-                       w.sleep.island);
+    const SleepArrays sleep{w.sleep.timer, w.sleep.island, w.sleep.anchor, w.sleep.anchored};
+    if (!w.collision) return entityKeyed(*w.layout, {}, {}, sleep);
+    return entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision), sleep);
 }
 
 void World::setSolverState(const SolverState& state) {
@@ -698,10 +711,18 @@ void World::setSolverState(const SolverState& state) {
         for (std::size_t b = 0; b < w.bodyEntity.size(); ++b) bodyOf.emplace(w.bodyEntity[b], std::uint32_t(b));
         std::fill(w.sleep.timer.begin(), w.sleep.timer.end(), 0.0);
         std::fill(w.sleep.island.begin(), w.sleep.island.end(), -1);
+        std::fill(w.sleep.anchored.begin(), w.sleep.anchored.end(), 0);
         for (const BodySleep& s : state.bodies) {
             const auto body = bodyOf.find(s.body);
             if (body == bodyOf.end()) continue;  // no longer a dynamic body
             w.sleep.timer[body->second] = s.sleepTime;
+            if (s.stillAt) {
+                double* a = &w.sleep.anchor[3 * body->second];
+                a[0] = s.stillAt->x;
+                a[1] = s.stillAt->y;
+                a[2] = s.stillAngle;
+                w.sleep.anchored[body->second] = 1;
+            }
             const auto label = s.island.isNull() ? bodyOf.end() : bodyOf.find(s.island);
             // Asleep only where sleeping is on, and a body that may sleep.
             if (label != bodyOf.end() && w.sleep.enabled && !w.sleep.restless[body->second])
@@ -737,8 +758,8 @@ void World::setSolverState(const SolverState& state) {
 
 std::size_t WorldState::bytes() const {
     return sizeof(double) * (x.capacity() + v.capacity() + spinAngle.capacity() + colliderAngle.capacity() +
-                             colliderSpin.capacity() + sleepTimer.capacity()) +
-           sizeof(std::int32_t) * sleepIsland.capacity() +
+                             colliderSpin.capacity() + sleepTimer.capacity() + sleepAnchor.capacity()) +
+           sizeof(std::int32_t) * sleepIsland.capacity() + sleepAnchored.capacity() +
            sizeof(CachedImpulse) * contacts.capacity() + sizeof(JointImpulse) * joints.capacity();
 }
 
@@ -754,6 +775,8 @@ WorldState World::saveState() const {
     s.spinAngle = w.angle;
     s.sleepTimer = w.sleep.timer;
     s.sleepIsland = w.sleep.island;
+    s.sleepAnchor = w.sleep.anchor;
+    s.sleepAnchored = w.sleep.anchored;
     if (w.collision) {
         s.colliderAngle.assign(w.collision->angles().begin(), w.collision->angles().end());
         s.colliderSpin.assign(w.collision->angularVelocities().begin(), w.collision->angularVelocities().end());
@@ -766,7 +789,8 @@ WorldState World::saveState() const {
 Result<void> World::restoreState(const WorldState& s) {
     WorldImpl& w = *impl_;
     if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout) || s.joints.size() != w.layout->joints.size() ||
-        s.sleepTimer.size() != w.bodyEntity.size() || s.sleepIsland.size() != w.bodyEntity.size())
+        s.sleepTimer.size() != w.bodyEntity.size() || s.sleepIsland.size() != w.bodyEntity.size() ||
+        s.sleepAnchor.size() != 3 * w.bodyEntity.size() || s.sleepAnchored.size() != w.bodyEntity.size())
         return Error{"the snapshot was taken from a world with other bodies or shapes"};
     std::copy(s.x.begin(), s.x.end(), w.x[w.current].begin());
     std::copy(s.v.begin(), s.v.end(), w.v[w.current].begin());
@@ -776,6 +800,8 @@ Result<void> World::restoreState(const WorldState& s) {
     // before the cache (it is split by it).
     w.sleep.timer = s.sleepTimer;
     w.sleep.island = s.sleepIsland;
+    w.sleep.anchor = s.sleepAnchor;
+    w.sleep.anchored = s.sleepAnchored;
     if (!w.sleep.enabled) std::fill(w.sleep.island.begin(), w.sleep.island.end(), -1);
     w.sleep.refresh();
     w.sleepChanged();

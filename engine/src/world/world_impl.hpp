@@ -62,6 +62,7 @@ public:
     detail::SleepIslands sleep;
     std::vector<std::int32_t> colliderOfBody;
     std::vector<double> sleepSpeed;  ///< scratch: each awake body's fastest point, m/s
+    std::vector<double> sleepAngle;  ///< scratch: each body's angle, rad
 
     const double* xs() const { return x[current].data(); }
     const double* vs() const { return v[current].data(); }

@@ -38,7 +38,11 @@ void WorldImpl::updateSleep(const double* startX, const double* startV) {
         if (colliderOfBody[b] >= 0) w = collision->angularVelocity(std::size_t(colliderOfBody[b]));
         speed[b] = std::sqrt(pv[2 * b] * pv[2 * b] + pv[2 * b + 1] * pv[2 * b + 1]) + sleep.extent[b] * std::abs(w);
     }
-    if (!sleep.advanceTimers(speed, settings.dt)) return;
+    std::vector<double>& angle = sleepAngle;
+    angle.assign(n, 0.0);
+    for (std::size_t b = 0; b < n; ++b)
+        if (colliderOfBody[b] >= 0) angle[b] = collision->angle(std::size_t(colliderOfBody[b]));
+    if (!sleep.advanceTimers(speed, px, angle, settings.dt)) return;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
     for (const detail::SpringData& s : model.springs)
         if (s.b != detail::kNoBody) edges.emplace_back(s.a, s.b);
