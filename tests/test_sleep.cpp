@@ -266,16 +266,28 @@ TEST(Sleep, EditsSettersAndTheMouseSpringWakeTheIslandsTheyTouch) {
         ASSERT_TRUE(w.reload(scene).ok());
         EXPECT_EQ(w.sleepingBodyCount(), 0u);
     }
-    {   // a world setting wakes everything; so does another integrator
+    {   // a world setting wakes everything at the next step (an edit undone
+        // before a step wakes nothing); so does another integrator
         Scene scene = boxStacks(2, 3);
         World w = build(scene);
         asleepScene(scene, w);
         scene.world.gravity.y = -5.0;
         ASSERT_TRUE(w.reload(scene).ok());
+        EXPECT_EQ(w.sleepingBodyCount(), 6u);
+        ASSERT_TRUE(w.step().ok());
         EXPECT_EQ(w.sleepingBodyCount(), 0u);
         asleepScene(scene, w);
         ASSERT_TRUE(w.setIntegrator("velocity_verlet").ok());
+        EXPECT_TRUE(w.wakeIfSettingsChanged());
         EXPECT_EQ(w.sleepingBodyCount(), 0u);
+        scene.world.integrator = "velocity_verlet";  // the reloads below keep it
+        asleepScene(scene, w);
+        scene.world.gravity.y = -2.0;
+        ASSERT_TRUE(w.reload(scene).ok());
+        scene.world.gravity.y = -5.0;
+        ASSERT_TRUE(w.reload(scene).ok());
+        ASSERT_TRUE(w.step().ok());
+        EXPECT_EQ(w.sleepingBodyCount(), 6u) << "gravity changed and changed back before a step";
     }
     {   // the API: wake(entity) wakes that island only
         Scene scene = boxStacks(2, 3);

@@ -267,6 +267,11 @@ public:
     /// asleep. An application that moves or pushes a body itself calls this;
     /// edits that go through reload() and the setters wake what they change.
     bool wake(Entity entity);
+    /// A step under world settings other than those the sleeping islands
+    /// were last stepped under wakes them all first; this does it now (the
+    /// editor's "Save simulation state" after a settings edit, so that the
+    /// file resumes as the session goes on). True if it woke something.
+    bool wakeIfSettingsChanged();
 
     /// Dynamic bodies, in the order of the state vector.
     std::size_t bodyCount() const;

@@ -412,6 +412,7 @@ Result<World> World::build(const Scene& scene) {
         if (w.angularVelocity[k] != 0.0) w.sleep.restless[w.spinBody[k]] = 1;
     if (w.collision)
         w.collision->setSleepSource(&w.sleep.asleep, [impl = &w](std::uint32_t body) { impl->sleep.wake(body); });
+    w.sleptUnder = w.settings;
 
     if (f.gravityOn) w.active.push_back("gravity");
     if (f.dragOn) w.active.push_back("drag");
@@ -459,6 +460,7 @@ Result<void> World::step() {
     f.resetTimers();
     const Clock::time_point t0 = timed ? Clock::now() : Clock::time_point{};
     const std::size_t m = 2 * f.n;
+    w.wakeForChangedSettings();  // a settings edit since the last step wakes every island
     const int substeps = w.settings.substeps;
     const double h = w.settings.dt / double(substeps);
     w.stepStartKnown = false;  // set again once this step succeeds
@@ -730,6 +732,7 @@ void World::setSolverState(const SolverState& state) {
         }
         w.sleep.refresh();
         w.sleepChanged();
+        w.sleptUnder = w.settings;  // a resume steps on under the settings it is given
     }
     if (!w.collision) return;
     std::unordered_map<Entity, std::uint32_t> colliderOf;
@@ -805,6 +808,7 @@ Result<void> World::restoreState(const WorldState& s) {
     if (!w.sleep.enabled) std::fill(w.sleep.island.begin(), w.sleep.island.end(), -1);
     w.sleep.refresh();
     w.sleepChanged();
+    w.sleptUnder = w.settings;
     if (w.collision) {
         w.collision->setWarmStartCache(s.contacts);
         const std::span<joints::JointConstraint> joints = w.collision->jointConstraints();
@@ -858,11 +862,7 @@ const WorldSettings& World::settings() const { return impl_->settings; }
 Result<void> World::setIntegrator(std::string_view name) {
     const auto kind = detail::integratorKind(name);
     if (!kind) return Error{"unknown integrator \"" + std::string(name) + "\""};
-    if (*kind != impl_->kind) {
-        impl_->sleep.wakeAll();  // another integrator moves every body differently
-        impl_->sleepChanged();
-    }
-    impl_->setIntegratorKind(*kind);
+    impl_->setIntegratorKind(*kind);  // another integrator: the next step wakes every island (sleptUnder)
     return {};
 }
 

@@ -63,6 +63,14 @@ public:
     std::vector<std::int32_t> colliderOfBody;
     std::vector<double> sleepSpeed;  ///< scratch: each awake body's fastest point, m/s
     std::vector<double> sleepAngle;  ///< scratch: each body's angle, rad
+    /// The world settings the sleeping islands were last stepped under. A
+    /// step under other settings (gravity turned, dt changed ...) wakes them
+    /// all first. Checked at the step, not at the edit, so that an edit
+    /// undone before any step (a system switched off and on) wakes nothing;
+    /// a restore or a resume sets it to the settings it is stepped under.
+    WorldSettings sleptUnder;
+    /// Wakes every island when `settings` differ from sleptUnder.
+    void wakeForChangedSettings();
 
     const double* xs() const { return x[current].data(); }
     const double* vs() const { return v[current].data(); }

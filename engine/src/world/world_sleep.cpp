@@ -99,13 +99,18 @@ bool sameMotionSettings(WorldSettings a, WorldSettings b) {
 
 } // namespace
 
-void WorldImpl::wakeEdited(const WorldImpl& before) {
-    if (!sleep.anyAsleep()) return;
-    if (!sameMotionSettings(settings, before.settings) || kind != before.kind) {
+void WorldImpl::wakeForChangedSettings() {
+    if (sleep.anyAsleep() && !sameMotionSettings(settings, sleptUnder)) {
         sleep.wakeAll();
         sleepChanged();
-        return;
     }
+    sleptUnder = settings;
+}
+
+void WorldImpl::wakeEdited(const WorldImpl& before) {
+    // Settings: judged at the next step (wakeForChangedSettings).
+    sleptUnder = before.sleptUnder;
+    if (!sleep.anyAsleep()) return;
     std::unordered_map<Entity, std::uint32_t> bodyOf, oldBodyOf;
     for (std::size_t b = 0; b < bodyEntity.size(); ++b) bodyOf.emplace(bodyEntity[b], std::uint32_t(b));
     for (std::size_t b = 0; b < before.bodyEntity.size(); ++b) oldBodyOf.emplace(before.bodyEntity[b], std::uint32_t(b));
@@ -221,6 +226,13 @@ std::vector<Entity> World::sleepingBodies() const {
     out.reserve(impl_->sleep.sleeping.size());
     for (const std::uint32_t b : impl_->sleep.sleeping) out.push_back(impl_->bodyEntity[b]);
     return out;
+}
+
+bool World::wakeIfSettingsChanged() {
+    WorldImpl& w = *impl_;
+    const std::size_t before = w.sleep.sleeping.size();
+    w.wakeForChangedSettings();
+    return w.sleep.sleeping.size() != before;
 }
 
 bool World::wake(Entity entity) {
