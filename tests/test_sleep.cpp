@@ -131,8 +131,8 @@ std::string firstDifference(const std::string& a, const std::string& b) {
 // (timers add dt from the first still step), plus the steps the soft
 // contacts need to take up the load (the stack sinks by its overlap, micro-
 // metres here, at under 0.05 m/s): bound 0.5 s + 0.25 s = 45 steps
-// (measured 31). A heap of 60 circles in columns collapses and rolls for a
-// while: measured asleep after 185 steps; bound 240 (4 s).
+// (measured 32). A heap of 60 circles in columns collapses and rolls for a
+// while: measured asleep after 186 steps; bound 240 (4 s).
 TEST(Sleep, ASettledPileSleepsWithinItsBoundAndThenStaysBitIdentical) {
     Scene stacks = boxStacks(2, 4);
     World w = build(stacks);
