@@ -14,6 +14,7 @@
 #include "stepwise/world.hpp"
 #include "world/world_internals.hpp"
 #include "report/scenes.hpp"
+#include "collision/collision_scenes.hpp"
 
 #include <benchmark/benchmark.h>
 #include <boost/numeric/odeint/stepper/generation.hpp>
@@ -45,6 +46,7 @@ std::string particleName(std::size_t i) {
 Scene makeScene(Problem p, std::size_t n) {
     Scene s;
     s.world.dt = p == Problem::Springs ? 1e-3 : 1.0 / 60.0;
+    s.world.sleep = false;  // the integrators' cost per particle-step, whatever the chain does
     s.registry.reserve(2 * n + 1);
     for (std::size_t i = 0; i < n; ++i) {
         Entity e = s.registry.create();
@@ -422,6 +424,53 @@ int registerAll() {
     return 0;
 }
 const int kRegistered = registerAll();
+
+// Sleeping (issue 16): the 2,000-circle pile of bench/collision
+// (circlesInBox, levels/pile.json) while it falls (its first 2 s), and
+// settled (after range(1) steps) with sleeping on and off. Goal: settled
+// with sleep under 15% of falling. Counter "asleep": the fraction of bodies
+// asleep during the timed steps.
+enum class PilePhase { Falling, SettledSleep, SettledAwake };
+void BM_CirclePile(benchmark::State& state, PilePhase phase) {
+    Scene scene = bench::circlesInBox(2000);
+    scene.world.sleep = phase != PilePhase::SettledAwake;
+    const auto fresh = [&] {
+        Result<World> w = World::build(scene);
+        if (!w) throw std::runtime_error(w.error());
+        w->setProfiling(false);
+        return std::move(*w);
+    };
+    World w = fresh();
+    const std::uint64_t settle = std::uint64_t(state.range(0));
+    if (phase != PilePhase::Falling) advance(w, settle);
+    double asleep = 0.0;
+    std::uint64_t taken = 0;
+    for (auto _ : state) {
+        if (phase == PilePhase::Falling && taken == 120) {
+            state.PauseTiming();
+            w = fresh();
+            taken = 0;
+            state.ResumeTiming();
+        }
+        if (!w.step().ok()) {
+            state.SkipWithError("diverged");
+            return;
+        }
+        ++taken;
+        asleep += double(w.sleepingBodyCount()) / double(w.bodyCount());
+    }
+    state.counters["asleep"] = asleep / double(state.iterations());
+}
+const int kPileRegistered = [] {
+    benchmark::RegisterBenchmark("SleepPile/falling", BM_CirclePile, PilePhase::Falling)->Arg(0)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("SleepPile/settled_sleep", BM_CirclePile, PilePhase::SettledSleep)
+        ->Arg(900)
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("SleepPile/settled_awake", BM_CirclePile, PilePhase::SettledAwake)
+        ->Arg(900)
+        ->Unit(benchmark::kMillisecond);
+    return 0;
+}();
 
 } // namespace
 

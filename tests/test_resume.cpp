@@ -388,10 +388,18 @@ TEST(Resume, BadSolverStateIsRefusedWithWhereAndWhat) {
         {R"({"contacts": [{"a": 1, "b": 0, "feature": 0, "normal_impulse": 1}]})",
          "t.json: error: /solver_state/contacts/0: missing \"tangent_impulse\""},
         {R"({"impulses": []})",
-         "t.json: error: /solver_state/impulses: unknown key \"impulses\" in solver_state. Known keys: contacts, joints"},
+         "t.json: error: /solver_state/impulses: unknown key \"impulses\" in solver_state. Known keys: contacts, joints, "
+         "bodies"},
         {R"([])",
-         "t.json: error: /solver_state: expected an object {\"contacts\": [...], \"joints\": [...]}, got an empty "
-         "array"},
+         "t.json: error: /solver_state: expected an object {\"contacts\": [...], \"joints\": [...], \"bodies\": "
+         "[...]}, got an empty array"},
+        {R"({"bodies": [{"body": "wall", "sleep_time": 1}]})",
+         "t.json: error: /solver_state/bodies/0/body: entity \"wall\" is not a dynamic body (it needs a position and no "
+         "static)"},
+        {R"({"bodies": [{"body": "ball", "sleep_time": -1}]})",
+         "t.json: error: /solver_state/bodies/0/sleep_time: expected a number in [0, 1e+300], got -1"},
+        {R"({"bodies": [{"body": "dot"}, {"body": 2}]})",
+         "t.json: error: /solver_state/bodies/1/body: body 2 has an entry already"},
         {R"({"joints": [{"joint": "ball", "linear_impulse": {"x": 1, "y": 0}}]})",
          "t.json: error: /solver_state/joints/0/joint: entity \"ball\" is not a joint"},
         {R"({"joints": [{"joint": "pin"}, {"joint": 3}]})",

@@ -146,7 +146,10 @@ TEST(SceneSave, LayoutIsTheContractsLayout) {
     "dt": 0.016666666666666666,
     "time": 0.0,
     "tolerance": 1e-06,
-    "theta": 0.5
+    "theta": 0.5,
+    "sleep": true,
+    "sleep_velocity": 0.05,
+    "sleep_time": 0.5
   },
   "entities": [
     {

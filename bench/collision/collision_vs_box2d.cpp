@@ -149,6 +149,7 @@ std::string g_broadPhase;
 
 Outcome runStepwise(const Scene& initial, int steps, std::size_t topIndex) {
     Scene scene = initial;
+    scene.world.sleep = false;  // Box2D runs with sleeping off too
     Result<World> built = World::build(scene);
     if (!built) {
         std::cerr << "stepwise cannot build the scene: " << built.error() << "\n";
@@ -318,7 +319,9 @@ struct PileOutcome {
     double deepest = 0.0;  ///< metres, deepest contact overlap at the end (each engine's collision shapes)
 };
 
-PileOutcome runPolygonPileStepwise(const Scene& scene, int steps) {
+PileOutcome runPolygonPileStepwise(const Scene& level, int steps) {
+    Scene scene = level;
+    scene.world.sleep = false;  // Box2D runs with sleeping off too
     Result<World> built = World::build(scene);
     if (!built) {
         std::cerr << "stepwise cannot build the polygon pile: " << built.error() << "\n";
@@ -460,6 +463,7 @@ int runAdversarial(int crowd, int crowdSteps) {
         s.world.gravity = g;
         s.world.substeps = 4;
         s.world.solverIterations = 2;
+        s.world.sleep = false;  // the crowd at rest is the peer: it must cost what resting contacts cost
         return s;
     };
     const auto msPerStep = [](const Scene& scene, int warm, int steps) {

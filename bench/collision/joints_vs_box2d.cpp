@@ -41,7 +41,9 @@ struct Outcome {
 };
 
 
-Outcome runStepwise(const Scene& scene, int steps) {
+Outcome runStepwise(const Scene& level, int steps) {
+    Scene scene = level;
+    scene.world.sleep = false;  // Box2D runs with sleeping off too
     Result<World> built = World::build(scene);
     if (!built) {
         std::cerr << "stepwise cannot build the level: " << built.error() << "\n";

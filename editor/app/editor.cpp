@@ -106,8 +106,12 @@ bool Editor::saveStateAs(const std::filesystem::path& file) {
     // that playing the saved file on gives the bits this session would.
     Scene state = doc.scene;
     state.solverState.reset();
-    if (sim.running() && sim.ensureWorld(doc.scene))
+    if (sim.running() && sim.ensureWorld(doc.scene)) {
+        // A settings edit wakes the sleeping islands at the next step: done
+        // now, so the file resumes as this session goes on.
+        sim.world()->wakeIfSettingsChanged();
         if (SolverState solver = sim.world()->solverState(); !solver.empty()) state.solverState = std::move(solver);
+    }
     if (Result<void> r = saveSceneFile(state, file); !r) {
         errorModal = "Cannot save " + file.string() + ":\n" + r.error();
         return false;

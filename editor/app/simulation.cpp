@@ -316,7 +316,8 @@ namespace {
 bool sameState(const WorldState& a, const WorldState& b) {
     return a.time == b.time && a.adaptiveStep == b.adaptiveStep && a.steps == b.steps && a.x == b.x && a.v == b.v &&
            a.spinAngle == b.spinAngle && a.colliderAngle == b.colliderAngle && a.colliderSpin == b.colliderSpin &&
-           a.contacts == b.contacts && a.joints == b.joints;
+           a.contacts == b.contacts && a.joints == b.joints && a.sleepTimer == b.sleepTimer &&
+           a.sleepIsland == b.sleepIsland && a.sleepAnchor == b.sleepAnchor && a.sleepAnchored == b.sleepAnchored;
 }
 } // namespace
 

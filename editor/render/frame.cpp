@@ -145,6 +145,8 @@ public:
           textScale_(h < 360 ? 1.0 : h < 700 ? 1.5 : double(h / 700 + 1)),
           arrowRef_(0.06 * h) {
         for (Entity e : input.selection) selected_.insert(e);
+        if (input.world)
+            for (Entity e : input.world->sleepingBodies()) sleeping_.insert(e);
         // Level of detail: with thousands of bodies, per-body lines get
         // thinner and trails coarser. Legibility is unchanged (the arrows
         // would overlap anyway) and llvmpipe shades a third of the pixels.
@@ -358,6 +360,14 @@ private:
     std::vector<Batch> layer_;  ///< the current stage's batches, one per kind (see batch())
     bool dense_ = false;        ///< thousands of bodies: thinner per-body lines
     std::unordered_set<Entity> selected_;
+    std::unordered_set<Entity> sleeping_;  ///< bodies of sleeping islands: drawn dimmed
+    /// A body's fill: its colour, dimmed to 55% (towards black, so it stays
+    /// its hue on the dark background) while its island sleeps.
+    Rgba bodyColour(Entity e) const {
+        const Rgba c = colourOf(scene_, e, kDefaultBody);
+        if (sleeping_.empty() || !sleeping_.count(e)) return c;
+        return {0.55f * c.r, 0.55f * c.g, 0.55f * c.b, c.a};
+    }
     struct LegendRow {
         std::string label;
         Rgba colour;
@@ -717,7 +727,7 @@ void Builder::bodies() {
         const Position* p = scene_.registry.tryGet<Position>(e);
         if (!poly || !p || poly->vertices.size() < 3) continue;
         const Angle* a = scene_.registry.tryGet<Angle>(e);
-        polygon(*poly, p->value, a ? a->value : 0.0, colourOf(scene_, e, kDefaultBody), selected_.count(e) != 0,
+        polygon(*poly, p->value, a ? a->value : 0.0, bodyColour(e), selected_.count(e) != 0,
                 isStatic(scene_, e));
     }
     for (Entity e : scene_.registry.entities()) {
@@ -730,7 +740,7 @@ void Builder::bodies() {
         if (isStatic(scene_, e)) flags += kStatic;
         // Corner rounding of half a pixel's worth keeps rotated corners clean.
         box(toPx(p->value), {0.5 * b->width * ppm_, 0.5 * b->height * ppm_}, a ? a->value : 0.0,
-            colourOf(scene_, e, kDefaultBody), flags, 1.0);
+            bodyColour(e), flags, 1.0);
     }
     for (Entity e : scene_.registry.entities()) {
         const Position* p = scene_.registry.tryGet<Position>(e);
@@ -741,7 +751,7 @@ void Builder::bodies() {
         float flags = 0;
         if (selected_.count(e)) flags += kSelected;
         if (isStatic(scene_, e)) flags += kStatic;
-        const Rgba c = colourOf(scene_, e, kDefaultBody);
+        const Rgba c = bodyColour(e);
         if (r) {
             disc(toPx(p->value), r->value * ppm_, a ? a->value : 0.0, c, flags + kTick);
         } else {

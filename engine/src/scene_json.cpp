@@ -376,7 +376,8 @@ void readEntry(const Json& entry, const std::string& at, std::string_view what,
 SolverState readSolverState(const Json& v, const Registry& registry) {
     const std::string pointer = "/solver_state";
     if (!v.is_object())
-        refuse(pointer, "expected an object {\"contacts\": [...], \"joints\": [...]}, got " + describeFound(v));
+        refuse(pointer, "expected an object {\"contacts\": [...], \"joints\": [...], \"bodies\": [...]}, got " +
+                            describeFound(v));
     const auto& entities = registry.entities();
     std::map<std::string, Entity, std::less<>> byName;
     for (const Entity e : entities)
@@ -405,8 +406,8 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
     SolverState state;
     for (const auto& [key, value] : v.items()) {
         const std::string at = child(pointer, key);
-        if (key != "contacts" && key != "joints")
-            refuse(at, "unknown key \"" + key + "\" in solver_state. Known keys: contacts, joints");
+        if (key != "contacts" && key != "joints" && key != "bodies")
+            refuse(at, "unknown key \"" + key + "\" in solver_state. Known keys: contacts, joints, bodies");
         if (!value.is_array()) refuse(at, "expected an array of " + key + ", got " + describeFound(value));
         if (key == "contacts") {
             state.contacts.reserve(value.size());
@@ -421,6 +422,40 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
                               else c.tangentImpulse = readNumber(fv, fa, NumberRange{});
                           });
                 state.contacts.push_back(c);
+            }
+            continue;
+        }
+        if (key == "bodies") {
+            // Sleep timers and islands (an addition): "body" is required.
+            static constexpr std::array<std::string_view, 5> kBodyKeys{"body", "sleep_time", "still_at", "still_angle",
+                                                                       "island"};
+            std::unordered_set<Entity> seenBodies;
+            const auto dynamicAt = [&](const Json& ref, const std::string& fa) {
+                const Entity e = entityAt(ref, fa);
+                const Static* st = registry.tryGet<Static>(e);
+                if (!registry.has<Position>(e) || (st && st->value))
+                    refuse(fa, "entity " + ref.dump() + " is not a dynamic body (it needs a position and no static)");
+                return e;
+            };
+            for (std::size_t i = 0; i < value.size(); ++i) {
+                BodySleep b;
+                readEntry(value[i], child(at, i), "a body", kBodyKeys, 1,
+                          [&](const std::string& field, const Json& fv, const std::string& fa) {
+                              if (field == "body") {
+                                  b.body = dynamicAt(fv, fa);
+                                  if (!seenBodies.insert(b.body).second)
+                                      refuse(fa, "body " + fv.dump() + " has an entry already");
+                              } else if (field == "sleep_time") {
+                                  b.sleepTime = readNumber(fv, fa, NumberRange{0.0, 1e300});
+                              } else if (field == "still_at") {
+                                  b.stillAt = readVector(fv, fa);
+                              } else if (field == "still_angle") {
+                                  b.stillAngle = readNumber(fv, fa, NumberRange{});
+                              } else {
+                                  b.island = dynamicAt(fv, fa);
+                              }
+                          });
+                state.bodies.push_back(b);
             }
             continue;
         }
@@ -909,6 +944,25 @@ void appendSolverState(const SolverState& state, const Registry& registry, std::
         }
         out += first ? "]" : "\n    ]";
     }
+    const auto dynamic = [&](Entity e) {
+        const Static* st = registry.tryGet<Static>(e);
+        return registry.has<Position>(e) && !(st && st->value);
+    };
+    bool anyBody = false;
+    for (const BodySleep& b : state.bodies) {
+        const std::optional<std::string> body = ref(b.body, dynamic(b.body));
+        if (!body) continue;
+        out += anyBody ? ",\n      " : ",\n    \"bodies\": [\n      ";
+        anyBody = true;
+        out += "{\"body\": " + *body + ", \"sleep_time\": " + number(b.sleepTime);
+        if (b.stillAt)
+            out += ", \"still_at\": {\"x\": " + number(b.stillAt->x) + ", \"y\": " + number(b.stillAt->y) +
+                   "}, \"still_angle\": " + number(b.stillAngle);
+        if (!b.island.isNull())
+            if (const std::optional<std::string> island = ref(b.island, dynamic(b.island))) out += ", \"island\": " + *island;
+        out += "}";
+    }
+    if (anyBody) out += "\n    ]";
     out += "\n  }\n}";
 }
 

@@ -162,13 +162,26 @@ std::string sceneJsonSchema() {
               {"motor_impulse", impulse("hinge motor N*m*s, slider motor N*s")},
               {"lower_impulse", oneSided("hinge, slider: lower limit")},
               {"upper_impulse", oneSided("hinge, slider: upper limit; rope: its pull, N*s")}}}};
+    Json bodySleep = Json{
+        {"type", "object"},
+        {"description", "one dynamic body's sleep state: seconds it has been still and, while it sleeps, its island "
+                        "(one of the island's bodies); an awake body with no time still has no entry"},
+        {"additionalProperties", false},
+        {"required", Json::array({"body"})},
+        {"properties", Json{{"body", entityRef},
+                            {"sleep_time", Json{{"type", "number"}, {"minimum", 0}, {"description", "s"}}},
+                            {"still_at", Json{{"$ref", "#/$defs/vector"},
+                                              {"description", "where its still window began, m"}}},
+                            {"still_angle", Json{{"type", "number"}, {"description", "its angle then, rad"}}},
+                            {"island", entityRef}}}};
     Json solverState = Json{
         {"type", "object"},
         {"description", "what the solver carries between steps, written with a running state (stepwise run --out, the "
                         "editor's Save simulation state) so that a resumed run is bit-identical; absent: a cold start"},
         {"additionalProperties", false},
         {"properties", Json{{"contacts", Json{{"type", "array"}, {"items", contact}}},
-                            {"joints", Json{{"type", "array"}, {"items", joint}}}}}};
+                            {"joints", Json{{"type", "array"}, {"items", joint}}},
+                            {"bodies", Json{{"type", "array"}, {"items", bodySleep}}}}}};
 
     Json schema = Json::object();
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema";

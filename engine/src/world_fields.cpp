@@ -46,6 +46,13 @@ std::vector<WorldFieldInfo> buildTable() {
                                                  "dopri5's proposed next internal step, saved for exact resume; "
                                                  "absent: none yet"),
          true},
+        {makeField<&WorldSettings::sleep>("sleep", {}, "",
+                                          "islands of bodies that stay still for sleep_time sleep (cost nothing) "
+                                          "until touched or edited")},
+        {makeField<&WorldSettings::sleepVelocity>("sleep_velocity", {0.0, 1e6}, "m/s",
+                                                  "a body is still while its fastest point moves slower than this")},
+        {makeField<&WorldSettings::sleepTime>("sleep_time", {0.0, 1e6}, "s",
+                                              "how long an island must stay still before it sleeps")},
     };
 }
 

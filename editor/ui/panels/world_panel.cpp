@@ -61,6 +61,15 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
         if (attractors) {
             worldFieldWidget(ui, ed, "theta");
         }
+        // Sleeping: the switch, its thresholds while it is on, and how many
+        // bodies sleep now (drawn dimmed in the viewport).
+        worldFieldWidget(ui, ed, "sleep");
+        if (ws.sleep) {
+            for (const char* key : {"sleep_velocity", "sleep_time"}) worldFieldWidget(ui, ed, key);
+            if (world && world->bodyCount() > 0)
+                ImGui::TextColored(kDim, "%zu of %zu bodies asleep (dimmed)", world->sleepingBodyCount(),
+                                   world->bodyCount());
+        }
         if (world) {
             // A pile the level's substeps cannot hold: said before playing.
             if (const std::optional<PileHint> pile = world->pileHint()) {

@@ -44,6 +44,16 @@ struct WorldSettings {
     /// state, so that a saved and reloaded run continues bit for bit. 0: none
     /// yet (the first step tries the whole frame).
     double adaptiveStep = 0.0;
+    /// Sleeping (Box2D's islands): dynamic bodies connected by touching
+    /// contacts, springs and joints sleep as a whole when every one of them
+    /// stays under sleepVelocity for sleepTime seconds; asleep, they cost
+    /// almost nothing until something touches or edits them (docs/physics.md).
+    bool sleep = true;
+    /// m/s: a body is "still" while |v| + r_max |omega| (the speed of its
+    /// fastest point, r_max its farthest point from the centre of mass)
+    /// stays under this. Box2D v3's b2_defaultSleepThreshold.
+    double sleepVelocity = 0.05;
+    double sleepTime = 0.5;  ///< s an island must stay still before it sleeps (Box2D's b2_timeToSleep)
 
     friend bool operator==(const WorldSettings&, const WorldSettings&) = default;
 };
@@ -89,6 +99,23 @@ struct JointImpulse {
     friend bool operator==(const JointImpulse&, const JointImpulse&) = default;
 };
 
+/// One dynamic body's sleep state (an addition): how long it has been
+/// still, where that began, and the island it sleeps in. Awake bodies with
+/// no still window have no entry.
+struct BodySleep {
+    Entity body;
+    double sleepTime = 0.0;  ///< seconds it has stayed under world.sleep_velocity
+    /// Where its still window began (position m, angle rad): a body that
+    /// drifts 0.1 sleep_velocity sleep_time from it starts again.
+    std::optional<Vec2> stillAt;
+    double stillAngle = 0.0;
+    /// Asleep: the island's label, one of its bodies (the first in scene
+    /// order); the island wakes as a whole. Null: awake.
+    Entity island;
+
+    friend bool operator==(const BodySleep&, const BodySleep&) = default;
+};
+
 /// What the solver carries from one step to the next beyond what the
 /// entities hold (positions, velocities, angles, spins). A World built from
 /// a scene with this state steps exactly as the World that wrote it: the
@@ -98,8 +125,9 @@ struct JointImpulse {
 struct SolverState {
     std::vector<ContactImpulse> contacts;  ///< warm start, sorted by the solver's key
     std::vector<JointImpulse> joints;      ///< joints' warm start, in scene order
+    std::vector<BodySleep> bodies;         ///< sleep timers and sleeping islands, in body (scene) order
 
-    bool empty() const { return contacts.empty() && joints.empty(); }
+    bool empty() const { return contacts.empty() && joints.empty() && bodies.empty(); }
     friend bool operator==(const SolverState&, const SolverState&) = default;
 };
 

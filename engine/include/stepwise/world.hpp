@@ -133,6 +133,10 @@ struct WorldState {
     std::vector<double> colliderAngle, colliderSpin;  ///< colliders, rad and rad/s
     std::vector<CachedImpulse> contacts;       ///< the warm-start cache
     std::vector<JointImpulse> joints;          ///< every joint's accumulated impulses, in layout.joints order
+    std::vector<double> sleepTimer;            ///< bodies: seconds still (world.sleep_time)
+    std::vector<std::int32_t> sleepIsland;     ///< bodies: -1 awake, else the sleeping island's first body
+    std::vector<double> sleepAnchor;           ///< bodies: where the still window began (x, y m, angle rad)
+    std::vector<std::uint8_t> sleepAnchored;   ///< bodies: 1 while a still window runs
     /// Heap bytes held (the layout, shared, not counted).
     std::size_t bytes() const;
     /// The warm start keyed by entities (as World::solverState()).
@@ -253,6 +257,21 @@ public:
     /// forces depend on position only, and the velocity-dependent forces
     /// (drag, spring damping, boids) act on bodies, not on a probe.
     Vec2 probeForce(Vec2 point, Vec2 velocity = {}) const;
+
+    /// Sleeping (world.sleep; docs/physics.md "Sleeping"): whether dynamic
+    /// body `body` sleeps, how many do, and their entities.
+    bool asleep(std::size_t body) const;
+    std::size_t sleepingBodyCount() const;
+    std::vector<Entity> sleepingBodies() const;
+    /// Wakes the island of `entity` (a dynamic body); false when it was not
+    /// asleep. An application that moves or pushes a body itself calls this;
+    /// edits that go through reload() and the setters wake what they change.
+    bool wake(Entity entity);
+    /// A step under world settings other than those the sleeping islands
+    /// were last stepped under wakes them all first; this does it now (the
+    /// editor's "Save simulation state" after a settings edit, so that the
+    /// file resumes as the session goes on). True if it woke something.
+    bool wakeIfSettingsChanged();
 
     /// Dynamic bodies, in the order of the state vector.
     std::size_t bodyCount() const;

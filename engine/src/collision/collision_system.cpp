@@ -60,6 +60,8 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
         colliders_.back().shape.polygon = &polygons_.back();
     }
     const bool dynamic = c.body >= 0 && c.mass > 0.0;
+    colliderAsleep_.push_back(0);
+    if (dynamic) awakeSolverColliders_.push_back(index);
     angles_.push_back(angle);
     angularVelocities_.push_back(dynamic ? angularVelocity : 0.0);
     invMass_.push_back(dynamic ? 1.0 / c.mass : 0.0);
@@ -95,6 +97,207 @@ void CollisionSystem::setWarmStartCache(std::vector<CachedImpulse> cache) {
     if (!std::is_sorted(cache.begin(), cache.end())) std::sort(cache.begin(), cache.end());
     cache_ = std::move(cache);
     cacheCursor_ = 0;
+    sleepingCache_.clear();
+    if (anySleeping_) splitCache();
+}
+
+std::vector<CachedImpulse> CollisionSystem::warmStartCache() const {
+    if (sleepingCache_.empty()) return cache_;
+    std::vector<CachedImpulse> all(cache_.size() + sleepingCache_.size());
+    std::merge(cache_.begin(), cache_.end(), sleepingCache_.begin(), sleepingCache_.end(), all.begin());
+    return all;
+}
+
+void CollisionSystem::splitCache() {
+    std::vector<CachedImpulse> all = warmStartCache();
+    cache_.clear();
+    sleepingCache_.clear();
+    for (const CachedImpulse& e : all)
+        (colliderAsleep_[e.colliderA()] || colliderAsleep_[e.colliderB()] ? sleepingCache_ : cache_).push_back(e);
+    cacheCursor_ = 0;
+}
+
+void CollisionSystem::refreshSleeping(std::span<const Vec2> x) {
+    const std::size_t n = colliders_.size();
+    anySleeping_ = false;
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::int32_t body = colliders_[i].body;
+        colliderAsleep_[i] = bodyAsleep_ && body >= 0 && (*bodyAsleep_)[std::size_t(body)] ? 1 : 0;
+        anySleeping_ = anySleeping_ || colliderAsleep_[i];
+    }
+    awakeSolverColliders_.clear();
+    for (std::size_t i = 0; i < n; ++i)
+        if (solverIndex_[i] != 0 && !colliderAsleep_[i]) awakeSolverColliders_.push_back(std::uint32_t(i));
+    for (joints::JointConstraint& j : joints_)
+        j.asleep = (j.a.collider >= 0 && colliderAsleep_[std::size_t(j.a.collider)]) ||
+                   (j.b.collider >= 0 && colliderAsleep_[std::size_t(j.b.collider)]);
+    splitCache();
+
+    // What detect() reads of a collider that does not move: its centre, its
+    // rotation, no motion of its own.
+    centres_.resize(n);
+    rotScratch_.resize(n);
+    endV_.resize(n);
+    startV_.resize(n);
+    spin_.resize(n);
+    margins_.resize(n);
+    awakeProxies_.clear();
+    std::vector<Aabb> frozenBoxes;
+    std::vector<std::uint32_t> frozenProxies;
+    for (std::size_t k = 0; k < finite_.size() && anySleeping_; ++k) {
+        const std::uint32_t i = finite_[k];
+        if (colliders_[i].body >= 0 && !colliderAsleep_[i]) {
+            awakeProxies_.push_back(std::uint32_t(k));
+            continue;
+        }
+        // A sleeping body keeps its (small) velocity but does not move:
+        // its margin and its pairs' speculative margins count no motion.
+        centres_[i] = centreOfMass(i, x);
+        rotScratch_[i] = Rot::fromAngle(angles_[i]);
+        endV_[i] = startV_[i] = Vec2{};
+        spin_[i] = 0.0;
+        margins_[i] = kSpeculativeBase;
+        Aabb box = computeAabb(colliders_[i].shape, centres_[i], rotScratch_[i]);
+        box.lower -= Vec2{kSpeculativeBase, kSpeculativeBase};
+        box.upper += Vec2{kSpeculativeBase, kSpeculativeBase};
+        frozenBoxes.push_back(box);
+        frozenProxies.push_back(std::uint32_t(k));
+    }
+    if (anySleeping_) frozen_.build(frozenBoxes, frozenProxies);
+    else frozen_.clear();
+
+    // The sleeping islands' contacts stay listed (the contacts view, the
+    // count, break-on-contact): recomputed once here from the frozen shapes
+    // and their kept impulses, then kept at the front of records_.
+    std::vector<ContactRecord> awakeRecords;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> awakePairs;
+    for (std::size_t r = sleepingRecordCount_; r < records_.size(); ++r)
+        if (!colliderAsleep_[recordPairs_[r].first] && !colliderAsleep_[recordPairs_[r].second]) {
+            awakeRecords.push_back(records_[r]);
+            awakePairs.push_back(recordPairs_[r]);
+        }
+    records_.clear();
+    recordPairs_.clear();
+    for (std::size_t k = 0; k < sleepingCache_.size();) {
+        const std::uint32_t a = sleepingCache_[k].colliderA(), b = sleepingCache_[k].colliderB();
+        std::size_t end = k;
+        while (end < sleepingCache_.size() && sleepingCache_[end].colliderA() == a && sleepingCache_[end].colliderB() == b)
+            ++end;
+        const bool planeA = colliders_[a].shape.kind == ShapeKind::Plane;
+        const Manifold m = collide(colliders_[a].shape, planeA ? Vec2{} : centreOfMass(a, x),
+                                   planeA ? Rot{} : Rot::fromAngle(angles_[a]), colliders_[b].shape,
+                                   centreOfMass(b, x), Rot::fromAngle(angles_[b]), 2.0 * kSpeculativeBase);
+        for (int p = 0; p < m.pointCount; ++p) {
+            double normal = 0.0, tangent = 0.0;
+            for (std::size_t e = k; e < end; ++e)
+                if ((sleepingCache_[e].key & 0xFFFF) == (m.points[p].id & 0xFFFF)) {
+                    normal = sleepingCache_[e].normal;
+                    tangent = sleepingCache_[e].tangent;
+                    break;
+                }
+            if (m.points[p].separation > kLinearSlop && normal == 0.0) continue;
+            ContactRecord r;
+            r.a = colliders_[a].entity;
+            r.b = colliders_[b].entity;
+            r.point = m.points[p].point;
+            r.normal = m.normal;
+            if (solverIndex_[a] == 0 && solverIndex_[b] != 0) {
+                std::swap(r.a, r.b);
+                r.normal = -r.normal;
+            }
+            r.depth = -m.points[p].separation;
+            r.normalImpulse = normal;
+            r.tangentImpulse = tangent;
+            records_.push_back(r);
+            recordPairs_.emplace_back(a, b);
+        }
+        k = end;
+    }
+    sleepingRecordCount_ = records_.size();
+    records_.insert(records_.end(), awakeRecords.begin(), awakeRecords.end());
+    recordPairs_.insert(recordPairs_.end(), awakePairs.begin(), awakePairs.end());
+}
+
+void CollisionSystem::bodyEdges(std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const {
+    // Only contacts that touch (a point within the slop, or one that carried
+    // load) join islands. A speculative point across a gap does not: a trio
+    // of circles rolling along the floor at 1 cm/s, 13 mm from a settled
+    // pile, would otherwise keep all 2,000 bodies of the pile awake (the
+    // trio never sleeps: it rolls, see islands.hpp); apart, the pile sleeps
+    // and the trio wakes it when it comes within reach (sleepingBroadPhase).
+    for (std::size_t k = 0; k < details_.size(); ++k) {
+        const ContactDetail& d = details_[k];
+        const ContactConstraint& c = constraints_[k];
+        bool touching = false;
+        for (int i = 0; i < c.pointCount; ++i)
+            touching = touching || d.separation[i] < kLinearSlop || c.points[i].normalImpulse > 0.0;
+        if (!touching) continue;
+        const std::int32_t a = colliders_[d.colliderA].body, b = colliders_[d.colliderB].body;
+        if (a >= 0 && b >= 0) out.emplace_back(std::uint32_t(a), std::uint32_t(b));
+    }
+    for (const joints::JointConstraint& j : joints_) {
+        if (j.a.collider < 0 || j.b.collider < 0) continue;
+        const std::int32_t a = colliders_[std::size_t(j.a.collider)].body, b = colliders_[std::size_t(j.b.collider)].body;
+        if (a >= 0 && b >= 0) out.emplace_back(std::uint32_t(a), std::uint32_t(b));
+    }
+}
+
+bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, Vec2 ref1) {
+    awakeBoxes_.resize(awakeProxies_.size());
+    awakeMovable_.assign(awakeProxies_.size(), 1);
+    for (std::size_t j = 0; j < awakeProxies_.size(); ++j) {
+        const std::uint32_t i = finite_[awakeProxies_[j]];
+        Aabb box = computeAabb(colliders_[i].shape, centres_[i], rots[i]);
+        const Vec2 fat{margins_[i], margins_[i]};
+        box.lower -= fat;
+        box.upper += fat;
+        awakeBoxes_[j] = box;
+    }
+    if (autoBroadPhase_)
+        broadPhase_.setKind(awakeProxies_.size() > 512 ? BroadPhaseKind::UniformGrid : BroadPhaseKind::SweepAndPrune);
+    broadPhase_.findPairs(awakeBoxes_, awakeMovable_, awakePairs_);
+    // awakeProxies_ ascends, so the mapped pairs keep (a, b) order.
+    pairs_.clear();
+    for (const ProxyPair& p : awakePairs_) pairs_.push_back({awakeProxies_[p.a], awakeProxies_[p.b]});
+    // In the full broad phase a frozen shape's margin holds its drift from
+    // the reference motion, dt |ref|; here the awake box carries it.
+    const double refDrift = dt_ * std::max(length(ref0), length(ref1));
+    const std::size_t awakeAwake = pairs_.size();
+    for (std::size_t j = 0; j < awakeProxies_.size(); ++j) {
+        Aabb box = awakeBoxes_[j];
+        box.lower -= Vec2{refDrift, refDrift};
+        box.upper += Vec2{refDrift, refDrift};
+        const std::uint32_t k = awakeProxies_[j];
+        frozen_.query(box, [&](std::uint32_t f) { pairs_.push_back({std::min(k, f), std::max(k, f)}); });
+    }
+    if (pairs_.size() != awakeAwake) std::sort(pairs_.begin(), pairs_.end());
+    crowdBodies_.clear();
+    const std::span<const std::uint8_t> crowded = broadPhase_.crowded();
+    for (std::size_t j = 0; j < crowded.size(); ++j)
+        if (crowded[j]) crowdBodies_.push_back(solverIndex_[finite_[awakeProxies_[j]]]);
+
+    // An awake shape with a manifold against a sleeping one wakes its island.
+    std::vector<std::uint32_t> woken;
+    for (const ProxyPair& pair : pairs_) {
+        const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
+        if (!colliderAsleep_[a] && !colliderAsleep_[b]) continue;
+        if (!noCollide_.empty()) {
+            const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+            if (std::binary_search(noCollide_.begin(), noCollide_.end(), key)) continue;
+        }
+        const double closing = std::max(length(startV_[a] - startV_[b]), length(endV_[a] - endV_[b]));
+        // Within reach this step: the gap the two can close in dt (the
+        // speeds at both ends of the step, forces included, and the spin)
+        // plus the slop. Farther, the awake shape cannot touch the sleeping
+        // one before the next step looks again; a wider margin would let a
+        // body resting or rolling a few millimetres away keep waking a pile.
+        const Manifold m = collide(colliders_[a].shape, centres_[a], rots[a], colliders_[b].shape, centres_[b], rots[b],
+                                   kLinearSlop + dt_ * closing + spin_[a] + spin_[b]);
+        if (m.pointCount > 0) woken.push_back(std::uint32_t(colliders_[colliderAsleep_[a] ? a : b].body));
+    }
+    if (woken.empty()) return true;
+    for (const std::uint32_t body : woken) wakeBody_(body);
+    return false;
 }
 
 void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_t filterA, std::int32_t filterB,
@@ -168,6 +371,7 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
     dt_ = dt;
     substeps_ = substeps;
     detected_ = false;
+    stepStartX_ = x;
     timings_ = {};
     const std::size_t n = colliders_.size();
     centres_.resize(n);
@@ -178,7 +382,7 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
         const Collider& c = colliders_[i];
         centres_[i] = centreOfMass(i, x);
         stepStart_[i] = centres_[i];
-        startV_[i] = c.body >= 0 ? v[std::size_t(c.body)] : Vec2{};
+        startV_[i] = c.body >= 0 && !colliderAsleep_[i] ? v[std::size_t(c.body)] : Vec2{};  // asleep: not moving
     }
     jointImpulsesBefore_.resize(joints_.size());
     for (std::size_t k = 0; k < joints_.size(); ++k) jointImpulsesBefore_[k] = joints::impulsesOf(joints_[k]);
@@ -195,6 +399,16 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = colliders_.size();
     const double dt = dt_;
+    // While islands sleep, only the awake colliders are visited; the frozen
+    // ones' motion, margins and rotations were set by refreshSleeping. With
+    // none asleep every collider is visited, in the same order.
+    const auto forEachActive = [&](auto&& visit) {
+        if (anySleeping_)
+            for (const std::uint32_t i : awakeSolverColliders_) visit(std::size_t(i));
+        else
+            for (std::size_t i = 0; i < n; ++i) visit(i);
+    };
+  for (;;) {  // once, or again after an awake shape woke a sleeping island
     // The motion within the step, not only at its start: the velocity after
     // the first substep's forces, extrapolated to the end of the step as a
     // constant acceleration (v0 + substeps (v1 - v0)). A body at rest pulled
@@ -203,11 +417,11 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     // speed is convex in time under constant acceleration, so the larger of
     // the two ends bounds it over the whole step.
     endV_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
+    forEachActive([&](std::size_t i) {
         const Collider& c = colliders_[i];
         endV_[i] = c.body >= 0 ? startV_[i] + double(substeps_) * (firstSubstepV[std::size_t(c.body)] - startV_[i])
                                : Vec2{};
-    }
+    });
     // Broad phase in a frame moving with the bodies' mean velocity (at both
     // ends of the step): what matters for contact is relative motion, so a
     // crowd moving together (or falling together) is fattened as if at rest
@@ -216,35 +430,41 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     // overlapping boxes, since |u_a - u_b| <= |u_a - ref| + |u_b - ref|.
     Vec2 ref0{}, ref1{};
     std::size_t moving = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        if (solverIndex_[i] == 0) continue;
+    forEachActive([&](std::size_t i) {
+        if (solverIndex_[i] == 0) return;
         ref0 += startV_[i];
         ref1 += endV_[i];
         ++moving;
-    }
+    });
     if (moving > 0) {
         ref0 = ref0 / double(moving);
         ref1 = ref1 / double(moving);
     }
     margins_.resize(n);
     spin_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
+    forEachActive([&](std::size_t i) {
         // How far any point of the shape can swing about its centre (m).
         spin_[i] = dt * std::abs(angularVelocities_[i]) * maxExtent_[i];
         const double drift = std::max(length(startV_[i] - ref0), length(endV_[i] - ref1));
         margins_[i] = kSpeculativeBase + dt * drift + spin_[i];
-    }
+    });
 
     // One sincos per collider per step, shared by the boxes and the narrow phase.
     std::vector<Rot>& rots = rotScratch_;
     rots.resize(n);
     // Circles and planes never read theirs (narrow phase, boxes): no sincos
     // for them.
-    for (std::size_t i = 0; i < n; ++i) {
+    forEachActive([&](std::size_t i) {
         const ShapeKind kind = colliders_[i].shape.kind;
         rots[i] = kind == ShapeKind::Circle || kind == ShapeKind::Plane ? Rot{} : Rot::fromAngle(angles_[i]);
-    }
+    });
 
+    if (anySleeping_) {
+        if (!sleepingBroadPhase(rots, ref0, ref1)) {
+            refreshSleeping(stepStartX_);  // the woken island's shapes join the awake ones
+            continue;
+        }
+    } else {
     boxes_.resize(finite_.size());
     movable_.resize(finite_.size());
     for (std::size_t k = 0; k < finite_.size(); ++k) {
@@ -268,8 +488,12 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     const std::span<const std::uint8_t> crowded = broadPhase_.crowded();
     for (std::size_t k = 0; k < crowded.size(); ++k)
         if (crowded[k] && solverIndex_[finite_[k]] != 0) crowdBodies_.push_back(solverIndex_[finite_[k]]);
+    }
+    break;
+  }
     timings_.broadPhaseMs = msSince(start);
 
+    const std::vector<Rot>& rots = rotScratch_;
     const auto narrowStart = std::chrono::steady_clock::now();
     constraints_.clear();
     details_.clear();
@@ -289,6 +513,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     };
     for (const ProxyPair& pair : pairs_) {
         const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
+        if (colliderAsleep_[a] || colliderAsleep_[b]) continue;  // no manifold: it would have woken them
         if (!noCollide_.empty()) {
             // Bodies joined with collide_connected false do not collide.
             const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
@@ -304,7 +529,8 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     // Planes against every movable finite shape: planes are few and infinite,
     // so they stay out of the broad phase.
     for (const std::uint32_t p : planes_) {
-        for (const std::uint32_t b : finite_) {
+        for (std::size_t k = 0, count = anySleeping_ ? awakeProxies_.size() : finite_.size(); k < count; ++k) {
+            const std::uint32_t b = finite_[anySleeping_ ? awakeProxies_[k] : k];
             if (colliders_[b].body < 0) continue;
             const Manifold m = collide(colliders_[p].shape, {}, {}, colliders_[b].shape, centres_[b], rots[b],
                                        pairMargin(p, b));
@@ -337,9 +563,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = colliders_.size();
     unconstrainedV_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
+    for (const std::uint32_t i : awakeSolverColliders_) {
         const std::uint32_t s = solverIndex_[i];
-        if (s == 0) continue;
         const std::size_t body = std::size_t(colliders_[i].body);
         bodies_[s].v = v[body];
         bodies_[s].w = angularVelocities_[i];
@@ -391,9 +616,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // Positions: the integrator moved x with the unconstrained velocity; add
     // the contact velocity change over the substep. Angles integrate here
     // (only contacts make torque).
-    for (std::size_t i = 0; i < n; ++i) {
+    for (const std::uint32_t i : awakeSolverColliders_) {
         const std::uint32_t s = solverIndex_[i];
-        if (s == 0) continue;
         SolverBody& b = bodies_[s];
         const std::size_t body = std::size_t(colliders_[i].body);
         x[body] += h * (b.v - unconstrainedV_[i]);
@@ -409,6 +633,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // position: p = c - R(angle) offset, with the centre c moved as above.
     for (std::size_t k = 0; k < offsetBodies_.size(); ++k) {
         const std::uint32_t i = offsetBodies_[k];
+        if (colliderAsleep_[i]) continue;
         const Collider& c = colliders_[i];
         SolverBody& b = bodies_[solverIndex_[i]];
         const std::size_t body = std::size_t(c.body);
@@ -421,9 +646,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
     }
 
-    for (std::size_t i = 0; i < n; ++i) {
+    for (const std::uint32_t i : awakeSolverColliders_) {
         const std::uint32_t s = solverIndex_[i];
-        if (s == 0) continue;
         v[std::size_t(colliders_[i].body)] = bodies_[s].v;
         angularVelocities_[i] = bodies_[s].w;
     }
@@ -443,7 +667,8 @@ void CollisionSystem::endStep() {
     previousCache_.swap(cache_);
     cache_.clear();
     coloured_.storeImpulses(constraints_);
-    records_.clear();
+    records_.resize(sleepingRecordCount_);  // the sleeping islands' contacts stay
+    recordPairs_.resize(sleepingRecordCount_);
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
         const ContactConstraint& c = constraints_[k];
         const ContactDetail& d = details_[k];
@@ -468,6 +693,7 @@ void CollisionSystem::endStep() {
             r.normalImpulse = p.normalImpulse + d.restitutionImpulse[i];
             r.tangentImpulse = p.tangentImpulse;
             records_.push_back(r);
+            recordPairs_.emplace_back(d.colliderA, d.colliderB);
         }
     }
     jointRecords_.clear();

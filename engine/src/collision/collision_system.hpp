@@ -9,6 +9,7 @@
 #include "collision/broad_phase.hpp"
 #include "collision/contact_bundles.hpp"
 #include "collision/contact_solver.hpp"
+#include "collision/frozen_boxes.hpp"
 #include "collision/narrow_phase.hpp"
 #include "joints/joint_solver.hpp"
 
@@ -17,6 +18,8 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
+#include <utility>
 #include <span>
 #include <vector>
 
@@ -106,7 +109,12 @@ public:
     void endStep();
 
     std::span<const ContactRecord> contacts() const { return records_; }
-    void clearContactRecords() { records_.clear(); }
+    /// Forgets the last step's contacts (a restore replaced that step); the
+    /// sleeping islands' contacts stay listed.
+    void clearContactRecords() {
+        records_.resize(sleepingRecordCount_);
+        recordPairs_.resize(sleepingRecordCount_);
+    }
     std::size_t contactPointCount() const { return records_.size(); }
     /// Broad-phase pairs and narrow-phase manifolds of the last detection.
     std::size_t candidatePairCount() const { return pairs_.size(); }
@@ -135,14 +143,44 @@ public:
     std::span<const double> angularVelocities() const { return angularVelocities_; }
 
     /// The warm-start cache the next step starts from (sorted by key): with
-    /// the bodies' state, all a step reads that an earlier step wrote.
-    const std::vector<CachedImpulse>& warmStartCache() const { return cache_; }
-    /// Replaces it (resume from a snapshot or a file); sorted here.
+    /// the bodies' state, all a step reads that an earlier step wrote. The
+    /// sleeping islands' entries are kept aside while they sleep and merged
+    /// in here.
+    std::vector<CachedImpulse> warmStartCache() const;
+    /// Replaces it (resume from a snapshot or a file); sorted here. Set the
+    /// sleeping bodies first (refreshSleeping): the entries are split by them.
     void setWarmStartCache(std::vector<CachedImpulse> cache);
+
+    // --- Sleeping (world/islands.hpp). The World owns the islands; this
+    // system reads which bodies sleep and asks the World to wake an island.
+    /// `bodyAsleep` (per state-vector body, 1 = asleep) stays owned by the
+    /// caller and must outlive this system; `wake(body)` wakes its island.
+    void setSleepSource(const std::vector<std::uint8_t>* bodyAsleep, std::function<void(std::uint32_t)> wake) {
+        bodyAsleep_ = bodyAsleep;
+        wakeBody_ = std::move(wake);
+    }
+    /// Takes the sleeping set again after it changed: awake lists, the frozen
+    /// boxes (at positions `x`), the cache split, the sleeping contacts'
+    /// records, the joints' flags.
+    void refreshSleeping(std::span<const Vec2> x);
+    /// Pairs of dynamic bodies (state-vector indices) joined by a manifold of
+    /// the last step or by a joint: the island edges this system knows of.
+    void bodyEdges(std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
+    /// Farthest point of collider i from its centre of mass, metres.
+    double maxExtent(std::size_t i) const { return maxExtent_[i]; }
 
 private:
 
     void addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m, std::span<const Vec2> centres);
+    /// Broad phase while some bodies sleep: the awake boxes among themselves
+    /// and against the frozen ones (static and sleeping), pairs sorted as
+    /// the full broad phase sorts them. Returns false when it woke an
+    /// island (an awake body has a manifold with a sleeping one): then the
+    /// detection starts over with that island awake.
+    bool sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, Vec2 ref1);
+    /// Moves cache entries that touch a sleeping collider to sleepingCache_
+    /// and the others back to cache_ (each stays sorted).
+    void splitCache();
     /// Broad and narrow phase at the step-start positions; `firstSubstepV`
     /// is the unconstrained velocity after the first substep's forces.
     void detect(std::span<const Vec2> firstSubstepV);
@@ -191,6 +229,22 @@ private:
     std::vector<std::uint64_t> noCollide_;  // sorted (min collider << 32 | max collider)
     std::vector<JointRecord> jointRecords_;
     double lastH_ = 0.0;
+    // Sleeping: see refreshSleeping(). With nothing asleep these are the
+    // full lists and every stage runs exactly as without sleeping.
+    const std::vector<std::uint8_t>* bodyAsleep_ = nullptr;
+    std::function<void(std::uint32_t)> wakeBody_;
+    bool anySleeping_ = false;
+    std::vector<std::uint8_t> colliderAsleep_;           // per collider
+    std::vector<std::uint32_t> awakeSolverColliders_;    // colliders with a solver body, awake, ascending
+    std::vector<std::uint32_t> awakeProxies_;            // finite_ indices of awake dynamic shapes, ascending
+    FrozenBoxes frozen_;                                 // static and sleeping shapes' boxes
+    std::vector<Aabb> awakeBoxes_;
+    std::vector<std::uint8_t> awakeMovable_;
+    std::vector<ProxyPair> awakePairs_;
+    std::vector<CachedImpulse> sleepingCache_;           // warm start of the sleeping islands' contacts
+    std::size_t sleepingRecordCount_ = 0;                // records_ starts with the sleeping contacts
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> recordPairs_;  // colliders of each record
+    std::span<const Vec2> stepStartX_;                   // beginStep's positions (valid during the step)
     CollisionTimings timings_;
     double dt_ = 0.0;
     int substeps_ = 1;

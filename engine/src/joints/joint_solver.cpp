@@ -250,6 +250,7 @@ void setImpulses(JointConstraint& j, const JointImpulse& in) {
 void prepareJoints(std::span<JointConstraint> joints, std::span<const SolverBody> bodies,
                    std::span<const Vec2> centres, std::span<const double> angles) {
     for (JointConstraint& j : joints) {
+        if (j.asleep) continue;  // its island sleeps: nothing moves it
         const auto pose = [&](const JointEnd& e, Vec2& centre, double& angle) {
             centre = e.collider >= 0 ? centres[std::size_t(e.collider)] : e.fixedCentre;
             angle = e.collider >= 0 ? angles[std::size_t(e.collider)] : e.fixedAngle;
@@ -270,6 +271,7 @@ void prepareJoints(std::span<JointConstraint> joints, std::span<const SolverBody
 
 void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies) {
     for (JointConstraint& j : joints) {
+        if (j.asleep) continue;
         SolverBody& a = bodies[j.a.solverBody];
         SolverBody& b = bodies[j.b.solverBody];
         Pair p(a, b);
@@ -310,6 +312,7 @@ void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bo
 void solveJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies, double h, const Softness& soft,
                  bool useBias) {
     for (JointConstraint& j : joints) {
+        if (j.asleep) continue;
         SolverBody& a = bodies[j.a.solverBody];
         SolverBody& b = bodies[j.b.solverBody];
         Pair p(a, b);

@@ -54,6 +54,9 @@ struct JointConstraint {
     double dampingRatio = 1.0;
     Entity entity;                 ///< the joint's own entity
     Entity entityA, entityB;       ///< its ends (entityB null: the world)
+    /// Its island sleeps (world/islands.hpp): the solver passes skip it and
+    /// its impulses stay as they were, ready for the wake.
+    bool asleep = false;
 
     // Prepared at step start.
     Vec2 anchorA, anchorB;         ///< anchors rotated to world orientation, relative to the centres, m

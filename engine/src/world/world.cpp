@@ -184,6 +184,10 @@ Result<World> World::build(const Scene& scene) {
         return Error{"world.theta: expected a number in [0, 1], got " + format(ws.theta)};
     if (!(ws.adaptiveStep >= 0.0) || !std::isfinite(ws.adaptiveStep))
         return Error{"world.adaptive_step: expected a finite number >= 0, got " + format(ws.adaptiveStep)};
+    if (!(ws.sleepVelocity >= 0.0) || !std::isfinite(ws.sleepVelocity))
+        return Error{"world.sleep_velocity: expected a finite number >= 0, got " + format(ws.sleepVelocity)};
+    if (!(ws.sleepTime >= 0.0) || !std::isfinite(ws.sleepTime))
+        return Error{"world.sleep_time: expected a finite number >= 0, got " + format(ws.sleepTime)};
 
     const Registry& reg = scene.registry;
     const std::vector<Entity>& order = reg.entities();
@@ -384,6 +388,32 @@ Result<World> World::build(const Scene& scene) {
     }
     w.angleBackup.resize(w.angle.size());
 
+    // Sleeping (world/islands.hpp). A dynamic attractor moves the field every
+    // body feels, so nothing is ever still for long: no sleeping then.
+    w.sleep.resize(n);
+    bool movingField = false;
+    for (const detail::AttractorData& a : f.attractors) movingField = movingField || a.body != kNoBody;
+    w.sleep.enabled = ws.sleep && !movingField;
+    w.sleep.velocity = ws.sleepVelocity;
+    w.sleep.time = ws.sleepTime;
+    w.colliderOfBody.assign(n, -1);
+    if (w.collision)
+        for (std::size_t c = 0; c < w.collision->colliderCount(); ++c)
+            if (const std::int32_t body = w.collision->collider(c).body; body >= 0) {
+                w.colliderOfBody[std::size_t(body)] = std::int32_t(c);
+                // A shapeless jointed body turns like a disc of kShapelessRadius.
+                w.sleep.extent[std::size_t(body)] = w.collision->collider(c).solverOnly ? detail::kShapelessRadius
+                                                                                          : w.collision->maxExtent(c);
+            }
+    // Boids steer by their neighbours and never rest; a shapeless body that
+    // turns (its spin is constant: nothing applies torque) would stop turning.
+    for (const std::uint32_t b : f.boids.body) w.sleep.restless[b] = 1;
+    for (std::size_t k = 0; k < w.spinBody.size(); ++k)
+        if (w.angularVelocity[k] != 0.0) w.sleep.restless[w.spinBody[k]] = 1;
+    if (w.collision)
+        w.collision->setSleepSource(&w.sleep.asleep, [impl = &w](std::uint32_t body) { impl->sleep.wake(body); });
+    w.sleptUnder = w.settings;
+
     if (f.gravityOn) w.active.push_back("gravity");
     if (f.dragOn) w.active.push_back("drag");
     if (f.springsOn()) w.active.push_back("springs");
@@ -430,6 +460,7 @@ Result<void> World::step() {
     f.resetTimers();
     const Clock::time_point t0 = timed ? Clock::now() : Clock::time_point{};
     const std::size_t m = 2 * f.n;
+    w.wakeForChangedSettings();  // a settings edit since the last step wakes every island
     const int substeps = w.settings.substeps;
     const double h = w.settings.dt / double(substeps);
     w.stepStartKnown = false;  // set again once this step succeeds
@@ -524,6 +555,8 @@ Result<void> World::step() {
     }
     w.settings.time += w.settings.dt;
     w.stepStartKnown = true;
+    w.updateSleep(substeps > 1 ? w.backupX.data() : w.x[1 - w.current].data(),
+                  substeps > 1 ? w.backupV.data() : w.v[1 - w.current].data());
     if (w.kind == detail::IntegratorKind::Dopri5) w.settings.adaptiveStep = w.integrator->proposedStep();
     ++w.stats.step;
     w.stats.forceEvaluations = evaluations;
@@ -621,9 +654,28 @@ bool carriesNothing(const JointImpulse& j) {
            isPlusZero(j.motor) && isPlusZero(j.lower) && isPlusZero(j.upper);
 }
 
+/// The bodies' sleep state, one array of each (WorldState's or the live one's).
+struct SleepArrays {
+    std::span<const double> timer;
+    std::span<const std::int32_t> island;
+    std::span<const double> anchor;
+    std::span<const std::uint8_t> anchored;
+};
+
 SolverState entityKeyed(const WorldLayout& layout, std::span<const CachedImpulse> cache,
-                        std::span<const JointImpulse> jointImpulses) {
+                        std::span<const JointImpulse> jointImpulses, const SleepArrays& sleep) {
     SolverState state;
+    // An awake body with no still window carries nothing: no entry.
+    for (std::size_t b = 0; b < sleep.timer.size(); ++b) {
+        if (sleep.island[b] < 0 && !sleep.anchored[b] && isPlusZero(sleep.timer[b])) continue;
+        BodySleep entry{layout.bodies[b], sleep.timer[b], std::nullopt, 0.0,
+                        sleep.island[b] >= 0 ? layout.bodies[std::size_t(sleep.island[b])] : Entity{}};
+        if (sleep.anchored[b]) {
+            entry.stillAt = Vec2{sleep.anchor[3 * b], sleep.anchor[3 * b + 1]};
+            entry.stillAngle = sleep.anchor[3 * b + 2];
+        }
+        state.bodies.push_back(entry);
+    }
     state.contacts.reserve(cache.size());
     for (const CachedImpulse& c : cache)
         state.contacts.push_back(
@@ -642,16 +694,46 @@ std::vector<JointImpulse> jointImpulsesOf(const collision::CollisionSystem& syst
 }
 } // namespace
 
-SolverState WorldState::solverState() const { return entityKeyed(*layout, contacts, joints); }
+SolverState WorldState::solverState() const {
+    return entityKeyed(*layout, contacts, joints, {sleepTimer, sleepIsland, sleepAnchor, sleepAnchored});
+}
 
 SolverState World::solverState() const {
     const WorldImpl& w = *impl_;
-    if (!w.collision) return {};
-    return entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision));
+    const SleepArrays sleep{w.sleep.timer, w.sleep.island, w.sleep.anchor, w.sleep.anchored};
+    if (!w.collision) return entityKeyed(*w.layout, {}, {}, sleep);
+    return entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision), sleep);
 }
 
 void World::setSolverState(const SolverState& state) {
     WorldImpl& w = *impl_;
+    // Sleep first: the contacts' cache is split by it.
+    {
+        std::unordered_map<Entity, std::uint32_t> bodyOf;
+        for (std::size_t b = 0; b < w.bodyEntity.size(); ++b) bodyOf.emplace(w.bodyEntity[b], std::uint32_t(b));
+        std::fill(w.sleep.timer.begin(), w.sleep.timer.end(), 0.0);
+        std::fill(w.sleep.island.begin(), w.sleep.island.end(), -1);
+        std::fill(w.sleep.anchored.begin(), w.sleep.anchored.end(), 0);
+        for (const BodySleep& s : state.bodies) {
+            const auto body = bodyOf.find(s.body);
+            if (body == bodyOf.end()) continue;  // no longer a dynamic body
+            w.sleep.timer[body->second] = s.sleepTime;
+            if (s.stillAt) {
+                double* a = &w.sleep.anchor[3 * body->second];
+                a[0] = s.stillAt->x;
+                a[1] = s.stillAt->y;
+                a[2] = s.stillAngle;
+                w.sleep.anchored[body->second] = 1;
+            }
+            const auto label = s.island.isNull() ? bodyOf.end() : bodyOf.find(s.island);
+            // Asleep only where sleeping is on, and a body that may sleep.
+            if (label != bodyOf.end() && w.sleep.enabled && !w.sleep.restless[body->second])
+                w.sleep.island[body->second] = std::int32_t(label->second);
+        }
+        w.sleep.refresh();
+        w.sleepChanged();
+        w.sleptUnder = w.settings;  // a resume steps on under the settings it is given
+    }
     if (!w.collision) return;
     std::unordered_map<Entity, std::uint32_t> colliderOf;
     const std::vector<Entity>& colliders = w.layout->colliders;
@@ -679,7 +761,8 @@ void World::setSolverState(const SolverState& state) {
 
 std::size_t WorldState::bytes() const {
     return sizeof(double) * (x.capacity() + v.capacity() + spinAngle.capacity() + colliderAngle.capacity() +
-                             colliderSpin.capacity()) +
+                             colliderSpin.capacity() + sleepTimer.capacity() + sleepAnchor.capacity()) +
+           sizeof(std::int32_t) * sleepIsland.capacity() + sleepAnchored.capacity() +
            sizeof(CachedImpulse) * contacts.capacity() + sizeof(JointImpulse) * joints.capacity();
 }
 
@@ -693,6 +776,10 @@ WorldState World::saveState() const {
     s.x.assign(w.x[w.current].begin(), w.x[w.current].end());
     s.v.assign(w.v[w.current].begin(), w.v[w.current].end());
     s.spinAngle = w.angle;
+    s.sleepTimer = w.sleep.timer;
+    s.sleepIsland = w.sleep.island;
+    s.sleepAnchor = w.sleep.anchor;
+    s.sleepAnchored = w.sleep.anchored;
     if (w.collision) {
         s.colliderAngle.assign(w.collision->angles().begin(), w.collision->angles().end());
         s.colliderSpin.assign(w.collision->angularVelocities().begin(), w.collision->angularVelocities().end());
@@ -704,13 +791,25 @@ WorldState World::saveState() const {
 
 Result<void> World::restoreState(const WorldState& s) {
     WorldImpl& w = *impl_;
-    if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout) || s.joints.size() != w.layout->joints.size())
+    if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout) || s.joints.size() != w.layout->joints.size() ||
+        s.sleepTimer.size() != w.bodyEntity.size() || s.sleepIsland.size() != w.bodyEntity.size() ||
+        s.sleepAnchor.size() != 3 * w.bodyEntity.size() || s.sleepAnchored.size() != w.bodyEntity.size())
         return Error{"the snapshot was taken from a world with other bodies or shapes"};
     std::copy(s.x.begin(), s.x.end(), w.x[w.current].begin());
     std::copy(s.v.begin(), s.v.end(), w.v[w.current].begin());
     w.angle = s.spinAngle;
+    if (w.collision) w.collision->restoreRotation(s.colliderAngle, s.colliderSpin);
+    // Sleep after the rotations (the frozen shapes' boxes use them) and
+    // before the cache (it is split by it).
+    w.sleep.timer = s.sleepTimer;
+    w.sleep.island = s.sleepIsland;
+    w.sleep.anchor = s.sleepAnchor;
+    w.sleep.anchored = s.sleepAnchored;
+    if (!w.sleep.enabled) std::fill(w.sleep.island.begin(), w.sleep.island.end(), -1);
+    w.sleep.refresh();
+    w.sleepChanged();
+    w.sleptUnder = w.settings;
     if (w.collision) {
-        w.collision->restoreRotation(s.colliderAngle, s.colliderSpin);
         w.collision->setWarmStartCache(s.contacts);
         const std::span<joints::JointConstraint> joints = w.collision->jointConstraints();
         for (std::size_t k = 0; k < joints.size(); ++k) joints::setImpulses(joints[k], s.joints[k]);
@@ -728,7 +827,10 @@ Result<void> World::restoreState(const WorldState& s) {
 Result<void> World::reload(const Scene& scene) {
     Result<World> next = build(scene);
     if (!next) return Error{next.error()};
-    if (!scene.solverState) next->setSolverState(solverState());
+    if (!scene.solverState) {
+        next->setSolverState(solverState());
+        next->impl_->wakeEdited(*impl_);  // an edit wakes the islands it touches
+    }
     next->impl_->stats.step = impl_->stats.step;
     next->impl_->profiling = impl_->profiling;
     impl_ = std::move(next->impl_);
@@ -760,13 +862,17 @@ const WorldSettings& World::settings() const { return impl_->settings; }
 Result<void> World::setIntegrator(std::string_view name) {
     const auto kind = detail::integratorKind(name);
     if (!kind) return Error{"unknown integrator \"" + std::string(name) + "\""};
-    impl_->setIntegratorKind(*kind);
+    impl_->setIntegratorKind(*kind);  // another integrator: the next step wakes every island (sleptUnder)
     return {};
 }
 
 Result<void> World::setSpringAnchor(Entity spring, Vec2 anchor) {
     for (detail::SpringData& s : impl_->model.springs)
         if (s.entity == spring && s.b == detail::kNoBody) {
+            if (s.fx != anchor.x || s.fy != anchor.y) {
+                impl_->sleep.wake(s.a);  // the mouse spring pulls its body out of its island's sleep
+                impl_->sleepChanged();
+            }
             s.fx = anchor.x;
             s.fy = anchor.y;
             return {};

@@ -5,6 +5,7 @@
 #include "collision/collision_system.hpp"
 #include "forces/force_model.hpp"
 #include "integrators/integrator.hpp"
+#include "world/islands.hpp"
 #include "stepwise/world.hpp"
 
 #include <chrono>
@@ -56,6 +57,21 @@ public:
     /// Entities of the state arrays (saveState/restoreState); set by build.
     std::shared_ptr<const WorldLayout> layout;
 
+    /// Sleeping islands (world/islands.hpp) and, per body, its collider
+    /// (-1: none).
+    detail::SleepIslands sleep;
+    std::vector<std::int32_t> colliderOfBody;
+    std::vector<double> sleepSpeed;  ///< scratch: each awake body's fastest point, m/s
+    std::vector<double> sleepAngle;  ///< scratch: each body's angle, rad
+    /// The world settings the sleeping islands were last stepped under. A
+    /// step under other settings (gravity turned, dt changed ...) wakes them
+    /// all first. Checked at the step, not at the edit, so that an edit
+    /// undone before any step (a system switched off and on) wakes nothing;
+    /// a restore or a resume sets it to the settings it is stepped under.
+    WorldSettings sleptUnder;
+    /// Wakes every island when `settings` differ from sleptUnder.
+    void wakeForChangedSettings();
+
     const double* xs() const { return x[current].data(); }
     const double* vs() const { return v[current].data(); }
     double* xs() { return x[current].data(); }
@@ -68,6 +84,16 @@ public:
     /// system: entity 0 (\"a\"), entity 1 (\"b\")".
     std::string describeSolveFailure(const detail::SolveFailure& failure, std::uint64_t stepNumber) const;
     void setIntegratorKind(detail::IntegratorKind k);
+    /// The sleeping set changed: the collision system takes it again.
+    void sleepChanged();
+    /// End of a successful step: sleeping bodies go back to their frozen
+    /// state (`startX`, `startV`: the step's start), the awake bodies'
+    /// timers advance, and still islands fall asleep.
+    void updateSleep(const double* startX, const double* startV);
+    /// After reload(): wakes the islands whose bodies, springs or joints
+    /// differ from `before` (the World this one replaces), all of them when
+    /// the world settings differ, and those that touched a removed body.
+    void wakeEdited(const WorldImpl& before);
 };
 
 } // namespace stepwise

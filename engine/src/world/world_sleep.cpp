@@ -1,0 +1,247 @@
+// The World's side of sleeping (world/islands.hpp): what a step does with
+// the islands, and which islands an edit wakes.
+
+#include "world/world_collisions.hpp"
+#include "world/world_impl.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <unordered_map>
+
+namespace stepwise {
+
+void WorldImpl::sleepChanged() {
+    if (!sleep.changed) return;
+    sleep.changed = false;
+    if (collision) collision->refreshSleeping(detail::asVec2(xs(), bodyEntity.size()));
+}
+
+void WorldImpl::updateSleep(const double* startX, const double* startV) {
+    if (!sleep.enabled) return;
+    double* px = xs();
+    double* pv = vs();
+    // Asleep through the step: integrated with the rest (the integrators
+    // run over whole arrays) but not solved; put back exactly.
+    for (const std::uint32_t b : sleep.sleeping) {
+        px[2 * b] = startX[2 * b];
+        px[2 * b + 1] = startX[2 * b + 1];
+        pv[2 * b] = startV[2 * b];
+        pv[2 * b + 1] = startV[2 * b + 1];
+    }
+    const std::size_t n = bodyEntity.size();
+    std::vector<double>& speed = sleepSpeed;
+    speed.resize(n);
+    for (std::size_t b = 0; b < n; ++b) {
+        if (sleep.island[b] >= 0) continue;
+        double w = 0.0;
+        if (colliderOfBody[b] >= 0) w = collision->angularVelocity(std::size_t(colliderOfBody[b]));
+        speed[b] = std::sqrt(pv[2 * b] * pv[2 * b] + pv[2 * b + 1] * pv[2 * b + 1]) + sleep.extent[b] * std::abs(w);
+    }
+    std::vector<double>& angle = sleepAngle;
+    angle.assign(n, 0.0);
+    for (std::size_t b = 0; b < n; ++b)
+        if (colliderOfBody[b] >= 0) angle[b] = collision->angle(std::size_t(colliderOfBody[b]));
+    if (!sleep.advanceTimers(speed, px, angle, settings.dt)) return;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+    for (const detail::SpringData& s : model.springs)
+        if (s.b != detail::kNoBody) edges.emplace_back(s.a, s.b);
+    if (collision) collision->bodyEdges(edges);
+    // An island falls asleep as it is: velocities and spins (all under
+    // sleep_velocity) are kept, frozen, so a wake resumes it exactly where
+    // it paused, and a saved file shows the state it paused in.
+    if (sleep.fallAsleep(edges).empty()) return;
+    sleepChanged();
+}
+
+namespace {
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool sameBits(Vec2 a, Vec2 b) { return sameBits(a.x, b.x) && sameBits(a.y, b.y); }
+
+/// Everything of a collider an edit can change (its motion aside).
+bool sameCollider(const collision::Collider& a, const collision::Collider& b) {
+    if (a.shape.kind != b.shape.kind || !sameBits(a.shape.radius, b.shape.radius) ||
+        !sameBits(a.shape.halfExtents, b.shape.halfExtents) || !sameBits(a.shape.normal, b.shape.normal) ||
+        !sameBits(a.shape.offset, b.shape.offset) ||
+        (a.body < 0 && !sameBits(a.staticPosition, b.staticPosition)) ||  // a body's is where it was built
+        !sameBits(a.mass, b.mass) || !sameBits(a.restitution, b.restitution) || !sameBits(a.friction, b.friction) ||
+        a.solverOnly != b.solverOnly || !sameBits(a.inertia, b.inertia) || !sameBits(a.centreOfMass, b.centreOfMass))
+        return false;
+    if (a.shape.polygon && b.shape.polygon) {
+        const collision::ConvexPolygon &p = *a.shape.polygon, &q = *b.shape.polygon;
+        if (p.count != q.count) return false;
+        for (int i = 0; i < p.count; ++i)
+            if (!sameBits(p.vertices[i], q.vertices[i])) return false;
+    }
+    return true;
+}
+
+bool sameJoint(const joints::JointConstraint& a, const joints::JointConstraint& b) {
+    const auto sameEnd = [](const joints::JointEnd& p, const joints::JointEnd& q) {
+        return sameBits(p.fixedCentre, q.fixedCentre) && sameBits(p.fixedAngle, q.fixedAngle) && sameBits(p.local, q.local);
+    };
+    return a.kind == b.kind && a.entityA == b.entityA && a.entityB == b.entityB && sameEnd(a.a, b.a) &&
+           sameEnd(a.b, b.b) && sameBits(a.localAxis, b.localAxis) && sameBits(a.referenceAngle, b.referenceAngle) &&
+           a.hasLower == b.hasLower && a.hasUpper == b.hasUpper && sameBits(a.lower, b.lower) &&
+           sameBits(a.upper, b.upper) && a.motor == b.motor && sameBits(a.motorSpeed, b.motorSpeed) &&
+           sameBits(a.maxMotor, b.maxMotor) && sameBits(a.length, b.length) && sameBits(a.stiffnessHz, b.stiffnessHz) &&
+           sameBits(a.dampingRatio, b.dampingRatio);
+}
+
+/// The settings that change how bodies move (time and the dopri5 step are
+/// state, not settings).
+bool sameMotionSettings(WorldSettings a, WorldSettings b) {
+    a.time = b.time;
+    a.adaptiveStep = b.adaptiveStep;
+    return a == b;
+}
+
+} // namespace
+
+void WorldImpl::wakeForChangedSettings() {
+    if (sleep.anyAsleep() && !sameMotionSettings(settings, sleptUnder)) {
+        sleep.wakeAll();
+        sleepChanged();
+    }
+    sleptUnder = settings;
+}
+
+void WorldImpl::wakeEdited(const WorldImpl& before) {
+    // Settings: judged at the next step (wakeForChangedSettings).
+    sleptUnder = before.sleptUnder;
+    if (!sleep.anyAsleep()) return;
+    std::unordered_map<Entity, std::uint32_t> bodyOf, oldBodyOf;
+    for (std::size_t b = 0; b < bodyEntity.size(); ++b) bodyOf.emplace(bodyEntity[b], std::uint32_t(b));
+    for (std::size_t b = 0; b < before.bodyEntity.size(); ++b) oldBodyOf.emplace(before.bodyEntity[b], std::uint32_t(b));
+    const auto wakeEntity = [&](Entity e) {
+        if (const auto it = bodyOf.find(e); it != bodyOf.end()) sleep.wake(it->second);
+    };
+    // Bodies: state and parameters, bit for bit (an untouched body was
+    // written back from the old World and reads back the same).
+    const double *px = xs(), *pv = vs(), *ox = before.xs(), *ov = before.vs();
+    for (std::size_t b = 0; b < bodyEntity.size(); ++b) {
+        if (sleep.island[b] < 0) continue;
+        const auto it = oldBodyOf.find(bodyEntity[b]);
+        const std::size_t o = it == oldBodyOf.end() ? 0 : it->second;
+        const bool same = it != oldBodyOf.end() && sameBits(px[2 * b], ox[2 * o]) && sameBits(px[2 * b + 1], ox[2 * o + 1]) &&
+                          sameBits(pv[2 * b], ov[2 * o]) && sameBits(pv[2 * b + 1], ov[2 * o + 1]) &&
+                          sameBits(model.mass[b], before.model.mass[o]) &&
+                          sameBits(model.dragOn ? model.dragB[b] : 0.0, before.model.dragOn ? before.model.dragB[o] : 0.0);
+        if (!same) sleep.wake(std::uint32_t(b));
+    }
+    // Shapes: a changed, added or removed static shape wakes everything (it
+    // may hold up any island); a changed body's shape, angle or spin wakes
+    // its island; a removed shape wakes what it touched (its cached contacts).
+    if (collision || before.collision) {
+        std::unordered_map<Entity, std::size_t> oldCollider;
+        if (before.collision)
+            for (std::size_t c = 0; c < before.collision->colliderCount(); ++c)
+                oldCollider.emplace(before.collision->collider(c).entity, c);
+        std::size_t staticCount = 0, oldStaticCount = 0;
+        if (before.collision)
+            for (std::size_t c = 0; c < before.collision->colliderCount(); ++c)
+                oldStaticCount += before.collision->collider(c).body < 0 ? 1 : 0;
+        bool staticEdited = false;
+        if (collision)
+            for (std::size_t c = 0; c < collision->colliderCount(); ++c) {
+                const collision::Collider& col = collision->collider(c);
+                const auto it = oldCollider.find(col.entity);
+                const bool same = it != oldCollider.end() && sameCollider(col, before.collision->collider(it->second)) &&
+                                  sameBits(collision->angle(c), before.collision->angle(it->second)) &&
+                                  sameBits(collision->angularVelocity(c), before.collision->angularVelocity(it->second));
+                if (col.body < 0) {
+                    ++staticCount;
+                    staticEdited = staticEdited || !same;
+                } else if (!same) {
+                    sleep.wake(std::uint32_t(col.body));
+                }
+            }
+        if (staticEdited || staticCount != oldStaticCount) sleep.wakeAll();
+        if (before.collision) {
+            std::unordered_map<Entity, bool> present;
+            if (collision)
+                for (std::size_t c = 0; c < collision->colliderCount(); ++c) present.emplace(collision->collider(c).entity, true);
+            const std::vector<Entity>& oldColliders = before.layout->colliders;
+            for (const CachedImpulse& e : before.collision->warmStartCache()) {
+                const Entity a = oldColliders[e.colliderA()], b = oldColliders[e.colliderB()];
+                if (!present.count(a)) wakeEntity(b);
+                if (!present.count(b)) wakeEntity(a);
+            }
+        }
+        // Joints: changed, added or removed ones wake both ends.
+        std::unordered_map<Entity, const joints::JointConstraint*> oldJoints;
+        if (before.collision)
+            for (const joints::JointConstraint& j : before.collision->jointConstraints()) oldJoints.emplace(j.entity, &j);
+        std::unordered_map<Entity, bool> jointKept;
+        if (collision)
+            for (const joints::JointConstraint& j : collision->jointConstraints()) {
+                const auto it = oldJoints.find(j.entity);
+                if (it != oldJoints.end()) jointKept.emplace(j.entity, true);
+                if (it == oldJoints.end() || !sameJoint(j, *it->second)) {
+                    wakeEntity(j.entityA);
+                    wakeEntity(j.entityB);
+                }
+            }
+        for (const auto& [entity, j] : oldJoints)
+            if (!jointKept.count(entity)) {
+                wakeEntity(j->entityA);
+                wakeEntity(j->entityB);
+            }
+    }
+    // Springs: the same, by entity.
+    std::unordered_map<Entity, const detail::SpringData*> oldSprings;
+    for (const detail::SpringData& s : before.model.springs) oldSprings.emplace(s.entity, &s);
+    const auto endEntity = [](const WorldImpl& w, std::uint32_t body) {
+        return body == detail::kNoBody ? Entity{} : w.bodyEntity[body];
+    };
+    std::unordered_map<Entity, bool> springKept;
+    for (const detail::SpringData& s : model.springs) {
+        const auto it = oldSprings.find(s.entity);
+        bool same = it != oldSprings.end();
+        if (same) {
+            const detail::SpringData& o = *it->second;
+            springKept.emplace(s.entity, true);
+            same = endEntity(*this, s.a) == endEntity(before, o.a) && endEntity(*this, s.b) == endEntity(before, o.b) &&
+                   sameBits(s.k, o.k) && sameBits(s.c, o.c) && sameBits(s.rest, o.rest) && sameBits(s.fx, o.fx) &&
+                   sameBits(s.fy, o.fy);
+        }
+        if (!same) {
+            sleep.wake(s.a);
+            if (s.b != detail::kNoBody) sleep.wake(s.b);
+        }
+    }
+    for (const auto& [entity, o] : oldSprings)
+        if (!springKept.count(entity)) {
+            wakeEntity(endEntity(before, o->a));
+            wakeEntity(endEntity(before, o->b));
+        }
+    sleepChanged();
+}
+
+bool World::asleep(std::size_t body) const { return impl_->sleep.island.at(body) >= 0; }
+std::size_t World::sleepingBodyCount() const { return impl_->sleep.sleeping.size(); }
+std::vector<Entity> World::sleepingBodies() const {
+    std::vector<Entity> out;
+    out.reserve(impl_->sleep.sleeping.size());
+    for (const std::uint32_t b : impl_->sleep.sleeping) out.push_back(impl_->bodyEntity[b]);
+    return out;
+}
+
+bool World::wakeIfSettingsChanged() {
+    WorldImpl& w = *impl_;
+    const std::size_t before = w.sleep.sleeping.size();
+    w.wakeForChangedSettings();
+    return w.sleep.sleeping.size() != before;
+}
+
+bool World::wake(Entity entity) {
+    WorldImpl& w = *impl_;
+    const auto it = std::find(w.bodyEntity.begin(), w.bodyEntity.end(), entity);
+    if (it == w.bodyEntity.end()) return false;
+    const bool woke = w.sleep.wake(std::uint32_t(it - w.bodyEntity.begin()));
+    w.sleepChanged();
+    return woke;
+}
+
+} // namespace stepwise
