@@ -5,6 +5,7 @@
 // overlap tests), speed is in bench/ (docs/incoming/collide.md).
 
 #include "collision/collision_system.hpp"
+#include "generated_scenes.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
@@ -281,20 +282,7 @@ TEST(CollisionHard, RestitutionThresholdRoundTripsAndIsRefusedWhenNegative) {
 
 namespace {
 /// 30 rows of 10 circles (radius 0.25) in a 5.2 m wide box, 60 Hz.
-Scene tallPile() {
-    Scene s;
-    s.world.gravity = {0.0, -10.0};
-    s.world.dt = 1.0 / 60.0;
-    staticBoxAt(s, {0.0, -0.5}, 8.0, 1.0);
-    staticBoxAt(s, {-3.1, 10.0}, 1.0, 22.0);
-    staticBoxAt(s, {3.1, 10.0}, 1.0, 22.0);
-    for (int i = 0; i < 300; ++i) {
-        const double jitter = 0.01 * double((i * 7919) % 11 - 5) / 5.0;
-        const Entity e = circleBody(s, {-2.3 + 0.51 * (i % 10) + jitter, 0.3 + 0.52 * (i / 10)}, 0.25);
-        s.registry.emplace<Friction>(e, Friction{0.6});
-    }
-    return s;
-}
+using scenes::tallPile;
 double deepestOverlapAfter(World& w, int steps) {
     double deepest = 0.0;
     for (int i = 0; i < steps; ++i) {
