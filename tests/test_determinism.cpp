@@ -19,6 +19,7 @@
 #include "stepwise/integrators.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -97,21 +98,8 @@ const char* kPolygonScene = R"({
 
 constexpr int kSteps = 240;  // 4 s: the pile settles, the chain swings into it
 
-/// FNV-1a, 64 bit: tiny, stable, and every byte matters.
-std::uint64_t fnv1a(const std::string& bytes) {
-    std::uint64_t h = 0xcbf29ce484222325ull;
-    for (unsigned char c : bytes) {
-        h ^= c;
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}
-
-std::string hex(std::uint64_t v) {
-    char buffer[24];
-    std::snprintf(buffer, sizeof buffer, "0x%016llx", static_cast<unsigned long long>(v));
-    return buffer;
-}
+using test::fnv1a;
+using test::hex;
 
 /// Recorded from a gcc 12 build (RelWithDebInfo + ASan/UBSan,
 /// and checked equal in Release); see the header for re-recording.

@@ -10,6 +10,7 @@
 
 #include "app/scene_edit.hpp"
 #include "generated_scenes.hpp"
+#include "test_support.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
@@ -26,21 +27,8 @@ using namespace stepwise;
 
 namespace {
 
-/// FNV-1a, 64 bit (as test_determinism): every byte matters.
-std::uint64_t fnv1a(const std::string& bytes) {
-    std::uint64_t h = 14695981039346656037ull;
-    for (unsigned char c : bytes) {
-        h ^= c;
-        h *= 1099511628211ull;
-    }
-    return h;
-}
-
-std::string hex(std::uint64_t v) {
-    char buffer[24];
-    std::snprintf(buffer, sizeof buffer, "0x%016llx", static_cast<unsigned long long>(v));
-    return buffer;
-}
+using test::fnv1a;
+using test::hex;
 
 void expectBytes(const Scene& scene, std::uint64_t recorded, std::size_t size, const char* what) {
     const std::string text = sceneToJsonText(scene);
