@@ -5,6 +5,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
+#include <imgui_internal.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -30,7 +31,15 @@ void writeDebugState(const std::string& path, ui::Session& session, std::uint64_
     const ui::Session::DialogState d = session.dialogState();
     out << ",\n  \"modal\": " << nlohmann::json(d.modal).dump() << ",\n  \"status\": " << nlohmann::json(d.status).dump()
         << ",\n  \"open_folder\": " << nlohmann::json(d.openFolder).dump() << ",\n  \"open_files\": " << d.openFiles
-        << ",\n  \"save_as_suggestion\": " << nlohmann::json(d.saveAsSuggestion).dump() << ",\n  \"positions\": [";
+        << ",\n  \"save_as_suggestion\": " << nlohmann::json(d.saveAsSuggestion).dump();
+    // Rectangles (x, y, w, h) in window pixels of the panels and of the
+    // inspector's fields, from the last frame.
+    nlohmann::json windows = nlohmann::json::object(), widgets = nlohmann::json::object();
+    for (const char* name : {"Tools", "Entities", "Viewport", "Inspector", "World", "Debug"})
+        if (const ImGuiWindow* w = ImGui::FindWindowByName(name); w && w->WasActive)
+            windows[name] = {w->Pos.x, w->Pos.y, w->Size.x, w->Size.y};
+    for (const auto& [key, r] : session.ui().widgetRects) widgets[key] = {r.x, r.y, r.z, r.w};
+    out << ",\n  \"windows\": " << windows.dump() << ",\n  \"widgets\": " << widgets.dump() << ",\n  \"positions\": [";
     int n = 0;
     for (Entity e : ed.doc.scene.registry.entities()) {
         const Position* pos = ed.doc.scene.registry.tryGet<Position>(e);
