@@ -185,6 +185,10 @@ int runScripted(const EditOptions& o, int width, int height) {
                 session.queue(e);
                 frame();
             }
+            // A whole keypress lets go of its modifiers too: a held ctrl
+            // made ImGui drop the characters of a following `text` line
+            // (after ctrl+shift+s, Save as kept its suggestion).
+            if (c.kind == K::Key) pressMods(c.mods, false);
             break;
         }
         case K::Move:
