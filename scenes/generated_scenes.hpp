@@ -79,7 +79,7 @@ struct NamedScene {
     Scene scene;
     double seconds;     ///< simulated time the benchmark runs
 };
-/// pile, pyramid and rain, with the simulated time the benchmark runs each.
+/// pile, pile300, pyramid and rain, with the simulated time the benchmark runs each.
 std::vector<NamedScene> benchmarkScenes();
 
 // ---- the tests' scenes -------------------------------------------------------

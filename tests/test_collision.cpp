@@ -4,9 +4,11 @@
 
 #include "collision/collision_system.hpp"
 #include "collision/narrow_phase.hpp"
+#include "integrators/integrator.hpp"
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -316,4 +318,103 @@ TEST(Collision, PileOfCirclesSettlesWithoutEscapes) {
     // this machine, bench/collision); Stepwise must do at least as well.
     EXPECT_LT(deepest, 0.0125);
     EXPECT_LT(w.kinetic() / 400.0, 1.1e-7) << "mean kinetic energy per body at rest, J";
+}
+
+namespace {
+/// Positions, velocities and angles of every body, as bits.
+std::vector<std::uint64_t> stateBits(const MiniWorld& w) {
+    std::vector<std::uint64_t> bits;
+    for (std::size_t i = 0; i < w.x.size(); ++i)
+        for (double d : {w.x[i].x, w.x[i].y, w.v[i].x, w.v[i].y}) bits.push_back(std::bit_cast<std::uint64_t>(d));
+    for (std::size_t c = 0; c < w.collision.colliderCount(); ++c)
+        for (double d : {w.collision.angle(c), w.collision.angularVelocity(c)})
+            bits.push_back(std::bit_cast<std::uint64_t>(d));
+    return bits;
+}
+
+/// The coloured contacts solved in SIMD bundles on every instruction set the
+/// machine has, and one at a time (SolverSettings::simd off), must give the
+/// same bits. `make` builds the scene.
+template <class Make>
+void expectSimdMatchesOneAtATime(Make make, int steps, const char* scene) {
+    MiniWorld reference = make();
+    reference.collision.settings().simd = false;
+    for (int i = 0; i < steps; ++i) reference.step(1.0 / 60.0);
+    const std::vector<std::uint64_t> expected = stateBits(reference);
+    int levelsRun = 0;
+    for (detail::SimdLevel level : {detail::SimdLevel::Baseline, detail::SimdLevel::Avx2, detail::SimdLevel::Avx512}) {
+        if (detail::setSimdLevel(level) != level) continue;
+        ++levelsRun;
+        MiniWorld w = make();
+        w.collision.settings().simd = true;
+        for (int i = 0; i < steps; ++i) w.step(1.0 / 60.0);
+        EXPECT_TRUE(stateBits(w) == expected) << scene << ": SIMD level " << int(level) << " differs from one at a time";
+    }
+    detail::setSimdLevel(detail::SimdLevel::Avx512);  // back to the best there is
+    EXPECT_GE(levelsRun, 1);
+}
+} // namespace
+
+TEST(Collision, SimdBundlesGiveTheBitsOfTheOneAtATimeSolveOnEveryInstructionSet) {
+    // Boxes: two-point manifolds, block solve, friction, static ground.
+    expectSimdMatchesOneAtATime(
+        [] {
+            int top = 0;
+            MiniWorld w = pyramid(12, top);
+            w.collision.settings().iterations = 2;
+            return w;
+        },
+        120, "pyramid");
+    // Circles with restitution in a box of planes: one-point manifolds,
+    // impact propagation, many colours.
+    expectSimdMatchesOneAtATime(
+        [] {
+            MiniWorld w;
+            w.gravity = {0.0, -10.0};
+            w.fixed(plane({0, 1}, 0.0), {});
+            w.fixed(plane({1, 0}, -3.0), {});
+            w.fixed(plane({-1, 0}, -3.0), {});
+            std::mt19937 rng(5);
+            std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+            for (int i = 0; i < 150; ++i)
+                w.dynamic(circle(0.2 + 0.05 * (i % 3)), {-2.5 + 0.6 * (i % 9) + jitter(rng), 0.5 + 0.6 * (i / 9)}, {},
+                          1.0 + 0.5 * (i % 4), 0.3, 0.4);
+            // A spinning box falling into it: two-point manifolds against circles.
+            w.dynamic(box(1.0, 0.5), {0.3, 12.0}, {0.0, -5.0}, 3.0, 0.0, 0.5, 0.4);
+            return w;
+        },
+        180, "circles");
+    // A crowd started at one point: bodies with more contacts than there are
+    // colours, so the overflow (solved one at a time between the SIMD
+    // colours) takes part.
+    const auto crowd = [] {
+        MiniWorld w;
+        w.fixed(plane({0, 1}, -2.0), {});
+        for (int i = 0; i < 60; ++i)  // every pair touches: 59 contacts a body
+            w.dynamic(circle(0.3), {0.001 * (i % 8), 0.001 * (i / 8)}, {}, 1.0, 0.0, 0.3);
+        return w;
+    };
+    expectSimdMatchesOneAtATime(crowd, 30, "crowd");
+    MiniWorld w = crowd();
+    w.step(1.0 / 60.0);
+    EXPECT_GT(w.collision.colouredContacts().overflowCount(), 0u) << "the crowd should overflow the colours";
+}
+
+TEST(Collision, SmallRotationMatchesLibmWithinTwoUnitsInTheLastPlace) {
+    // rotationBy's series against std::sin and std::cos over its range
+    // (|x| < 1/16 rad) and past it (libm itself).
+    int worstSin = 0, worstCos = 0;
+    for (int i = -20000; i <= 20000; ++i) {
+        const double x = 0.07 * double(i) / 20000.0 + 1e-7 * double(i % 7);
+        const Rot q = rotationBy(x);
+        const auto ulps = [](double a, double b) {
+            return int(std::abs(std::bit_cast<std::int64_t>(a) - std::bit_cast<std::int64_t>(b)));
+        };
+        worstSin = std::max(worstSin, ulps(q.s, std::sin(x)));
+        worstCos = std::max(worstCos, ulps(q.c, std::cos(x)));
+    }
+    EXPECT_LE(worstSin, 2);
+    EXPECT_LE(worstCos, 2);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(rotationBy(0.0).s), 0u);  // no turn: exactly the identity
+    EXPECT_EQ(rotationBy(0.0).c, 1.0);
 }

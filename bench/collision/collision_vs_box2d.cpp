@@ -8,7 +8,7 @@
 //
 // --quick runs a fifth of the simulated time, once; otherwise each engine
 // runs three times, alternating, and the fastest run counts. --scene runs
-// only that scene (pile, pyramid or rain), e.g. while tuning the solver;
+// only that scene (pile, pile300, pyramid or rain), e.g. while tuning the solver;
 // --scene polygons runs the polygon pile (issue 15), which is not in the
 // default set and prints one line.
 // --adversarial times issue 13's scenes (fast crowds, one huge shape, free
@@ -566,7 +566,7 @@ int main(int argc, char** argv) {
             g_broadPhase = argv[++i];
         else {
             std::cerr << "collision_vs_box2d: error: unknown argument \"" << arg
-                      << "\"; usage: collision_vs_box2d [--quick] [--sweep] [--adversarial] [--crowd N [--steps S]] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pyramid|rain|polygons]\n";
+                      << "\"; usage: collision_vs_box2d [--quick] [--sweep] [--adversarial] [--crowd N [--steps S]] [--out DIR] [--write-levels DIR] [--broad-phase sap|grid] [--scene pile|pile300|pyramid|rain|polygons]\n";
             return 2;
         }
     }
@@ -588,7 +588,7 @@ int main(int argc, char** argv) {
     if (!only.empty()) {
         std::erase_if(scenes, [&](const scenes::NamedScene& s) { return s.name != only; });
         if (scenes.empty()) {
-            std::cerr << "collision_vs_box2d: error: no scene named \"" << only << "\" (pile, pyramid, rain, polygons)\n";
+            std::cerr << "collision_vs_box2d: error: no scene named \"" << only << "\" (pile, pile300, pyramid, rain, polygons)\n";
             return 2;
         }
     }

@@ -5,6 +5,36 @@
 
 namespace stepwise::collision {
 
+namespace {
+/// Sorts 64-bit keys ascending, the order std::sort gives, in linear time:
+/// least-significant-digit radix sort by bytes, skipping the bytes that are
+/// the same in every key (most are: indices below 65,536, a few cells).
+/// Measured on the 2,000-circle pile: the pair and cell sorts were a fifth
+/// of the broad phase.
+void radixSort(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch) {
+    const std::size_t n = keys.size();
+    if (n < 256) {
+        std::sort(keys.begin(), keys.end());
+        return;
+    }
+    std::uint64_t anyOne = 0, allOne = ~std::uint64_t(0);
+    for (const std::uint64_t k : keys) {
+        anyOne |= k;
+        allOne &= k;
+    }
+    const std::uint64_t varying = anyOne ^ allOne;
+    scratch.resize(n);
+    for (int shift = 0; shift < 64; shift += 8) {
+        if (((varying >> shift) & 0xFF) == 0) continue;
+        std::size_t start[257] = {};
+        for (const std::uint64_t k : keys) ++start[((k >> shift) & 0xFF) + 1];
+        for (int d = 0; d < 256; ++d) start[d + 1] += start[d];
+        for (const std::uint64_t k : keys) scratch[start[(k >> shift) & 0xFF]++] = k;
+        keys.swap(scratch);
+    }
+}
+} // namespace
+
 void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
                            std::vector<ProxyPair>& pairs) {
     pairs.clear();
@@ -27,7 +57,12 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uin
                 if ((movable[i] || movable[j]) && overlaps(boxes[i], boxes[j])) pairs.push_back({i, j});
         break;
     }
-    std::sort(pairs.begin(), pairs.end());
+    // (a, b) as one key a * 2^32 + b: its order is ProxyPair's.
+    pairKeys_.resize(pairs.size());
+    for (std::size_t i = 0; i < pairs.size(); ++i) pairKeys_[i] = (std::uint64_t(pairs[i].a) << 32) | pairs[i].b;
+    radixSort(pairKeys_, sortScratch_);
+    for (std::size_t i = 0; i < pairs.size(); ++i)
+        pairs[i] = {std::uint32_t(pairKeys_[i] >> 32), std::uint32_t(pairKeys_[i])};
 }
 
 void BroadPhase::sweepAndPrune(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
@@ -124,7 +159,7 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
             for (std::int64_t y = y0; y <= y1; ++y)
                 cellKeys_.push_back((std::uint64_t((x & 0xFFFF) | ((y & 0xFFFF) << 16)) << 32) | i);
     }
-    std::sort(cellKeys_.begin(), cellKeys_.end());
+    radixSort(cellKeys_, sortScratch_);
     for (std::size_t begin = 0; begin < cellKeys_.size();) {
         std::size_t end = begin + 1;
         while (end < cellKeys_.size() && (cellKeys_[end] >> 32) == (cellKeys_[begin] >> 32)) ++end;

@@ -61,6 +61,7 @@ private:
     std::vector<SortedBox> sorted_;     // SAP: the boxes in that order, packed for the sweep
     std::vector<std::uint64_t> cellKeys_;  // grid: (cell, proxy) entries
     std::vector<std::uint64_t> mortonKeys_;  // grid, crowded cell: (Z-order code, proxy)
+    std::vector<std::uint64_t> pairKeys_, sortScratch_;  // findPairs: pairs as (a << 32 | b), and radixSort's buffer
     std::vector<double> extents_, median_;  // grid: each box's larger side, and a copy for the median (m)
     std::vector<std::uint32_t> large_;
     std::size_t overlapTests_ = 0;

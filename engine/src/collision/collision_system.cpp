@@ -111,8 +111,10 @@ void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_
 void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m,
                                   std::span<const Vec2> centres) {
     if (m.pointCount == 0) return;
-    ContactConstraint c;
-    ContactDetail detail;
+    // Built in place (detect() reserved room for every manifold): a copy of
+    // both would double the bytes written per manifold.
+    ContactConstraint& c = constraints_.emplace_back();
+    ContactDetail& detail = details_.emplace_back();
     detail.colliderA = a;
     detail.colliderB = b;
     detail.restitution = std::max(colliders_[a].restitution, colliders_[b].restitution);
@@ -145,7 +147,10 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
         const auto from = cacheCursor_ < cache_.size() && cache_[cacheCursor_].key <= pairKey
                               ? cache_.begin() + std::ptrdiff_t(cacheCursor_)
                               : cache_.begin();
-        auto it = std::lower_bound(from, cache_.end(), CachedImpulse{pairKey, 0, 0});
+        // Usually a few entries on: step there, and search only past that.
+        auto it = from;
+        for (int step = 0; step < 8 && it != cache_.end() && it->key < pairKey; ++step) ++it;
+        if (it != cache_.end() && it->key < pairKey) it = std::lower_bound(it, cache_.end(), CachedImpulse{pairKey, 0, 0});
         cacheCursor_ = std::size_t(it - cache_.begin());
         bool found[2] = {false, false};  // the first entry of a key counts, as lower_bound finds it
         for (; it != cache_.end() && (it->key >> 16) == (pairKey >> 16); ++it) {
@@ -157,8 +162,6 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
             }
         }
     }
-    details_.push_back(detail);
-    constraints_.push_back(c);
 }
 
 void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v, double dt, int substeps) {
@@ -235,7 +238,12 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     // One sincos per collider per step, shared by the boxes and the narrow phase.
     std::vector<Rot>& rots = rotScratch_;
     rots.resize(n);
-    for (std::size_t i = 0; i < n; ++i) rots[i] = Rot::fromAngle(angles_[i]);
+    // Circles and planes never read theirs (narrow phase, boxes): no sincos
+    // for them.
+    for (std::size_t i = 0; i < n; ++i) {
+        const ShapeKind kind = colliders_[i].shape.kind;
+        rots[i] = kind == ShapeKind::Circle || kind == ShapeKind::Plane ? Rot{} : Rot::fromAngle(angles_[i]);
+    }
 
     boxes_.resize(finite_.size());
     movable_.resize(finite_.size());
@@ -304,6 +312,8 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
         }
     }
     prepareContacts(constraints_, details_, bodies_);
+    coloured_.build(constraints_, bodies_, settings_.simd);
+    indexImpacts(constraints_, bodies_.size(), impactScratch_);
     if (!joints_.empty()) joints::prepareJoints(joints_, bodies_, centres_, angles_);
     timings_.narrowPhaseMs = msSince(narrowStart);
 }
@@ -354,13 +364,14 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // In a crowd every pair approaches every other: the passes would run to
     // the bound over hundreds of thousands of contacts (measured: 60% of a
     // 2,000-body crowd's step). Two passes there; the push-apart does the rest.
-    propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, crowdBodies_.empty() ? 64 : 2);
+    propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, crowdBodies_.empty() ? 64 : 2,
+                     impactScratch_);
     crowdSaved_.resize(crowdBodies_.size());
     for (std::size_t k = 0; k < crowdBodies_.size(); ++k)
         crowdSaved_[k] = {bodies_[crowdBodies_[k]].v, bodies_[crowdBodies_[k]].w};
     if (settings_.warmStart) {
         if (jointed) joints::warmStartJoints(joints_, bodies_);
-        warmStart(constraints_, bodies_);
+        coloured_.warmStart(constraints_, bodies_);
     }
     // Bodies in a crowd (many on top of each other) take the biased
     // passes' push (and the warm start's) as a position correction only
@@ -372,7 +383,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     bool reverse = false;
     for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse) {
         if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, true);
-        solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
+        coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
     }
 
     offsetAngleBefore_.resize(offsetBodies_.size());
@@ -388,7 +399,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         x[body] += h * (b.v - unconstrainedV_[i]);
         angles_[i] += h * b.w;
         b.dp = x[body] - stepStart_[i];
-        b.dq = Rot::fromAngle(angles_[i] - stepStartAngle_[i]);
+        b.dq = rotationBy(angles_[i] - stepStartAngle_[i]);
     }
     for (std::size_t k = 0; k < crowdBodies_.size(); ++k) {
         bodies_[crowdBodies_[k]].v = crowdSaved_[k].v;
@@ -407,7 +418,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     }
     for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse) {
         if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, false);
-        solveContacts(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
+        coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
     }
 
     for (std::size_t i = 0; i < n; ++i) {
@@ -431,6 +442,7 @@ void CollisionSystem::endStep() {
     // divergence can put it back.
     previousCache_.swap(cache_);
     cache_.clear();
+    coloured_.storeImpulses(constraints_);
     records_.clear();
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
         const ContactConstraint& c = constraints_[k];

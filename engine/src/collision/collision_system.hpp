@@ -7,6 +7,7 @@
 // create torque.
 
 #include "collision/broad_phase.hpp"
+#include "collision/contact_bundles.hpp"
 #include "collision/contact_solver.hpp"
 #include "collision/narrow_phase.hpp"
 #include "joints/joint_solver.hpp"
@@ -111,6 +112,8 @@ public:
     std::size_t candidatePairCount() const { return pairs_.size(); }
     std::size_t manifoldCount() const { return constraints_.size(); }
     const CollisionTimings& timings() const { return timings_; }
+    /// The last step's contacts in colours (counts, order), for tests and benchmarks.
+    const ColouredContacts& colouredContacts() const { return coloured_; }
 
     /// Sets the rotational state: undoes a step's change (after a
     /// divergence), or resumes from a snapshot.
@@ -174,6 +177,8 @@ private:
     std::vector<SolverBody> bodies_;
     std::vector<ContactConstraint> constraints_;
     std::vector<ContactDetail> details_;  // parallel to constraints_
+    ColouredContacts coloured_;           // constraints_ in colours and SIMD bundles
+    ImpactScratch impactScratch_;         // which constraints_ touch which body (propagateImpacts)
     std::vector<CachedImpulse> cache_;
     std::vector<CachedImpulse> previousCache_;     // the cache the last step started from (undoSolverState)
     std::vector<JointImpulse> jointImpulsesBefore_;  // the joints' impulses at the last beginStep

@@ -1,6 +1,7 @@
 #include "collision/contact_solver.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace stepwise::collision {
@@ -86,58 +87,102 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
     }
 }
 
+void indexImpacts(std::span<const ContactConstraint> contacts, std::size_t bodyCount, ImpactScratch& scratch) {
+    // Counting sort of (body, contact) by body; static body 0 never changes
+    // velocity, so it lists nothing.
+    scratch.start.assign(bodyCount + 1, 0u);
+    for (const ContactConstraint& c : contacts) {
+        if (c.bodyA != 0) ++scratch.start[c.bodyA + 1];
+        if (c.bodyB != 0) ++scratch.start[c.bodyB + 1];
+    }
+    for (std::size_t b = 0; b < bodyCount; ++b) scratch.start[b + 1] += scratch.start[b];
+    scratch.incident.resize(scratch.start[bodyCount]);
+    std::vector<std::uint32_t>& at = scratch.now32;  // next free slot per body
+    at.assign(scratch.start.begin(), scratch.start.end() - 1);
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+        const ContactConstraint& c = contacts[k];
+        if (c.bodyA != 0) scratch.incident[at[c.bodyA]++] = std::uint32_t(k);
+        if (c.bodyB != 0) scratch.incident[at[c.bodyB]++] = std::uint32_t(k);
+    }
+}
+
 void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDetail> details,
-                      std::span<SolverBody> bodies, double h, double threshold, int maxPasses) {
+                      std::span<SolverBody> bodies, double h, double threshold, int maxPasses,
+                      ImpactScratch& scratch) {
     // Touching within this many metres counts as an impact (Box2D's linear
     // slop): without it a pair that closes its gap exactly at the end of a
     // substep would be stopped by the speculative constraint instead.
     constexpr double kSlop = 0.005;
+    const std::size_t words = (contacts.size() + 63) / 64;
+    std::vector<std::uint64_t>& now = scratch.now;
+    std::vector<std::uint64_t>& next = scratch.next;
+    now.assign(words, ~std::uint64_t(0));
+    if (contacts.size() % 64 != 0) now.back() = (std::uint64_t(1) << (contacts.size() % 64)) - 1;
+    // Contact k changed its bodies: every contact on them looks again, later
+    // in this pass if it comes after k, else in the next pass (k included).
+    const auto touched = [&](std::uint32_t body, std::size_t k) {
+        if (body == 0) return;
+        for (std::uint32_t i = scratch.start[body]; i < scratch.start[body + 1]; ++i) {
+            const std::uint32_t m = scratch.incident[i];
+            (m > k ? now : next)[m / 64] |= std::uint64_t(1) << (m % 64);
+        }
+    };
     for (int pass = 0; pass < maxPasses; ++pass) {
         bool any = false;
-        for (std::size_t k = 0; k < contacts.size(); ++k) {
-            ContactConstraint& c = contacts[k];
-            ContactDetail& detail = details[k];
-            SolverBody& a = bodies[c.bodyA];
-            SolverBody& b = bodies[c.bodyB];
-            // The approaching points that touch within this substep; the
-            // impulse acts at their centroid (the projections are linear in
-            // the anchor, so the centroid's are the mean) so a flat landing
-            // box does not pick up spin from the order of its two corners.
-            double rnA = 0.0, rnB = 0.0, gap = 0.0;
-            int count = 0;
-            for (int i = 0; i < c.pointCount; ++i) {
-                const ContactPoint& p = c.points[i];
-                const double vn = normalSpeed(a, b, c.normal, p.rnA, p.rnB);
-                if (vn >= -threshold) continue;  // resting contacts leave here
-                const double separation = currentSeparation(a, b, c.normal, p);
-                if (separation + vn * h < kSlop) {
-                    rnA += p.rnA;
-                    rnB += p.rnB;
-                    gap += separation;
-                    ++count;
+        next.assign(words, 0);
+        for (std::size_t word = 0; word < words; ++word) {
+            while (now[word] != 0) {
+                const std::size_t k = word * 64 + std::size_t(std::countr_zero(now[word]));
+                now[word] &= now[word] - 1;
+                ContactConstraint& c = contacts[k];
+                ContactDetail& detail = details[k];
+                SolverBody& a = bodies[c.bodyA];
+                SolverBody& b = bodies[c.bodyB];
+                // The approaching points that touch within this substep; the
+                // impulse acts at their centroid (the projections are linear in
+                // the anchor, so the centroid's are the mean) so a flat landing
+                // box does not pick up spin from the order of its two corners.
+                double rnA = 0.0, rnB = 0.0, gap = 0.0;
+                int count = 0;
+                for (int i = 0; i < c.pointCount; ++i) {
+                    const ContactPoint& p = c.points[i];
+                    const double vn = normalSpeed(a, b, c.normal, p.rnA, p.rnB);
+                    if (vn >= -threshold) continue;  // resting contacts leave here
+                    const double separation = currentSeparation(a, b, c.normal, p);
+                    if (separation + vn * h < kSlop) {
+                        rnA += p.rnA;
+                        rnB += p.rnB;
+                        gap += separation;
+                        ++count;
+                    }
                 }
+                if (count == 0) continue;
+                rnA /= double(count);
+                rnB /= double(count);
+                gap = std::max(gap / double(count), 0.0);
+                const double vn = normalSpeed(a, b, c.normal, rnA, rnB);
+                // Bouncy pairs leave at e times the approach speed. Inelastic ones
+                // close exactly the remaining gap this substep, so a fast body
+                // stopped by a speculative contact ends up touching, not hovering.
+                const double target = detail.restitution > 0.0 ? -detail.restitution * vn : -gap / h;
+                if (vn >= target) continue;
+                const double impulse = (target - vn) * effectiveMass(a, b, rnA, rnB);
+                applyImpulse(a, b, c.normal, rnA, rnB, impulse);
+                for (int i = 0; i < c.pointCount; ++i) detail.restitutionImpulse[i] += impulse / double(c.pointCount);
+                touched(c.bodyA, k);
+                touched(c.bodyB, k);
+                any = true;
             }
-            if (count == 0) continue;
-            rnA /= double(count);
-            rnB /= double(count);
-            gap = std::max(gap / double(count), 0.0);
-            const double vn = normalSpeed(a, b, c.normal, rnA, rnB);
-            // Bouncy pairs leave at e times the approach speed. Inelastic ones
-            // close exactly the remaining gap this substep, so a fast body
-            // stopped by a speculative contact ends up touching, not hovering.
-            const double target = detail.restitution > 0.0 ? -detail.restitution * vn : -gap / h;
-            if (vn >= target) continue;
-            const double impulse = (target - vn) * effectiveMass(a, b, rnA, rnB);
-            applyImpulse(a, b, c.normal, rnA, rnB, impulse);
-            for (int i = 0; i < c.pointCount; ++i) detail.restitutionImpulse[i] += impulse / double(c.pointCount);
-            any = true;
         }
         if (!any) break;
+        now.swap(next);
     }
 }
 
-void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies) {
-    for (ContactConstraint& c : contacts) {
+void warmStart(std::span<ContactConstraint> contacts, std::span<const std::uint32_t> order,
+               std::span<SolverBody> bodies) {
+    for (const std::uint32_t k : order) {
+        ContactConstraint& c = contacts[k];
         SolverBody& a = bodies[c.bodyA];
         SolverBody& b = bodies[c.bodyB];
         const Vec2 t = tangentOf(c.normal);
@@ -149,13 +194,13 @@ void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodi
     }
 }
 
-void solveContacts(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h,
-                   const Softness& soft, const Softness& staticSoft, double pushMaxVelocity, bool useBias,
-                   bool reverse) {
+void solveContacts(std::span<ContactConstraint> contacts, std::span<const std::uint32_t> order,
+                   std::span<SolverBody> bodies, double h, const Softness& soft, const Softness& staticSoft,
+                   double pushMaxVelocity, bool useBias, bool reverse) {
     const double invH = 1.0 / h;
-    const std::size_t count = contacts.size();
+    const std::size_t count = order.size();
     for (std::size_t k = 0; k < count; ++k) {
-        ContactConstraint& c = contacts[reverse ? count - 1 - k : k];
+        ContactConstraint& c = contacts[order[reverse ? count - 1 - k : k]];
         SolverBody& a = bodies[c.bodyA];
         SolverBody& b = bodies[c.bodyB];
         // Work on local copies of the two bodies' velocities and store them

@@ -92,6 +92,10 @@ struct SolverSettings {
     int iterations = 2;                ///< biased solve iterations per substep (world.solver_iterations)
     int relaxIterations = 1;           ///< unbiased iterations per substep
     bool warmStart = true;
+    /// Solve the coloured bundles in SIMD lanes (contact_bundles.hpp). Off:
+    /// the same contacts in the same coloured order, one at a time through
+    /// solveContacts below; both give the same bits (tests compare them).
+    bool simd = true;
 };
 
 /// Prepares masses, the block solve's 2x2 systems and adjusted separations
@@ -105,15 +109,31 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
 /// and touches within the substep `h`, until none does (or `maxPasses`).
 /// Exact for two-body impacts; passes a cradle's impulse down the row, which
 /// accumulated-impulse restitution cannot do.
+///
+/// A pass looks only at the contacts whose bodies changed velocity since the
+/// contact was last looked at (or that fired then): the others would find
+/// what they found before and do nothing, so the result is that of passes
+/// over every contact, at the cost of the contacts that move. `scratch` holds
+/// which contacts touch which body; build it with indexImpacts once a step.
+struct ImpactScratch {
+    std::vector<std::uint32_t> start;     ///< solver body b's contacts: incident[start[b], start[b + 1])
+    std::vector<std::uint32_t> incident;  ///< contact indices, ascending per body
+    std::vector<std::uint64_t> now, next;  ///< contacts to look at in this pass and the next (bit sets)
+    std::vector<std::uint32_t> now32;      ///< indexImpacts' cursor per body
+};
+void indexImpacts(std::span<const ContactConstraint> contacts, std::size_t bodyCount, ImpactScratch& scratch);
 void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDetail> details,
-                      std::span<SolverBody> bodies, double h, double threshold, int maxPasses);
+                      std::span<SolverBody> bodies, double h, double threshold, int maxPasses,
+                      ImpactScratch& scratch);
 
-void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies);
-/// One Gauss-Seidel pass: normal (soft when useBias) then friction, in
-/// contact order or (reverse) backwards. Alternating the direction between
-/// passes cancels the drift a fixed order feeds into stacks.
-void solveContacts(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h,
-                   const Softness& soft, const Softness& staticSoft, double pushMaxVelocity, bool useBias,
-                   bool reverse);
+/// Applies the accumulated impulses of contacts[order[0]], contacts[order[1]], ...
+void warmStart(std::span<ContactConstraint> contacts, std::span<const std::uint32_t> order,
+               std::span<SolverBody> bodies);
+/// One Gauss-Seidel pass: normal (soft when useBias) then friction, over
+/// contacts[order[k]] for k forwards or (reverse) backwards. Alternating the
+/// direction between passes cancels the drift a fixed order feeds into stacks.
+void solveContacts(std::span<ContactConstraint> contacts, std::span<const std::uint32_t> order,
+                   std::span<SolverBody> bodies, double h, const Softness& soft, const Softness& staticSoft,
+                   double pushMaxVelocity, bool useBias, bool reverse);
 
 } // namespace stepwise::collision

@@ -80,8 +80,8 @@ public:
 };
 
 /// Instruction sets the streaming kernels (semi-implicit Euler and RK4 with
-/// local forces) are compiled for; the best one the CPU has is picked at
-/// run time. Every level performs the same IEEE operations per value in
+/// local forces) and the contact solver's bundles (collision/contact_bundles)
+/// are compiled for; the best one the CPU has is picked at run time. Every level performs the same IEEE operations per value in
 /// the same order, and no FMA (-ffp-contract=off), so results are
 /// bit-identical whichever runs.
 enum class SimdLevel { Baseline, Avx2, Avx512 };

@@ -1,0 +1,95 @@
+#pragma once
+// The contact solve in SIMD lanes (the design of Box2D v3, from Erin Catto's
+// "Solver2D" and "SIMD Matters" notes; the code is ours): the contacts of a
+// step are coloured so that no two contacts of one colour share a dynamic
+// body, and each colour is cut into bundles of kContactLanes contacts whose
+// data sit side by side (one array per quantity). A bundle is solved as one
+// contact in vector registers: its lanes touch different bodies, so solving
+// them together gives what solving them one after another gives.
+//
+// Bit-identical on every instruction set: the lane width is fixed at four
+// doubles whatever the machine (SSE2 does it as two halves, AVX2 and
+// AVX-512 in one register), each lane does the scalar solver's operations
+// in the scalar solver's order (selects replace its branches), and the
+// engine is built without fused multiply-add. The same coloured order,
+// solved one contact at a time by solveContacts (SolverSettings::simd off),
+// gives the same bits; the tests check both.
+
+#include "collision/contact_solver.hpp"
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace stepwise::collision {
+
+/// Contacts solved together. Fixed (not the machine's vector width) so the
+/// colouring, and so the results, are the same everywhere.
+constexpr int kContactLanes = 4;
+/// Colours tried before a contact goes to the overflow, which is solved one
+/// contact at a time after the colours (a crowd at one point overflows).
+constexpr int kContactColours = 24;
+
+/// One contact point of kContactLanes contacts (see ContactPoint).
+struct PointLanes {
+    alignas(32) double rnA[kContactLanes], rnB[kContactLanes], dnA[kContactLanes], dnB[kContactLanes];
+    alignas(32) double adjustedSeparation[kContactLanes];
+    alignas(32) double normalMass[kContactLanes], tangentMass[kContactLanes];
+    alignas(32) double normalImpulse[kContactLanes], tangentImpulse[kContactLanes];
+};
+
+/// kContactLanes contacts of `Points` points each, one array per quantity.
+/// Unused lanes join static body 0 to itself with zero masses: they compute
+/// zeros and write nothing that matters.
+template <int Points>
+struct ContactBundle {
+    std::uint32_t bodyA[kContactLanes], bodyB[kContactLanes];
+    std::uint32_t source[kContactLanes];  ///< index in the step's contacts; ~0u for an unused lane
+    alignas(32) double nx[kContactLanes], ny[kContactLanes], friction[kContactLanes];
+    alignas(32) double invMassA[kContactLanes], invInertiaA[kContactLanes];  ///< 1/kg, 1/(kg m^2)
+    alignas(32) double invMassB[kContactLanes], invInertiaB[kContactLanes];
+    alignas(32) std::int64_t touchesStatic[kContactLanes];  ///< all bits set or clear
+    alignas(32) std::int64_t block[kContactLanes];          ///< all bits set or clear (two points only)
+    /// The block solve's K and its inverse (BlockMass), two points only.
+    alignas(32) double k11[kContactLanes], k12[kContactLanes], k22[kContactLanes];
+    alignas(32) double i11[kContactLanes], i12[kContactLanes], i22[kContactLanes];
+    PointLanes points[Points];
+};
+
+/// The step's contacts in colours and bundles. Built once a step, after
+/// prepareContacts; the impulses live in the bundles until storeImpulses.
+class ColouredContacts {
+public:
+    /// Colours the contacts greedily in their (deterministic) order: each
+    /// takes the first colour that neither of its dynamic bodies has yet;
+    /// static body 0 never blocks a colour. `simd` picks the path for the
+    /// whole step (SolverSettings::simd).
+    void build(std::span<const ContactConstraint> contacts, std::span<const SolverBody> bodies, bool simd);
+    void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies);
+    /// One pass over the colours (then the overflow), or backwards.
+    void solve(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h, const Softness& soft,
+               const Softness& staticSoft, double pushMaxVelocity, bool useBias, bool reverse);
+    /// Copies the bundles' impulses back to the contacts (warm starting, records).
+    void storeImpulses(std::span<ContactConstraint> contacts) const;
+
+    /// Contact indices colour by colour, then the overflow: the order both
+    /// paths solve in.
+    std::span<const std::uint32_t> order() const { return order_; }
+    int colourCount() const { return colourCount_; }
+    std::size_t overflowCount() const { return order_.size() - colourStart_[std::size_t(colourCount_)]; }
+
+private:
+    bool simd_ = true;
+    int colourCount_ = 0;
+    std::vector<std::uint32_t> order_;
+    std::vector<std::uint32_t> colourStart_;  ///< colourCount_ + 1 offsets into order_
+    std::vector<std::uint32_t> colourMask_;   ///< per solver body: colours it is in
+    std::vector<std::uint8_t> colourOf_;      ///< per contact; kContactColours = overflow
+    std::vector<ContactBundle<1>> one_;
+    std::vector<ContactBundle<2>> two_;
+    /// Per colour: its one-point bundles one_[oneStart_[c], oneStart_[c+1]) and
+    /// two-point bundles two_[twoStart_[c], twoStart_[c+1]).
+    std::vector<std::uint32_t> oneStart_, twoStart_;
+};
+
+} // namespace stepwise::collision
