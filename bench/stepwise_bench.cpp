@@ -14,7 +14,7 @@
 #include "stepwise/world.hpp"
 #include "world/world_internals.hpp"
 #include "report/scenes.hpp"
-#include "collision/collision_scenes.hpp"
+#include "generated_scenes.hpp"
 
 #include <benchmark/benchmark.h>
 #include <boost/numeric/odeint/stepper/generation.hpp>
@@ -432,7 +432,7 @@ const int kRegistered = registerAll();
 // asleep during the timed steps.
 enum class PilePhase { Falling, SettledSleep, SettledAwake };
 void BM_CirclePile(benchmark::State& state, PilePhase phase) {
-    Scene scene = bench::circlesInBox(2000);
+    Scene scene = scenes::circlesInBox(2000);
     scene.world.sleep = phase != PilePhase::SettledAwake;
     const auto fresh = [&] {
         Result<World> w = World::build(scene);

@@ -1,6 +1,7 @@
 // The `stepwise` command line as a user meets it: exit codes, messages on
 // stderr, outputs written or not written, same bytes for the same input.
 
+#include "stepwise/scene_io.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -486,6 +487,28 @@ TEST_F(Cli, EditScriptNamesTheBadLineForAnUnknownSystemOrEntity) {
                  (dir_ / "cfg").string() + " --script " + breakon.string());
     EXPECT_EQ(o.exitCode, 2);
     EXPECT_NE(o.err.find(breakon.string() + ":3: breakon: no entity named \"plnet\""), std::string::npos) << o.err;
+}
+
+// `text` types into the Save as field: the dialog opened by ctrl+shift+s
+// takes the typed path and saves there. (A `key` line kept its modifiers
+// held, ImGui drops typed characters while ctrl is down, and the dialog
+// saved over the level under its suggested name instead.)
+TEST_F(Cli, EditScriptTextTypesIntoTheSaveAsField) {
+    const fs::path mine = dir_ / "mine.json", typed = dir_ / "typed.json";
+    fs::copy_file(level("orbit.json"), mine);
+    const std::string original = readFile(mine);
+    const fs::path script = write("save_as.txt", "key ctrl+shift+s\nwait 2\nkey ctrl+a\ntext \"" + typed.string() +
+                                                     "\"\nkey Enter\nwait 2\n");
+    Outcome o = stepwise("edit " + mine.string() + " --builtin-font --size 640x400 --config " + (dir_ / "cfg").string() +
+                         " --script " + script.string());
+    EXPECT_EQ(o.exitCode, 0) << o.err;
+    ASSERT_TRUE(fs::exists(typed)) << "nothing saved at the typed path";
+    stepwise::Result<stepwise::Scene> saved = stepwise::parseScene(readFile(typed), typed.string());
+    ASSERT_TRUE(saved) << saved.error();
+    stepwise::Result<stepwise::Scene> before = stepwise::parseScene(original, mine.string());
+    ASSERT_TRUE(before);
+    EXPECT_EQ(saved->registry.size(), before->registry.size());
+    EXPECT_EQ(readFile(mine), original) << "saved over the open level";
 }
 
 TEST_F(Cli, ClockwisePolygonExitsTwoNamingTheEntityAndLeavesTheOutputAlone) {

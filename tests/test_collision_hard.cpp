@@ -5,6 +5,7 @@
 // overlap tests), speed is in bench/ (docs/incoming/collide.md).
 
 #include "collision/collision_system.hpp"
+#include "generated_scenes.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
@@ -30,14 +31,7 @@ Entity circleBody(Scene& s, Vec2 p, double r, Vec2 v = {}, double mass = 1.0) {
     reg.emplace<Radius>(e, Radius{r});
     return e;
 }
-Entity staticBoxAt(Scene& s, Vec2 p, double w, double h) {
-    Registry& reg = s.registry;
-    const Entity e = reg.create();
-    reg.emplace<Position>(e, Position{p});
-    reg.emplace<Static>(e, Static{true});
-    reg.emplace<Box>(e, Box{w, h});
-    return e;
-}
+using scenes::addStaticBox;
 Entity staticCircleAt(Scene& s, Vec2 p, double r) {
     Registry& reg = s.registry;
     const Entity e = reg.create();
@@ -186,7 +180,7 @@ TEST(CollisionHard, BallAtRestPulledByAStiffSpringStopsAtAThinWall) {
             Scene s = emptyWorld({0.0, 0.0}, substeps, 1.0 / hz);
             const Entity ball = circleBody(s, {0.0, 0.0}, 0.1);
             s.registry.emplace<Name>(ball, Name{"ball"});
-            staticBoxAt(s, {0.5, 0.0}, 0.05, 2.0);  // 5 cm wall, near face at x = 0.475
+            addStaticBox(s, {0.5, 0.0}, 0.05, 2.0);  // 5 cm wall, near face at x = 0.475
             const Entity spring = s.registry.create();
             // Rest length 0 at x = 2: k = 1e4, m = 1 (omega = 100 rad/s).
             s.registry.emplace<Spring>(spring, Spring{ball, Entity{}, Vec2{2.0, 0.0}, 1e4, 0.0, 0.0});
@@ -210,7 +204,7 @@ TEST(CollisionHard, BallFallingFromRestUnderStrongGravityStopsOnAThinBox) {
             const double height = 1.0 + 0.05 * k;
             Scene s = emptyWorld({0.0, -500.0}, substeps);
             circleBody(s, {0.0, height}, 0.1);
-            staticBoxAt(s, {0.0, 0.0}, 4.0, 0.05);  // top face at y = 0.025
+            addStaticBox(s, {0.0, 0.0}, 4.0, 0.05);  // top face at y = 0.025
             Result<World> w = World::build(s);
             ASSERT_TRUE(w) << w.error();
             double lowest = 1e9;
@@ -281,20 +275,7 @@ TEST(CollisionHard, RestitutionThresholdRoundTripsAndIsRefusedWhenNegative) {
 
 namespace {
 /// 30 rows of 10 circles (radius 0.25) in a 5.2 m wide box, 60 Hz.
-Scene tallPile() {
-    Scene s;
-    s.world.gravity = {0.0, -10.0};
-    s.world.dt = 1.0 / 60.0;
-    staticBoxAt(s, {0.0, -0.5}, 8.0, 1.0);
-    staticBoxAt(s, {-3.1, 10.0}, 1.0, 22.0);
-    staticBoxAt(s, {3.1, 10.0}, 1.0, 22.0);
-    for (int i = 0; i < 300; ++i) {
-        const double jitter = 0.01 * double((i * 7919) % 11 - 5) / 5.0;
-        const Entity e = circleBody(s, {-2.3 + 0.51 * (i % 10) + jitter, 0.3 + 0.52 * (i / 10)}, 0.25);
-        s.registry.emplace<Friction>(e, Friction{0.6});
-    }
-    return s;
-}
+using scenes::tallPile;
 double deepestOverlapAfter(World& w, int steps) {
     double deepest = 0.0;
     for (int i = 0; i < steps; ++i) {

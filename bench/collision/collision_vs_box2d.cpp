@@ -17,7 +17,7 @@
 // --sweep runs every setting (substeps x iterations) of both engines and, with
 // --out DIR, writes the work-precision plot DIR/collisions_work_precision.png.
 
-#include "collision/collision_scenes.hpp"
+#include "generated_scenes.hpp"
 
 #include "collision/broad_phase.hpp"
 #include "collision/collision_system.hpp"
@@ -283,7 +283,7 @@ std::string measuredOn(int argc, char** argv) {
 /// built from the same Scene. Sleeping off in Box2D, as above.
 Scene polygonPileScene(int count) {
     Scene s;
-    // The other scenes' settings (collision_scenes.cpp): 4 substeps, 2 iterations.
+    // The other scenes' settings (engine/scenes/generated_scenes.cpp): 4 substeps, 2 iterations.
     s.world.gravity = {0.0, -10.0};
     s.world.substeps = 4;
     s.world.solverIterations = 2;
@@ -366,7 +366,7 @@ PileOutcome runPolygonPileBox2d(const Scene& scene, int steps) {
 /// overlap at the end, for each setting (substeps x iterations) of each
 /// engine on each scene, in the same run. Writes collisions_sweep.csv and
 /// .md, and collisions_work_precision.png (gnuplot) into `outDir`.
-int runSweep(const std::vector<bench::NamedScene>& scenes, bool quick, const std::string& outDir) {
+int runSweep(const std::vector<scenes::NamedScene>& scenes, bool quick, const std::string& outDir) {
     struct Setting {
         int substeps, iterations;
     };
@@ -588,9 +588,9 @@ int main(int argc, char** argv) {
                     mine.msPerStep, peer.msPerStep, peer.msPerStep / mine.msPerStep, 1e3 * mine.deepest, 1e3 * peer.deepest);
         return 0;
     }
-    std::vector<bench::NamedScene> scenes = bench::benchmarkScenes();
+    std::vector<scenes::NamedScene> scenes = scenes::benchmarkScenes();
     if (!only.empty()) {
-        std::erase_if(scenes, [&](const bench::NamedScene& s) { return s.name != only; });
+        std::erase_if(scenes, [&](const scenes::NamedScene& s) { return s.name != only; });
         if (scenes.empty()) {
             std::cerr << "collision_vs_box2d: error: no scene named \"" << only << "\" (pile, pile300, pyramid, rain, polygons)\n";
             return 2;

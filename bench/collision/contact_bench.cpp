@@ -14,7 +14,7 @@
 //   build/bench/contact_bench --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 
 #include "collision/box2d_bodies.hpp"
-#include "collision/collision_scenes.hpp"
+#include "generated_scenes.hpp"
 #include "collision/collision_system.hpp"
 #include "stepwise/world.hpp"
 #include "world/world_internals.hpp"
@@ -29,13 +29,13 @@ using namespace stepwise;
 namespace {
 
 struct BenchScene {
-    const char* name;  // bench::benchmarkScenes() name
+    const char* name;  // scenes::benchmarkScenes() name
     int steps;
 };
 constexpr BenchScene kScenes[] = {{"pile", 600}, {"pile300", 900}, {"pyramid", 600}};
 
 Scene sceneNamed(const std::string& name) {
-    for (bench::NamedScene& s : bench::benchmarkScenes())
+    for (scenes::NamedScene& s : scenes::benchmarkScenes())
         if (s.name == name) return std::move(s.scene);
     return {};
 }

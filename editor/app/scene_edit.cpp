@@ -1,5 +1,7 @@
 #include "app/scene_edit.hpp"
 
+#include "generated_scenes.hpp"
+
 #include "stepwise/scene_io.hpp"
 
 #include <algorithm>
@@ -548,6 +550,29 @@ Entity addPlane(Scene& scene, Vec2 through, Vec2 normal) {
     reg.emplace(e, Plane{n, dot(n, through)});
     reg.emplace(e, Color{Rgb{0.55, 0.58, 0.62}});
     return e;
+}
+
+Scene benchScene(int bodies) {
+    Scene s;
+    s.view = View{{0.0, 10.0}, 30.0};
+    const int columns = int(std::ceil(std::sqrt(double(bodies) * 1.6)));
+    addPlane(s, {0.0, 0.0}, {0.0, 1.0});
+    addPlane(s, {-0.3 * columns - 1.0, 0.0}, {1.0, 0.0});
+    addPlane(s, {0.3 * columns + 1.0, 0.0}, {-1.0, 0.0});
+    scenes::CircleGrid grid;
+    grid.count = bodies;
+    grid.columns = columns;
+    grid.first = {-0.3 * columns, 0.5};  // x: the grid's left edge, centred in its cell below
+    grid.pitch = {0.6, 0.6};
+    grid.centring = 0.3;
+    grid.jitter = scenes::Jitter::Lcg;
+    grid.jitterAmplitude = 0.025;
+    grid.velocityPerJitter = 20.0;
+    grid.mass = 1.0;
+    grid.namePrefix = "c";
+    grid.colours = scenes::CircleColours::Gradient;
+    scenes::addCircleGrid(s, grid);
+    return s;
 }
 
 namespace {

@@ -148,6 +148,12 @@ Entity addPolygon(Scene& scene, const std::vector<Vec2>& worldVertices, std::str
 Entity addBox(Scene& scene, Vec2 at, double width = 1.0, double height = 1.0);
 /// A wall through `through` with the given normal (normalised here).
 Entity addPlane(Scene& scene, Vec2 through, Vec2 normal);
+/// The synthetic level of `stepwise edit --bench-bodies N`: N circles
+/// (0.25 m, 1 kg) in a box of three planes under gravity, jittered so they
+/// do not stack in perfect columns (a scenes::CircleGrid). Named c0, c1, ...
+/// directly: generating 100,000 bodies through the palette's one-at-a-time
+/// naming would be quadratic.
+Scene benchScene(int bodies);
 /// A spring between two bodies (named here if they have no name: files
 /// refer to them by name), rest length = current distance.
 Entity addSpring(Scene& scene, Entity a, Entity b);

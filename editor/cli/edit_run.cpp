@@ -2,10 +2,10 @@
 
 #include "cli/cli_common.hpp"
 
-#include "app/scene_edit.hpp"
-
 #include "stepwise/components.hpp"
+#include "stepwise/scene_io.hpp"
 
+#include <imgui_internal.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -15,29 +15,6 @@
 #include <sstream>
 
 namespace stepwise::cli {
-
-Scene benchScene(int bodies) {
-    Scene s;
-    s.view = View{{0.0, 10.0}, 30.0};
-    const int columns = int(std::ceil(std::sqrt(double(bodies) * 1.6)));
-    editor::addPlane(s, {0.0, 0.0}, {0.0, 1.0});
-    editor::addPlane(s, {-0.3 * columns - 1.0, 0.0}, {1.0, 0.0});
-    editor::addPlane(s, {0.3 * columns + 1.0, 0.0}, {-1.0, 0.0});
-    std::uint32_t seed = 7u;
-    for (int i = 0; i < bodies; ++i) {
-        const int cx = i % columns, cy = i / columns;
-        seed = seed * 1664525u + 1013904223u;
-        const double jitter = (double(seed >> 8) / double(1u << 24) - 0.5) * 0.05;
-        const Entity e = s.registry.create();
-        s.registry.emplace(e, Name{"c" + std::to_string(i)});
-        s.registry.emplace(e, Position{{-0.3 * columns + 0.6 * cx + jitter + 0.3, 0.5 + 0.6 * cy}});
-        s.registry.emplace(e, Velocity{{jitter * 20.0, 0.0}});
-        s.registry.emplace(e, Mass{1.0});
-        s.registry.emplace(e, Radius{0.25});
-        s.registry.emplace(e, Color{Rgb{0.3 + 0.6 * double(cx) / columns, 0.5, 0.9 - 0.5 * double(cy % 20) / 20.0}});
-    }
-    return s;
-}
 
 void writeDebugState(const std::string& path, ui::Session& session, std::uint64_t frame) {
     editor::Editor& ed = session.editor();
@@ -54,7 +31,15 @@ void writeDebugState(const std::string& path, ui::Session& session, std::uint64_
     const ui::Session::DialogState d = session.dialogState();
     out << ",\n  \"modal\": " << nlohmann::json(d.modal).dump() << ",\n  \"status\": " << nlohmann::json(d.status).dump()
         << ",\n  \"open_folder\": " << nlohmann::json(d.openFolder).dump() << ",\n  \"open_files\": " << d.openFiles
-        << ",\n  \"save_as_suggestion\": " << nlohmann::json(d.saveAsSuggestion).dump() << ",\n  \"positions\": [";
+        << ",\n  \"save_as_suggestion\": " << nlohmann::json(d.saveAsSuggestion).dump();
+    // Rectangles (x, y, w, h) in window pixels of the panels and of the
+    // inspector's fields, from the last frame.
+    nlohmann::json windows = nlohmann::json::object(), widgets = nlohmann::json::object();
+    for (const char* name : {"Tools", "Entities", "Viewport", "Inspector", "World", "Debug"})
+        if (const ImGuiWindow* w = ImGui::FindWindowByName(name); w && w->WasActive)
+            windows[name] = {w->Pos.x, w->Pos.y, w->Size.x, w->Size.y};
+    for (const auto& [key, r] : session.ui().widgetRects) widgets[key] = {r.x, r.y, r.z, r.w};
+    out << ",\n  \"windows\": " << windows.dump() << ",\n  \"widgets\": " << widgets.dump() << ",\n  \"positions\": [";
     int n = 0;
     for (Entity e : ed.doc.scene.registry.entities()) {
         const Position* pos = ed.doc.scene.registry.tryGet<Position>(e);

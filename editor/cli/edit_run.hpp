@@ -35,12 +35,6 @@ struct EditOptions {
 
 constexpr double kFrameSeconds = 1.0 / 60.0;  // scripted frames: fixed, so runs are deterministic
 
-/// A synthetic level for --bench-bodies: N circles (0.25 m, 1 kg) in a
-/// box of three planes under gravity, jittered so they do not stack in
-/// perfect columns. Named c0, c1, ... directly: generating 100,000 bodies
-/// through the palette's one-at-a-time naming would be quadratic.
-Scene benchScene(int bodies);
-
 /// Writes the editor's state (mode, time, steps, viewport, camera, the first
 /// 64 positions) as JSON, atomically, for tests that watch a running editor.
 void writeDebugState(const std::string& path, ui::Session& session, std::uint64_t frame);

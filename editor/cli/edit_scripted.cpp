@@ -6,6 +6,7 @@
 #include "cli/commands.hpp"
 #include "cli/edit_run.hpp"
 
+#include "app/scene_edit.hpp"
 #include "app/script.hpp"
 #include "app/script_actions.hpp"
 #include "render/image.hpp"
@@ -125,7 +126,7 @@ int runScripted(const EditOptions& o, int width, int height) {
     ed.autosaveSeconds = 1e300;  // no autosave in scripted runs
     bool badLevel = false;
     if (o.benchBodies > 0) {
-        ed.doc.reset(benchScene(o.benchBodies));
+        ed.doc.reset(editor::benchScene(o.benchBodies));
         ed.fitView();
     } else if (!session.openAtStart(o.level)) {
         badLevel = true;
@@ -184,6 +185,10 @@ int runScripted(const EditOptions& o, int width, int height) {
                 session.queue(e);
                 frame();
             }
+            // A whole keypress lets go of its modifiers too: a held ctrl
+            // made ImGui drop the characters of a following `text` line
+            // (after ctrl+shift+s, Save as kept its suggestion).
+            if (c.kind == K::Key) pressMods(c.mods, false);
             break;
         }
         case K::Move:

@@ -6,6 +6,7 @@
 #include "cli/commands.hpp"
 
 #include "app/events.hpp"
+#include "app/scene_edit.hpp"
 #include "ui/session.hpp"
 
 #include <SDL.h>
@@ -18,7 +19,7 @@ namespace stepwise::platform {
 
 using cli::EditOptions;
 using cli::FrameTimes;
-using cli::benchScene;
+using editor::benchScene;
 using cli::kExitFailure;
 using cli::kExitOk;
 using cli::reportError;

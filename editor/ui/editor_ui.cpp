@@ -230,6 +230,7 @@ void drawEditorUi(UiState& ui, Editor& ed) {
     const ImGuiViewport* vp = ImGui::GetMainViewport();
     const PanelRects r = defaultLayout(vp->Size.x, vp->Size.y, ui.scale);
     beginLayout(ui, vp->Size);
+    ui.widgetRects.clear();
     menuBar(ui, ed);
     toolsPanel(ui, ed, r);
     entitiesPanel(ui, ed, r);

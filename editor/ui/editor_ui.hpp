@@ -59,6 +59,11 @@ struct UiState {
     // Viewport, filled by drawEditorUi each frame
     ImVec2 viewportPos{0, 0}, viewportSize{1, 1};
     bool viewportHovered = false;
+    /// This frame's inspector fields as window-pixel rectangles (x, y, w, h),
+    /// keyed "inspector/<component>" or "inspector/<component>.<field>":
+    /// --debug-state reports them, so a test clicks a field wherever the
+    /// layout and the window size put it.
+    std::map<std::string, ImVec4, std::less<>> widgetRects;
 
     // Dialog buffers
     std::string openPath, saveAsPath, entityFilter, contactFilter;

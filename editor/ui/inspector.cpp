@@ -274,6 +274,16 @@ void drawInspector(UiState& ui, Editor& ed) {
                 const bool typeNow = ui.typeInto == id;
                 if (typeNow) ui.typeInto = 0;
                 const bool changed = fieldWidget(f, value, label.c_str(), reg, typeNow);
+                {  // where the field is this frame, for --debug-state (tests click it wherever the layout puts it)
+                    const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+                    std::string key = "inspector/";
+                    key += info.name;
+                    if (!f.key.empty()) {
+                        key += '.';
+                        key += f.key;
+                    }
+                    ui.widgetRects[key] = ImVec4(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y);
+                }
                 // ImGui's drag fields take typed text only after a double
                 // click; a designer clicks once and types, and the digits
                 // then went to the tool shortcuts. A click released without
