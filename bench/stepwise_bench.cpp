@@ -425,7 +425,7 @@ int registerAll() {
 }
 const int kRegistered = registerAll();
 
-// Sleeping (issue 16): the 2,000-circle pile of bench/collision
+// Sleeping: the 2,000-circle pile of bench/collision
 // (circlesInBox, levels/pile.json) while it falls (its first 2 s), and
 // settled (after range(1) steps) with sleeping on and off. Goal: settled
 // with sleep under 15% of falling. Counter "asleep": the fraction of bodies

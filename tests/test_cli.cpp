@@ -541,7 +541,7 @@ TEST_F(Cli, EditWithNoDisplaySaysSoAndExitsOne) {
         << readFile(err);
 }
 
-// ---- Issue 14: outputs ---------------------------------------------------------
+// ---- outputs ---------------------------------------------------------
 
 // `--out missing/o.json --trace t.csv --contacts c.jsonl` ran the whole
 // simulation, wrote t.csv and c.jsonl, then failed on --out with exit 2.
@@ -760,7 +760,7 @@ TEST_F(Cli, ALongRunShowsProgressOnATerminal) {
     EXPECT_NE(shown.find(" left"), std::string::npos) << shown;
 }
 
-// ---- Issue 14: silent wrong answers -----------------------------------------
+// ---- silent wrong answers -----------------------------------------
 
 // implicit_euler with one spring of k >= 1e25 (m = 1) and an unconnected
 // falling body kept every body where it started, exit 0; at k = 1e100 the
@@ -821,7 +821,7 @@ TEST_F(Cli, ANonFiniteEnergyIsANonFiniteValue) {
     EXPECT_NE(o.err.find("the total energy became -nan J (kinetic -nan"), std::string::npos) << o.err;
 }
 
-// ---- Issue 14: the scripted editor -------------------------------------------
+// ---- the scripted editor -------------------------------------------
 
 // `saveas missing/x.json`, `open missing.json` and `savestate missing/x.json`
 // exited 0 with nothing on stderr: the failure showed only in a dialog.

@@ -1,4 +1,4 @@
-// Collision cases off the tuned path (issue 13): fast crowds, one huge
+// Collision cases off the tuned path: fast crowds, one huge
 // shape, bodies started at one point, tunnelling from rest, slow elastic
 // impacts, tall piles at the user's settings. Each test failed before the
 // fix it covers. No test reads a clock: cost is asserted as work done (pairs,
@@ -142,7 +142,7 @@ TEST(CollisionHard, CrowdAtOnePointIsBoundedAndSpreadsWithoutExploding) {
 }
 
 TEST(CollisionHard, TwentyThousandAtOnePointKeepFewPairsPerBodyAndDoNotFling) {
-    // Issue 13: 10,000 at one point ended in bad_alloc; the first bound kept
+    // 10,000 at one point ended in bad_alloc; the first bound kept
     // 16 pairs per body (320,000 manifolds here, 819 MB for 100,000) and let
     // the rim fly out at 29 m/s within 20 steps. Now each crowded box pairs
     // with its next 4 in Z-order: about 4 manifolds per body, the memory and

@@ -67,7 +67,7 @@ const char* kScene = R"({
   ]
 })";
 
-/// Polygons (issue 15), in their own scene so the scene above keeps its
+/// Polygons, in their own scene so the scene above keeps its
 /// recorded values (which shows polygons changed nothing for the other
 /// shapes): a static polygon ramp, triangles, n-gons, an off-centre body
 /// (its centroid 2 m from its position), against planes, a box, a circle
@@ -108,7 +108,7 @@ using test::withoutSleepLines;
 /// Re-recorded when the saved world gained "tolerance" and "theta" (the
 /// fast branch): the text changed, the physics did not. The eight earlier
 /// values were reproduced exactly from the new build with those two lines
-/// removed from the text. dopri5 recorded then. Re-recorded (issue 16) when
+/// removed from the text. dopri5 recorded then. Re-recorded when
 /// the contacts came to be solved in graph colours (SIMD bundles: the
 /// Gauss-Seidel order changed, and a body's turn within a step is rotated by
 /// a series instead of libm's sincos; the physics tests passed unchanged
@@ -179,7 +179,7 @@ TEST(Determinism, FinalStateHashUnderEveryIntegratorMatchesTheRecordedValue) {
 
 namespace {
 
-/// The hashes recorded before sleeping existed (issue 16; with the coloured
+/// The hashes recorded before sleeping existed (with the coloured
 /// contact solve), for the same scenes. With sleep off and the three sleep lines the saved world gained
 /// taken out of the text, the engine must still give these bytes: sleeping
 /// off changes nothing.
@@ -238,10 +238,10 @@ TEST(Determinism, TheSameRunTwiceInOneProcessGivesTheSameBytes) {
 
 namespace {
 
-/// Joints (issue 15): every joint type of tests/data/joints_every_type.json
+/// Joints: every joint type of tests/data/joints_every_type.json
 /// (hinge with limits and motor, slider with limits and motor, soft weld,
 /// distance, rope) on boxes, circles and a shapeless body, with contacts.
-/// Re-record as above (re-recorded when sleeping came, issue 16).
+/// Re-record as above (re-recorded when sleeping came).
 const std::map<std::string, std::uint64_t> kRecordedJoints = {
     {"rk4", 0x407b12c876bb213eull},
     {"semi_implicit_euler", 0x14a0e307afccd871ull},
@@ -267,8 +267,8 @@ TEST(Determinism, JointSceneHashMatchesTheRecordedValue) {
     }
 }
 
-/// Recorded when polygons were added (issue 15), Release build, gcc 12;
-/// re-recorded when sleeping came (issue 16), as above.
+/// Recorded when polygons were added, Release build, gcc 12;
+/// re-recorded when sleeping came, as above.
 const std::map<std::string, std::uint64_t> kRecordedPolygons = {
     {"explicit_euler", 0x2cad3262c274b6b8ull},
     {"semi_implicit_euler", 0xc3c25d010573854aull},

@@ -237,7 +237,7 @@ TEST(EditorWindow, PlayPlaceUndoSaveThroughXvfbAndXdotool) {
     fs::remove_all(tmp);
 }
 
-// Issue 12: started from another folder, the Open list is not empty and Save
+// Started from another folder, the Open list is not empty and Save
 // as of an untitled level proposes a folder it can write; Save as onto an
 // existing file asks, and Cancel keeps the file; renaming a body that a
 // spring uses (typed into the inspector) keeps the spring: Play runs and

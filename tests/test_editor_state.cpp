@@ -1,4 +1,4 @@
-// The editor's one live World (issue 12, "The seam, redesigned", item 4):
+// The editor's one live World:
 // step back N then step N replays the same bytes with contacts; an edit
 // while paused keeps the warm start; the step-back history holds states,
 // not scenes; "Save simulation state" resumes exactly.
@@ -57,7 +57,7 @@ std::string straightRun(const std::string& level, int steps) {
 
 } // namespace
 
-// Issue 12 item 4: in default.json, step 60, step 30, step back 30, step 30
+// In default.json, step 60, step 30, step back 30, step 30
 // ended up to 0.1 mm off the first pass (the World was rebuilt from the
 // scene on step back and the warm start dropped). Failed before.
 TEST(EditorState, StepBackThenStepReplaysTheFirstPassBitForBitWithContacts) {
@@ -202,7 +202,7 @@ TEST(EditorState, ScriptedStepBackAndReplaySaveTheSameBytes) {
     EXPECT_TRUE(first == straightRun("default.json", 90));
 }
 
-// Issue 12: "Undo stores what changed, not two whole scenes per edit". A
+// Undo stores what changed, not two whole scenes per edit. A
 // thousand edits (each moves one body) of a 2,000-body level; heap in use
 // measured with mallinfo2. The old stack held two copies of the scene per
 // command (and dropped all but the last 256 commands).

@@ -1,4 +1,4 @@
-// Issue 12, "smaller faults": what the debugging overlays show must be true
+// What the debugging overlays show must be true
 // and legible. The force overlay offers the applied force (gravity, springs,
 // ...) and the net force (m dv/dt over the last step, contacts included), and
 // says which is which; gravity stays visible next to a strong attractor; the

@@ -1,4 +1,4 @@
-// Joints (issue 15): the file format (names, defaults, round trip, errors)
+// Joints: the file format (names, defaults, round trip, errors)
 // and the solver against analytic answers and hard cases.
 
 #include "stepwise/components.hpp"
@@ -542,8 +542,8 @@ TEST(JointPhysics, HingedPolygonsKeepTheirVerticesTogether) {
     EXPECT_LT(worst, 0.02);
 }
 
-// levels/car.json (issue 15: "a motorised car with hinged wheels driving
-// over polygon terrain"): every piece of its terrain is a polygon, and in
+// levels/car.json, a motorised car with hinged wheels driving over
+// polygon terrain: every piece of its terrain is a polygon, and in
 // 10 s the car drives over all of it, upright, wheels on their axles and
 // never sunk into the ground.
 TEST(JointLevels, TheCarDrivesOverItsPolygonTerrain) {

@@ -193,7 +193,7 @@ TEST(LoaderRegressions, EveryFileInTheFuzzCorpusSatisfiesTheFuzzersProperty) {
     EXPECT_GE(files, 6);
 }
 
-// ---- Issue 14: the JSON itself -----------------------------------------------
+// ---- the JSON itself -----------------------------------------------
 
 // Duplicate keys were accepted, the last one winning: a level with "mass"
 // twice loaded with the second. Refused now, naming the second by its JSON

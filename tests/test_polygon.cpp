@@ -1,4 +1,4 @@
-// Convex polygon shapes (issue 15): the file format's checks with their
+// Convex polygon shapes: the file format's checks with their
 // exact messages, mass properties against the textbook formulas, contact
 // manifolds against hand-computed normals and depths, and whole-world runs
 // with analytic answers (resting, sliding on a slope, a head-on elastic

@@ -1,5 +1,5 @@
 // Exact resume: N steps, save, load, N steps equals 2N straight steps, bit
-// for bit, on every shipped level (issue 13). The bodies' state goes to the
+// for bit, on every shipped level. The bodies' state goes to the
 // file through writeBack; the solver's warm start through `solver_state`.
 // Also the in-memory forms the editor uses: saveState/restoreState and
 // reload (an edit of the live World that keeps the warm start).

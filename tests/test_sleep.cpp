@@ -1,4 +1,4 @@
-// Sleeping (issue 16, world.sleep; engine/src/world/islands.hpp): still
+// Sleeping (world.sleep; engine/src/world/islands.hpp): still
 // islands fall asleep and then cost nothing and move not a bit; a touch, an
 // edit, a setter or the mouse spring wakes the island concerned and only
 // it; a sleeping run looks like an awake one; resume and step back stay

@@ -303,7 +303,7 @@ TEST(WorldCli, ExplicitBlowUpOnStiffChainExitsThree) {
 
 } // namespace
 
-// Issue 14: a spring of k = 1e25 on 1 kg bodies makes M + h^2 K singular in
+// A spring of k = 1e25 on 1 kg bodies makes M + h^2 K singular in
 // doubles (the masses are lost to rounding). The factorisation failed and
 // the step kept v1 = v0 for every body, a free falling one too, reporting
 // success. Refused now, like a non-finite value: the state stays at the

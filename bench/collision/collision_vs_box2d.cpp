@@ -9,9 +9,9 @@
 // --quick runs a fifth of the simulated time, once; otherwise each engine
 // runs three times, alternating, and the fastest run counts. --scene runs
 // only that scene (pile, pile300, pyramid or rain), e.g. while tuning the solver;
-// --scene polygons runs the polygon pile (issue 15), which is not in the
+// --scene polygons runs the polygon pile, which is not in the
 // default set and prints one line.
-// --adversarial times issue 13's scenes (fast crowds, one huge shape, free
+// --adversarial times the adversarial scenes (fast crowds, one huge shape, free
 // fall) as ratios against the crowd at rest; --crowd N runs N circles
 // started at one point for S steps (default 60; wrap in /usr/bin/time -v for the peak memory).
 // --sweep runs every setting (substeps x iterations) of both engines and, with
@@ -278,7 +278,7 @@ std::string measuredOn(int argc, char** argv) {
            " hardware threads) by `" + command + "`.";
 }
 
-/// A pile of regular 3- to 8-gons (issue 15) dropped between static box
+/// A pile of regular 3- to 8-gons dropped between static box
 /// walls: the polygon narrow phase and manifolds under load, both engines
 /// built from the same Scene. Sleeping off in Box2D, as above.
 Scene polygonPileScene(int count) {
@@ -447,7 +447,7 @@ int runSweep(const std::vector<scenes::NamedScene>& scenes, bool quick, const st
     return 0;
 }
 
-/// Adversarial scenes of issue 13: ms/step of each, as ratios against the
+/// Adversarial scenes: ms/step of each, as ratios against the
 /// same crowd at rest in the same run. `crowd` > 0 instead runs only N
 /// circles started at one point for 60 steps (for /usr/bin/time -v).
 int runAdversarial(int crowd, int crowdSteps) {

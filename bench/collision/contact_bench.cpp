@@ -1,4 +1,4 @@
-// Google Benchmark: the contact solver's three scenes of issue 16 (the
+// Google Benchmark: the contact solver's three scenes (the
 // 2,000-circle pile for 600 steps, the 300-circle pile for 900, the 20-row
 // box pyramid for 600), ms per step over the whole run:
 //   - Stepwise as shipped (coloured contacts in SIMD bundles),

@@ -169,7 +169,7 @@ Scene circleRain(int count) {
 std::vector<NamedScene> benchmarkScenes() {
     std::vector<NamedScene> scenes;
     scenes.push_back({"pile", circlesInBox(), 10.0});
-    // Issue 16's smaller pile (900 steps): the same box, 300 circles.
+    // The smaller pile of the solver benchmark (900 steps): the same box, 300 circles.
     scenes.push_back({"pile300", circlesInBox(300), 15.0});
     scenes.push_back({"pyramid", boxPyramid(), 10.0});
     scenes.push_back({"rain", circleRain(), 20.0});  // the last drops land after ~12 s
