@@ -33,6 +33,40 @@ void radixSort(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scr
         keys.swap(scratch);
     }
 }
+
+/// Sorts keys ascending, the order std::sort gives, when `bucketOf(key)`
+/// (below `buckets`) never decreases as the key grows: a counting sort by
+/// bucket (stable, one pass to count and one to place), then each bucket's
+/// few keys by insertion. Cheaper than radixSort's four byte passes when
+/// the buckets are about as many as the keys (a grid's cells, a broad
+/// phase's boxes).
+template <typename BucketOf>
+void bucketSort(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch, std::size_t buckets,
+                std::vector<std::uint32_t>& start, BucketOf bucketOf) {
+    start.assign(buckets + 1, 0u);
+    for (const std::uint64_t k : keys) ++start[bucketOf(k) + 1];
+    for (std::size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
+    scratch.resize(keys.size());
+    for (const std::uint64_t k : keys) scratch[start[bucketOf(k)]++] = k;
+    keys.swap(scratch);
+    // start[b] is now the end of bucket b: sort each bucket's low halves.
+    std::size_t begin = 0;
+    for (std::size_t b = 0; b < buckets; ++b) {
+        const std::size_t end = start[b];
+        if (end - begin > 32) {  // a floor against every box: not by insertion
+            std::sort(keys.begin() + std::ptrdiff_t(begin), keys.begin() + std::ptrdiff_t(end));
+            begin = end;
+            continue;
+        }
+        for (std::size_t i = begin + 1; i < end; ++i) {
+            const std::uint64_t key = keys[i];
+            std::size_t j = i;
+            for (; j > begin && key < keys[j - 1]; --j) keys[j] = keys[j - 1];
+            keys[j] = key;
+        }
+        begin = end;
+    }
+}
 } // namespace
 
 void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
@@ -60,7 +94,13 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uin
     // (a, b) as one key a * 2^32 + b: its order is ProxyPair's.
     pairKeys_.resize(pairs.size());
     for (std::size_t i = 0; i < pairs.size(); ++i) pairKeys_[i] = (std::uint64_t(pairs[i].a) << 32) | pairs[i].b;
-    radixSort(pairKeys_, sortScratch_);
+    // Keyed by the first box: a counting sort by it, when there are not
+    // far more boxes than pairs.
+    if (boxes.size() <= 4 * pairs.size() + 4096)
+        bucketSort(pairKeys_, sortScratch_, boxes.size(), bucketStart_,
+                   [](std::uint64_t k) { return std::size_t(k >> 32); });
+    else
+        radixSort(pairKeys_, sortScratch_);
     for (std::size_t i = 0; i < pairs.size(); ++i)
         pairs[i] = {std::uint32_t(pairKeys_[i] >> 32), std::uint32_t(pairKeys_[i])};
 }
@@ -151,15 +191,32 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
     }
     cellKeys_.clear();
     auto cellOf = [&](double v, double origin) { return std::int64_t(std::floor((v - origin) / cell)); };
+    lowerCell_.resize(n);
     for (std::uint32_t i = 0; i < n; ++i) {
         if (extents_[i] > kLargeCells * cell) continue;
         const std::int64_t x0 = cellOf(boxes[i].lower.x, lo.x), x1 = cellOf(boxes[i].upper.x, lo.x);
         const std::int64_t y0 = cellOf(boxes[i].lower.y, lo.y), y1 = cellOf(boxes[i].upper.y, lo.y);
+        lowerCell_[i] = {x0, y0};
         for (std::int64_t x = x0; x <= x1; ++x)
             for (std::int64_t y = y0; y <= y1; ++y)
                 cellKeys_.push_back((std::uint64_t((x & 0xFFFF) | ((y & 0xFFFF) << 16)) << 32) | i);
     }
-    radixSort(cellKeys_, sortScratch_);
+    // Cells are (x, y) with y in the high 16 bits: as a row-major index
+    // y (maxX + 1) + x they keep their order, so when the grid has about as
+    // many cells as entries a counting sort by that index sorts the keys.
+    std::uint64_t maxX = 0, maxY = 0;
+    for (const std::uint64_t k : cellKeys_) {
+        maxX = std::max(maxX, (k >> 32) & 0xFFFF);
+        maxY = std::max(maxY, k >> 48);
+    }
+    if ((maxX + 1) * (maxY + 1) <= 4 * cellKeys_.size() + 4096) {
+        const std::uint64_t columns = maxX + 1;
+        bucketSort(cellKeys_, sortScratch_, std::size_t(columns * (maxY + 1)), bucketStart_, [columns](std::uint64_t k) {
+            return std::size_t((k >> 48) * columns + ((k >> 32) & 0xFFFF));
+        });
+    } else {
+        radixSort(cellKeys_, sortScratch_);
+    }
     for (std::size_t begin = 0; begin < cellKeys_.size();) {
         std::size_t end = begin + 1;
         while (end < cellKeys_.size() && (cellKeys_[end] >> 32) == (cellKeys_[begin] >> 32)) ++end;
@@ -205,19 +262,30 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
             reach = kDenseNeighbours;
             for (std::size_t i = begin; i < end; ++i) crowded_[std::uint32_t(cellKeys_[i])] = 1;
         }
+        // The cell's boxes packed in cell order: the pair loop then reads
+        // memory in order instead of jumping through the box array
+        // (measured on the 2,000-circle pile: a third of the grid's time).
+        cellBoxes_.resize(end - begin);
         for (std::size_t i = begin; i < end; ++i) {
-            const std::uint32_t a = std::uint32_t(cellKeys_[i]);
-            const std::size_t last = std::min(end, i + 1 + reach);
+            const std::uint32_t k = std::uint32_t(cellKeys_[i]);
+            cellBoxes_[i - begin] = {boxes[k], lowerCell_[k].x, lowerCell_[k].y, k, movable[k]};
+        }
+        const CellBox* cellBox = cellBoxes_.data();
+        const std::size_t count = end - begin;
+        for (std::size_t i = 0; i < count; ++i) {
+            const CellBox& a = cellBox[i];
+            const std::size_t last = std::min(count, i + 1 + reach);
             overlapTests_ += last - i - 1;
             for (std::size_t j = i + 1; j < last; ++j) {
-                const std::uint32_t b = std::uint32_t(cellKeys_[j]);
-                if (!(movable[a] || movable[b]) || !overlaps(boxes[a], boxes[b])) continue;
+                const CellBox& b = cellBox[j];
+                if (!(a.movable || b.movable) || !overlaps(a.box, b.box)) continue;
                 // Report the pair only in the cell holding the lower corner of
-                // the two boxes' intersection, so it is found once.
-                const double ix = std::max(boxes[a].lower.x, boxes[b].lower.x);
-                const double iy = std::max(boxes[a].lower.y, boxes[b].lower.y);
-                if ((cellOf(ix, lo.x) & 0xFFFF) != cx || (cellOf(iy, lo.y) & 0xFFFF) != cy) continue;
-                pairs.push_back(a < b ? ProxyPair{a, b} : ProxyPair{b, a});
+                // the two boxes' intersection, so it is found once. Its cell
+                // is the larger of the two lower cells: floor((v - lo) / cell)
+                // never decreases as v grows, so the cell of the larger lower
+                // coordinate is the larger cell (no division per pair).
+                if ((std::max(a.cellX, b.cellX) & 0xFFFF) != cx || (std::max(a.cellY, b.cellY) & 0xFFFF) != cy) continue;
+                pairs.push_back(a.index < b.index ? ProxyPair{a.index, b.index} : ProxyPair{b.index, a.index});
             }
         }
         begin = end;

@@ -60,8 +60,20 @@ private:
     std::vector<std::uint32_t> order_;  // SAP: proxies sorted by lower.x (kept between steps: nearly sorted)
     std::vector<SortedBox> sorted_;     // SAP: the boxes in that order, packed for the sweep
     std::vector<std::uint64_t> cellKeys_;  // grid: (cell, proxy) entries
+    struct CellIndex {
+        std::int64_t x, y;
+    };
+    std::vector<CellIndex> lowerCell_;  // grid: the cell of each box's lower corner
+    struct CellBox {
+        Aabb box;
+        std::int64_t cellX, cellY;  // the cell of its lower corner
+        std::uint32_t index;
+        std::uint8_t movable;
+    };
+    std::vector<CellBox> cellBoxes_;  // grid: one cell's boxes, packed for its pair loop
     std::vector<std::uint64_t> mortonKeys_;  // grid, crowded cell: (Z-order code, proxy)
     std::vector<std::uint64_t> pairKeys_, sortScratch_;  // findPairs: pairs as (a << 32 | b), and radixSort's buffer
+    std::vector<std::uint32_t> bucketStart_;  // bucketSort's counts
     std::vector<double> extents_, median_;  // grid: each box's larger side, and a copy for the median (m)
     std::vector<std::uint32_t> large_;
     std::size_t overlapTests_ = 0;

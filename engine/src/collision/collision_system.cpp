@@ -559,16 +559,21 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     if (!detected_) {
         detect(v);
         detected_ = true;
+        // The awake solver bodies' indices side by side, for the substeps'
+        // loops (a Collider is over a hundred bytes; these are twelve).
+        awakeSolved_.resize(awakeSolverColliders_.size());
+        for (std::size_t k = 0; k < awakeSolverColliders_.size(); ++k) {
+            const std::uint32_t i = awakeSolverColliders_[k];
+            awakeSolved_[k] = {i, solverIndex_[i], std::uint32_t(colliders_[i].body)};
+        }
     }
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = colliders_.size();
     unconstrainedV_.resize(n);
-    for (const std::uint32_t i : awakeSolverColliders_) {
-        const std::uint32_t s = solverIndex_[i];
-        const std::size_t body = std::size_t(colliders_[i].body);
-        bodies_[s].v = v[body];
-        bodies_[s].w = angularVelocities_[i];
-        unconstrainedV_[i] = v[body];
+    for (const SolvedBody& sb : awakeSolved_) {
+        bodies_[sb.solver].v = v[sb.body];
+        bodies_[sb.solver].w = angularVelocities_[sb.collider];
+        unconstrainedV_[sb.collider] = v[sb.body];
     }
     // Contact stiffness may not exceed a quarter of the substep rate, or the
     // soft constraint itself becomes unstable (Box2D v3.0's cap; v3.1
@@ -616,13 +621,12 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // Positions: the integrator moved x with the unconstrained velocity; add
     // the contact velocity change over the substep. Angles integrate here
     // (only contacts make torque).
-    for (const std::uint32_t i : awakeSolverColliders_) {
-        const std::uint32_t s = solverIndex_[i];
-        SolverBody& b = bodies_[s];
-        const std::size_t body = std::size_t(colliders_[i].body);
-        x[body] += h * (b.v - unconstrainedV_[i]);
+    for (const SolvedBody& sb : awakeSolved_) {
+        const std::uint32_t i = sb.collider;
+        SolverBody& b = bodies_[sb.solver];
+        x[sb.body] += h * (b.v - unconstrainedV_[i]);
         angles_[i] += h * b.w;
-        b.dp = x[body] - stepStart_[i];
+        b.dp = x[sb.body] - stepStart_[i];
         b.dq = rotationBy(angles_[i] - stepStartAngle_[i]);
     }
     for (std::size_t k = 0; k < crowdBodies_.size(); ++k) {
@@ -646,10 +650,9 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
     }
 
-    for (const std::uint32_t i : awakeSolverColliders_) {
-        const std::uint32_t s = solverIndex_[i];
-        v[std::size_t(colliders_[i].body)] = bodies_[s].v;
-        angularVelocities_[i] = bodies_[s].w;
+    for (const SolvedBody& sb : awakeSolved_) {
+        v[sb.body] = bodies_[sb.solver].v;
+        angularVelocities_[sb.collider] = bodies_[sb.solver].w;
     }
     timings_.solveMs += msSince(start);
 }

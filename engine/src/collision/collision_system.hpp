@@ -236,6 +236,10 @@ private:
     bool anySleeping_ = false;
     std::vector<std::uint8_t> colliderAsleep_;           // per collider
     std::vector<std::uint32_t> awakeSolverColliders_;    // colliders with a solver body, awake, ascending
+    struct SolvedBody {
+        std::uint32_t collider, solver, body;  // collider, SolverBody and state-vector indices
+    };
+    std::vector<SolvedBody> awakeSolved_;                // awakeSolverColliders_'s indices, set each step
     std::vector<std::uint32_t> awakeProxies_;            // finite_ indices of awake dynamic shapes, ascending
     FrozenBoxes frozen_;                                 // static and sleeping shapes' boxes
     std::vector<Aabb> awakeBoxes_;

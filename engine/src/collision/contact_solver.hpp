@@ -120,6 +120,11 @@ struct ImpactScratch {
     std::vector<std::uint32_t> incident;  ///< contact indices, ascending per body
     std::vector<std::uint64_t> now, next;  ///< contacts to look at in this pass and the next (bit sets)
     std::vector<std::uint32_t> now32;      ///< indexImpacts' cursor per body
+    /// Per solver body: the largest |rn| of its contact points this step
+    /// (m), and at the start of a substep a bound on the normal speed any
+    /// of its points can have, |v.x| + |v.y| + |w| reach (m/s).
+    std::vector<double> reach, bound;
+    std::vector<std::uint32_t> pairBodies;  ///< bodyA, bodyB of each contact, packed
 };
 void indexImpacts(std::span<const ContactConstraint> contacts, std::size_t bodyCount, ImpactScratch& scratch);
 void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDetail> details,
