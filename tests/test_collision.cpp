@@ -154,6 +154,47 @@ TEST(BroadPhase, StrategiesAgreeWithBruteForce) {
     EXPECT_EQ(grid, brute);
 }
 
+// The pair sort counts pairs by their first box and sorts each box's pairs
+// by insertion, or with std::sort past 32; the grid's cells are counted
+// when the grid is dense and radix-sorted when it is sparse. A floor first
+// (index 0, meeting every box) and boxes spread over thousands of cells per axis
+// (200 m apart) reach the other branches; every strategy still gives brute force's pairs.
+TEST(BroadPhase, StrategiesAgreeWithAFloorFirstAndASparseGrid) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> x(-20, 20), size(0.1, 0.5);
+    std::vector<Aabb> boxes{{{-30, -1}, {30, 0.05}}};  // the floor, box 0
+    std::vector<std::uint8_t> movable{0};
+    for (int i = 0; i < 300; ++i) {
+        const Vec2 p{x(rng), 0.0}, h{size(rng), size(rng)};
+        boxes.push_back({p - h, p + h});
+        movable.push_back(1);
+    }
+    for (int i = 0; i < 40; ++i) {  // sparse: far apart, in pairs that touch
+        const Vec2 p{200.0 * i, 300.0 * (i % 7)};
+        boxes.push_back({p, p + Vec2{0.3, 0.3}});
+        boxes.push_back({p + Vec2{0.2, 0.2}, p + Vec2{0.5, 0.5}});
+        movable.push_back(1);
+        movable.push_back(1);
+    }
+    std::vector<ProxyPair> brute, sap, grid;
+    BroadPhase(BroadPhaseKind::BruteForce).findPairs(boxes, movable, brute);
+    BroadPhase(BroadPhaseKind::SweepAndPrune).findPairs(boxes, movable, sap);
+    BroadPhase(BroadPhaseKind::UniformGrid).findPairs(boxes, movable, grid);
+    std::size_t floorPairs = 0;
+    for (const ProxyPair& p : brute) floorPairs += p.a == 0 ? 1 : 0;
+    EXPECT_GT(floorPairs, 200u);
+    EXPECT_EQ(sap, brute);
+    EXPECT_EQ(grid, brute);
+    // The sparse part alone: 80 boxes over a grid far larger than the keys.
+    std::vector<Aabb> sparse(boxes.end() - 80, boxes.end());
+    std::vector<std::uint8_t> sparseMovable(80, 1);
+    std::vector<ProxyPair> sparseBrute, sparseGrid;
+    BroadPhase(BroadPhaseKind::BruteForce).findPairs(sparse, sparseMovable, sparseBrute);
+    BroadPhase(BroadPhaseKind::UniformGrid).findPairs(sparse, sparseMovable, sparseGrid);
+    EXPECT_EQ(sparseBrute.size(), 40u);
+    EXPECT_EQ(sparseGrid, sparseBrute);
+}
+
 // ---------------------------------------------------------------- response
 
 TEST(Collision, HeadOnElasticUnequalMassesMatchTheCourseNotesFormula) {

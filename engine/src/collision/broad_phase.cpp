@@ -278,7 +278,14 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
             overlapTests_ += last - i - 1;
             for (std::size_t j = i + 1; j < last; ++j) {
                 const CellBox& b = cellBox[j];
-                if (!(a.movable || b.movable) || !overlaps(a.box, b.box)) continue;
+                // overlaps() and the movable test without a branch each: in a
+                // pile about half the boxes of a cell overlap, which no
+                // branch predictor guesses.
+                const bool hit = (a.movable | b.movable) != 0 && ((a.box.lower.x <= b.box.upper.x) &
+                                                                   (b.box.lower.x <= a.box.upper.x) &
+                                                                   (a.box.lower.y <= b.box.upper.y) &
+                                                                   (b.box.lower.y <= a.box.upper.y));
+                if (!hit) continue;
                 // Report the pair only in the cell holding the lower corner of
                 // the two boxes' intersection, so it is found once. Its cell
                 // is the larger of the two lower cells: floor((v - lo) / cell)

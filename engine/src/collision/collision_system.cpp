@@ -519,11 +519,24 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
             const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
             if (std::binary_search(noCollide_.begin(), noCollide_.end(), key)) continue;
         }
-        Manifold m = collide(colliders_[a].shape, centres_[a], rots[a], colliders_[b].shape, centres_[b], rots[b],
-                             pairMargin(a, b));
-        if (m.pointCount == 1 && colliders_[a].shape.kind == ShapeKind::Circle &&
-            colliders_[b].shape.kind == ShapeKind::Circle && centres_[a] == centres_[b])
-            m.normal = coincidentNormal(a, b);
+        const Shape& shapeA = colliders_[a].shape;
+        const Shape& shapeB = colliders_[b].shape;
+        if (shapeA.kind == ShapeKind::Circle && shapeB.kind == ShapeKind::Circle) {
+            // Two circles: the margin only decides whether the pair is in
+            // reach. Every margin is at least 2 kSpeculativeBase, and a sum of
+            // non-negative terms never rounds below a smaller one, so a pair
+            // within that reach is within its own: its two square roots
+            // (pairMargin) are skipped. collideCircles' test, same bits.
+            const double closest = shapeA.radius + shapeB.radius + 2.0 * kSpeculativeBase;
+            const double margin = lengthSquared(centres_[b] - centres_[a]) <= closest * closest
+                                      ? 2.0 * kSpeculativeBase
+                                      : pairMargin(a, b);
+            Manifold m = collideCircles(shapeA.radius, centres_[a], shapeB.radius, centres_[b], margin);
+            if (m.pointCount == 1 && centres_[a] == centres_[b]) m.normal = coincidentNormal(a, b);
+            addManifold(a, b, m, centres_);
+            continue;
+        }
+        const Manifold m = collide(shapeA, centres_[a], rots[a], shapeB, centres_[b], rots[b], pairMargin(a, b));
         addManifold(a, b, m, centres_);
     }
     // Planes against every movable finite shape: planes are few and infinite,

@@ -365,7 +365,8 @@ template <int Points>
 void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32_t> order,
             std::span<const ContactConstraint> contacts, std::span<const SolverBody> bodies) {
     const std::size_t first = out.size(), count = (order.size() + kContactLanes - 1) / kContactLanes;
-    out.resize(first + count);  // value-initialised: all zero
+    out.resize(first + count);
+    std::memset(static_cast<void*>(out.data() + first), 0, count * sizeof(ContactBundle<Points>));  // unused lanes: all zero
     for (std::size_t k = 0; k < order.size(); ++k)
         fillLane(out[first + k / kContactLanes], int(k % kContactLanes), contacts[order[k]], order[k], bodies);
     for (std::size_t k = order.size(); k < count * kContactLanes; ++k)

@@ -43,6 +43,10 @@ struct PointLanes {
 /// zeros and write nothing that matters.
 template <int Points>
 struct ContactBundle {
+    /// Leaves the lanes unset: the bundles are rebuilt every step and each
+    /// is zeroed once as it is filled (a value-initialising resize zeroed
+    /// one and copied it to the rest, a seventh of the build).
+    ContactBundle() noexcept {}
     std::uint32_t bodyA[kContactLanes], bodyB[kContactLanes];
     std::uint32_t source[kContactLanes];  ///< index in the step's contacts; ~0u for an unused lane
     alignas(32) double nx[kContactLanes], ny[kContactLanes], friction[kContactLanes];
