@@ -366,7 +366,9 @@ void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32
             std::span<const ContactConstraint> contacts, std::span<const SolverBody> bodies) {
     const std::size_t first = out.size(), count = (order.size() + kContactLanes - 1) / kContactLanes;
     out.resize(first + count);
-    std::memset(static_cast<void*>(out.data() + first), 0, count * sizeof(ContactBundle<Points>));  // unused lanes: all zero
+    // fillLane sets every field of a used lane; only the last bundle can
+    // have unused lanes, which must be all zero.
+    if (count > 0) std::memset(static_cast<void*>(&out.back()), 0, sizeof(ContactBundle<Points>));
     for (std::size_t k = 0; k < order.size(); ++k)
         fillLane(out[first + k / kContactLanes], int(k % kContactLanes), contacts[order[k]], order[k], bodies);
     for (std::size_t k = order.size(); k < count * kContactLanes; ++k)

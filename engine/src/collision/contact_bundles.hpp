@@ -43,9 +43,10 @@ struct PointLanes {
 /// zeros and write nothing that matters.
 template <int Points>
 struct ContactBundle {
-    /// Leaves the lanes unset: the bundles are rebuilt every step and each
-    /// is zeroed once as it is filled (a value-initialising resize zeroed
-    /// one and copied it to the rest, a seventh of the build).
+    /// Leaves the lanes unset: the bundles are rebuilt every step, every
+    /// field of a used lane is set, and only a colour's last bundle (which
+    /// may have unused lanes) is zeroed first. A value-initialising resize
+    /// wrote each bundle twice (a seventh of the build).
     ContactBundle() noexcept {}
     std::uint32_t bodyA[kContactLanes], bodyB[kContactLanes];
     std::uint32_t source[kContactLanes];  ///< index in the step's contacts; ~0u for an unused lane

@@ -124,26 +124,27 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
     const std::size_t words = (contacts.size() + 63) / 64;
     std::vector<std::uint64_t>& now = scratch.now;
     std::vector<std::uint64_t>& next = scratch.next;
-    // The first pass looks at every contact that could approach faster than
-    // the threshold at the substep's start velocities. Its normal speed is
-    // at most |vA| + |vB| + |wA rnA| + |wB rnB| <= bound[A] + bound[B]
-    // (|dot(dv, n)| <= |dv.x| + |dv.y|); one under the threshold by more
-    // than rounding would find nothing to do, unless a contact before it
-    // changes its bodies, which then marks it (touched, below). So the
-    // result is that of a first pass over every contact; in a resting pile
-    // it skips almost all of them without reading them.
+    // A contact's normal speed is at most |vA| + |vB| + |wA rnA| + |wB rnB|
+    // <= bound[A] + bound[B] (n is a unit vector, so |dot(dv, n)| <= |dv.x|
+    // + |dv.y|). One whose bound is under the threshold by more than
+    // rounding would find nothing to do, so it is passed over without
+    // reading it: the result is that of looking at it. The bounds follow the
+    // bodies' velocities (set here, renewed for the two bodies of each
+    // impulse). In a resting pile almost every contact is passed over.
     std::vector<double>& bound = scratch.bound;
+    const auto boundOf = [&](const SolverBody& b) {
+        return (std::abs(b.v.x) + std::abs(b.v.y)) + std::abs(b.w) * scratch.reach[std::size_t(&b - bodies.data())];
+    };
     bound.resize(bodies.size());
-    for (std::size_t b = 0; b < bodies.size(); ++b)
-        bound[b] = (std::abs(bodies[b].v.x) + std::abs(bodies[b].v.y)) + std::abs(bodies[b].w) * scratch.reach[b];
-    // Rounding in the normal speed is a few units in the last place of the
+    for (std::size_t b = 0; b < bodies.size(); ++b) bound[b] = boundOf(bodies[b]);
+    // Rounding in the normal speed is a few units in the last place of its
     // terms, far under a millionth of the bound.
     const double quiet = threshold * (1.0 - 1e-6);
+    // The first pass: the contacts not passed over at the start velocities.
     now.assign(words, 0);
-    for (std::size_t k = 0; k < contacts.size(); ++k) {
-        const std::uint32_t a = scratch.pairBodies[2 * k], b = scratch.pairBodies[2 * k + 1];
-        if (!(bound[a] + bound[b] < quiet)) now[k / 64] |= std::uint64_t(1) << (k % 64);
-    }
+    for (std::size_t k = 0; k < contacts.size(); ++k)
+        if (!(bound[scratch.pairBodies[2 * k]] + bound[scratch.pairBodies[2 * k + 1]] < quiet))
+            now[k / 64] |= std::uint64_t(1) << (k % 64);
     // Contact k changed its bodies: every contact on them looks again, later
     // in this pass if it comes after k, else in the next pass (k included).
     const auto touched = [&](std::uint32_t body, std::size_t k) {
@@ -160,6 +161,7 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
             while (now[word] != 0) {
                 const std::size_t k = word * 64 + std::size_t(std::countr_zero(now[word]));
                 now[word] &= now[word] - 1;
+                if (bound[scratch.pairBodies[2 * k]] + bound[scratch.pairBodies[2 * k + 1]] < quiet) continue;
                 ContactConstraint& c = contacts[k];
                 ContactDetail& detail = details[k];
                 SolverBody& a = bodies[c.bodyA];
@@ -194,6 +196,8 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
                 if (vn >= target) continue;
                 const double impulse = (target - vn) * effectiveMass(a, b, rnA, rnB);
                 applyImpulse(a, b, c.normal, rnA, rnB, impulse);
+                bound[c.bodyA] = boundOf(a);
+                bound[c.bodyB] = boundOf(b);
                 for (int i = 0; i < c.pointCount; ++i) detail.restitutionImpulse[i] += impulse / double(c.pointCount);
                 touched(c.bodyA, k);
                 touched(c.bodyB, k);
