@@ -190,7 +190,13 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
         }
     }
     cellKeys_.clear();
-    auto cellOf = [&](double v, double origin) { return std::int64_t(std::floor((v - origin) / cell)); };
+    // The boxes in the grid lie above and right of lo, so the quotient is
+    // not negative and truncation is floor (std::floor is a library call
+    // without SSE4.1); the else branch keeps floor for anything else.
+    auto cellOf = [&](double v, double origin) {
+        const double q = (v - origin) / cell;
+        return q >= 0.0 ? std::int64_t(q) : std::int64_t(std::floor(q));
+    };
     lowerCell_.resize(n);
     for (std::uint32_t i = 0; i < n; ++i) {
         if (extents_[i] > kLargeCells * cell) continue;
