@@ -269,8 +269,9 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
             for (std::size_t i = begin; i < end; ++i) crowded_[std::uint32_t(cellKeys_[i])] = 1;
         }
         // The cell's boxes packed in cell order: the pair loop then reads
-        // memory in order instead of jumping through the box array
-        // (measured on the 2,000-circle pile: a third of the grid's time).
+        // memory in order instead of jumping through the box array (with
+        // the reporting cell found without a division, 13% fewer
+        // instructions in the grid on the 2,000-circle pile, callgrind).
         cellBoxes_.resize(end - begin);
         for (std::size_t i = begin; i < end; ++i) {
             const std::uint32_t k = std::uint32_t(cellKeys_[i]);
@@ -285,8 +286,8 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
             for (std::size_t j = i + 1; j < last; ++j) {
                 const CellBox& b = cellBox[j];
                 // overlaps() and the movable test without a branch each: in a
-                // pile about half the boxes of a cell overlap, which no
-                // branch predictor guesses.
+                // pile the boxes of a cell overlap or not with no pattern a
+                // branch predictor could learn.
                 const bool hit = (a.movable | b.movable) != 0 && ((a.box.lower.x <= b.box.upper.x) &
                                                                    (b.box.lower.x <= a.box.upper.x) &
                                                                    (a.box.lower.y <= b.box.upper.y) &

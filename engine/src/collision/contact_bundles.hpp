@@ -46,7 +46,7 @@ struct ContactBundle {
     /// Leaves the lanes unset: the bundles are rebuilt every step, every
     /// field of a used lane is set, and only a colour's last bundle (which
     /// may have unused lanes) is zeroed first. A value-initialising resize
-    /// wrote each bundle twice (a seventh of the build).
+    /// wrote each bundle twice (a sixth of the build's time, perf).
     ContactBundle() noexcept {}
     std::uint32_t bodyA[kContactLanes], bodyB[kContactLanes];
     std::uint32_t source[kContactLanes];  ///< index in the step's contacts; ~0u for an unused lane
