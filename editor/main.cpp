@@ -3,6 +3,8 @@
 
 #include "cli/commands.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <exception>
 #include <iostream>
 #include <string>

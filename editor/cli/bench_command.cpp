@@ -7,6 +7,8 @@
 
 #include "report/accuracy.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <filesystem>
 #include <iostream>
 #include <memory>

@@ -3,8 +3,6 @@
 
 #include "stepwise/scene.hpp"
 
-#include <CLI/CLI.hpp>
-
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,23 +19,6 @@ void reportError(const std::string& message);
 /// One-line description of what a scene contains and needs:
 /// "12 entities; components: name, position, ...; systems: gravity, springs".
 std::string sceneSummary(const Scene& scene);
-
-/// CLI11 check for a step count: a whole number >= 0. The message names the
-/// option and what was expected ("--steps: expected a whole number >= 0,
-/// got -5"); CLI::NonNegativeNumber printed all 309 digits of DBL_MAX as
-/// the range and called "abc" a value out of range.
-CLI::Validator wholeNumberAtLeastZero();
-
-/// CLI11 check for an output file option: a non-empty name ("--out:
-/// expected a file name, got \"\""; an empty name gave ": error: ..." with
-/// no name at all).
-CLI::Validator outputFileName();
-
-/// CLI11 check for --dt: a number of seconds in (0, 10], the documented
-/// range of world.dt; subnormal values (1e-320) included. "nan", "inf" and
-/// "0" are refused naming the option, without CLI::PositiveNumber's 309
-/// digits of DBL_MAX.
-CLI::Validator secondsPerStep();
 
 /// An output named on the command line: the option and the path.
 struct OutputFile {

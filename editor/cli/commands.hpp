@@ -2,7 +2,9 @@
 // Each subcommand lives in its own file and registers itself on the app.
 // `exitCode` is written by the subcommand's callback.
 
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;
+}
 
 namespace stepwise::cli {
 

@@ -5,6 +5,7 @@
 // the headless runner cli/edit_scripted.cpp.
 
 #include "cli/cli_common.hpp"
+#include "cli/option_checks.hpp"
 #include "cli/commands.hpp"
 #include "cli/edit_run.hpp"
 

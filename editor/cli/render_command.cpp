@@ -3,6 +3,7 @@
 // trails while stepping, and writes a numbered sequence (--frames/--every).
 
 #include "cli/cli_common.hpp"
+#include "cli/option_checks.hpp"
 #include "cli/commands.hpp"
 
 #include "render/offscreen.hpp"

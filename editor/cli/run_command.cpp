@@ -3,6 +3,7 @@
 // the contacts of every step.
 
 #include "cli/cli_common.hpp"
+#include "cli/option_checks.hpp"
 #include "cli/commands.hpp"
 
 #include "stepwise/components.hpp"

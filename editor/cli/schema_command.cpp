@@ -2,6 +2,7 @@
 // from the component table.
 
 #include "cli/cli_common.hpp"
+#include "cli/option_checks.hpp"
 #include "cli/commands.hpp"
 
 #include "stepwise/scene_io.hpp"

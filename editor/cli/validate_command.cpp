@@ -7,6 +7,8 @@
 #include "stepwise/components.hpp"
 #include "stepwise/world.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <iostream>
 #include <memory>
 #include <string>
