@@ -4,13 +4,15 @@
 // PNG encode on the side. Not a ctest test: timing depends on the machine.
 //
 //   build/render_bench [--bodies N] [--width W] [--height H] [--frames F] [--overlay LIST] [--out FILE.png]
-//                      [--level FILE --steps N --trail N]
+//                      [--level FILE --steps N --trail N] [--no-pixel-layers] [--batches]
 //
 // --level draws a saved level instead of the generated scene, after N steps
 // (default 32) with the last `--trail` steps (default 32) as trails, through
 // the level's camera: the editor's viewport in its bench (`stepwise edit
 // --bench-bodies 2000`, saved with the script line `saveas`) is
 // `--level pile.json --steps 600 --trail 64 --width 720 --height 476`.
+// --no-pixel-layers draws crowded AABB outlines as quads (BuildOptions);
+// --batches lists the first frame's batches.
 
 #include "offscreen.hpp"
 
@@ -94,7 +96,23 @@ double processCpuMs() {
 int main(int argc, char** argv) {
     int bodies = 10000, width = 1920, height = 1080, frames = 10, steps = 32, trail = 32;
     std::string out, overlays = "all", level;
-    for (int i = 1; i + 1 < argc; i += 2) {
+    BuildOptions options;
+    bool batches = false;
+    for (int i = 1; i < argc; i += 2) {
+        if (!std::strcmp(argv[i], "--no-pixel-layers")) {
+            options.pixelLayers = false;
+            --i;
+            continue;
+        }
+        if (!std::strcmp(argv[i], "--batches")) {
+            batches = true;
+            --i;
+            continue;
+        }
+        if (i + 1 >= argc) {
+            std::fprintf(stderr, "render_bench: %s needs a value\n", argv[i]);
+            return 2;
+        }
         if (!std::strcmp(argv[i], "--bodies")) bodies = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--width")) width = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--height")) height = std::atoi(argv[i + 1]);
@@ -167,7 +185,7 @@ int main(int argc, char** argv) {
     const double cpu0 = processCpuMs();
     for (int f = 0; f < frames; ++f) {
         const auto t0 = std::chrono::steady_clock::now();
-        DrawData data = buildDrawData(input, width, height);
+        DrawData data = buildDrawData(input, width, height, options);
         const auto t1 = std::chrono::steady_clock::now();
         headless.renderer().draw(data);
         const auto tSubmit = std::chrono::steady_clock::now();
@@ -181,6 +199,8 @@ int main(int argc, char** argv) {
         submitMs += ms(tSubmit - t1);
         best = std::min(best, ms(t2 - t0));
         instances = data.instanceCount();
+        if (f == 0 && batches)
+            for (const Batch& b : data.batches) std::printf("  batch: kind %d, plain %d, %zu instances\n", int(b.kind), int(b.plain), b.count());
         calls = headless.renderer().lastDrawCalls();
     }
     const double cpuMs = (processCpuMs() - cpu0) / frames;
