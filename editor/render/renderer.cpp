@@ -164,7 +164,6 @@ Result<std::unique_ptr<Renderer>> Renderer::create(GetProcAddress getProc) {
     }
     im.gl.GenBuffers(1, &im.quadIndices);
     im.ensureQuadIndices(4096);
-
     if (GLenum err = im.gl.GetError(); err != GL_NO_ERROR)
         return Error{"OpenGL error " + std::to_string(err) + " while creating the renderer"};
     return r;
