@@ -27,10 +27,21 @@ void main() {
         u = c.x < 0.0 ? -halfW : len + halfW;
         v = c.y * halfW;
     } else {
-        // Same head size as arrow.frag.
+        // Same head size as arrow.frag. The quad holds every pixel the
+        // shader covers: the shaft (halfW), and the head, at most 0.9 px
+        // outside its triangle, so 1.5 px of margin around the head's back
+        // corners and its tip. A long arrow's quad is a trapezoid, narrow at
+        // the tail and wide enough at the head's back: about 28% fewer
+        // pixels than the rectangle as wide as the head, which llvmpipe
+        // shades and blends just the same when they are transparent.
         float headLen = min(4.5 + 3.0 * aWidth, 0.6 * len);
+        float headHalf = max(halfW, 0.55 * headLen + 1.5);
+        float headBack = len - headLen - 0.5 + halfW;  // from the quad's tail edge
+        float far = len + 1.5 + halfW;
+        float wide = headBack > 0.0 ? halfW + (headHalf - halfW) * far / headBack : headHalf;
+        bool trapezoid = wide + halfW < 2.0 * headHalf;  // else a short arrow: the rectangle is smaller
         u = c.x < 0.0 ? -halfW : len + 1.5;
-        v = c.y * max(halfW, 0.55 * headLen + 1.5);
+        v = c.y * (!trapezoid ? headHalf : (c.x < 0.0 ? halfW : wide));
     }
     vLocal = vec2(u, v);
     vLength = len;

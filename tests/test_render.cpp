@@ -268,6 +268,69 @@ TEST(RenderLevelOfDetail, CrowdedArrowsKeepOnePerCellAndTheSelection) {
     EXPECT_TRUE(arrowAt(buildDrawData(input, w, h), at));
 }
 
+/// A 40 x 50 square packing of circles (2,000 bounding boxes) at 720x476
+/// with the aabb overlay and no HUD: the editor bench's crowd.
+FrameInput crowdedAabb(const Scene& scene, int w, int h) {
+    FrameInput input;
+    input.scene = &scene;
+    input.camera = fitCamera(scene, w, h);
+    input.overlays.add(Overlay::Aabb);
+    input.hud = false;
+    return input;
+}
+
+TEST(RenderAabb, CrowdedOutlinesAreOneLayerWithTheBoxShadersCoverage) {
+    const int w = 720, h = 476;
+    const Scene scene = packedCircles(40, 50);
+    const FrameInput input = crowdedAabb(scene, w, h);
+    const DrawData data = buildDrawData(input, w, h);
+    ASSERT_EQ(countOf(data, BatchKind::Image), 1u);
+    ASSERT_EQ(data.images.size(), 1u);
+    EXPECT_EQ(countOf(data, BatchKind::Box), 0u) << "no outline is drawn twice";
+    const Batch* layerBatch = nullptr;
+    for (const Batch& b : data.batches)
+        if (b.kind == BatchKind::Image) layerBatch = &b;
+    const int x0 = int(layerBatch->data[0]), y0 = int(layerBatch->data[1]);
+    const PixelLayer& layer = data.images[0];
+    EXPECT_EQ(int(layerBatch->data[2]) - x0, layer.width);
+    EXPECT_EQ(int(layerBatch->data[3]) - y0, layer.height);
+    ASSERT_EQ(layer.rgba.size(), std::size_t(layer.width) * std::size_t(layer.height) * 4);
+    const auto alphaAt = [&](int x, int y) { return int(layer.rgba[(std::size_t(y - y0) * std::size_t(layer.width) + std::size_t(x - x0)) * 4 + 3]); };
+    // The bottom-left circle: its box's left edge has no neighbour. Along it,
+    // box.frag's outline coverage clamp(1.1 - |d|) x 0.75 (d: the distance
+    // from the pixel centre to the box's edge), to the 8-bit rounding.
+    const double ppm = input.camera.pixelsPerMetre(h);
+    const Vec2 c = pixelOf(input, {0.0, 0.25}, w, h);
+    const double half = 0.25 * ppm;
+    const int y = int(std::floor(c.y));  // a row through the middle of the box
+    for (int x = int(std::floor(c.x - half)) - 2; x <= int(std::floor(c.x - half)) + 2; ++x) {
+        const double d = std::abs(std::abs(x + 0.5 - c.x) - half);
+        const double expected = std::clamp(1.1 - d, 0.0, 1.0) * 0.75 * 255.0;
+        EXPECT_NEAR(alphaAt(x, y), expected, 1.0) << "pixel " << x << ", " << y;
+    }
+    // Inside the box, away from its edges and from any neighbour's: nothing.
+    EXPECT_EQ(alphaAt(int(std::floor(c.x)), y), 0);
+    // Every texel carries the overlay's colour (0x68d391): only alpha varies.
+    EXPECT_EQ(int(layer.rgba[0]), 0x68);
+    EXPECT_EQ(int(layer.rgba[1]), 0xd3);
+    EXPECT_EQ(int(layer.rgba[2]), 0x91);
+    // Asked not to, the same frame draws one box quad per body.
+    const DrawData quads = buildDrawData(input, w, h, BuildOptions{.pixelLayers = false});
+    EXPECT_EQ(countOf(quads, BatchKind::Image), 0u);
+    EXPECT_EQ(countOf(quads, BatchKind::Box), 2000u);
+}
+
+TEST(RenderAabb, FewOutlinesStayOneQuadEach) {
+    // A ring of 100 small circles spread over the image: one layer over
+    // them all would shade far more pixels than their 100 quads.
+    const Scene scene = ringOfCircles(100);
+    const FrameInput input = crowdedAabb(scene, 800, 600);
+    const DrawData data = buildDrawData(input, 800, 600);
+    EXPECT_EQ(countOf(data, BatchKind::Image), 0u);
+    EXPECT_TRUE(data.images.empty());
+    EXPECT_EQ(countOf(data, BatchKind::Box), 100u);
+}
+
 TEST(RenderBatching, SameInputSameFloats) {
     Scene scene = ringOfCircles(300);
     FrameInput input;

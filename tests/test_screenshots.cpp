@@ -197,6 +197,43 @@ TEST(Screenshots, FailureWritesActualAndDiffImages) {
     fs::remove(golden);
 }
 
+TEST(Screenshots, CrowdedAabbLayerDrawsWhatTheBoxQuadsDraw) {
+    // 2,000 touching circles with the aabb overlay: the outlines drawn on
+    // the CPU as one layer (BatchKind::Image) and drawn by box.frag as one
+    // quad per box give the same picture through llvmpipe, to the 8-bit
+    // rounding of alpha (a tolerance of 8, a quarter of the goldens').
+    Scene scene;
+    for (int r = 0; r < 40; ++r)
+        for (int c = 0; c < 50; ++c) {
+            const Entity e = scene.registry.create();
+            scene.registry.emplace<Position>(e, {{0.5 * c, 0.25 + 0.5 * r}});
+            scene.registry.emplace<Radius>(e, {0.25});
+        }
+    OffscreenRenderer& gl = headless();
+    FrameInput input;
+    input.scene = &scene;
+    input.camera = fitCamera(scene, gl.width(), gl.height());
+    input.overlays.add(Overlay::Aabb);
+    input.hud = false;
+    const auto draw = [&](bool layers) {
+        const DrawData data = buildDrawData(input, gl.width(), gl.height(), BuildOptions{.pixelLayers = layers});
+        EXPECT_EQ(data.images.size(), layers ? 1u : 0u);
+        gl.renderer().draw(data);
+        return gl.renderer().readPixels(gl.width(), gl.height());
+    };
+    const Image layered = draw(true), quads = draw(false);
+    const ImageDiff diff = compareImages(quads, layered, 8);
+    EXPECT_EQ(diff.differing, 0u) << "between x " << diff.x0 << ".." << diff.x1 << ", y " << diff.y0 << ".." << diff.y1;
+    // ... and the outlines are there: the overlay's green on a box's left edge.
+    const ImageDiff withoutOutlines = compareImages(quads, [&] {
+        input.overlays = OverlaySet{};
+        const DrawData data = buildDrawData(input, gl.width(), gl.height());
+        gl.renderer().draw(data);
+        return gl.renderer().readPixels(gl.width(), gl.height());
+    }(), 32);
+    EXPECT_GT(withoutOutlines.fraction(), 0.05);
+}
+
 // ---- determinism ---------------------------------------------------------
 
 TEST(Screenshots, SameBuildRendersIdenticalBytesTwiceInProcess) {

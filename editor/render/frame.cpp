@@ -135,8 +135,8 @@ std::string formatLength(double metres) {
 
 class Builder {
 public:
-    Builder(DrawData& out, const FrameInput& input, int w, int h)
-        : out_(out), in_(input), scene_(*input.scene), w_(w), h_(h),
+    Builder(DrawData& out, const FrameInput& input, int w, int h, const BuildOptions& options)
+        : out_(out), in_(input), options_(options), scene_(*input.scene), w_(w), h_(h),
           ppm_(input.camera.pixelsPerMetre(h)),
           // 1.5 pixels per font unit from a 360 px image up to 700 (capitals
           // about 10 px tall, like the editor's 13 px UI font): one unit was
@@ -305,6 +305,7 @@ private:
 
     DrawData& out_;
     const FrameInput& in_;
+    BuildOptions options_;
     const Scene& scene_;
     int w_, h_;
     double ppm_;        ///< pixels per metre at this image height
@@ -499,10 +500,13 @@ void Builder::aabbCells() {
     }
     std::sort(cells.begin(), cells.end());
     cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
-    const double halfPx = 0.5 * cell * ppm_;
     for (const auto& [x, y] : cells) {
-        const Vec2 c = toPx({(double(x) + 0.5) * cell, (double(y) + 0.5) * cell});
-        box(c, {halfPx - 1.0, halfPx - 1.0}, 0.0, kAabbCell, kFlat);
+        // Axis-aligned, so plain triangles with whole-pixel edges, 1 px in
+        // from the cell's (a 2 px gap between neighbours) instead of a box
+        // quad and its distance shader.
+        const Vec2 lo = toPx({double(x) * cell, double(y) * cell}), hi = toPx({double(x + 1) * cell, double(y + 1) * cell});
+        if (!segmentVisible(lo, hi, 0.0)) continue;
+        rect(std::round(lo.x) + 1.0, std::round(lo.y) + 1.0, std::round(hi.x) - 1.0, std::round(hi.y) - 1.0, kAabbCell);
     }
 }
 
@@ -880,11 +884,97 @@ void Builder::polygonPreview() {
 }
 
 void Builder::aabbOutlines() {
+    // Each box is its outline at the box shader's anti-aliased edge
+    // (coverage clamp(1.1 - |d|), d the distance to the rectangle). Drawn
+    // as one quad per box, llvmpipe shades every 4x4-pixel block a quad
+    // touches, inside included, once per triangle: a settled pile of 2,000
+    // boxes 10 px wide is about 3 blocks per pixel of the pile. When that is
+    // more than twice the blocks of one layer over all the boxes, the
+    // outlines are drawn on the CPU into that layer instead (the same
+    // coverage, pixel for pixel) and the layer is drawn as one quad.
+    std::vector<std::pair<Vec2, Vec2>> shown;  // centre, half extents, pixels
+    Bounds area;
+    double quadBlocks = 0.0;
     for (Entity e : scene_.registry.entities()) {
         const auto shape = shapeBox(scene_, e);
         if (!shape) continue;
-        box(toPx(shape->centre), shape->half * ppm_, 0.0, kAabb, kOutline);
+        const Vec2 c = toPx(shape->centre), half = shape->half * ppm_;
+        if (!visible(c, std::hypot(half.x, half.y) + 8)) continue;
+        shown.emplace_back(c, half);
+        area.add(c - half - Vec2{2.0, 2.0});
+        area.add(c + half + Vec2{2.0, 2.0});
+        // The quad is the box plus 1.5 px (box.vert); each triangle shades the blocks it touches.
+        quadBlocks += 1.5 * (std::floor((2.0 * half.x + 3.0) / 4.0) + 2.0) * (std::floor((2.0 * half.y + 3.0) / 4.0) + 2.0);
     }
+    if (shown.empty()) return;
+    const int x0 = std::max(0, int(std::floor(area.lo.x))), y0 = std::max(0, int(std::floor(area.lo.y)));
+    const int x1 = std::min(w_, int(std::ceil(area.hi.x))), y1 = std::min(h_, int(std::ceil(area.hi.y)));
+    const double layerBlocks = (std::floor(double(x1 - x0) / 4.0) + 2.0) * (std::floor(double(y1 - y0) / 4.0) + 2.0);
+    if (x1 <= x0 || y1 <= y0 || 2.0 * layerBlocks >= quadBlocks || !options_.pixelLayers) {
+        for (const auto& [c, half] : shown) box(c, half, 0.0, kAabb, kOutline);
+        return;
+    }
+    const int lw = x1 - x0, lh = y1 - y0;
+    // Coverage of the boxes, composited "over" like the blend: all share one
+    // colour, so only alpha accumulates.
+    std::vector<float> alpha(std::size_t(lw) * std::size_t(lh), 0.0f);
+    const auto cover = [](float d) { return std::min(std::max(1.1f - std::abs(d), 0.0f), 1.0f) * kAabb.a; };
+    const auto over = [](float& dst, float a) { dst = a + dst * (1.0f - a); };
+    for (const auto& [c, half] : shown) {
+        // Only pixels whose centre is within 1.1 px of an edge's line can be
+        // covered: bands of rows along the bottom and top edges and bands of
+        // columns along the left and right. Where a row band meets a column
+        // band (the corners) the distance is box.frag's, exactly; elsewhere
+        // it equals the row's distance to its edge (in a row band) or the
+        // column's (in a column band), or both give no coverage, so each
+        // row's or column's coverage is computed once and blended along it.
+        // This runs for thousands of boxes a frame.
+        const float cx = float(c.x - x0), cy = float(c.y - y0), hx = float(half.x), hy = float(half.y);
+        // Pixels i whose centre i + 0.5 lies in [from, to] (at most 3 for a band 2.2 px wide).
+        const auto band = [](float from, float to) { return std::pair{int(std::ceil(from - 0.5f)), int(std::floor(to - 0.5f))}; };
+        const auto [b0, b1] = band(cy - hy - 1.1f, cy - hy + 1.1f);  // rows along the bottom edge
+        const auto [t0, t1] = band(cy + hy - 1.1f, cy + hy + 1.1f);  // rows along the top edge
+        const auto [l0, l1] = band(cx - hx - 1.1f, cx - hx + 1.1f);  // columns along the left edge
+        const auto [g0, g1] = band(cx + hx - 1.1f, cx + hx + 1.1f);  // columns along the right edge
+        const auto qxOf = [&](int i) { return std::abs(float(i) + 0.5f - cx) - hx; };
+        const auto qyOf = [&](int j) { return std::abs(float(j) + 0.5f - cy) - hy; };
+        const auto exact = [&](int i, int j) {
+            const float qx = qxOf(i), qy = qyOf(j), mx = std::max(qx, 0.0f), my = std::max(qy, 0.0f);
+            return cover(std::sqrt(mx * mx + my * my) + std::min(std::max(qx, qy), 0.0f));
+        };
+        const int jLo = std::max(b0, 0), jHi = std::min(t1, lh - 1), iLo = std::max(l0, 0), iHi = std::min(g1, lw - 1);
+        if (b1 >= t0 || l1 >= g0) {
+            // Too small for separate bands: every pixel exactly.
+            for (int j = jLo; j <= jHi; ++j)
+                for (int i = iLo; i <= iHi; ++i) over(alpha[std::size_t(j) * std::size_t(lw) + std::size_t(i)], exact(i, j));
+            continue;
+        }
+        float columnCover[2][4];  // the left and the right band's columns (at most 3 each)
+        for (int i = l0; i <= l1; ++i) columnCover[0][i - l0] = cover(qxOf(i));
+        for (int i = g0; i <= g1; ++i) columnCover[1][i - g0] = cover(qxOf(i));
+        for (int j = jLo; j <= jHi; ++j) {
+            float* row = alpha.data() + std::size_t(j) * std::size_t(lw);
+            const bool edgeRow = j <= b1 || j >= t0;
+            if (edgeRow) {
+                for (int i = iLo; i <= std::min(l1, lw - 1); ++i) over(row[i], exact(i, j));
+                const float a = cover(qyOf(j));
+                for (int i = std::max(l1 + 1, 0); i <= std::min(g0 - 1, lw - 1); ++i) over(row[i], a);
+                for (int i = std::max(g0, 0); i <= iHi; ++i) over(row[i], exact(i, j));
+            } else {
+                for (int i = iLo; i <= std::min(l1, lw - 1); ++i) over(row[i], columnCover[0][i - l0]);
+                for (int i = std::max(g0, 0); i <= iHi; ++i) over(row[i], columnCover[1][i - g0]);
+            }
+        }
+    }
+    PixelLayer layer{lw, lh, std::vector<std::uint8_t>(alpha.size() * 4)};
+    const std::uint8_t r = std::uint8_t(kAabb.r * 255.0f + 0.5f), g = std::uint8_t(kAabb.g * 255.0f + 0.5f),
+                       b = std::uint8_t(kAabb.b * 255.0f + 0.5f);
+    for (std::size_t k = 0; k < alpha.size(); ++k) {
+        std::uint8_t* px = layer.rgba.data() + 4 * k;
+        px[0] = r, px[1] = g, px[2] = b, px[3] = std::uint8_t(alpha[k] * 255.0f + 0.5f);
+    }
+    push(batch(BatchKind::Image), {double(x0), double(y0), double(x1), double(y1), double(out_.images.size())});
+    out_.images.push_back(std::move(layer));
 }
 
 void Builder::bodyArrows() {
@@ -1085,6 +1175,7 @@ std::size_t floatsPerInstance(BatchKind kind) {
     case BatchKind::Segment: return 9;
     case BatchKind::Arrow: return 9;
     case BatchKind::Solid: return 6;
+    case BatchKind::Image: return 5;
     }
     return 1;
 }
@@ -1097,13 +1188,13 @@ std::size_t DrawData::instanceCount() const {
     return n;
 }
 
-DrawData buildDrawData(const FrameInput& input, int widthPx, int heightPx) {
+DrawData buildDrawData(const FrameInput& input, int widthPx, int heightPx, const BuildOptions& options) {
     DrawData out;
     out.width = widthPx;
     out.height = heightPx;
     out.scales = input.scales;
     if (!input.scene || widthPx <= 0 || heightPx <= 0) return out;
-    Builder(out, input, widthPx, heightPx).build();
+    Builder(out, input, widthPx, heightPx, options).build();
     return out;
 }
 

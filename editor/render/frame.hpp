@@ -16,7 +16,10 @@ namespace stepwise::render {
 
 /// Instance batches, each drawn with one call. Floats, pixel coordinates
 /// with the origin at the bottom-left (GL's convention), y up.
-enum class BatchKind : std::uint8_t { Plane, Disc, Box, Segment, Arrow, Solid };
+/// Image: a layer of pixels drawn on the CPU (DrawData::images), for marks
+/// so many and so small that llvmpipe would shade far more pixels drawing
+/// them one quad at a time than the layer has.
+enum class BatchKind : std::uint8_t { Plane, Disc, Box, Segment, Arrow, Solid, Image };
 
 struct Batch {
     BatchKind kind;
@@ -30,11 +33,20 @@ struct Batch {
     std::size_t count() const;
 };
 
+/// Pixels drawn on the CPU: straight-alpha RGBA8, rows bottom-up (GL's
+/// order), placed by an Image batch's record {x0, y0, x1, y1, index}.
+struct PixelLayer {
+    int width = 0;
+    int height = 0;
+    std::vector<std::uint8_t> rgba;
+};
+
 struct DrawData {
     int width = 0;
     int height = 0;
     double gridSpacing = 0.0;     ///< metres between minor grid lines (majors every 5)
     std::vector<Batch> batches;   ///< in drawing order
+    std::vector<PixelLayer> images;  ///< what Image batches draw
     ArrowScales scales;           ///< the references used (auto ones resolved)
     std::vector<std::string> notes;  ///< e.g. "force-field: no World (scene has shapes)"
     std::vector<std::string> legend; ///< the legend's arrow rows, e.g. "applied force = 20 N"
@@ -44,8 +56,15 @@ struct DrawData {
 /// Floats per instance of each kind.
 std::size_t floatsPerInstance(BatchKind kind);
 
+/// How buildDrawData may draw; the defaults are what every caller wants.
+struct BuildOptions {
+    /// Crowded AABB outlines as one layer of pixels drawn on the CPU (see
+    /// BatchKind::Image); false: one quad per box always (to compare the two).
+    bool pixelLayers = true;
+};
+
 /// Builds the frame's geometry. Deterministic: same input, same floats.
-DrawData buildDrawData(const FrameInput& input, int widthPx, int heightPx);
+DrawData buildDrawData(const FrameInput& input, int widthPx, int heightPx, const BuildOptions& options = {});
 
 /// The arrow references buildDrawData would choose for this input (for
 /// freezing them across a frame sequence).

@@ -36,12 +36,13 @@ std::vector<Attribute> layoutOf(BatchKind kind) {
     case BatchKind::Segment:
     case BatchKind::Arrow: return {{0, 2}, {1, 2}, {2, 1}, {3, 4}};
     case BatchKind::Solid: return {{0, 2}, {1, 4}};
+    case BatchKind::Image: return {{0, 4}, {1, 1}};
     }
     return {};
 }
 
 constexpr std::array kKinds = {BatchKind::Plane, BatchKind::Disc, BatchKind::Box,
-                               BatchKind::Segment, BatchKind::Arrow, BatchKind::Solid};
+                               BatchKind::Segment, BatchKind::Arrow, BatchKind::Solid, BatchKind::Image};
 
 } // namespace
 
@@ -134,6 +135,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(GetProcAddress getProc) {
         case BatchKind::Segment: break;
         case BatchKind::Arrow: frag = "arrow.frag"; break;
         case BatchKind::Solid: vert = "solid.vert", frag = "solid.frag"; break;
+        case BatchKind::Image: vert = "image.vert", frag = "image.frag"; break;
         }
         Result<GLuint> program = im.link(vert, frag);
         if (!program) return Error{program.error()};
@@ -237,7 +239,37 @@ void Renderer::draw(const DrawData& data, int originX, int originY) {
             gl.BindBuffer(GL_ARRAY_BUFFER, st.vbo);
             gl.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(im.expanded.size() * sizeof(float)), im.expanded.data(),
                           GL_STREAM_DRAW);
-            gl.DrawElements(GL_TRIANGLES, GLsizei(count * 6), GL_UNSIGNED_INT, nullptr);
+            if (batch.kind != BatchKind::Image) {
+                gl.DrawElements(GL_TRIANGLES, GLsizei(count * 6), GL_UNSIGNED_INT, nullptr);
+            } else {
+                // One texture and quad per layer. A new texture each time:
+                // re-specifying one that the previous frame's drawing still
+                // reads would make the driver wait for that drawing (the
+                // editor overlaps it with the next frame); a deleted texture
+                // lives on until the drawing that reads it is done.
+                gl.ActiveTexture(GL_TEXTURE0);
+                gl.Uniform1i(gl.GetUniformLocation(program, "uImage"), 0);
+                gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+                for (std::size_t i = 0; i < count; ++i) {
+                    const std::size_t index = std::size_t(batch.data[i * stride + 4]);
+                    if (index >= data.images.size()) continue;
+                    const PixelLayer& layer = data.images[index];
+                    GLuint texture = 0;
+                    gl.GenTextures(1, &texture);
+                    gl.BindTexture(GL_TEXTURE_2D, texture);
+                    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+                    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+                    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+                    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+                    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, layer.width, layer.height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                                  layer.rgba.data());
+                    gl.DrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT,
+                                    reinterpret_cast<const void*>(i * 6 * sizeof(GLuint)));
+                    gl.BindTexture(GL_TEXTURE_2D, 0);
+                    gl.DeleteTextures(1, &texture);
+                    if (i + 1 < count) ++drawCalls_;
+                }
+            }
         }
         ++drawCalls_;
     }
