@@ -4,6 +4,7 @@
 
 #include "editor_fixture.hpp"
 
+#include "app/contact_rows.hpp"
 #include "app/tools/tools.hpp"
 
 #include <set>
@@ -436,4 +437,33 @@ TEST(ToolTable, KeysAndTheScriptPickEveryTool) {
         EXPECT_EQ(ed.tool, info.tool) << info.scriptName;
     }
     EXPECT_TRUE(host.errors.empty());
+}
+
+// The Debug panel's contacts table: the filter matches either body's name,
+// and each column sorts stably both ways (names as strings, a plane as "").
+TEST(ContactTable, FiltersByEitherNameAndSortsStablyByTheChosenColumn) {
+    Registry reg;
+    const Entity c2 = reg.create(), c10 = reg.create(), wall = reg.create();
+    reg.emplace<Name>(c2, Name{"c2"});
+    reg.emplace<Name>(c10, Name{"c10"});
+    reg.emplace<Name>(wall, Name{"wall"});
+    std::vector<ContactRecord> contacts(4);
+    contacts[0] = {c2, wall, {1.0, 0.0}, {0.0, 1.0}, 0.010, 2.0, 0.1};
+    contacts[1] = {c10, Entity{}, {-1.0, 0.0}, {0.0, -1.0}, -0.002, 0.0, 0.0};  // against a plane
+    contacts[2] = {c2, c10, {0.5, 0.0}, {1.0, 0.0}, 0.005, 1.0, -0.3};
+    contacts[3] = {wall, c2, {0.0, 0.0}, {0.0, 1.0}, 0.001, 3.0, 0.2};
+    using V = std::vector<std::size_t>;
+    const auto rows = [&](const std::string& filter, ContactSort sort) { return contactRows(contacts, reg, filter, sort); };
+
+    EXPECT_EQ(rows("", {}), (V{0, 1, 2, 3}));
+    EXPECT_EQ(rows("c1", {}), (V{1, 2}));      // c10 on side a, then on side b
+    EXPECT_EQ(rows("wall", {}), (V{0, 3}));
+    EXPECT_EQ(rows("nobody", {}), V{});
+    EXPECT_EQ(rows("", {true, ContactColumn::A, false}), (V{1, 0, 2, 3}));  // "c10" < "c2" < "wall"; 0 stays before 2
+    EXPECT_EQ(rows("", {true, ContactColumn::A, true}), (V{3, 0, 2, 1}));
+    EXPECT_EQ(rows("", {true, ContactColumn::B, false}), (V{1, 2, 3, 0}));  // "" (the plane) < "c10" < "c2" < "wall"
+    EXPECT_EQ(rows("", {true, ContactColumn::Depth, false}), (V{1, 3, 2, 0}));
+    EXPECT_EQ(rows("", {true, ContactColumn::NormalImpulse, true}), (V{3, 0, 2, 1}));
+    EXPECT_EQ(rows("", {true, ContactColumn::NormalY, false}), (V{1, 2, 0, 3}));  // -1, 0, then the two 1s in step order
+    EXPECT_EQ(rows("c1", {true, ContactColumn::TangentImpulse, false}), (V{2, 1}));
 }

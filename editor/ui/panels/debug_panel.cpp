@@ -2,6 +2,7 @@
 
 #include "ui/panels/panels.hpp"
 
+#include "app/contact_rows.hpp"
 #include "app/scene_edit.hpp"
 
 #include "stepwise/components.hpp"
@@ -44,48 +45,20 @@ void contactsTab(UiState& ui, Editor& ed) {
                           "(a speculative contact, not touching yet).\nimpulse: normal and tangent (friction) "
                           "impulse the solver applied this step. The pair that stopped the run is in red.");
     if (contacts.empty()) return;
-    // Rows shown: filtered by name, in the order the header asks for.
-    std::vector<std::size_t> rows;
-    for (std::size_t i = 0; i < contacts.size(); ++i) {
-        if (!ui.contactFilter.empty()) {
-            const ContactRecord& c = contacts[i];
-            const bool match = editor::displayName(reg, c.a).find(ui.contactFilter) != std::string::npos ||
-                               (reg.alive(c.b) && editor::displayName(reg, c.b).find(ui.contactFilter) != std::string::npos);
-            if (!match) continue;
-        }
-        rows.push_back(i);
-    }
     if (ImGui::BeginTable("contacts", 7, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_Borders |
                                              ImGuiTableFlags_Resizable | ImGuiTableFlags_Sortable)) {
         ImGui::TableSetupScrollFreeze(0, 1);
         for (const char* h : {"a", "b", "point [m]", "normal", "depth [m]", "normal impulse [N s]", "tangent impulse [N s]"})
             ImGui::TableSetupColumn(h);
         ImGui::TableHeadersRow();
+        // Rows shown: filtered by name, in the order the header asks for.
+        editor::ContactSort order;
         if (const ImGuiTableSortSpecs* sort = ImGui::TableGetSortSpecs(); sort && sort->SpecsCount > 0) {
-            const int column = sort->Specs[0].ColumnIndex;
-            const bool descending = sort->Specs[0].SortDirection == ImGuiSortDirection_Descending;
-            auto key = [&](std::size_t i) -> double {
-                const ContactRecord& c = contacts[i];
-                switch (column) {
-                case 2: return c.point.x;
-                case 3: return c.normal.y;
-                case 4: return c.depth;
-                case 5: return c.normalImpulse;
-                case 6: return c.tangentImpulse;
-                default: return 0.0;
-                }
-            };
-            std::stable_sort(rows.begin(), rows.end(), [&](std::size_t x, std::size_t y) {
-                if (column <= 1) {
-                    const Entity ex = column == 0 ? contacts[x].a : contacts[x].b;
-                    const Entity ey = column == 0 ? contacts[y].a : contacts[y].b;
-                    const std::string nx = reg.alive(ex) ? editor::displayName(reg, ex) : std::string();
-                    const std::string ny = reg.alive(ey) ? editor::displayName(reg, ey) : std::string();
-                    return descending ? ny < nx : nx < ny;
-                }
-                return descending ? key(y) < key(x) : key(x) < key(y);
-            });
+            order.sorted = true;
+            order.column = editor::ContactColumn(std::clamp(int(sort->Specs[0].ColumnIndex), 0, 6));
+            order.descending = sort->Specs[0].SortDirection == ImGuiSortDirection_Descending;
         }
+        const std::vector<std::size_t> rows = editor::contactRows(contacts, reg, ui.contactFilter, order);
         ImGuiListClipper clipper;
         clipper.Begin(int(rows.size()));
         while (clipper.Step())
