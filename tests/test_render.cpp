@@ -294,8 +294,8 @@ TEST(RenderAabb, CrowdedOutlinesAreOneLayerWithTheBoxShadersCoverage) {
     const PixelLayer& layer = data.images[0];
     EXPECT_EQ(int(layerBatch->data[2]) - x0, layer.width);
     EXPECT_EQ(int(layerBatch->data[3]) - y0, layer.height);
-    ASSERT_EQ(layer.rgba.size(), std::size_t(layer.width) * std::size_t(layer.height) * 4);
-    const auto alphaAt = [&](int x, int y) { return int(layer.rgba[(std::size_t(y - y0) * std::size_t(layer.width) + std::size_t(x - x0)) * 4 + 3]); };
+    ASSERT_EQ(layer.coverage.size(), std::size_t(layer.width) * std::size_t(layer.height));
+    const auto alphaAt = [&](int x, int y) { return int(layer.coverage[std::size_t(y - y0) * std::size_t(layer.width) + std::size_t(x - x0)]); };
     // The bottom-left circle: its box's left edge has no neighbour. Along it,
     // box.frag's outline coverage clamp(1.1 - |d|) x 0.75 (d: the distance
     // from the pixel centre to the box's edge), to the 8-bit rounding.
@@ -310,10 +310,18 @@ TEST(RenderAabb, CrowdedOutlinesAreOneLayerWithTheBoxShadersCoverage) {
     }
     // Inside the box, away from its edges and from any neighbour's: nothing.
     EXPECT_EQ(alphaAt(int(std::floor(c.x)), y), 0);
-    // Every texel carries the overlay's colour (0x68d391): only alpha varies.
-    EXPECT_EQ(int(layer.rgba[0]), 0x68);
-    EXPECT_EQ(int(layer.rgba[1]), 0xd3);
-    EXPECT_EQ(int(layer.rgba[2]), 0x91);
+    // The layer is drawn in the overlay's colour (0x68d391).
+    EXPECT_EQ(int(layer.colour[0] * 255.0f + 0.5f), 0x68);
+    EXPECT_EQ(int(layer.colour[1] * 255.0f + 0.5f), 0xd3);
+    EXPECT_EQ(int(layer.colour[2] * 255.0f + 0.5f), 0x91);
+    // Where two boxes' outlines meet, each covers the pixel and they are
+    // composited "over" in 8 bits, as the quads blend into the framebuffer:
+    // the shared edge of the two bottom-left boxes, at x = 0.25 m.
+    const double edge = pixelOf(input, {0.25, 0.25}, w, h).x;
+    for (int x = int(std::floor(edge)) - 1; x <= int(std::floor(edge)) + 1; ++x) {
+        const int a = int(std::clamp(1.1 - std::abs(x + 0.5 - edge), 0.0, 1.0) * 0.75 * 255.0 + 0.5);
+        EXPECT_NEAR(alphaAt(x, y), a + (a * (255 - a) + 127) / 255, 1.0) << "pixel " << x << ", " << y;
+    }
     // Asked not to, the same frame draws one box quad per body.
     const DrawData quads = buildDrawData(input, w, h, BuildOptions{.pixelLayers = false});
     EXPECT_EQ(countOf(quads, BatchKind::Image), 0u);
@@ -329,6 +337,51 @@ TEST(RenderAabb, FewOutlinesStayOneQuadEach) {
     EXPECT_EQ(countOf(data, BatchKind::Image), 0u);
     EXPECT_TRUE(data.images.empty());
     EXPECT_EQ(countOf(data, BatchKind::Box), 100u);
+}
+
+TEST(RenderFields, VelocityFieldIsTheGaussianWeightedMeanOfTheBodiesNearASample) {
+    // 640x480 at 24 px a metre: the field's samples sit 24 px = 1 m apart,
+    // at the centres of the metre cells. Two bodies near the sample at
+    // (0.5, 0.5) m: one 0.3 m to its right moving +x, one 1 m above moving
+    // +y. The field there is their mean weighted by exp(-r^2 / 2) (r in
+    // sample spacings), so its arrow points at atan2(wB, wA).
+    Scene scene;
+    const auto body = [&](Vec2 p, Vec2 v) {
+        const Entity e = scene.registry.create();
+        scene.registry.emplace<Position>(e, {p});
+        scene.registry.emplace<Velocity>(e, {v});
+        scene.registry.emplace<Mass>(e, {1.0});
+        scene.registry.emplace<Radius>(e, {0.1});
+    };
+    body({0.8, 0.5}, {1.0, 0.0});
+    body({0.5, 1.5}, {0.0, 1.0});
+    FrameInput input;
+    input.scene = &scene;
+    input.camera = Camera{{0.0, 0.0}, 36.0};  // 36 x 480 / 720 = 24 px a metre
+    input.overlays = *parseOverlayList("velocity-field");
+    input.hud = false;
+    const DrawData data = buildDrawData(input, 640, 480);
+    const auto arrowCentredAt = [&](double x, double y) -> const float* {
+        for (const Batch& b : data.batches) {
+            if (b.kind != BatchKind::Arrow) continue;
+            for (std::size_t i = 0; i < b.count(); ++i) {
+                const float* a = b.data.data() + i * 9;
+                if (std::abs(0.5 * (a[0] + a[2]) - x) < 1e-3 && std::abs(0.5 * (a[1] + a[3]) - y) < 1e-3) return a;
+            }
+        }
+        return nullptr;
+    };
+    const float* a = arrowCentredAt(320.0 + 0.5 * 24.0, 240.0 + 0.5 * 24.0);
+    ASSERT_NE(a, nullptr) << "no arrow at the sample (0.5, 0.5) m";
+    const double wA = std::exp(-0.5 * 0.3 * 0.3), wB = std::exp(-0.5 * 1.0);
+    EXPECT_NEAR(std::atan2(a[3] - a[1], a[2] - a[0]), std::atan2(wB, wA), 1e-5);
+    // The sample at (1.5, 0.5) m: A is 0.7 m away, B sqrt(2) m.
+    const float* right = arrowCentredAt(320.0 + 1.5 * 24.0, 240.0 + 0.5 * 24.0);
+    ASSERT_NE(right, nullptr) << "no arrow at the sample (1.5, 0.5) m";
+    EXPECT_NEAR(std::atan2(right[3] - right[1], right[2] - right[0]), std::atan2(std::exp(-1.0), std::exp(-0.5 * 0.49)), 1e-5);
+    // Beyond two spacings of every body, no sample has a value: no arrow.
+    EXPECT_EQ(arrowCentredAt(320.0 + 4.5 * 24.0, 240.0 + 4.5 * 24.0), nullptr);
+    EXPECT_EQ(arrowCentredAt(320.0 - 3.5 * 24.0, 240.0 + 0.5 * 24.0), nullptr);
 }
 
 TEST(RenderBatching, SameInputSameFloats) {
@@ -365,10 +418,11 @@ TEST(RenderContacts, AFloorContactArrowPointsOutOfTheFloor) {
     input.hud = false;
     const DrawData data = buildDrawData(input, 400, 300);
     int arrows = 0;
-    for (const Batch& b : data.batches)
-        if (b.kind == BatchKind::Arrow)
-            for (std::size_t i = 0; i < b.count(); ++i, ++arrows)
-                EXPECT_GT(b.data[i * 9 + 3], b.data[i * 9 + 1]) << "tip below the base: the arrow points into the floor";
+    for (const Batch& b : data.batches) {
+        if (b.kind != BatchKind::Arrow) continue;
+        for (std::size_t i = 0; i < b.count(); ++i, ++arrows)
+            EXPECT_GT(b.data[i * 9 + 3], b.data[i * 9 + 1]) << "tip below the base: the arrow points into the floor";
+    }
     EXPECT_GT(arrows, 0);
 }
 

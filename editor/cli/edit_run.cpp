@@ -14,6 +14,8 @@
 #include <numeric>
 #include <sstream>
 
+#include <ctime>
+
 namespace stepwise::cli {
 
 void writeDebugState(const std::string& path, ui::Session& session, std::uint64_t frame) {
@@ -51,7 +53,17 @@ void writeDebugState(const std::string& path, ui::Session& session, std::uint64_
     (void)writeFileAtomically(path, out.str());
 }
 
+namespace {
+double processCpuSeconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+} // namespace
+
 void FrameTimes::add(double frameMs, const ui::UiState::FrameParts& parts) {
+    processCpuLast = processCpuSeconds();
+    if (processCpuStart < 0.0) processCpuStart = processCpuLast;
     ms.push_back(frameMs);
     sum.uiMs += parts.uiMs;
     sum.stepMs += parts.stepMs;
@@ -80,6 +92,10 @@ void FrameTimes::report(const char* what, std::size_t bodies) const {
                 "ui draw %.2f ms, present %.2f ms, rest %.2f ms\n",
                 sum.uiMs / n, sum.stepMs / n, double(sum.steps) / n, sum.sceneMs / n, sum.drawUiMs / n,
                 sum.presentMs / n, std::max(0.0, mean - parts));
+    // Between the first and the last add(): n - 1 frames apart.
+    if (sorted.size() > 1)
+        std::printf("  CPU time of all the process's threads: %.2f ms a frame\n",
+                    1e3 * (processCpuLast - processCpuStart) / (n - 1.0));
     std::printf("  viewport, last frame: %zu instances in %d draw calls\n", last.instances, last.drawCalls);
 }
 

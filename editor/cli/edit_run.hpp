@@ -43,6 +43,10 @@ struct FrameTimes {
     std::vector<double> ms;
     ui::UiState::FrameParts sum;  ///< the parts summed over the recorded frames
     ui::UiState::FrameParts last; ///< the last recorded frame's parts
+    /// CPU seconds of the whole process (every thread: the editor's and the
+    /// rasteriser's) at the first and the last add(). On a shared machine
+    /// the CPU time a frame takes moves less than its wall time.
+    double processCpuStart = -1.0, processCpuLast = 0.0;
 
     void add(double frameMs, const ui::UiState::FrameParts& parts);
     /// Prints the mean, median, p95 and max frame time and where a frame goes.

@@ -490,17 +490,27 @@ void Builder::aabbCells() {
     }
     if (boxes.empty()) return;
     const double cell = niceCeil(2.0 * autoReference(extents));
-    std::vector<std::pair<long long, long long>> cells;
+    // The occupied cells, each once, in (x, y) order. Only cells on screen
+    // are drawn, so they are marked in a bitmap over the image's cells
+    // (a few thousand) instead of listing every box's cells and sorting.
+    const Vec2 viewLo = toWorld({0, 0}), viewHi = toWorld({double(w_), double(h_)});
+    const long long vx0 = (long long)std::floor(viewLo.x / cell), vx1 = (long long)std::floor(viewHi.x / cell);
+    const long long vy0 = (long long)std::floor(viewLo.y / cell), vy1 = (long long)std::floor(viewHi.y / cell);
+    const long long nx = vx1 - vx0 + 1, ny = vy1 - vy0 + 1;
+    // A cell is drawn 1 px in from each side: under 3 px there is nothing
+    // left to draw (and the bitmap stays at most ~w*h/9 entries).
+    if (cell * ppm_ < 3.0 || nx <= 0 || ny <= 0) return;
+    std::vector<std::uint8_t> occupied(std::size_t(nx * ny), 0);
     for (const auto& [c, half] : boxes) {
         const long long x0 = (long long)std::floor((c.x - half.x) / cell), x1 = (long long)std::floor((c.x + half.x) / cell);
         const long long y0 = (long long)std::floor((c.y - half.y) / cell), y1 = (long long)std::floor((c.y + half.y) / cell);
         if ((x1 - x0 + 1) * (y1 - y0 + 1) > 64) continue;  // huge shape: its box says enough
-        for (long long x = x0; x <= x1; ++x)
-            for (long long y = y0; y <= y1; ++y) cells.emplace_back(x, y);
+        for (long long x = std::max(x0, vx0); x <= std::min(x1, vx1); ++x)
+            for (long long y = std::max(y0, vy0); y <= std::min(y1, vy1); ++y) occupied[std::size_t((x - vx0) * ny + (y - vy0))] = 1;
     }
-    std::sort(cells.begin(), cells.end());
-    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
-    for (const auto& [x, y] : cells) {
+    for (std::size_t k = 0; k < occupied.size(); ++k) {
+        if (!occupied[k]) continue;
+        const long long x = vx0 + (long long)k / ny, y = vy0 + (long long)k % ny;
         // Axis-aligned, so plain triangles with whole-pixel edges, 1 px in
         // from the cell's (a 2 px gap between neighbours) instead of a box
         // quad and its distance shader.
@@ -578,51 +588,43 @@ void Builder::fields() {
         }
     }
     if (vField) {
-        // Gaussian kernel of width h = grid spacing, cut at 2h; bodies are
-        // binned into cells of size s so each sample visits 5x5 cells.
-        // Samples sit at the centres of cells i0..i1 x j0..j1, so only
-        // bodies within two cells of those count: a flat grid over that
-        // range, filled by counting sort in scene order (no hashing, no
-        // allocation per cell, and the sums keep their order).
-        struct Sample { Vec2 p, v; };
-        const long long gx0 = i0 - 2, gy0 = j0 - 2, nx = i1 - i0 + 5, ny = j1 - j0 + 5;
-        auto cellOf = [&](Vec2 p) -> long long {
-            const long long cx = (long long)std::floor(p.x / s) - gx0, cy = (long long)std::floor(p.y / s) - gy0;
-            return cx < 0 || cy < 0 || cx >= nx || cy >= ny ? -1 : cy * nx + cx;
-        };
-        std::vector<std::size_t> cellStart(std::size_t(nx * ny) + 1, 0);
-        std::vector<std::pair<long long, Sample>> binned;
+        // Gaussian kernel of width h = grid spacing, cut at 2h. Each body
+        // adds itself to the samples within two cells of its own: the
+        // kernel is separable, exp(-(dx^2 + dy^2)/2) = exp(-dx^2/2)
+        // exp(-dy^2/2), so a body costs 10 exponentials, not one per sample
+        // it reaches (up to 25). Sums run in scene order (deterministic).
+        const long long ni = i1 - i0 + 1;
+        std::vector<Vec2> sums(points.size());
+        std::vector<double> weights(points.size(), 0.0);
         scene_.registry.each<Position, Velocity>([&](Entity e, const Position& p, const Velocity& v) {
             if (isStatic(scene_, e)) return;
-            const long long c = cellOf(p.value);
-            if (c < 0) return;
-            binned.push_back({c, {p.value, v.value}});
-            ++cellStart[std::size_t(c) + 1];
+            const double fx = p.value.x / s, fy = p.value.y / s;  // in grid cells
+            const long long cx = (long long)std::floor(fx), cy = (long long)std::floor(fy);
+            if (cx < i0 - 2 || cx > i1 + 2 || cy < j0 - 2 || cy > j1 + 2) return;
+            double dx2[5], dy2[5], ex[5], ey[5];  // squared offsets to the samples at cells c-2..c+2, and exp(-d^2/2)
+            for (int d = 0; d < 5; ++d) {
+                const double dx = fx - (double(cx + d - 2) + 0.5), dy = fy - (double(cy + d - 2) + 0.5);
+                dx2[d] = dx * dx, dy2[d] = dy * dy;
+                ex[d] = std::exp(-0.5 * dx2[d]), ey[d] = std::exp(-0.5 * dy2[d]);
+            }
+            for (int dj = 0; dj < 5; ++dj) {
+                const long long j = cy + dj - 2;
+                if (j < j0 || j > j1) continue;
+                for (int di = 0; di < 5; ++di) {
+                    const long long i = cx + di - 2;
+                    if (i < i0 || i > i1 || dx2[di] + dy2[dj] > 4.0) continue;
+                    const std::size_t k = std::size_t((j - j0) * ni + (i - i0));
+                    const double w = ex[di] * ey[dj];
+                    sums[k] += w * v.value;
+                    weights[k] += w;
+                }
+            }
         });
-        for (std::size_t c = 1; c < cellStart.size(); ++c) cellStart[c] += cellStart[c - 1];
-        std::vector<Sample> bodies(binned.size());
-        {
-            std::vector<std::size_t> next(cellStart.begin(), cellStart.end() - 1);
-            for (const auto& [c, b] : binned) bodies[next[std::size_t(c)]++] = b;
-        }
         std::vector<std::pair<Vec2, double>> fieldValues;  // mean velocity, confidence
         std::vector<double> mags;
-        for (Vec2 p : points) {
-            const long long ci = (long long)std::floor(p.x / s) - gx0, cj = (long long)std::floor(p.y / s) - gy0;
-            Vec2 sum;
-            double wsum = 0.0;
-            for (long long dj = -2; dj <= 2; ++dj)
-                for (long long di = -2; di <= 2; ++di) {
-                    const std::size_t c = std::size_t((cj + dj) * nx + ci + di);
-                    for (std::size_t k = cellStart[c]; k < cellStart[c + 1]; ++k) {
-                        const Sample& b = bodies[k];
-                        const double r2 = lengthSquared(b.p - p) / (s * s);
-                        if (r2 > 4.0) continue;
-                        const double w = std::exp(-0.5 * r2);
-                        sum += w * b.v;
-                        wsum += w;
-                    }
-                }
+        for (std::size_t k = 0; k < points.size(); ++k) {
+            const Vec2 sum = sums[k];
+            const double wsum = weights[k];
             if (wsum < 0.02) {
                 fieldValues.push_back({{}, 0.0});
                 continue;
@@ -662,9 +664,10 @@ void Builder::trails() {
         if (!thin.keep(toPx(t.points.back()), selected_.count(t.entity) != 0)) continue;
         const Rgba c = colourOf(scene_, t.entity, kDefaultBody);
         const std::size_t n = t.points.size();
-        Vec2 prev = toPx(t.points[0]);
+        auto it = t.points.begin();  // a deque: iterators, not an index (a division each)
+        Vec2 prev = toPx(*it);
         for (std::size_t k = 1; k < n; ++k) {
-            const Vec2 cur = toPx(t.points[k]);
+            const Vec2 cur = toPx(*++it);
             // Merge steps into segments at least 3 px long (8 px when
             // coarse; the newest one excepted): a 10,000-body scene draws
             // ~8 segments per trail instead of 47, and the curve looks the same.
@@ -916,10 +919,14 @@ void Builder::aabbOutlines() {
     }
     const int lw = x1 - x0, lh = y1 - y0;
     // Coverage of the boxes, composited "over" like the blend: all share one
-    // colour, so only alpha accumulates.
-    std::vector<float> alpha(std::size_t(lw) * std::size_t(lh), 0.0f);
-    const auto cover = [](float d) { return std::min(std::max(1.1f - std::abs(d), 0.0f), 1.0f) * kAabb.a; };
-    const auto over = [](float& dst, float a) { dst = a + dst * (1.0f - a); };
+    // colour, so only alpha accumulates, in 8 bits as in the framebuffer the
+    // quads would blend into (so overlaps round as they would there).
+    PixelLayer layer{lw, lh, {kAabb.r, kAabb.g, kAabb.b}, std::vector<std::uint8_t>(std::size_t(lw) * std::size_t(lh), 0)};
+    std::uint8_t* const alpha = layer.coverage.data();
+    const auto cover = [](float d) {
+        return int(std::min(std::max(1.1f - std::abs(d), 0.0f), 1.0f) * kAabb.a * 255.0f + 0.5f);
+    };
+    const auto over = [](std::uint8_t& dst, int a) { dst = std::uint8_t(a + (int(dst) * (255 - a) + 127) / 255); };
     for (const auto& [c, half] : shown) {
         // Only pixels whose centre is within 1.1 px of an edge's line can be
         // covered: bands of rows along the bottom and top edges and bands of
@@ -949,29 +956,23 @@ void Builder::aabbOutlines() {
                 for (int i = iLo; i <= iHi; ++i) over(alpha[std::size_t(j) * std::size_t(lw) + std::size_t(i)], exact(i, j));
             continue;
         }
-        float columnCover[2][4];  // the left and the right band's columns (at most 3 each)
+        int columnCover[2][4];  // the left and the right band's columns (at most 3 each)
         for (int i = l0; i <= l1; ++i) columnCover[0][i - l0] = cover(qxOf(i));
         for (int i = g0; i <= g1; ++i) columnCover[1][i - g0] = cover(qxOf(i));
         for (int j = jLo; j <= jHi; ++j) {
-            float* row = alpha.data() + std::size_t(j) * std::size_t(lw);
+            std::uint8_t* row = alpha + std::size_t(j) * std::size_t(lw);
             const bool edgeRow = j <= b1 || j >= t0;
             if (edgeRow) {
                 for (int i = iLo; i <= std::min(l1, lw - 1); ++i) over(row[i], exact(i, j));
-                const float a = cover(qyOf(j));
-                for (int i = std::max(l1 + 1, 0); i <= std::min(g0 - 1, lw - 1); ++i) over(row[i], a);
+                const int a = cover(qyOf(j));
+                if (a > 0)
+                    for (int i = std::max(l1 + 1, 0); i <= std::min(g0 - 1, lw - 1); ++i) over(row[i], a);
                 for (int i = std::max(g0, 0); i <= iHi; ++i) over(row[i], exact(i, j));
             } else {
                 for (int i = iLo; i <= std::min(l1, lw - 1); ++i) over(row[i], columnCover[0][i - l0]);
                 for (int i = std::max(g0, 0); i <= iHi; ++i) over(row[i], columnCover[1][i - g0]);
             }
         }
-    }
-    PixelLayer layer{lw, lh, std::vector<std::uint8_t>(alpha.size() * 4)};
-    const std::uint8_t r = std::uint8_t(kAabb.r * 255.0f + 0.5f), g = std::uint8_t(kAabb.g * 255.0f + 0.5f),
-                       b = std::uint8_t(kAabb.b * 255.0f + 0.5f);
-    for (std::size_t k = 0; k < alpha.size(); ++k) {
-        std::uint8_t* px = layer.rgba.data() + 4 * k;
-        px[0] = r, px[1] = g, px[2] = b, px[3] = std::uint8_t(alpha[k] * 255.0f + 0.5f);
     }
     push(batch(BatchKind::Image), {double(x0), double(y0), double(x1), double(y1), double(out_.images.size())});
     out_.images.push_back(std::move(layer));

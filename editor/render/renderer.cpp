@@ -261,8 +261,9 @@ void Renderer::draw(const DrawData& data, int originX, int originY) {
                     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
                     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
                     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-                    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, layer.width, layer.height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                                  layer.rgba.data());
+                    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_R8, layer.width, layer.height, 0, GL_RED, GL_UNSIGNED_BYTE,
+                                  layer.coverage.data());
+                    gl.Uniform3f(gl.GetUniformLocation(program, "uColour"), layer.colour[0], layer.colour[1], layer.colour[2]);
                     gl.DrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT,
                                     reinterpret_cast<const void*>(i * 6 * sizeof(GLuint)));
                     gl.BindTexture(GL_TEXTURE_2D, 0);
