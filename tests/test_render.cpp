@@ -296,31 +296,39 @@ TEST(RenderAabb, CrowdedOutlinesAreOneLayerWithTheBoxShadersCoverage) {
     EXPECT_EQ(int(layerBatch->data[3]) - y0, layer.height);
     ASSERT_EQ(layer.coverage.size(), std::size_t(layer.width) * std::size_t(layer.height));
     const auto alphaAt = [&](int x, int y) { return int(layer.coverage[std::size_t(y - y0) * std::size_t(layer.width) + std::size_t(x - x0)]); };
-    // The bottom-left circle: its box's left edge has no neighbour. Along it,
-    // box.frag's outline coverage clamp(1.1 - |d|) x 0.75 (d: the distance
-    // from the pixel centre to the box's edge), to the 8-bit rounding.
+    // Cells and outlines share the layer: an occupied cell of the grid (1 m
+    // here, twice the median extent) is a fill of alpha 0.06, 1 px in from
+    // the cell's sides, and the outlines are composited "over" it in 8 bits,
+    // as the quads would blend into the framebuffer.
+    const int cellFill = int(0.06 * 255.0 + 0.5);
+    const auto over = [](int dst, int a) { return a + (dst * (255 - a) + 127) / 255; };
+    // box.frag's outline coverage clamp(1.1 - |d|) x 0.75, d the distance
+    // from the pixel centre to the box's edge, to the 8-bit rounding.
+    const auto outline = [](double d) { return int(std::clamp(1.1 - d, 0.0, 1.0) * 0.75 * 255.0 + 0.5); };
+    // The bottom-left circle: its box's left edge (x = -0.25 m, inside the
+    // cell from -1 to 0 m) has no neighbour.
     const double ppm = input.camera.pixelsPerMetre(h);
     const Vec2 c = pixelOf(input, {0.0, 0.25}, w, h);
     const double half = 0.25 * ppm;
     const int y = int(std::floor(c.y));  // a row through the middle of the box
     for (int x = int(std::floor(c.x - half)) - 2; x <= int(std::floor(c.x - half)) + 2; ++x) {
         const double d = std::abs(std::abs(x + 0.5 - c.x) - half);
-        const double expected = std::clamp(1.1 - d, 0.0, 1.0) * 0.75 * 255.0;
-        EXPECT_NEAR(alphaAt(x, y), expected, 1.0) << "pixel " << x << ", " << y;
+        EXPECT_NEAR(alphaAt(x, y), over(cellFill, outline(d)), 1.0) << "pixel " << x << ", " << y;
     }
-    // Inside the box, away from its edges and from any neighbour's: nothing.
+    // Inside the box, away from its edges: the cell's fill alone ...
+    EXPECT_EQ(alphaAt(int(std::floor(pixelOf(input, {-0.125, 0.25}, w, h).x)), y), cellFill);
+    // ... and at its centre, x = 0 m, the 2 px gap between two cells: nothing.
     EXPECT_EQ(alphaAt(int(std::floor(c.x)), y), 0);
     // The layer is drawn in the overlay's colour (0x68d391).
     EXPECT_EQ(int(layer.colour[0] * 255.0f + 0.5f), 0x68);
     EXPECT_EQ(int(layer.colour[1] * 255.0f + 0.5f), 0xd3);
     EXPECT_EQ(int(layer.colour[2] * 255.0f + 0.5f), 0x91);
-    // Where two boxes' outlines meet, each covers the pixel and they are
-    // composited "over" in 8 bits, as the quads blend into the framebuffer:
-    // the shared edge of the two bottom-left boxes, at x = 0.25 m.
+    // Where two boxes' outlines meet, each covers the pixel, one over the
+    // other: the shared edge of the two bottom-left boxes, at x = 0.25 m.
     const double edge = pixelOf(input, {0.25, 0.25}, w, h).x;
     for (int x = int(std::floor(edge)) - 1; x <= int(std::floor(edge)) + 1; ++x) {
-        const int a = int(std::clamp(1.1 - std::abs(x + 0.5 - edge), 0.0, 1.0) * 0.75 * 255.0 + 0.5);
-        EXPECT_NEAR(alphaAt(x, y), a + (a * (255 - a) + 127) / 255, 1.0) << "pixel " << x << ", " << y;
+        const int a = outline(std::abs(x + 0.5 - edge));
+        EXPECT_NEAR(alphaAt(x, y), over(over(cellFill, a), a), 1.0) << "pixel " << x << ", " << y;
     }
     // Asked not to, the same frame draws one box quad per body.
     const DrawData quads = buildDrawData(input, w, h, BuildOptions{.pixelLayers = false});

@@ -53,6 +53,8 @@ constexpr double kPiD = 3.14159265358979323846;
 constexpr Rgba kAabb = rgb(0x68d391, 0.75f);
 constexpr Rgba kSelectionRing = rgb(0xffd166);  // the shaders' uHighlight (renderer.cpp)
 constexpr Rgba kAabbCell = rgb(0x68d391, 0.06f);
+// The overlay's layer (Builder::boundingBoxes) is one colour with alpha per pixel.
+static_assert(kAabbCell.r == kAabb.r && kAabbCell.g == kAabb.g && kAabbCell.b == kAabb.b);
 constexpr Rgba kText = rgb(0xd5dde8);
 constexpr Rgba kTextDim = rgb(0x8190a5);
 constexpr Rgba kPanel = rgb(0x0a0d12, 0.82f);
@@ -309,7 +311,6 @@ private:
     // ---- layers --------------------------------------------------------
     void grid();
     void planes();
-    void aabbCells();
     void attractorGlows();
     void fields();
     void trails();
@@ -318,7 +319,11 @@ private:
     void joints();
     void jointForces();
     void polygonPreview();
-    void aabbOutlines();
+    /// The aabb overlay: occupied grid cells, then each box's outline.
+    void boundingBoxes();
+    /// The occupied cells of the grid the overlay pictures, as whole-pixel
+    /// rectangles {x0, y0, x1, y1} (the cell 1 px in from each side).
+    std::vector<std::array<double, 4>> occupiedCells() const;
     void bodyArrows();
     void contacts();
     void hud();
@@ -431,7 +436,6 @@ void Builder::build() {
     };
     layer(&Builder::grid);
     layer(&Builder::planes);
-    if (in_.overlays.has(Overlay::Aabb)) layer(&Builder::aabbCells);
     layer(&Builder::attractorGlows);
     layer(&Builder::fields);
     if (in_.overlays.has(Overlay::Trails)) layer(&Builder::trails);
@@ -440,7 +444,7 @@ void Builder::build() {
     layer(&Builder::joints);
     if (in_.overlays.has(Overlay::Joints)) layer(&Builder::jointForces);
     if (!in_.polygonPreview.empty() || !in_.polygonClicks.empty()) layer(&Builder::polygonPreview);
-    if (in_.overlays.has(Overlay::Aabb)) layer(&Builder::aabbOutlines);
+    if (in_.overlays.has(Overlay::Aabb)) layer(&Builder::boundingBoxes);
     layer(&Builder::bodyArrows);
     if (in_.overlays.has(Overlay::Contacts)) layer(&Builder::contacts);
     if (in_.hud) layer(&Builder::hud);
@@ -494,7 +498,7 @@ void Builder::planes() {
     });
 }
 
-void Builder::aabbCells() {
+std::vector<std::array<double, 4>> Builder::occupiedCells() const {
     // The broad phase's uniform grid as the renderer pictures it: cells of
     // the 1-2-5 size just above twice the median shape extent, shaded where
     // a bounding box overlaps them. The engine's broad phase does not expose
@@ -508,7 +512,8 @@ void Builder::aabbCells() {
         boxes.emplace_back(shape->centre, shape->half);
         extents.push_back(2.0 * std::max(shape->half.x, shape->half.y));
     }
-    if (boxes.empty()) return;
+    std::vector<std::array<double, 4>> rects;
+    if (boxes.empty()) return rects;
     const double cell = niceCeil(2.0 * autoReference(extents));
     // The occupied cells, each once, in (x, y) order. Only cells on screen
     // are drawn, so they are marked in a bitmap over the image's cells
@@ -519,7 +524,7 @@ void Builder::aabbCells() {
     const long long nx = vx1 - vx0 + 1, ny = vy1 - vy0 + 1;
     // A cell is drawn 1 px in from each side: under 3 px there is nothing
     // left to draw (and the bitmap stays at most ~w*h/9 entries).
-    if (cell * ppm_ < 3.0 || nx <= 0 || ny <= 0) return;
+    if (cell * ppm_ < 3.0 || nx <= 0 || ny <= 0) return rects;
     std::vector<std::uint8_t> occupied(std::size_t(nx * ny), 0);
     for (const auto& [c, half] : boxes) {
         const long long x0 = (long long)std::floor((c.x - half.x) / cell), x1 = (long long)std::floor((c.x + half.x) / cell);
@@ -531,13 +536,12 @@ void Builder::aabbCells() {
     for (std::size_t k = 0; k < occupied.size(); ++k) {
         if (!occupied[k]) continue;
         const long long x = vx0 + (long long)k / ny, y = vy0 + (long long)k % ny;
-        // Axis-aligned, so plain triangles with whole-pixel edges, 1 px in
-        // from the cell's (a 2 px gap between neighbours) instead of a box
-        // quad and its distance shader.
+        // Whole-pixel edges, 1 px in from the cell's (a 2 px gap between neighbours).
         const Vec2 lo = toPx({double(x) * cell, double(y) * cell}), hi = toPx({double(x + 1) * cell, double(y + 1) * cell});
         if (!segmentVisible(lo, hi, 0.0)) continue;
-        rect(std::round(lo.x) + 1.0, std::round(lo.y) + 1.0, std::round(hi.x) - 1.0, std::round(hi.y) - 1.0, kAabbCell);
+        rects.push_back({std::round(lo.x) + 1.0, std::round(lo.y) + 1.0, std::round(hi.x) - 1.0, std::round(hi.y) - 1.0});
     }
+    return rects;
 }
 
 void Builder::attractorGlows() {
@@ -906,18 +910,27 @@ void Builder::polygonPreview() {
     for (const Vec2 v : in_.polygonClicks) disc(toPx(v), 3.5, 0.0, kSelectionRing, kFlat);
 }
 
-void Builder::aabbOutlines() {
-    // Each box is its outline at the box shader's anti-aliased edge
-    // (coverage clamp(1.1 - |d|), d the distance to the rectangle). Drawn
-    // as one quad per box, llvmpipe shades every 4x4-pixel block a quad
-    // touches, inside included, once per triangle: a settled pile of 2,000
-    // boxes 10 px wide is about 3 blocks per pixel of the pile. When that is
-    // more than twice the blocks of one layer over all the boxes, the
-    // outlines are drawn on the CPU into that layer instead (the same
-    // coverage, pixel for pixel) and the layer is drawn as one quad.
+void Builder::boundingBoxes() {
+    // The occupied cells, a faint fill, and each box's outline at the box
+    // shader's anti-aliased edge (coverage clamp(1.1 - |d|), d the distance
+    // to the rectangle), both over the bodies. Drawn as triangles and one
+    // quad per box, llvmpipe shades every 4x4-pixel block a triangle
+    // touches, once per triangle: a settled pile of 2,000 boxes 10 px wide
+    // is about 3 blocks per pixel of the pile for the outlines and one more
+    // for the cells. When that is more than twice the blocks of one layer
+    // over them all, cells and outlines are drawn on the CPU into that layer
+    // instead (the same coverage, pixel for pixel; they share one colour)
+    // and the layer is drawn as one quad.
+    const std::vector<std::array<double, 4>> cells = occupiedCells();
     std::vector<std::pair<Vec2, Vec2>> shown;  // centre, half extents, pixels
     Bounds area;
     double quadBlocks = 0.0;
+    for (const auto& [cx0, cy0, cx1, cy1] : cells) {
+        area.add({cx0, cy0});
+        area.add({cx1, cy1});
+        // Two triangles, each shading the blocks it touches (about 0.6 of the rectangle's and its diagonal).
+        quadBlocks += 1.2 * (std::floor((cx1 - cx0) / 4.0) + 2.0) * (std::floor((cy1 - cy0) / 4.0) + 2.0);
+    }
     for (Entity e : scene_.registry.entities()) {
         const auto shape = shapeBox(scene_, e);
         if (!shape) continue;
@@ -929,11 +942,14 @@ void Builder::aabbOutlines() {
         // The quad is the box plus 1.5 px (box.vert); each triangle shades the blocks it touches.
         quadBlocks += 1.5 * (std::floor((2.0 * half.x + 3.0) / 4.0) + 2.0) * (std::floor((2.0 * half.y + 3.0) / 4.0) + 2.0);
     }
-    if (shown.empty()) return;
+    if (shown.empty() && cells.empty()) return;
     const int x0 = std::max(0, int(std::floor(area.lo.x))), y0 = std::max(0, int(std::floor(area.lo.y)));
     const int x1 = std::min(w_, int(std::ceil(area.hi.x))), y1 = std::min(h_, int(std::ceil(area.hi.y)));
     const double layerBlocks = (std::floor(double(x1 - x0) / 4.0) + 2.0) * (std::floor(double(y1 - y0) / 4.0) + 2.0);
     if (x1 <= x0 || y1 <= y0 || 2.0 * layerBlocks >= quadBlocks || !options_.pixelLayers) {
+        // Axis-aligned cells: plain triangles with whole-pixel edges, not a
+        // box quad and its distance shader; drawn first, under the outlines.
+        for (const auto& [cx0, cy0, cx1, cy1] : cells) rect(cx0, cy0, cx1, cy1, kAabbCell);
         for (const auto& [c, half] : shown) box(c, half, 0.0, kAabb, kOutline);
         return;
     }
@@ -947,6 +963,13 @@ void Builder::aabbOutlines() {
         return int(std::min(std::max(1.1f - std::abs(d), 0.0f), 1.0f) * kAabb.a * 255.0f + 0.5f);
     };
     const auto over = [](std::uint8_t& dst, int a) { dst = std::uint8_t(a + (int(dst) * (255 - a) + 127) / 255); };
+    // The cells first (they do not overlap: a 2 px gap between neighbours).
+    const std::uint8_t cellAlpha = std::uint8_t(kAabbCell.a * 255.0f + 0.5f);
+    for (const auto& [cx0, cy0, cx1, cy1] : cells) {
+        const int i0 = std::max(int(cx0) - x0, 0), i1 = std::min(int(cx1) - x0, lw);
+        for (int j = std::max(int(cy0) - y0, 0); j < std::min(int(cy1) - y0, lh); ++j)
+            if (i1 > i0) std::fill(alpha + std::size_t(j) * std::size_t(lw) + i0, alpha + std::size_t(j) * std::size_t(lw) + i1, cellAlpha);
+    }
     for (const auto& [c, half] : shown) {
         // Only pixels whose centre is within 1.1 px of an edge's line can be
         // covered: bands of rows along the bottom and top edges and bands of
