@@ -466,4 +466,11 @@ TEST(ContactTable, FiltersByEitherNameAndSortsStablyByTheChosenColumn) {
     EXPECT_EQ(rows("", {true, ContactColumn::NormalImpulse, true}), (V{3, 0, 2, 1}));
     EXPECT_EQ(rows("", {true, ContactColumn::NormalY, false}), (V{1, 2, 0, 3}));  // -1, 0, then the two 1s in step order
     EXPECT_EQ(rows("c1", {true, ContactColumn::TangentImpulse, false}), (V{2, 1}));
+    // Two bodies with one name sort as equals: their rows keep step order.
+    const Entity twin = reg.create();
+    reg.emplace<Name>(twin, Name{"c2"});
+    contacts.push_back({twin, wall, {2.0, 0.0}, {0.0, 1.0}, 0.003, 0.5, 0.0});
+    contacts.push_back({c2, c10, {3.0, 0.0}, {1.0, 0.0}, 0.004, 0.7, 0.0});
+    EXPECT_EQ(rows("", {true, ContactColumn::A, false}), (V{1, 0, 2, 4, 5, 3}));
+    EXPECT_EQ(rows("", {true, ContactColumn::A, true}), (V{3, 0, 2, 4, 5, 1}));
 }
