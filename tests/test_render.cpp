@@ -10,6 +10,7 @@
 
 #include <optional>
 #include <set>
+#include <stdexcept>
 
 using namespace stepwise;
 using namespace stepwise::render;
@@ -390,6 +391,45 @@ TEST(RenderFields, VelocityFieldIsTheGaussianWeightedMeanOfTheBodiesNearASample)
     // Beyond two spacings of every body, no sample has a value: no arrow.
     EXPECT_EQ(arrowCentredAt(320.0 + 4.5 * 24.0, 240.0 + 4.5 * 24.0), nullptr);
     EXPECT_EQ(arrowCentredAt(320.0 - 3.5 * 24.0, 240.0 + 0.5 * 24.0), nullptr);
+}
+
+TEST(RenderTrails, ATrailThatIsOnePointIsKnownAsOneAndDrawsNothing) {
+    // Capacity 4. A body that moves, then stops: its trail is one point
+    // once all four recorded positions are equal, not before.
+    Scene scene;
+    const Entity mover = scene.registry.create();
+    scene.registry.emplace<Position>(mover, {{0.0, 0.0}});
+    const Entity still = scene.registry.create();
+    scene.registry.emplace<Position>(still, {{2.0, 0.0}});
+    TrailRecorder trails(4);
+    const auto trailOf = [&](Entity e) -> const TrailRecorder::Trail& {
+        for (const TrailRecorder::Trail& t : trails.trails())
+            if (t.entity == e) return t;
+        throw std::runtime_error("no trail");
+    };
+    trails.record(scene);
+    scene.registry.tryGet<Position>(mover)->value = {1.0, 0.0};
+    for (int k = 0; k < 3; ++k) trails.record(scene);
+    EXPECT_EQ(trailOf(mover).points.size(), 4u);
+    EXPECT_FALSE(trailOf(mover).isPoint()) << "the first point is elsewhere";
+    EXPECT_TRUE(trailOf(still).isPoint());
+    // Drawn, the moving trail has its segment and the still one none.
+    FrameInput input;
+    input.scene = &scene;
+    input.camera = Camera{{1.0, 0.0}, 100.0};
+    input.overlays = *parseOverlayList("trails");
+    input.trails = &trails;
+    input.hud = false;
+    EXPECT_EQ(countOf(buildDrawData(input, 640, 480), BatchKind::Segment), 1u);
+    trails.record(scene);  // the move leaves the window of four
+    EXPECT_TRUE(trailOf(mover).isPoint());
+    EXPECT_EQ(trailOf(mover).points.size(), 4u);
+    EXPECT_EQ(countOf(buildDrawData(input, 640, 480), BatchKind::Segment), 0u);
+    // Moving again starts a line.
+    scene.registry.tryGet<Position>(mover)->value = {1.5, 0.0};
+    trails.record(scene);
+    EXPECT_FALSE(trailOf(mover).isPoint());
+    EXPECT_EQ(countOf(buildDrawData(input, 640, 480), BatchKind::Segment), 1u);
 }
 
 TEST(RenderBatching, SameInputSameFloats) {

@@ -686,6 +686,7 @@ void Builder::trails() {
     for (const TrailRecorder::Trail& t : in_.trails->trails()) {
         if (t.points.size() < 2 || !scene_.registry.alive(t.entity)) continue;
         if (!thin.keep(toPx(t.points.back()), selected_.count(t.entity) != 0)) continue;
+        if (t.isPoint()) continue;  // every segment would be empty (a settled pile: all of them)
         const Rgba c = colourOf(scene_, t.entity, kDefaultBody);
         const std::size_t n = t.points.size();
         auto it = t.points.begin();  // a deque: iterators, not an index (a division each)

@@ -17,11 +17,15 @@ TrailRecorder::Trail& TrailRecorder::trailFor(Entity e) {
     return trails_[slot - 1];
 }
 
+void TrailRecorder::append(Trail& t, Vec2 p) const {
+    t.repeats = !t.points.empty() && t.points.back() == p ? t.repeats + 1 : 0;
+    t.points.push_back(p);
+    if (t.points.size() > capacity_) t.points.pop_front();
+}
+
 void TrailRecorder::record(const World& world) {
     for (std::size_t i = 0; i < world.bodyCount(); ++i) {
-        Trail& t = trailFor(world.bodyEntity(i));
-        t.points.push_back(world.bodyPosition(i));
-        if (t.points.size() > capacity_) t.points.pop_front();
+        append(trailFor(world.bodyEntity(i)), world.bodyPosition(i));
     }
 }
 
@@ -29,9 +33,7 @@ void TrailRecorder::record(const Scene& scene) {
     for (Entity e : scene.registry.entities()) {
         const Position* p = scene.registry.tryGet<Position>(e);
         if (!p || isStatic(scene, e) || scene.registry.has<Spring>(e)) continue;
-        Trail& t = trailFor(e);
-        t.points.push_back(p->value);
-        if (t.points.size() > capacity_) t.points.pop_front();
+        append(trailFor(e), p->value);
     }
 }
 

@@ -29,12 +29,18 @@ public:
     struct Trail {
         Entity entity;
         std::deque<Vec2> points;  ///< oldest first, metres
+        /// How many of the newest points equal the point before them. At
+        /// points.size() - 1 the trail is one point (a body asleep all that
+        /// time): nothing to draw, and no need to walk it.
+        std::size_t repeats = 0;
+        bool isPoint() const { return points.empty() || repeats + 1 >= points.size(); }
     };
     const std::vector<Trail>& trails() const { return trails_; }
     std::size_t capacity() const { return capacity_; }
 
 private:
     Trail& trailFor(Entity e);
+    void append(Trail& t, Vec2 p) const;
     std::size_t capacity_;
     std::vector<Trail> trails_;
     std::vector<std::uint32_t> slotOfIndex_;  // entity index -> trails_ slot + 1 (0: none)
