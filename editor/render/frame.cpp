@@ -322,8 +322,9 @@ private:
     /// The aabb overlay: occupied grid cells, then each box's outline.
     void boundingBoxes();
     /// The occupied cells of the grid the overlay pictures, as whole-pixel
-    /// rectangles {x0, y0, x1, y1} (the cell 1 px in from each side).
-    std::vector<std::array<double, 4>> occupiedCells() const;
+    /// rectangles {x0, y0, x1, y1} (the cell 1 px in from each side), from
+    /// every shape's bounding box (metres).
+    std::vector<std::array<double, 4>> occupiedCells(const std::vector<ShapeBox>& boxes) const;
     void bodyArrows();
     void contacts();
     void hud();
@@ -498,20 +499,15 @@ void Builder::planes() {
     });
 }
 
-std::vector<std::array<double, 4>> Builder::occupiedCells() const {
+std::vector<std::array<double, 4>> Builder::occupiedCells(const std::vector<ShapeBox>& boxes) const {
     // The broad phase's uniform grid as the renderer pictures it: cells of
     // the 1-2-5 size just above twice the median shape extent, shaded where
     // a bounding box overlaps them. The engine's broad phase does not expose
     // its cells (and below 512 shapes it sweeps and prunes instead of using
     // a grid), so this is the renderer's own picture of bounding-box density.
-    std::vector<std::pair<Vec2, Vec2>> boxes;  // centre, half extents (metres)
     std::vector<double> extents;
-    for (Entity e : scene_.registry.entities()) {
-        const auto shape = shapeBox(scene_, e);
-        if (!shape) continue;
-        boxes.emplace_back(shape->centre, shape->half);
-        extents.push_back(2.0 * std::max(shape->half.x, shape->half.y));
-    }
+    extents.reserve(boxes.size());
+    for (const auto& [c, half] : boxes) extents.push_back(2.0 * std::max(half.x, half.y));
     std::vector<std::array<double, 4>> rects;
     if (boxes.empty()) return rects;
     const double cell = niceCeil(2.0 * autoReference(extents));
@@ -922,7 +918,10 @@ void Builder::boundingBoxes() {
     // over them all, cells and outlines are drawn on the CPU into that layer
     // instead (the same coverage, pixel for pixel; they share one colour)
     // and the layer is drawn as one quad.
-    const std::vector<std::array<double, 4>> cells = occupiedCells();
+    std::vector<ShapeBox> boxes;  // metres
+    for (Entity e : scene_.registry.entities())
+        if (const auto shape = shapeBox(scene_, e)) boxes.push_back(*shape);
+    const std::vector<std::array<double, 4>> cells = occupiedCells(boxes);
     std::vector<std::pair<Vec2, Vec2>> shown;  // centre, half extents, pixels
     Bounds area;
     double quadBlocks = 0.0;
@@ -932,10 +931,8 @@ void Builder::boundingBoxes() {
         // Two triangles, each shading the blocks it touches (about 0.6 of the rectangle's and its diagonal).
         quadBlocks += 1.2 * (std::floor((cx1 - cx0) / 4.0) + 2.0) * (std::floor((cy1 - cy0) / 4.0) + 2.0);
     }
-    for (Entity e : scene_.registry.entities()) {
-        const auto shape = shapeBox(scene_, e);
-        if (!shape) continue;
-        const Vec2 c = toPx(shape->centre), half = shape->half * ppm_;
+    for (const ShapeBox& shape : boxes) {
+        const Vec2 c = toPx(shape.centre), half = shape.half * ppm_;
         if (!visible(c, std::hypot(half.x, half.y) + 8)) continue;
         shown.emplace_back(c, half);
         area.add(c - half - Vec2{2.0, 2.0});
