@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
-#include <utility>
 
 namespace stepwise::render {
 
@@ -27,31 +26,33 @@ struct Attribute {
     GLint components;
 };
 
-/// Instance (or vertex) layout of each batch kind, matching frame.cpp's
-/// push order and the shaders' `layout(location = N)`.
-/// Copies each of `count` records of `stride` floats four times (one per
-/// quad corner). The size is a constant per kind so each copy compiles to
-/// a few vector moves: memcpy with a run-time size of a few dozen bytes is
-/// a library call per corner (46,000 a frame in the editor's bench), which
-/// cost more than the copying.
+/// Copies each of `count` records of `Stride` floats four times, one per
+/// quad corner. A size fixed at compile time makes each copy a few vector
+/// moves; memcpy with a run-time size of a few dozen bytes is a library
+/// call per corner (46,000 a frame in the editor's bench), which cost more
+/// than the copying.
 template <std::size_t Stride>
-void expandFixed(const float* src, float* dst, std::size_t count) {
+void expandToCorners(const float* src, float* dst, std::size_t count) {
     for (std::size_t i = 0; i < count; ++i, src += Stride)
         for (int v = 0; v < 4; ++v, dst += Stride) std::memcpy(dst, src, Stride * sizeof(float));
 }
 
-template <std::size_t... Strides>
-void expandToCorners(const float* src, float* dst, std::size_t count, std::size_t stride, std::index_sequence<Strides...>) {
-    const bool fixed = ((stride == Strides + 1 ? (expandFixed<Strides + 1>(src, dst, count), true) : false) || ...);
-    if (fixed) return;
+/// expandToCorners for each kind's record size (floatsPerInstance).
+void expandToCorners(BatchKind kind, const float* src, float* dst, std::size_t count) {
+    switch (floatsPerInstance(kind)) {
+    case 5: return expandToCorners<5>(src, dst, count);
+    case 9: return expandToCorners<9>(src, dst, count);
+    case 11: return expandToCorners<11>(src, dst, count);
+    case 12: return expandToCorners<12>(src, dst, count);
+    default: break;
+    }
+    const std::size_t stride = floatsPerInstance(kind);
     for (std::size_t i = 0; i < count; ++i, src += stride)
         for (int v = 0; v < 4; ++v, dst += stride) std::memcpy(dst, src, stride * sizeof(float));
 }
 
-void expandToCorners(const float* src, float* dst, std::size_t count, std::size_t stride) {
-    expandToCorners(src, dst, count, stride, std::make_index_sequence<16>{});
-}
-
+/// Instance (or vertex) layout of each batch kind, matching frame.cpp's
+/// push order and the shaders' `layout(location = N)`.
 std::vector<Attribute> layoutOf(BatchKind kind) {
     switch (kind) {
     case BatchKind::Plane: return {{0, 2}, {1, 1}, {2, 4}, {3, 1}, {4, 4}};
@@ -254,7 +255,7 @@ void Renderer::draw(const DrawData& data, int originX, int originY) {
             const std::size_t stride = floatsPerInstance(batch.kind);
             im.expanded.resize(count * 4 * stride);
             float* dst = im.expanded.data();
-            expandToCorners(batch.data.data(), dst, count, stride);
+            expandToCorners(batch.kind, batch.data.data(), dst, count);
             im.ensureQuadIndices(count);
             gl.BindVertexArray(st.vao);
             gl.BindBuffer(GL_ARRAY_BUFFER, st.vbo);
