@@ -59,6 +59,14 @@ if has asan; then
   export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1"
   export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
   export LSAN_OPTIONS="suppressions=$root/tests/sanitizer-suppressions/lsan.supp:print_suppressions=0"
+  # ctest starts the tests it knows to be long first (its cost data, written
+  # by each run); the asan build has none yet, so it borrows the release
+  # run's: same test names, and the long ones are long in both. Without it
+  # the longest tests start last and run alone at the end.
+  if [[ -f build/Testing/Temporary/CTestCostData.txt && ! -f build-asan/Testing/Temporary/CTestCostData.txt ]]; then
+    mkdir -p build-asan/Testing/Temporary
+    cp build/Testing/Temporary/CTestCostData.txt build-asan/Testing/Temporary/
+  fi
   timed asan-ctest ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 900 "$@"
   unset ASAN_OPTIONS UBSAN_OPTIONS LSAN_OPTIONS
 fi

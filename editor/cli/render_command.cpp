@@ -83,7 +83,7 @@ void progress(int done, int total) {
     std::fflush(stderr);
 }
 
-std::string number(double v) {
+std::string shortNumber(double v) {
     char buffer[32];
     std::snprintf(buffer, sizeof buffer, "%g", v);
     return buffer;
@@ -219,7 +219,7 @@ int render(const RenderOptions& o) {
         }
         if (world) world->writeBack(*scene);
         input.caption = o.noCaption ? std::string()
-                                    : levelName + "  |  t = " + number(scene->world.time) + " s  |  step " +
+                                    : levelName + "  |  t = " + shortNumber(scene->world.time) + " s  |  step " +
                                           std::to_string(stepsTaken) + "  |  " + scene->world.integrator;
 
         const auto start = std::chrono::steady_clock::now();
@@ -251,7 +251,7 @@ int render(const RenderOptions& o) {
     std::cout << "wrote " << (o.frames == 1 ? o.out : frameName(o.out, 0, o.frames) + " .. " +
                                                           frameName(o.out, o.frames - 1, o.frames))
               << " (" << o.width << "x" << o.height << ", " << stepsTaken << " steps, " << instances
-              << " instances, " << number(renderMs / o.frames) << " ms/frame)\n";
+              << " instances, " << shortNumber(renderMs / o.frames) << " ms/frame)\n";
     return kExitOk;
 }
 
