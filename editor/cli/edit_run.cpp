@@ -11,10 +11,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <numeric>
 #include <sstream>
-
-#include <ctime>
 
 namespace stepwise::cli {
 
