@@ -11,6 +11,7 @@
 #include "collision/contact_solver.hpp"
 #include "collision/frozen_boxes.hpp"
 #include "collision/narrow_phase.hpp"
+#include "collision/position_correction.hpp"
 #include "joints/joint_solver.hpp"
 
 #include "stepwise/entity.hpp"
@@ -170,6 +171,11 @@ public:
     double maxExtent(std::size_t i) const { return maxExtent_[i]; }
 
 private:
+    /// After the step's last substep: positions out of overlap beyond the
+    /// slop (position_correction.hpp), written back to `x` and the angles.
+    void correctStepPositions(std::span<Vec2> x);
+    /// Adds the bodies of deeply overlapping moving pairs to crowdBodies_.
+    void addDeepOverlapsToCrowd();
 
     void addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m, std::span<const Vec2> centres);
     /// Broad phase while some bodies sleep: the awake boxes among themselves
@@ -252,6 +258,11 @@ private:
     CollisionTimings timings_;
     double dt_ = 0.0;
     int substeps_ = 1;
+    std::vector<std::uint8_t> inCrowd_;  // per solver body: in crowdBodies_
+    std::vector<double> crowdImpulses_;  // every contact's impulses after the warm start, while a crowd is solved
+    int substepsDone_ = 0;  // of this step, counted by solveSubstep
+    PositionCorrectionSettings positionCorrection_;
+    PositionCorrectionScratch positionScratch_;
 };
 
 } // namespace stepwise::collision

@@ -168,19 +168,33 @@ template <int Points, bool UseBias>
     const D4 biasRate = isStatic ? splat(args.staticSoft.biasRate) : splat(args.soft.biasRate);
     const D4 massScale = isStatic ? splat(args.staticSoft.massScale) : splat(args.soft.massScale);
     const D4 impulseScale = isStatic ? splat(args.staticSoft.impulseScale) : splat(args.soft.impulseScale);
+    const D4 rigidDepth = isStatic ? splat(args.staticSoft.rigidDepth) : splat(args.soft.rigidDepth);
     const D4 baseGap = (b.dpx - a.dpx) * nx + (b.dpy - a.dpy) * ny;
     const D4 zero = splat(0.0), one = splat(1.0);
+    const M4 roundA = loadMask(c.roundA), roundB = loadMask(c.roundB);
+    const D4 qcA = roundA ? one : a.qc, qsA = roundA ? zero : a.qs;
+    const D4 qcB = roundB ? one : b.qc, qsB = roundB ? zero : b.qs;
     Target t[2];
     for (int i = 0; i < Points; ++i) {
         const PointLanes& p = c.points[i];
-        const D4 separation = ((baseGap + (b.qc * load(p.dnB) + b.qs * load(p.rnB))) -
-                               (a.qc * load(p.dnA) + a.qs * load(p.rnA))) +
+        const D4 separation = ((baseGap + (qcB * load(p.dnB) + qsB * load(p.rnB))) -
+                               (qcA * load(p.dnA) + qsA * load(p.rnA))) +
                               load(p.adjustedSeparation);
         const M4 apart = separation > zero;
         const D4 speculative = separation * splat(args.invH);
         if constexpr (UseBias) {
+            // Rigid past rigidDepth, or when the approach would carry the
+            // point past twice that within this substep (solveContacts says
+            // why).
+            const D4 vn = (((v.vBx - v.vAx) * nx + (v.vBy - v.vAy) * ny) + v.wB * load(p.rnB)) - v.wA * load(p.rnA);
+            const M4 rigid =
+                !(separation > -rigidDepth) | !((separation + vn / splat(args.invH)) > -(rigidDepth + rigidDepth));
+            const D4 toDepth = separation + rigidDepth;
+            const D4 rigidBias = toDepth > zero ? toDepth * splat(args.invH)
+                                                : maxOf(biasRate * toDepth, splat(-args.pushMaxVelocity));
             const D4 push = maxOf(biasRate * separation, splat(-args.pushMaxVelocity));
-            t[i] = {apart ? speculative : push, apart ? one : massScale, apart ? zero : impulseScale};
+            t[i] = {apart ? speculative : (rigid ? rigidBias : push), apart ? one : (rigid ? one : massScale),
+                    apart ? zero : (rigid ? zero : impulseScale)};
         } else {
             t[i] = {apart ? speculative : zero, one, zero};
         }
@@ -338,6 +352,8 @@ void fillLane(ContactBundle<Points>& bundle, int lane, const ContactConstraint& 
     bundle.invInertiaB[lane] = b.invInertia;
     bundle.touchesStatic[lane] = c.touchesStatic ? -1 : 0;
     bundle.block[lane] = c.block ? -1 : 0;
+    bundle.roundA[lane] = c.roundA ? -1 : 0;
+    bundle.roundB[lane] = c.roundB ? -1 : 0;
     bundle.k11[lane] = c.blockMass.k11;
     bundle.k12[lane] = c.blockMass.k12;
     bundle.k22[lane] = c.blockMass.k22;
@@ -373,6 +389,17 @@ void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32
         fillLane(out[first + k / kContactLanes], int(k % kContactLanes), contacts[order[k]], order[k], bodies);
     for (std::size_t k = order.size(); k < count * kContactLanes; ++k)
         out[first + k / kContactLanes].source[k % kContactLanes] = ~0u;
+}
+
+/// Visits each used lane's impulses as (bodyA, bodyB, normal, tangent).
+template <int Points, typename Bundles, typename Visit>
+void forEachLane(Bundles& bundles, Visit&& visit) {
+    for (auto& b : bundles)
+        for (int l = 0; l < kContactLanes; ++l) {
+            if (b.source[l] == ~0u) continue;
+            for (int i = 0; i < Points; ++i)
+                visit(b.bodyA[l], b.bodyB[l], b.points[i].normalImpulse[l], b.points[i].tangentImpulse[l]);
+        }
 }
 
 template <int Points>
@@ -509,6 +536,39 @@ void ColouredContacts::solve(std::span<ContactConstraint> contacts, std::span<So
         kernel(args);
     }
     if (!reverse) solveOverflow();
+}
+
+void ColouredContacts::saveImpulses(std::span<const ContactConstraint> contacts, std::vector<double>& out) const {
+    out.clear();
+    const auto save = [&](std::uint32_t, std::uint32_t, double normal, double tangent) {
+        out.push_back(normal);
+        out.push_back(tangent);
+    };
+    if (simd_) {
+        forEachLane<1>(one_, save);
+        forEachLane<2>(two_, save);
+    }
+    for (const ContactConstraint& c : contacts)
+        for (int i = 0; i < c.pointCount; ++i) save(c.bodyA, c.bodyB, c.points[i].normalImpulse, c.points[i].tangentImpulse);
+}
+
+void ColouredContacts::restoreImpulses(std::span<ContactConstraint> contacts, std::span<const std::uint8_t> marked,
+                                       std::span<const double> saved) {
+    std::size_t at = 0;
+    const auto restore = [&](std::uint32_t a, std::uint32_t b, double& normal, double& tangent) {
+        if (marked[a] || marked[b]) {
+            normal = saved[at];
+            tangent = saved[at + 1];
+        }
+        at += 2;
+    };
+    if (simd_) {
+        forEachLane<1>(one_, restore);
+        forEachLane<2>(two_, restore);
+    }
+    // The scalar path and the overflow keep their impulses in the contacts.
+    for (ContactConstraint& c : contacts)
+        for (int i = 0; i < c.pointCount; ++i) restore(c.bodyA, c.bodyB, c.points[i].normalImpulse, c.points[i].tangentImpulse);
 }
 
 void ColouredContacts::storeImpulses(std::span<ContactConstraint> contacts) const {

@@ -55,6 +55,8 @@ struct ContactBundle {
     alignas(32) double invMassB[kContactLanes], invInertiaB[kContactLanes];
     alignas(32) std::int64_t touchesStatic[kContactLanes];  ///< all bits set or clear
     alignas(32) std::int64_t block[kContactLanes];          ///< all bits set or clear (two points only)
+    /// ContactConstraint::roundA, roundB: all bits set or clear.
+    alignas(32) std::int64_t roundA[kContactLanes], roundB[kContactLanes];
     /// The block solve's K and its inverse (BlockMass), two points only.
     alignas(32) double k11[kContactLanes], k12[kContactLanes], k22[kContactLanes];
     alignas(32) double i11[kContactLanes], i12[kContactLanes], i22[kContactLanes];
@@ -76,6 +78,13 @@ public:
                const Softness& staticSoft, double pushMaxVelocity, bool useBias, bool reverse);
     /// Copies the bundles' impulses back to the contacts (warm starting, records).
     void storeImpulses(std::span<ContactConstraint> contacts) const;
+    /// Every contact's accumulated (normal, tangent) impulses, in the order
+    /// the bundles and then `contacts` hold them.
+    void saveImpulses(std::span<const ContactConstraint> contacts, std::vector<double>& out) const;
+    /// Puts back what saveImpulses saved, for the contacts that have a body
+    /// with `marked[body]` set.
+    void restoreImpulses(std::span<ContactConstraint> contacts, std::span<const std::uint8_t> marked,
+                         std::span<const double> saved);
 
     /// Contact indices colour by colour, then the overflow: the order both
     /// paths solve in.

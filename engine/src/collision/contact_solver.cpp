@@ -1,5 +1,7 @@
 #include "collision/contact_solver.hpp"
 
+#include "collision/position_correction.hpp"  // currentSeparation
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -29,13 +31,6 @@ inline void applyImpulse(SolverBody& a, SolverBody& b, Vec2 dir, double armA, do
 inline double effectiveMass(const SolverBody& a, const SolverBody& b, double armA, double armB) {
     const double k = a.invMass + b.invMass + a.invInertia * armA * armA + b.invInertia * armB * armB;
     return k > 0.0 ? 1.0 / k : 0.0;
-}
-/// Separation now: the step-start value plus the bodies' motion since, with
-/// the anchors turned by each body's rotation so far: dot(rotate(q, r), n) =
-/// q.c dn + q.s rn.
-inline double currentSeparation(const SolverBody& a, const SolverBody& b, Vec2 n, const ContactPoint& p) {
-    return dot(b.dp - a.dp, n) + (b.dq.c * p.dnB + b.dq.s * p.rnB) - (a.dq.c * p.dnA + a.dq.s * p.rnA) +
-           p.adjustedSeparation;
 }
 } // namespace
 
@@ -176,7 +171,7 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
                     const ContactPoint& p = c.points[i];
                     const double vn = normalSpeed(a, b, c.normal, p.rnA, p.rnB);
                     if (vn >= -threshold) continue;  // resting contacts leave here
-                    const double separation = currentSeparation(a, b, c.normal, p);
+                    const double separation = currentSeparation(a, b, c, p);
                     if (separation + vn * h < kSlop) {
                         rnA += p.rnA;
                         rnB += p.rnB;
@@ -253,12 +248,27 @@ void solveContacts(std::span<ContactConstraint> contacts, std::span<const std::u
         struct Target {
             double bias = 0.0, massScale = 1.0, impulseScale = 0.0;
         };
+        const Rot qA = c.roundA ? Rot{} : a.dq, qB = c.roundB ? Rot{} : b.dq;
         const auto targetOf = [&](const ContactPoint& p) {
-            const double separation = baseGap + (b.dq.c * p.dnB + b.dq.s * p.rnB) -
-                                      (a.dq.c * p.dnA + a.dq.s * p.rnA) + p.adjustedSeparation;
+            const double separation =
+                baseGap + (qB.c * p.dnB + qB.s * p.rnB) - (qA.c * p.dnA + qA.s * p.rnA) + p.adjustedSeparation;
             Target t;
             if (separation > 0.0) {
                 t.bias = separation * invH;
+            } else if (useBias &&
+                       (!(separation > -s.rigidDepth) ||
+                        !((separation + (dot(vB - vA, n) + wB * p.rnB - wA * p.rnA) / invH) >
+                          -(s.rigidDepth + s.rigidDepth)))) {
+                // Past rigidDepth, or an approach that would carry the point
+                // past twice that within this substep: a soft contact lets a
+                // few percent of the approach through (8 m in one substep at
+                // 10^6 m/s^2), so it turns rigid, closing at most to that
+                // depth and pushing out only what lies past it. (Twice: a
+                // resting point near the depth, approaching at g h, would
+                // otherwise switch between soft and rigid every substep and
+                // never sleep.)
+                const double toDepth = separation + s.rigidDepth;
+                t.bias = toDepth > 0.0 ? toDepth * invH : std::max(s.biasRate * toDepth, -pushMaxVelocity);
             } else if (useBias) {
                 t.bias = std::max(s.biasRate * separation, -pushMaxVelocity);
                 t.massScale = s.massScale;

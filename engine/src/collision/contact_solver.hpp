@@ -8,6 +8,7 @@
 #include "collision/collision_types.hpp"
 
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -33,6 +34,13 @@ struct Softness {
     double biasRate = 0.0;    ///< 1/s
     double massScale = 1.0;
     double impulseScale = 0.0;
+    /// Overlap (m) that the contact may reach softly: a point whose approach
+    /// would carry it past this depth within the substep, or that is past
+    /// it, is solved rigidly (no mass scaling, no impulse leak), closing at
+    /// most to this depth and pushing out only what lies past it. A soft
+    /// contact under a steady load settles at load / (m omega^2), however
+    /// deep; this bounds it. Infinite: always soft.
+    double rigidDepth = std::numeric_limits<double>::infinity();
     static Softness make(double hertz, double dampingRatio, double h);
 };
 
@@ -65,6 +73,13 @@ struct ContactConstraint {
     double friction = 0.0;
     std::int32_t pointCount = 0;
     bool touchesStatic = false;
+    /// A side whose surface is round about its centre (a circle): turning
+    /// it slides the contact point along the surface and leaves the gap as
+    /// it was, so the current separation ignores that side's rotation. With
+    /// the rotated step-start anchor instead, a disc spinning at 20 rad/s
+    /// would lift its contact 2.7 cm off the floor within one 1/60 s step,
+    /// read as a gap: no normal impulse, so no friction.
+    bool roundA = false, roundB = false;
     /// Two points whose normal impulses are solved together (K well
     /// conditioned); otherwise the points are solved one after the other.
     bool block = false;

@@ -1,0 +1,107 @@
+#include "collision/position_correction.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace stepwise::collision {
+
+namespace {
+inline Rot turnedBy(Rot q, double angle) {
+    const Rot r = Rot::fromAngle(angle);
+    return {q.c * r.c - q.s * r.s, q.s * r.c + q.c * r.s};
+}
+} // namespace
+
+double currentSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c, const ContactPoint& p) {
+    // A round side turns under its contact point (ContactConstraint::roundA).
+    const Rot qA = c.roundA ? Rot{} : a.dq, qB = c.roundB ? Rot{} : b.dq;
+    return dot(b.dp - a.dp, c.normal) + (qB.c * p.dnB + qB.s * p.rnB) - (qA.c * p.dnA + qA.s * p.rnA) +
+           p.adjustedSeparation;
+}
+
+bool correctPositions(std::span<const ContactConstraint> contacts, std::span<SolverBody> bodies,
+                      std::span<const std::uint8_t> crowd, const PositionCorrectionSettings& settings,
+                      PositionCorrectionScratch& scratch) {
+    const auto deepest = [&](const ContactConstraint& c) {
+        const SolverBody& a = bodies[c.bodyA];
+        const SolverBody& b = bodies[c.bodyB];
+        double s = currentSeparation(a, b, c, c.points[0]);
+        if (c.pointCount == 2) s = std::min(s, currentSeparation(a, b, c, c.points[1]));
+        return s;
+    };
+    // Moving pairs past the slop; static contacts that touch at all (the
+    // moving pass may push one of them deeper).
+    scratch.deepMoving.clear();
+    scratch.touchingStatic.clear();
+    bool any = false;  // a point this pass will move
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+        const double s = deepest(contacts[k]);
+        if (contacts[k].touchesStatic) {
+            if (s < 0.0) scratch.touchingStatic.push_back(std::uint32_t(k));
+            any = any || s < -settings.slop;
+        } else if (s < -settings.slop &&
+                   (crowd.empty() || crowd[contacts[k].bodyA] || crowd[contacts[k].bodyB])) {
+            scratch.deepMoving.push_back(std::uint32_t(k));
+            any = true;
+        }
+    }
+    if (!any) return false;
+
+    scratch.turned.assign(bodies.size(), 0.0);
+    scratch.moved.assign(bodies.size(), 0);
+    // Pushes contact k's points out to `fraction` of their excess past the
+    // slop, at most `cap` metres each; returns the deepest excess found.
+    const auto correct = [&](const ContactConstraint& c, double fraction, double cap) {
+        SolverBody& a = bodies[c.bodyA];
+        SolverBody& b = bodies[c.bodyB];
+        const Vec2 n = c.normal;
+        double worst = 0.0;
+        for (int i = 0; i < c.pointCount; ++i) {
+            const ContactPoint& p = c.points[i];
+            const double excess = currentSeparation(a, b, c, p) + settings.slop;  // < 0: too deep
+            if (excess >= 0.0) continue;
+            worst = std::min(worst, excess);
+            const double move = std::min(-fraction * excess, cap);
+            const double turning = std::min(move, settings.maxTurningCorrection);
+            const double inverseMass =
+                a.invMass + b.invMass + a.invInertia * p.rnA * p.rnA + b.invInertia * p.rnB * p.rnB;
+            const double linearMass = a.invMass + b.invMass;
+            if (inverseMass <= 0.0 || linearMass <= 0.0) continue;
+            const double impulse = turning / inverseMass;  // kg m: a position impulse
+            const double push = (move - turning) / linearMass;  // the rest, without turning
+            scratch.moved[c.bodyA] = 1;
+            scratch.moved[c.bodyB] = 1;
+            a.dp -= (a.invMass * (impulse + push)) * n;
+            b.dp += (b.invMass * (impulse + push)) * n;
+            const double turnA = -a.invInertia * p.rnA * impulse, turnB = b.invInertia * p.rnB * impulse;
+            if (turnA != 0.0) {
+                a.dq = turnedBy(a.dq, turnA);
+                scratch.turned[c.bodyA] += turnA;
+            }
+            if (turnB != 0.0) {
+                b.dq = turnedBy(b.dq, turnB);
+                scratch.turned[c.bodyB] += turnB;
+            }
+        }
+        return worst;
+    };
+    // Between moving bodies a fraction of the excess, once a step, as a
+    // Baumgarte factor: a deep crowd unfolds over a few steps instead of in
+    // one jump.
+    for (const std::uint32_t k : scratch.deepMoving)
+        correct(contacts[k], settings.movingFraction, settings.maxCorrection);
+    // Against the static world the whole excess, uncapped, until every
+    // point is within a micrometre of the slop: nothing else can carry the
+    // load, and a point left past its step-start plane may be on the far
+    // side of a thin shape at the next detection.
+    for (int pass = 0; pass < settings.maxPasses; ++pass) {
+        double worst = 0.0;  // before this pass's moves
+        for (const std::uint32_t k : scratch.touchingStatic)
+            worst = std::min(worst, correct(contacts[k], 1.0, std::numeric_limits<double>::infinity()));
+        if (worst > -1e-6) break;
+    }
+    return true;
+}
+
+} // namespace stepwise::collision

@@ -1,0 +1,57 @@
+#pragma once
+// Position correction after the soft step: a rigid pass over positions that
+// takes out overlap beyond the slop, moving bodies without changing their
+// velocities (non-linear Gauss-Seidel on positions, Box2D 2.4.1's
+// SolvePositionConstraints; Catto, "Solver2D", the NGS solver).
+//
+// Contacts with the static world are rigid in the velocity solve
+// (Softness::rigidDepth), which holds any load the step can resolve; this
+// pass is the backstop for the rest: the overlap with static geometry ends
+// each step at the slop whatever the load, the substeps or the iterations.
+// Between moving bodies it acts only on crowds (bodies started deep in one
+// another): a fifth of the excess a step, as 2.4.1's Baumgarte factor, so
+// the crowd unfolds through positions and is not flung. Other moving pairs
+// are left to the soft contacts: a second rule fighting their equilibrium
+// made piles jitter.
+
+#include "collision/contact_solver.hpp"
+
+#include <span>
+#include <vector>
+
+namespace stepwise::collision {
+
+struct PositionCorrectionSettings {
+    double slop = 0.005;             ///< m: overlap left alone (the soft contacts' working range)
+    double movingFraction = 0.2;     ///< of the excess between two moving bodies, per pass
+    double maxCorrection = 0.2;      ///< m: the largest move of one point between moving bodies in one pass
+    /// m: past this, a static contact's correction moves the body without
+    /// turning it (the turn is linearised: a metre of correction through a
+    /// corner would spin a box round).
+    double maxTurningCorrection = 0.05;
+    int maxPasses = 8;               ///< at most, over the static contacts per step
+};
+
+/// What the pass moved: per solver body, the change of its angle (rad); its
+/// displacement is added to SolverBody::dp and its rotation to dq.
+struct PositionCorrectionScratch {
+    std::vector<std::uint32_t> deepMoving;      ///< moving pairs with a point past the slop
+    std::vector<std::uint32_t> touchingStatic;  ///< contacts with the static world that overlap
+    std::vector<double> turned;       ///< rad, per solver body
+    std::vector<std::uint8_t> moved;  ///< per solver body: 1 when the pass moved it
+};
+
+/// Corrects the positions of the bodies of `contacts` (their dp and dq):
+/// every contact with the static world, and between moving bodies those
+/// with a body marked in `crowd` (per solver body; an empty span marks all).
+/// Returns false, having touched nothing, when no point is deeper than the
+/// slop: the common case costs one look at each contact's separations.
+bool correctPositions(std::span<const ContactConstraint> contacts, std::span<SolverBody> bodies,
+                      std::span<const std::uint8_t> crowd, const PositionCorrectionSettings& settings,
+                      PositionCorrectionScratch& scratch);
+
+/// The separation of point `p` of contact `c` at the bodies' current dp, dq
+/// (metres, negative when overlapping).
+double currentSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c, const ContactPoint& p);
+
+} // namespace stepwise::collision

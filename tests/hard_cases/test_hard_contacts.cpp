@@ -1,0 +1,237 @@
+// Contact hard cases as sweeps: each case runs across its parameter (spin,
+// load, crowd size) and the solver settings (substeps 1, 2, 4, 8 and the
+// engine's choice), and asserts the physical answer at every value.
+
+#include "generated_scenes.hpp"
+#include "stepwise/components.hpp"
+#include "stepwise/scene.hpp"
+#include "stepwise/world.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace stepwise;
+
+namespace {
+
+/// The engine's contact slop (collision/position_correction.hpp): the
+/// overlap the contacts are allowed to keep, and the position pass's
+/// tolerance on it.
+constexpr double kSlop = 0.005, kSlopTolerance = 1e-6;
+/// 0: the engine chooses (a level without `substeps`).
+const std::vector<int> kSubsteps{0, 1, 2, 4, 8};
+
+Scene world(Vec2 gravity, int substeps, int iterations = 0) {
+    Scene s;
+    s.world.gravity = gravity;
+    s.world.substeps = substeps;
+    s.world.solverIterations = iterations;
+    return s;
+}
+
+Entity disc(Scene& s, Vec2 p, double r, double friction = 0.9, double spin = 0.0) {
+    Registry& reg = s.registry;
+    const Entity e = reg.create();
+    reg.emplace<Position>(e, Position{p});
+    reg.emplace<Velocity>(e, Velocity{});
+    reg.emplace<Mass>(e, Mass{1.0});
+    reg.emplace<Radius>(e, Radius{r});
+    reg.emplace<Friction>(e, Friction{friction});
+    reg.emplace<AngularVelocity>(e, AngularVelocity{spin});
+    return e;
+}
+
+Entity crate(Scene& s, Vec2 p, double side, double mass = 1.0) {
+    Registry& reg = s.registry;
+    const Entity e = reg.create();
+    reg.emplace<Position>(e, Position{p});
+    reg.emplace<Velocity>(e, Velocity{});
+    reg.emplace<Mass>(e, Mass{mass});
+    reg.emplace<Box>(e, Box{side, side});
+    reg.emplace<Friction>(e, Friction{0.6});
+    return e;
+}
+
+/// A static box whose top face is at y = 0.
+Entity floorBox(Scene& s, double width, double thickness, double friction = 0.9) {
+    const Entity e = scenes::addStaticBox(s, {0.0, -0.5 * thickness}, width, thickness);
+    s.registry.emplace<Friction>(e, Friction{friction});
+    return e;
+}
+
+/// The plane y = 0, solid below.
+Entity floorPlane(Scene& s) {
+    Registry& reg = s.registry;
+    const Entity e = reg.create();
+    reg.emplace<Position>(e, Position{{0.0, 0.0}});
+    reg.emplace<Static>(e, Static{true});
+    reg.emplace<Plane>(e, Plane{});
+    return e;
+}
+
+std::string label(int substeps) { return substeps == 0 ? "the engine's choice" : std::to_string(substeps); }
+
+double spinOf(const World& w, const Scene& scene, Entity e) {
+    Scene out = scene;
+    w.writeBack(out);
+    return out.registry.tryGet<AngularVelocity>(e)->value;
+}
+
+} // namespace
+
+// A solid disc set down spinning on a rough floor slips until it rolls; the
+// friction impulse about the contact point leaves the angular momentum
+// about that point, I w0 = (I + m r^2) w, so it ends rolling at
+// v = -w0 r / 3 whatever the spin.
+TEST(HardContacts, SpinningDiscEndsRollingAtAThirdOfItsRimSpeed) {
+    const double r = 0.5, mu = 0.9, g = 9.81;
+    for (const double w0 : {-2.0, -8.0, -15.0, -20.0, -50.0, -100.0, -200.0}) {
+        for (const int substeps : kSubsteps) {
+            Scene s = world({0.0, -g}, substeps);
+            floorBox(s, 2000.0, 1.0);
+            const Entity d = disc(s, {0.0, r}, r, mu, w0);
+            Result<World> w = World::build(s);
+            ASSERT_TRUE(w) << w.error();
+            // Slipping ends after |w0| r / (3 mu g) seconds; run twice that.
+            const double slipTime = std::abs(w0) * r / (3.0 * mu * g);
+            const int steps = int(std::ceil(2.0 * slipTime / s.world.dt)) + 30;
+            const double startEnergy = 0.5 * (0.5 * r * r) * w0 * w0;
+            for (int i = 0; i < steps; ++i) ASSERT_TRUE(w->step());
+            const double v = w->bodyVelocity(0).x, spin = spinOf(*w, s, d);
+            const double expected = -w0 * r / 3.0;
+            SCOPED_TRACE("w0 " + std::to_string(w0) + " rad/s, substeps " + label(substeps));
+            EXPECT_NEAR(v, expected, 0.01 * std::abs(expected));
+            EXPECT_NEAR(-spin * r, v, 0.01 * std::abs(expected));  // rolling, not slipping
+            const double energy = 0.5 * v * v + 0.5 * (0.5 * r * r) * spin * spin;
+            EXPECT_LT(energy, startEnergy);  // friction only takes energy away
+        }
+    }
+}
+
+// A ball or a box resting on a thin static box or a plane under a steady
+// load of any size: the contacts may give way by the slop, never more, and
+// the floor is never crossed.
+TEST(HardContacts, StrongSteadyLoadNeverSinksPastTheSlop) {
+    const double r = 0.5;
+    for (const bool plane : {false, true}) {
+        for (const bool box : {false, true}) {
+            for (const double g : {10.0, 100.0, 1e3, 2e4, 1e5, 1e6}) {
+                for (const int substeps : kSubsteps) {
+                    Scene s = world({0.0, -g}, substeps);
+                    if (plane) floorPlane(s);
+                    else floorBox(s, 4.0, 0.02);
+                    if (box) crate(s, {0.0, r}, 2.0 * r);
+                    else disc(s, {0.0, r}, r);
+                    Result<World> w = World::build(s);
+                    ASSERT_TRUE(w) << w.error();
+                    double deepest = 0.0;
+                    for (int i = 0; i < 120; ++i) {
+                        ASSERT_TRUE(w->step());
+                        deepest = std::max(deepest, r - w->bodyPosition(0).y);
+                    }
+                    EXPECT_LE(deepest, kSlop + kSlopTolerance) << (box ? "box" : "ball") << " on "
+                                                      << (plane ? "a plane" : "a 2 cm box") << ", g " << g
+                                                      << ", substeps " << label(substeps);
+                }
+            }
+        }
+    }
+}
+
+// A stack of five on a thin static box, at loads its own contacts carry:
+// the bottom box holds on the floor at any settings. (Past them, at 100
+// m/s^2 with one substep and one iteration, the soft contacts between the
+// boxes give way by load / (m omega^2), 4 cm each, and the stack topples.)
+TEST(HardContacts, StackStaysOnAThinBoxAtAnySettings) {
+    for (const double g : {9.81, 20.0, 30.0}) {
+        for (const int substeps : kSubsteps) {
+            for (const int iterations : {1, 2, 8}) {
+                Scene s = world({0.0, -g}, substeps, iterations);
+                floorBox(s, 4.0, 0.02);
+                for (int k = 0; k < 5; ++k) crate(s, {0.0, 0.5 + k}, 1.0);
+                Result<World> w = World::build(s);
+                ASSERT_TRUE(w) << w.error();
+                double deepest = 0.0;
+                for (int i = 0; i < 120; ++i) {
+                    ASSERT_TRUE(w->step());
+                    deepest = std::max(deepest, 0.5 - w->bodyPosition(0).y);
+                }
+                EXPECT_LE(deepest, kSlop + kSlopTolerance)
+                    << "g " << g << ", substeps " << label(substeps) << ", iterations " << iterations;
+            }
+        }
+    }
+}
+
+// A pile given too few substeps overlaps deeply between its bodies (which
+// validate warns about), but its bottom row still sits on the floor.
+TEST(HardContacts, DeepPileAtAnySettingsKeepsItsBottomOnTheFloor) {
+    for (const int substeps : {1, 2}) {
+        for (const int iterations : {1, 2, 8}) {
+            Scene s = scenes::circlesInBox(400);
+            s.world.substeps = substeps;
+            s.world.solverIterations = iterations;
+            s.world.sleep = false;
+            Result<World> w = World::build(s);
+            ASSERT_TRUE(w) << w.error();
+            for (int i = 0; i < 240; ++i) ASSERT_TRUE(w->step());
+            // circlesInBox's floor is a static box whose top is at y = 0.
+            double deepest = 0.0;
+            for (std::size_t b = 0; b < w->bodyCount(); ++b) deepest = std::max(deepest, 0.25 - w->bodyPosition(b).y);
+            EXPECT_LE(deepest, kSlop + kSlopTolerance) << "substeps " << substeps << ", iterations " << iterations;
+        }
+    }
+}
+
+// Bodies started on top of each other push apart by their positions: no
+// body is flung. The soft contacts push out at up to 3 m/s each (Box2D's
+// cap); a body between two such pushes may reach twice that, never more.
+TEST(HardContacts, CrowdStartedAtOnePointSeparatesAtABoundedSpeed) {
+    for (const int n : {2, 10, 64, 100, 300, 1000}) {
+        for (const int substeps : {0, 1, 4}) {
+            Scene s = world({0.0, 0.0}, substeps);
+            s.world.sleep = false;
+            for (int i = 0; i < n; ++i) disc(s, {0.0, 0.0}, 0.25, 0.2);
+            Result<World> w = World::build(s);
+            ASSERT_TRUE(w) << w.error();
+            double fastest = 0.0;
+            for (int i = 0; i < 180; ++i) {
+                ASSERT_TRUE(w->step());
+                for (std::size_t b = 0; b < w->bodyCount(); ++b)
+                    fastest = std::max(fastest, length(w->bodyVelocity(b)));
+            }
+            double spread = 0.0;
+            for (std::size_t b = 0; b < w->bodyCount(); ++b) spread = std::max(spread, length(w->bodyPosition(b)));
+            SCOPED_TRACE(std::to_string(n) + " bodies, substeps " + label(substeps));
+            EXPECT_LE(fastest, 6.0);
+            // n discs of radius 0.25 need a disc of radius 0.25 sqrt(n / 0.9)
+            // to lie apart; in 3 s they have spread over half of it at least.
+            if (n >= 10) EXPECT_GT(spread, 0.5 * 0.25 * std::sqrt(n / 0.9));
+        }
+    }
+}
+
+// The same crowd under gravity above a floor: no body is pushed higher
+// than the crowd's unfolded radius (plus a body) above where it started.
+TEST(HardContacts, CrowdStartedAtOnePointAboveAFloorIsNotThrownUp) {
+    for (const int n : {10, 64, 100, 300}) {
+        for (const int substeps : {0, 1, 4}) {
+            Scene s = world({0.0, -9.81}, substeps);
+            floorBox(s, 400.0, 1.0);
+            for (int i = 0; i < n; ++i) disc(s, {0.0, 5.0}, 0.25, 0.2);
+            Result<World> w = World::build(s);
+            ASSERT_TRUE(w) << w.error();
+            double highest = 0.0;
+            for (int i = 0; i < 240; ++i) {
+                ASSERT_TRUE(w->step());
+                for (std::size_t b = 0; b < w->bodyCount(); ++b)
+                    highest = std::max(highest, w->bodyPosition(b).y);
+            }
+            EXPECT_LT(highest, 5.0 + 0.25 * std::sqrt(n / 0.9) + 0.5) << n << " bodies, substeps " << label(substeps);
+        }
+    }
+}
