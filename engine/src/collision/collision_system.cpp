@@ -304,6 +304,7 @@ void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_
                                bool collideConnected) {
     if (bodies_.empty()) bodies_.push_back(SolverBody{});
     joints_.push_back(joint);
+    directJoints_.reset();
     if (!collideConnected && filterA >= 0 && filterB >= 0) {
         const auto lo = std::uint64_t(std::min(filterA, filterB)), hi = std::uint64_t(std::max(filterA, filterB));
         const std::uint64_t key = (lo << 32) | hi;
@@ -612,6 +613,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     crowdSaved_.resize(crowdBodies_.size());
     for (std::size_t k = 0; k < crowdBodies_.size(); ++k)
         crowdSaved_[k] = {bodies_[crowdBodies_[k]].v, bodies_[crowdBodies_[k]].w};
+    if (jointed) joints::stiffenRotation(joints_, bodies_, h, stiffened_, stiffenScratch_);
     if (settings_.warmStart) {
         if (jointed) joints::warmStartJoints(joints_, bodies_);
         coloured_.warmStart(constraints_, bodies_);
@@ -624,8 +626,12 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // pushMaxVelocity) adds up along the crowd and flings its edge out at
     // tens of m/s. Ordinary scenes have no crowded cell and are unchanged.
     bool reverse = false;
+    if (jointed) directJoints_.factor(joints_, bodies_, jointSoft, true);
     for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse) {
-        if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, true);
+        if (jointed) {
+            joints::solveJoints(joints_, bodies_, h, jointSoft, true);
+            directJoints_.solve(joints_, bodies_);
+        }
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
     }
 
@@ -658,11 +664,38 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
                    rotate(Rot::fromAngle(offsetAngleBefore_[k]), c.centreOfMass);
         b.dp = centreOfMass(i, std::span<const Vec2>(x.data(), x.size())) - stepStart_[i];
     }
+    if (jointed) directJoints_.factor(joints_, bodies_, jointSoft, false);
     for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse) {
-        if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, false);
+        if (jointed) {
+            joints::solveJoints(joints_, bodies_, h, jointSoft, false);
+            directJoints_.solve(joints_, bodies_);
+        }
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
     }
 
+    // Tree-shaped joint groups: their positions projected onto the joints
+    // (direct_joints.hpp), which removes the drift a velocity solve leaves
+    // (a chain's links turn by up to a tenth of a radian a substep with a
+    // heavy end) without touching the velocities.
+    if (jointed && directJoints_.directJointCount() > 0) {
+        directJoints_.project(joints_, bodies_, jointMoves_, jointMoved_);
+        if (!jointMoved_.empty())
+            for (const SolvedBody& sb : awakeSolved_) {
+                const joints::DirectJoints::Move& m = jointMoves_[sb.solver];
+                if (m.dp == Vec2{} && m.dq == 0.0) continue;
+                const std::uint32_t i = sb.collider;
+                SolverBody& b = bodies_[sb.solver];
+                const double before = angles_[i];
+                x[sb.body] += m.dp;
+                angles_[i] += m.dq;
+                // A body turning about a centre of mass off its position moves its position.
+                if (const Vec2 com = colliders_[i].centreOfMass; com != Vec2{})
+                    x[sb.body] -= rotate(Rot::fromAngle(angles_[i]), com) - rotate(Rot::fromAngle(before), com);
+                b.dp += m.dp;
+                b.dq = rotationBy(angles_[i] - stepStartAngle_[i]);
+            }
+    }
+    if (jointed) joints::restoreInertia(bodies_, stiffened_);
     for (const SolvedBody& sb : awakeSolved_) {
         v[sb.body] = bodies_[sb.solver].v;
         angularVelocities_[sb.collider] = bodies_[sb.solver].w;

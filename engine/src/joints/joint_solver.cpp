@@ -319,15 +319,50 @@ void solveJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies
         switch (j.kind) {
         case JointKind::Hinge:
             solveHingeAxial(j, a, b, p, h, soft, useBias);
-            solvePoint(j, a, b, p, soft, useBias);
+            if (!j.direct) solvePoint(j, a, b, p, soft, useBias);
             break;
-        case JointKind::Weld: solveWeld(j, a, b, p, h, soft, useBias); break;
+        case JointKind::Weld:
+            if (!j.direct) solveWeld(j, a, b, p, h, soft, useBias);
+            break;
         case JointKind::Slider: solveSlider(j, a, b, p, h, soft, useBias); break;
         case JointKind::Distance:
         case JointKind::Rope: solveDistance(j, a, b, p, h, soft, useBias); break;
         }
         p.store(a, b);
     }
+}
+
+void stiffenRotation(std::span<const JointConstraint> joints, std::span<SolverBody> bodies, double h,
+                     std::vector<std::pair<std::uint32_t, double>>& saved, std::vector<double>& scratch) {
+    saved.clear();
+    scratch.resize(bodies.size());
+    // Bodies touched, in joint order (deterministic), each listed once.
+    for (const JointConstraint& j : joints) {
+        if (j.asleep || (j.kind != JointKind::Hinge && j.kind != JointKind::Weld)) continue;
+        for (const std::uint32_t body : {j.a.solverBody, j.b.solverBody})
+            if (body != 0 && bodies[body].invInertia > 0.0 && scratch[body] == 0.0) {
+                scratch[body] = 1.0;  // marks it listed; the sum starts below
+                saved.emplace_back(body, bodies[body].invInertia);
+            }
+    }
+    for (const auto& [body, invI] : saved) scratch[body] = 0.0;
+    for (const JointConstraint& j : joints) {
+        if (j.asleep || (j.kind != JointKind::Hinge && j.kind != JointKind::Weld)) continue;
+        // The impulse acts +linearImpulse on b at rB, - on a at rA.
+        const SolverBody& a = bodies[j.a.solverBody];
+        const SolverBody& b = bodies[j.b.solverBody];
+        if (j.a.solverBody != 0) scratch[j.a.solverBody] -= dot(rotate(a.dq, j.anchorA), j.linearImpulse);
+        if (j.b.solverBody != 0) scratch[j.b.solverBody] += dot(rotate(b.dq, j.anchorB), j.linearImpulse);
+    }
+    for (const auto& [body, invI] : saved) {
+        const double k = h * scratch[body];  // h^2 k, kg m^2
+        scratch[body] = 0.0;
+        if (k > 0.0) bodies[body].invInertia = 1.0 / (1.0 / invI + k);
+    }
+}
+
+void restoreInertia(std::span<SolverBody> bodies, std::span<const std::pair<std::uint32_t, double>> saved) {
+    for (const auto& [body, invI] : saved) bodies[body].invInertia = invI;
 }
 
 double jointAngle(const JointConstraint& j, std::span<const SolverBody> bodies) {

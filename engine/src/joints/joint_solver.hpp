@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace stepwise::joints {
@@ -57,6 +58,10 @@ struct JointConstraint {
     /// Its island sleeps (world/islands.hpp): the solver passes skip it and
     /// its impulses stay as they were, ready for the wake.
     bool asleep = false;
+    /// Its point rows (a rigid weld: all its rows) are solved exactly with
+    /// the rest of its tree (direct_joints.hpp); the Gauss-Seidel passes
+    /// solve only its limits and motor.
+    bool direct = false;
 
     // Prepared at step start.
     Vec2 anchorA, anchorB;         ///< anchors rotated to world orientation, relative to the centres, m
@@ -103,6 +108,26 @@ void warmStartJoints(std::span<JointConstraint> joints, std::span<collision::Sol
 /// softness (used in biased passes only).
 void solveJoints(std::span<JointConstraint> joints, std::span<collision::SolverBody> bodies, double h,
                  const collision::Softness& soft, bool useBias);
+
+/// Implicit geometric stiffness of the point joints (hinge, weld): a joint
+/// force F at anchor r turns with its body, so the torque r x F changes by
+/// -(r . F) per radian of turn: a body pulled outward at its anchors (a
+/// link in a taut chain) has a rotational stiffness k = sum of r . F. A
+/// light link under a heavy load then rings at sqrt(k / I), far above what
+/// a substep resolves (1000:1 at 240 Hz: sqrt(k/I) h is about 2, the
+/// semi-implicit step's limit), and the chain shakes itself apart. Taking
+/// that stiffness implicitly (backward Euler: (I + h^2 k) dw = h torque)
+/// is the same as giving each such body the inertia I + h^2 k for the
+/// substep: it damps only those modes (h^2 k is 0.1% of I for a 1 kg link
+/// under its own weight at 240 Hz) and vanishes as h -> 0. F is taken from
+/// the accumulated impulses of the previous substep (F h = impulse), so
+/// h^2 k = h (r . impulse). Compression (k < 0) is left alone: lowering
+/// the inertia would destabilise. Sets bodies' invInertia for the substep;
+/// `saved` receives (solver body, original invInertia) to restore with
+/// restoreInertia().
+void stiffenRotation(std::span<const JointConstraint> joints, std::span<collision::SolverBody> bodies, double h,
+                     std::vector<std::pair<std::uint32_t, double>>& saved, std::vector<double>& scratch);
+void restoreInertia(std::span<collision::SolverBody> bodies, std::span<const std::pair<std::uint32_t, double>> saved);
 
 /// The joint's pull on b (newtons) and torque on b (N*m) over the last
 /// substep of length h, from the accumulated impulses; a gets the opposite.
