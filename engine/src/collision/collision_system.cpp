@@ -573,6 +573,10 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     if (!detected_) {
         detect(v);
         detected_ = true;
+        // The joints' geometric stiffness, from the last step's impulses at
+        // this step's start: once a step (it changes slowly, and a pass over
+        // every joint each substep cost as much as a Gauss-Seidel pass).
+        if (!joints_.empty()) joints::stiffenRotation(joints_, bodies_, h, stiffened_, stiffenScratch_);
         // The awake solver bodies' indices side by side, for the substeps'
         // loops (a Collider is over a hundred bytes; these are twelve).
         awakeSolved_.resize(awakeSolverColliders_.size());
@@ -600,10 +604,17 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
 
     // A row of n touching bodies needs up to n passes; 64 bounds the cost.
     // Joints: rigid ones are corrected at up to half the substep rate
-    // (twice the contacts' cap, as Box2D v3), solved before the contacts.
+    // (twice the contacts' cap, as Box2D v3), solved before the contacts;
+    // the softness is the world's, else the engine's choice by how the
+    // joint is solved (JointSettings).
     const bool jointed = !joints_.empty();
-    const Softness jointSoft =
-        Softness::make(std::min(jointSettings_.hertz, 0.5 / h), jointSettings_.dampingRatio, h);
+    const double jointCap = 0.5 / h;
+    const Softness jointSoft = Softness::make(
+        std::min(jointSettings_.hertz.value_or(joints::JointSettings::kLoopHertz), jointCap),
+        jointSettings_.dampingRatio.value_or(joints::JointSettings::kLoopDampingRatio), h);
+    const Softness directSoft = Softness::make(
+        std::min(jointSettings_.hertz.value_or(jointCap), jointCap),
+        jointSettings_.dampingRatio.value_or(joints::JointSettings::kTreeDampingRatio), h);
     lastH_ = h;
     // In a crowd every pair approaches every other: the passes would run to
     // the bound over hundreds of thousands of contacts (measured: 60% of a
@@ -613,7 +624,6 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     crowdSaved_.resize(crowdBodies_.size());
     for (std::size_t k = 0; k < crowdBodies_.size(); ++k)
         crowdSaved_[k] = {bodies_[crowdBodies_[k]].v, bodies_[crowdBodies_[k]].w};
-    if (jointed) joints::stiffenRotation(joints_, bodies_, h, stiffened_, stiffenScratch_);
     if (settings_.warmStart) {
         if (jointed) joints::warmStartJoints(joints_, bodies_);
         coloured_.warmStart(constraints_, bodies_);
@@ -626,10 +636,10 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // pushMaxVelocity) adds up along the crowd and flings its edge out at
     // tens of m/s. Ordinary scenes have no crowded cell and are unchanged.
     bool reverse = false;
-    if (jointed) directJoints_.factor(joints_, bodies_, jointSoft, true);
+    if (jointed) directJoints_.factor(joints_, bodies_, directSoft, true);
     for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse) {
         if (jointed) {
-            joints::solveJoints(joints_, bodies_, h, jointSoft, true);
+            joints::solveJoints(joints_, bodies_, h, jointSoft, directSoft, true);
             directJoints_.solve(joints_, bodies_);
         }
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
@@ -664,10 +674,10 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
                    rotate(Rot::fromAngle(offsetAngleBefore_[k]), c.centreOfMass);
         b.dp = centreOfMass(i, std::span<const Vec2>(x.data(), x.size())) - stepStart_[i];
     }
-    if (jointed) directJoints_.factor(joints_, bodies_, jointSoft, false);
+    if (jointed) directJoints_.factor(joints_, bodies_, directSoft, false);
     for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse) {
         if (jointed) {
-            joints::solveJoints(joints_, bodies_, h, jointSoft, false);
+            joints::solveJoints(joints_, bodies_, h, jointSoft, directSoft, false);
             directJoints_.solve(joints_, bodies_);
         }
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
@@ -695,7 +705,6 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
                 b.dq = rotationBy(angles_[i] - stepStartAngle_[i]);
             }
     }
-    if (jointed) joints::restoreInertia(bodies_, stiffened_);
     for (const SolvedBody& sb : awakeSolved_) {
         v[sb.body] = bodies_[sb.solver].v;
         angularVelocities_[sb.collider] = bodies_[sb.solver].w;
@@ -704,6 +713,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
 }
 
 void CollisionSystem::undoSolverState() {
+    joints::restoreInertia(bodies_, stiffened_);
+    stiffened_.clear();
     cache_.swap(previousCache_);
     cacheCursor_ = 0;
     for (std::size_t k = 0; k < joints_.size() && k < jointImpulsesBefore_.size(); ++k)
@@ -711,6 +722,8 @@ void CollisionSystem::undoSolverState() {
 }
 
 void CollisionSystem::endStep() {
+    joints::restoreInertia(bodies_, stiffened_);
+    stiffened_.clear();
     // The cache this step started from is kept (swapped, not copied) so a
     // divergence can put it back.
     previousCache_.swap(cache_);

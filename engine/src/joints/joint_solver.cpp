@@ -309,10 +309,11 @@ void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bo
     }
 }
 
-void solveJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies, double h, const Softness& soft,
-                 bool useBias) {
+void solveJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies, double h, const Softness& loopSoft,
+                 const Softness& directSoft, bool useBias) {
     for (JointConstraint& j : joints) {
         if (j.asleep) continue;
+        const Softness& soft = j.direct ? directSoft : loopSoft;
         SolverBody& a = bodies[j.a.solverBody];
         SolverBody& b = bodies[j.b.solverBody];
         Pair p(a, b);
@@ -334,28 +335,27 @@ void solveJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies
 
 void stiffenRotation(std::span<const JointConstraint> joints, std::span<SolverBody> bodies, double h,
                      std::vector<std::pair<std::uint32_t, double>>& saved, std::vector<double>& scratch) {
+    // One pass over the joints sums h (r . impulse) per body in `scratch`
+    // (kept all zero between calls) and lists each body at its first touch
+    // (in joint order: deterministic); one pass over those bodies applies it.
     saved.clear();
-    scratch.resize(bodies.size());
-    // Bodies touched, in joint order (deterministic), each listed once.
+    if (scratch.size() != bodies.size()) scratch.assign(bodies.size(), 0.0);
+    const auto add = [&](std::uint32_t body, double k) {
+        if (body == 0 || !(bodies[body].invInertia > 0.0)) return;
+        if (scratch[body] == 0.0) saved.emplace_back(body, bodies[body].invInertia);
+        // A sum that lands on exactly 0 would list the body again; nudging
+        // it keeps the list unique (1e-300 kg m^2 changes no inertia).
+        scratch[body] += k;
+        if (scratch[body] == 0.0) scratch[body] = 1e-300;
+    };
     for (const JointConstraint& j : joints) {
         if (j.asleep || (j.kind != JointKind::Hinge && j.kind != JointKind::Weld)) continue;
-        for (const std::uint32_t body : {j.a.solverBody, j.b.solverBody})
-            if (body != 0 && bodies[body].invInertia > 0.0 && scratch[body] == 0.0) {
-                scratch[body] = 1.0;  // marks it listed; the sum starts below
-                saved.emplace_back(body, bodies[body].invInertia);
-            }
-    }
-    for (const auto& [body, invI] : saved) scratch[body] = 0.0;
-    for (const JointConstraint& j : joints) {
-        if (j.asleep || (j.kind != JointKind::Hinge && j.kind != JointKind::Weld)) continue;
-        // The impulse acts +linearImpulse on b at rB, - on a at rA.
-        const SolverBody& a = bodies[j.a.solverBody];
-        const SolverBody& b = bodies[j.b.solverBody];
-        if (j.a.solverBody != 0) scratch[j.a.solverBody] -= dot(rotate(a.dq, j.anchorA), j.linearImpulse);
-        if (j.b.solverBody != 0) scratch[j.b.solverBody] += dot(rotate(b.dq, j.anchorB), j.linearImpulse);
+        // The impulse acts +linearImpulse on b at its anchor, - on a.
+        add(j.a.solverBody, -h * dot(rotate(bodies[j.a.solverBody].dq, j.anchorA), j.linearImpulse));
+        add(j.b.solverBody, h * dot(rotate(bodies[j.b.solverBody].dq, j.anchorB), j.linearImpulse));
     }
     for (const auto& [body, invI] : saved) {
-        const double k = h * scratch[body];  // h^2 k, kg m^2
+        const double k = scratch[body];  // h^2 k, kg m^2
         scratch[body] = 0.0;
         if (k > 0.0) bodies[body].invInertia = 1.0 / (1.0 / invI + k);
     }

@@ -190,7 +190,7 @@ Result<World> World::build(const Scene& scene) {
         return Error{"world.sleep_time: expected a finite number >= 0, got " + format(ws.sleepTime)};
     // Scenes built in code reach here unchecked by the loader: same words.
     if (ws.jointHz && !(*ws.jointHz > 0.0 && *ws.jointHz <= 1e6))
-        return Error{"world.joint_hz: expected a number in (0, 1000000], got " + format(*ws.jointHz)};
+        return Error{"world.joint_hz: expected a number in (0, 1e+06], got " + format(*ws.jointHz)};
     if (ws.jointDampingRatio && !(*ws.jointDampingRatio >= 0.0 && *ws.jointDampingRatio <= 1e3))
         return Error{"world.joint_damping_ratio: expected a number in [0, 1000], got " + format(*ws.jointDampingRatio)};
 
