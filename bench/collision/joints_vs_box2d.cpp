@@ -5,7 +5,7 @@
 //
 //   joints_vs_box2d [--quick] [LEVEL ...]      (default: levels/chain.json levels/bridge.json)
 //   joints_vs_box2d --grid [--n N] [--substeps S] [--iterations I] [--steps K]
-//                          [--joint-hz HZ] [--joint-damping-ratio Z]
+//                          [--joint-hz HZ] [--joint-damping-ratio Z] [--stepwise-only]
 //
 // --grid builds Box2D v3's `joint_grid` benchmark scene (shared/benchmarks.c:
 // N x N circles of radius 0.4 m, 1 m apart, each hinged to its right and
@@ -194,12 +194,12 @@ Outcome runBox2d(const Scene& scene, int steps) {
 
 } // namespace
 
-int runGrid(int n, int substeps, int iterations, int steps, double hz, double zeta) {
+int runGrid(int n, int substeps, int iterations, int steps, double hz, double zeta, bool stepwiseOnly) {
     Scene scene = jointGrid(n, substeps, iterations);
     if (hz > 0.0) scene.world.jointHz = hz;
     if (zeta >= 0.0) scene.world.jointDampingRatio = zeta;
     const Outcome s = runStepwise(scene, steps);
-    const Outcome b = runBox2d(scene, steps);
+    const Outcome b = stepwiseOnly ? Outcome{} : runBox2d(scene, steps);
     std::printf("joint_grid %dx%d, %d steps; Stepwise %d substeps x %d iterations, Box2D 2.4.1 8+3 iterations\n", n, n,
                 steps, substeps, iterations);
     std::printf("| engine | ms/step | largest separation, m | at the end, m | diverged at step |\n|---|---|---|---|---|\n");
@@ -211,7 +211,7 @@ int runGrid(int n, int substeps, int iterations, int steps, double hz, double ze
 }
 
 int main(int argc, char** argv) {
-    bool quick = false, grid = false;
+    bool quick = false, grid = false, stepwiseOnly = false;
     int n = 100, substeps = 4, iterations = 1, steps = 60;
     double hz = 0.0, zeta = -1.0;  // joint_hz, joint_damping_ratio; unset: the engine's choice
     std::vector<std::string> levels;
@@ -219,6 +219,7 @@ int main(int argc, char** argv) {
         const auto next = [&] { return i + 1 < argc ? std::atoi(argv[++i]) : 0; };
         if (std::strcmp(argv[i], "--quick") == 0) quick = true;
         else if (std::strcmp(argv[i], "--grid") == 0) grid = true;
+        else if (std::strcmp(argv[i], "--stepwise-only") == 0) stepwiseOnly = true;  // for profiling
         else if (std::strcmp(argv[i], "--n") == 0) n = next();
         else if (std::strcmp(argv[i], "--substeps") == 0) substeps = next();
         else if (std::strcmp(argv[i], "--iterations") == 0) iterations = next();
@@ -227,7 +228,7 @@ int main(int argc, char** argv) {
         else if (std::strcmp(argv[i], "--joint-damping-ratio") == 0 && i + 1 < argc) zeta = std::atof(argv[++i]);
         else levels.push_back(argv[i]);
     }
-    if (grid) return runGrid(n, substeps, iterations, steps, hz, zeta);
+    if (grid) return runGrid(n, substeps, iterations, steps, hz, zeta, stepwiseOnly);
     if (levels.empty()) levels = {STEPWISE_SOURCE_DIR "/levels/chain.json", STEPWISE_SOURCE_DIR "/levels/bridge.json"};
     const int runs = quick ? 1 : 3;
     std::printf("| level | joints | speed (Box2D ms / Stepwise ms) | largest joint separation, mm (Stepwise / Box2D) | "
