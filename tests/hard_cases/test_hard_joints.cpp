@@ -131,6 +131,45 @@ INSTANTIATE_TEST_SUITE_P(Sweep, HardJointsMassRatio, ::testing::ValuesIn(massCas
                                     (p.param.substeps ? std::to_string(p.param.substeps) : "Default");
                          });
 
+/// The other way to build it: light links hanging straight down from a
+/// pin, a heavy ball (radius 0.3 m, `ratio` kg) on the last one, all
+/// swinging at 4 m/s at the bottom. The links stand in one column, so the
+/// engine's choice of substeps sees a stack there (4 substeps here).
+Scene hangingChain(int links, double ratio) {
+    std::ostringstream s;
+    s << R"({"world": {"gravity": {"x": 0, "y": -9.81}, "dt": 0.016666666666666666}, "entities": [)";
+    const double length = links * kLink + 0.3;
+    for (int i = 0; i < links; ++i) {
+        const double y = -(i + 0.5) * kLink;
+        s << (i ? ",\n" : "") << R"({"name": "link)" << i << R"(", "position": {"x": 0, "y": )" << num(y)
+          << R"(}, "velocity": {"x": )" << num(4.0 * (i + 0.5) * kLink / length) << R"(, "y": 0}, "mass": 1, "box": {"width": )"
+          << num(kLink * 0.1) << R"(, "height": )" << num(kLink) << "}}";
+    }
+    s << R"(, {"name": "weight", "position": {"x": 0, "y": )" << num(-length) << R"(}, "velocity": {"x": 4, "y": 0}, "mass": )"
+      << num(ratio) << R"(, "radius": 0.3})";
+    for (int i = 0; i < links; ++i) {
+        s << R"(, {"name": "pin)" << i << R"(", "joint": {"type": "hinge", "a": "link)" << i << "\"";
+        if (i > 0) s << R"(, "b": "link)" << (i - 1) << "\"";
+        s << R"(, "anchor": {"x": 0, "y": )" << num(-i * kLink) << "}}}";
+    }
+    s << R"(, {"name": "hook", "joint": {"type": "hinge", "a": "weight", "b": "link)" << (links - 1)
+      << R"(", "anchor": {"x": 0, "y": )" << num(-links * kLink) << "}}}";
+    s << "]}";
+    Result<Scene> scene = parseScene(s.str(), "hanging.json");
+    EXPECT_TRUE(scene) << (scene ? "" : scene.error());
+    return scene ? std::move(*scene) : Scene{};
+}
+
+TEST(HardJointsMassRatioHanging, HeavyWeightOnAHangingChainSwingsJoined) {
+    for (double ratio : {1.0, 10.0, 100.0, 1000.0}) {
+        const ChainRun r = run(hangingChain(10, ratio), 300);
+        std::printf("hanging chain, weight %g kg (ran %d x %d): largest opening %.3f mm, energy rise %.3g J of %.3g J\n",
+                    ratio, r.substeps, r.iterations, 1e3 * r.largest, r.energyRise, r.energyScale);
+        EXPECT_LT(r.largest, ratio >= 1000.0 ? 0.02 : 0.01 * kLink) << "weight " << ratio << " kg";
+        EXPECT_LT(r.energyRise, 0.005 * r.energyScale) << "weight " << ratio << " kg";
+    }
+}
+
 // ---------------------------------------------------------- chain length
 
 /// 2 to 40 equal links released horizontally, 5 s, at the defaults and at
