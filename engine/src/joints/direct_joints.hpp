@@ -21,7 +21,12 @@
 // Eigen's sparse LDL^T with its minimum-degree ordering finds that order,
 // so the cost is linear in the joints. The pattern is analysed once; each
 // pass factors the values (twice a substep: biased and relax) and each
-// iteration solves.
+// iteration solves. Groups of a few rows are factored dense instead.
+// After the relax pass, project() moves each group's positions back onto
+// its joints by the part of each error past a slop (see the .cpp).
+// Groups, their order and every factorisation depend only on the joints'
+// order and the state, so the same input gives the same bits, and a saved
+// and reloaded world (its impulses in solver_state) continues exactly.
 //
 // Rows solved here: a hinge's point (2 rows) and a rigid weld's angle and
 // point (3 rows). Limits, motors, sliders, distances, ropes, springs and
@@ -55,9 +60,10 @@ public:
     void solve(std::span<JointConstraint> joints, std::span<collision::SolverBody> bodies);
     /// After the relax pass (factor(..., false) at the substep's end pose):
     /// one exact projection of the groups' positions onto their joints,
-    /// x += M^-1 J^T dl with (J M^-1 J^T) dl = -C. Velocities are left
-    /// alone (a split impulse), so the correction adds no momentum and no
-    /// kinetic energy. Writes each moved solver body's displacement (m) and
+    /// x += M^-1 J^T dl with (J M^-1 J^T) dl = -C', C' each joint's error
+    /// beyond the slop (0.5 mm; 0.002 rad for a weld's angle). Velocities
+    /// are left alone (a split impulse), so the correction adds no momentum
+    /// and no kinetic energy. Writes each moved solver body's displacement (m) and
     /// turn (rad) into `moves` (sized to the bodies, zeroed here) and lists
     /// the moved bodies in `moved`; the caller moves its state.
     struct Move {
