@@ -206,9 +206,11 @@ INSTANTIATE_TEST_SUITE_P(Sweep, HardJointsChainLength, ::testing::ValuesIn(lengt
 
 // ----------------------------------------------------------------- energy
 
-/// A swinging chain may lose energy (the soft correction and the relax pass
-/// damp it) but must never gain: its total energy stays at or below the
-/// start, within 0.5% of the largest kinetic energy it reaches.
+/// A swinging chain may lose energy (the soft correction, the relax pass and
+/// the projection damp it) but must never gain: its total energy stays at
+/// or below the start, within 0.5% of the largest kinetic energy it reaches
+/// (a short chain's energy oscillates a little, as a symplectic step's
+/// does: +0.40% at most, a double pendulum at 4 substeps).
 struct EnergyCase {
     int links;
     double ratio;
@@ -227,9 +229,9 @@ TEST_P(HardJointsEnergy, SwingingChainCreatesNoEnergy) {
 
 std::vector<EnergyCase> energyCases() {
     std::vector<EnergyCase> out;
-    for (int links : {2, 10, 40})
-        for (double ratio : {1.0, 1000.0})
-            for (int substeps : {0, 1, 4}) out.push_back({links, ratio, substeps});
+    for (int links : {2, 3, 5, 10, 20, 40})
+        for (double ratio : {1.0, 10.0, 100.0, 1000.0})
+            for (int substeps : {0, 1, 2, 4, 8}) out.push_back({links, ratio, substeps});
     return out;
 }
 
