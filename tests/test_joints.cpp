@@ -266,8 +266,8 @@ std::string chainLevel(int links, double linkLength, double mass, double lastMas
 }
 
 /// The chains run 8 substeps of 4 iterations (levels/chain.json's
-/// settings): at 4 substeps the soft joints' cap is 120 Hz and the chain
-/// stretched 15 mm (3% of a link); the JointSweep test prints the table.
+/// substeps); the same chains at the defaults and at 1 to 8 substeps are
+/// swept in tests/hard_cases/test_hard_joints.cpp.
 Scene chainScene(int links, double lastMass) {
     Scene scene = load(chainLevel(links, 0.5, 1.0, lastMass, 8));
     scene.world.solverIterations = 4;
@@ -602,10 +602,10 @@ TEST(JointLevels, TheCarDrivesOverItsPolygonTerrain) {
 } // namespace
 namespace {
 
-/// The table behind JointSettings' defaults (joint_solver.hpp): largest
-/// separation of the 20-link chain and the 100:1 chain for substeps,
-/// iterations, joint stiffness (60 Hz or the cap) and damping ratio. A
-/// measurement, not a check: run it by hand with
+/// Largest separation of the 20-link chain and the 100:1 chain for
+/// substeps, iterations, joint stiffness (60 Hz or the cap) and damping
+/// ratio (the world's joint_hz and joint_damping_ratio). A measurement, not
+/// a check: run it by hand with
 ///   build/tests/test_joints --gtest_also_run_disabled_tests --gtest_filter='*Sweep*'
 TEST(JointSweep, DISABLED_Sweep) {
     for (int substeps : {4, 8}) for (int iters : {2, 4, 8}) for (double hz : {60.0, 1e9}) for (double zeta : {0.0, 1.0, 2.0, 5.0}) {

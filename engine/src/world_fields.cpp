@@ -53,6 +53,14 @@ std::vector<WorldFieldInfo> buildTable() {
                                                   "a body is still while its fastest point moves slower than this")},
         {makeField<&WorldSettings::sleepTime>("sleep_time", {0.0, 1e6}, "s",
                                               "how long an island must stay still before it sleeps")},
+        // Joint softness: above 0 (0 Hz would never correct a joint's error);
+        // the solver caps it at half the substep rate whatever is given.
+        {makeField<&WorldSettings::jointHz>("joint_hz", {0.0, 1e6, true}, "Hz",
+                                            "stiffness of rigid joints' position correction, capped at half the "
+                                            "substep rate; absent: the engine's choice (docs/joints.md)")},
+        {makeField<&WorldSettings::jointDampingRatio>("joint_damping_ratio", {0.0, 1e3}, "",
+                                                      "damping ratio of rigid joints' position correction; absent: "
+                                                      "the engine's choice (docs/joints.md)")},
     };
 }
 

@@ -61,6 +61,12 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
         if (attractors) {
             worldFieldWidget(ui, ed, "theta");
         }
+        // Joint softness: shown when the scene has joints.
+        bool jointed = false;
+        if (world)
+            for (std::string_view system : world->activeSystems()) jointed = jointed || system == "joints";
+        if (jointed)
+            for (const char* key : {"joint_hz", "joint_damping_ratio"}) worldFieldWidget(ui, ed, key);
         // Sleeping: the switch, its thresholds while it is on, and how many
         // bodies sleep now (drawn dimmed in the viewport).
         worldFieldWidget(ui, ed, "sleep");

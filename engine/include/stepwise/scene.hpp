@@ -54,6 +54,14 @@ struct WorldSettings {
     /// stays under this. Box2D v3's b2_defaultSleepThreshold.
     double sleepVelocity = 0.05;
     double sleepTime = 0.5;  ///< s an island must stay still before it sleeps (Box2D's b2_timeToSleep)
+    /// Softness of rigid joints in the soft step, Hz (Box2D v3's
+    /// jointHertz): how fast a joint's position error is corrected. Absent:
+    /// the engine's choice (docs/joints.md, "Softness"). Never stiffer than
+    /// half the substep rate.
+    std::optional<double> jointHz;
+    /// Damping ratio of that correction (Box2D v3's jointDampingRatio).
+    /// Absent: the engine's choice.
+    std::optional<double> jointDampingRatio;
 
     friend bool operator==(const WorldSettings&, const WorldSettings&) = default;
 };

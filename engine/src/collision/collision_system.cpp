@@ -304,6 +304,7 @@ void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_
                                bool collideConnected) {
     if (bodies_.empty()) bodies_.push_back(SolverBody{});
     joints_.push_back(joint);
+    directJoints_.reset();
     if (!collideConnected && filterA >= 0 && filterB >= 0) {
         const auto lo = std::uint64_t(std::min(filterA, filterB)), hi = std::uint64_t(std::max(filterA, filterB));
         const std::uint64_t key = (lo << 32) | hi;
@@ -600,6 +601,10 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     if (!detected_) {
         detect(v);
         detected_ = true;
+        // The joints' geometric stiffness, from the last step's impulses at
+        // this step's start: once a step (it changes slowly, and a pass over
+        // every joint each substep cost as much as a Gauss-Seidel pass).
+        if (!joints_.empty()) joints::stiffenRotation(joints_, bodies_, h, stiffened_, stiffenScratch_);
         // The awake solver bodies' indices side by side, for the substeps'
         // loops (a Collider is over a hundred bytes; these are twelve).
         awakeSolved_.resize(awakeSolverColliders_.size());
@@ -635,10 +640,17 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
 
     // A row of n touching bodies needs up to n passes; 64 bounds the cost.
     // Joints: rigid ones are corrected at up to half the substep rate
-    // (twice the contacts' cap, as Box2D v3), solved before the contacts.
+    // (twice the contacts' cap, as Box2D v3), solved before the contacts;
+    // the softness is the world's, else the engine's choice by how the
+    // joint is solved (JointSettings).
     const bool jointed = !joints_.empty();
-    const Softness jointSoft =
-        Softness::make(std::min(jointSettings_.hertz, 0.5 / h), jointSettings_.dampingRatio, h);
+    const double jointCap = 0.5 / h;
+    const Softness jointSoft = Softness::make(
+        std::min(jointSettings_.hertz.value_or(joints::JointSettings::kLoopHertz), jointCap),
+        jointSettings_.dampingRatio.value_or(joints::JointSettings::kLoopDampingRatio), h);
+    const Softness directSoft = Softness::make(
+        std::min(jointSettings_.hertz.value_or(jointCap), jointCap),
+        jointSettings_.dampingRatio.value_or(joints::JointSettings::kTreeDampingRatio), h);
     lastH_ = h;
     // In a crowd every pair approaches every other: the passes would run to
     // the bound over hundreds of thousands of contacts (measured: 60% of a
@@ -661,8 +673,12 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // pushMaxVelocity) adds up along the crowd and flings its edge out at
     // tens of m/s. Ordinary scenes have no crowd and are unchanged.
     bool reverse = false;
+    if (jointed) directJoints_.factor(joints_, bodies_, directSoft, true);
     for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse) {
-        if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, true);
+        if (jointed) {
+            joints::solveJoints(joints_, bodies_, h, jointSoft, directSoft, true);
+            directJoints_.solve(joints_, bodies_);
+        }
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
     }
 
@@ -702,11 +718,37 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
                    rotate(Rot::fromAngle(offsetAngleBefore_[k]), c.centreOfMass);
         b.dp = centreOfMass(i, std::span<const Vec2>(x.data(), x.size())) - stepStart_[i];
     }
+    if (jointed) directJoints_.factor(joints_, bodies_, directSoft, false);
     for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse) {
-        if (jointed) joints::solveJoints(joints_, bodies_, h, jointSoft, false);
+        if (jointed) {
+            joints::solveJoints(joints_, bodies_, h, jointSoft, directSoft, false);
+            directJoints_.solve(joints_, bodies_);
+        }
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
     }
 
+    // Tree-shaped joint groups: their positions projected onto the joints
+    // (direct_joints.hpp), which removes the drift a velocity solve leaves
+    // (a chain's links turn by up to a tenth of a radian a substep with a
+    // heavy end) without touching the velocities.
+    if (jointed && directJoints_.directJointCount() > 0) {
+        directJoints_.project(joints_, bodies_, jointMoves_, jointMoved_);
+        if (!jointMoved_.empty())
+            for (const SolvedBody& sb : awakeSolved_) {
+                const joints::DirectJoints::Move& m = jointMoves_[sb.solver];
+                if (m.dp == Vec2{} && m.dq == 0.0) continue;
+                const std::uint32_t i = sb.collider;
+                SolverBody& b = bodies_[sb.solver];
+                const double before = angles_[i];
+                x[sb.body] += m.dp;
+                angles_[i] += m.dq;
+                // A body turning about a centre of mass off its position moves its position.
+                if (const Vec2 com = colliders_[i].centreOfMass; com != Vec2{})
+                    x[sb.body] -= rotate(Rot::fromAngle(angles_[i]), com) - rotate(Rot::fromAngle(before), com);
+                b.dp += m.dp;
+                b.dq = rotationBy(angles_[i] - stepStartAngle_[i]);
+            }
+    }
     for (const SolvedBody& sb : awakeSolved_) {
         v[sb.body] = bodies_[sb.solver].v;
         angularVelocities_[sb.collider] = bodies_[sb.solver].w;
@@ -734,6 +776,8 @@ void CollisionSystem::correctStepPositions(std::span<Vec2> x) {
 }
 
 void CollisionSystem::undoSolverState() {
+    joints::restoreInertia(bodies_, stiffened_);
+    stiffened_.clear();
     cache_.swap(previousCache_);
     cacheCursor_ = 0;
     for (std::size_t k = 0; k < joints_.size() && k < jointImpulsesBefore_.size(); ++k)
@@ -741,6 +785,8 @@ void CollisionSystem::undoSolverState() {
 }
 
 void CollisionSystem::endStep() {
+    joints::restoreInertia(bodies_, stiffened_);
+    stiffened_.clear();
     // The cache this step started from is kept (swapped, not copied) so a
     // divergence can put it back.
     previousCache_.swap(cache_);

@@ -12,6 +12,7 @@
 #include "collision/frozen_boxes.hpp"
 #include "collision/narrow_phase.hpp"
 #include "collision/position_correction.hpp"
+#include "joints/direct_joints.hpp"
 #include "joints/joint_solver.hpp"
 
 #include "stepwise/entity.hpp"
@@ -81,6 +82,7 @@ public:
     /// Whether any collider has a shape (a system may hold only joints).
     bool hasShapes() const { return !finite_.empty() || !planes_.empty(); }
     joints::JointSettings& jointSettings() { return jointSettings_; }
+    const joints::DirectJoints& directJoints() const { return directJoints_; }
     /// The joints in solver (scene) order; their accumulated impulses are
     /// the joints' warm start, saved and restored with the contacts' cache.
     std::span<const joints::JointConstraint> jointConstraints() const { return joints_; }
@@ -232,6 +234,11 @@ private:
     std::vector<Rot> rotScratch_;
     std::vector<joints::JointConstraint> joints_;
     joints::JointSettings jointSettings_;
+    joints::DirectJoints directJoints_;  // the tree-shaped groups' exact solve
+    std::vector<joints::DirectJoints::Move> jointMoves_;  // per solver body: its projection (directJoints_.project)
+    std::vector<std::uint32_t> jointMoved_;
+    std::vector<std::pair<std::uint32_t, double>> stiffened_;  // bodies whose inertia a joint raised this substep
+    std::vector<double> stiffenScratch_;
     std::vector<std::uint64_t> noCollide_;  // sorted (min collider << 32 | max collider)
     std::vector<JointRecord> jointRecords_;
     double lastH_ = 0.0;

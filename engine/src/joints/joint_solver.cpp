@@ -309,25 +309,60 @@ void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bo
     }
 }
 
-void solveJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies, double h, const Softness& soft,
-                 bool useBias) {
+void solveJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies, double h, const Softness& loopSoft,
+                 const Softness& directSoft, bool useBias) {
     for (JointConstraint& j : joints) {
         if (j.asleep) continue;
+        const Softness& soft = j.direct ? directSoft : loopSoft;
         SolverBody& a = bodies[j.a.solverBody];
         SolverBody& b = bodies[j.b.solverBody];
         Pair p(a, b);
         switch (j.kind) {
         case JointKind::Hinge:
             solveHingeAxial(j, a, b, p, h, soft, useBias);
-            solvePoint(j, a, b, p, soft, useBias);
+            if (!j.direct) solvePoint(j, a, b, p, soft, useBias);
             break;
-        case JointKind::Weld: solveWeld(j, a, b, p, h, soft, useBias); break;
+        case JointKind::Weld:
+            if (!j.direct) solveWeld(j, a, b, p, h, soft, useBias);
+            break;
         case JointKind::Slider: solveSlider(j, a, b, p, h, soft, useBias); break;
         case JointKind::Distance:
         case JointKind::Rope: solveDistance(j, a, b, p, h, soft, useBias); break;
         }
         p.store(a, b);
     }
+}
+
+void stiffenRotation(std::span<const JointConstraint> joints, std::span<SolverBody> bodies, double h,
+                     std::vector<std::pair<std::uint32_t, double>>& saved, std::vector<double>& scratch) {
+    // One pass over the joints sums h (r . impulse) per body in `scratch`
+    // (kept all zero between calls) and lists each body at its first touch
+    // (in joint order: deterministic); one pass over those bodies applies it.
+    saved.clear();
+    if (scratch.size() != bodies.size()) scratch.assign(bodies.size(), 0.0);
+    const auto add = [&](std::uint32_t body, double k) {
+        if (body == 0 || !(bodies[body].invInertia > 0.0)) return;
+        if (scratch[body] == 0.0) saved.emplace_back(body, bodies[body].invInertia);
+        // A sum that lands on exactly 0 would list the body again; nudging
+        // it keeps the list unique (1e-300 kg m^2 changes no inertia).
+        scratch[body] += k;
+        if (scratch[body] == 0.0) scratch[body] = 1e-300;
+    };
+    for (const JointConstraint& j : joints) {
+        if (j.asleep || (j.kind != JointKind::Hinge && j.kind != JointKind::Weld)) continue;
+        // The impulse acts +linearImpulse on b at its anchor, - on a.
+        add(j.a.solverBody, -h * dot(rotate(bodies[j.a.solverBody].dq, j.anchorA), j.linearImpulse));
+        add(j.b.solverBody, h * dot(rotate(bodies[j.b.solverBody].dq, j.anchorB), j.linearImpulse));
+    }
+    for (const auto& [body, invI] : saved) {
+        const double k = scratch[body];  // h^2 k, kg m^2
+        scratch[body] = 0.0;
+        if (k > 0.0) bodies[body].invInertia = 1.0 / (1.0 / invI + k);
+    }
+}
+
+void restoreInertia(std::span<SolverBody> bodies, std::span<const std::pair<std::uint32_t, double>> saved) {
+    for (const auto& [body, invI] : saved) bodies[body].invInertia = invI;
 }
 
 double jointAngle(const JointConstraint& j, std::span<const SolverBody> bodies) {

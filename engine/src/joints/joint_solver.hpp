@@ -22,7 +22,9 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace stepwise::joints {
@@ -39,14 +41,40 @@ struct JointEnd {
 };
 
 /// One joint: its definition (from the scene) and its solver state.
-struct JointConstraint {
+/// What every pass of a hinge reads and writes (kind and flags, the
+/// step-start anchors, the centres' offset, the point impulse, both ends'
+/// solver bodies) comes first and fits two cache lines of the aligned
+/// struct: a grid of 20,000 hinges streams the array three times a substep,
+/// and with those fields spread over the struct the passes cost a third
+/// more (joint_grid, joints_vs_box2d --grid).
+struct alignas(64) JointConstraint {
     JointKind kind = JointKind::Hinge;
-    JointEnd a, b;
+    /// Its island sleeps (world/islands.hpp): the solver passes skip it and
+    /// its impulses stay as they were, ready for the wake.
+    bool asleep = false;
+    /// Its point rows (a rigid weld: all its rows) are solved exactly with
+    /// the rest of its tree (direct_joints.hpp); the Gauss-Seidel passes
+    /// solve only its limits and motor.
+    bool direct = false;
+    bool motor = false;
+    bool hasLower = false, hasUpper = false;
+
+    // Prepared at step start.
+    Vec2 anchorA, anchorB;         ///< anchors rotated to world orientation, relative to the centres, m
+    Vec2 deltaCenter;              ///< centre B - centre A, m
+    // Accumulated impulses (warm started), N*s and N*m*s.
+    Vec2 linearImpulse;            ///< hinge/weld point; slider: (perpendicular, angular)
+
+    JointEnd a, b;                 ///< solverBody first in each: still in the first two lines
+
+    double angularImpulse = 0.0;   ///< weld angle
+    double axialImpulse = 0.0;     ///< distance / rope along the line; slider: unused
+    double motorImpulse = 0.0;
+    double lowerImpulse = 0.0, upperImpulse = 0.0;
+
     Vec2 localAxis{1.0, 0.0};      ///< slider: unit axis in a's frame
     double referenceAngle = 0.0;   ///< rad
-    bool hasLower = false, hasUpper = false;
     double lower = 0.0, upper = 0.0;  ///< rad (hinge) or m (slider)
-    bool motor = false;
     double motorSpeed = 0.0;       ///< rad/s or m/s
     double maxMotor = 0.0;         ///< N*m or N
     double length = 0.0;           ///< distance, rope: metres
@@ -54,37 +82,31 @@ struct JointConstraint {
     double dampingRatio = 1.0;
     Entity entity;                 ///< the joint's own entity
     Entity entityA, entityB;       ///< its ends (entityB null: the world)
-    /// Its island sleeps (world/islands.hpp): the solver passes skip it and
-    /// its impulses stay as they were, ready for the wake.
-    bool asleep = false;
 
-    // Prepared at step start.
-    Vec2 anchorA, anchorB;         ///< anchors rotated to world orientation, relative to the centres, m
     Vec2 centreA, centreB;         ///< centres at step start, m
-    Vec2 deltaCenter;              ///< centre B - centre A, m
     double deltaAngle = 0.0;       ///< angle B - angle A - reference, rad
     Vec2 axisA;                    ///< slider axis in world orientation at step start
     double axialMass = 0.0;        ///< 1 / (iA + iB), kg m^2 (hinge motor/limits, weld angle)
-
-    // Accumulated impulses (warm started), N*s and N*m*s.
-    Vec2 linearImpulse;            ///< hinge/weld point; slider: (perpendicular, angular)
-    double angularImpulse = 0.0;   ///< weld angle
-    double axialImpulse = 0.0;     ///< distance / rope along the line; slider: unused
-    double motorImpulse = 0.0;
-    double lowerImpulse = 0.0, upperImpulse = 0.0;
 };
 
 struct JointSettings {
-    /// Stiffness of rigid joints' position correction, Hz, always capped at
-    /// half the substep rate (the soft step's stability limit, twice the
-    /// contacts' cap as in Box2D v3). The default is the cap itself: a
-    /// 20-link chain released horizontally stretched 4.1 mm at the cap and
-    /// 14.6 mm at 60 Hz (8 substeps, 4 iterations, links 0.5 m;
-    /// tests/test_joints.cpp, JointSweep).
-    double hertz = std::numeric_limits<double>::infinity();
-    /// Damping ratio of that correction. 1 (critical) measured 4.1 mm on the
-    /// chain above, 2 measured 5.3 mm and 5 measured 9.4 mm.
-    double dampingRatio = 1.0;
+    /// The world's joint_hz and joint_damping_ratio: the softness of every
+    /// rigid joint's position correction. Absent: the engine's choice, by
+    /// how the joint is solved (docs/joints.md, "Softness"):
+    ///  * in a tree solved exactly (direct_joints.hpp): half the substep
+    ///    rate, damping ratio 1 (stiff: the exact solve has no Gauss-Seidel
+    ///    lag to destabilise, and a pendulum keeps its period within 1e-4);
+    ///  * in a loop (Gauss-Seidel): 60 Hz, damping ratio 2, Box2D v3's
+    ///    jointHertz and jointDampingRatio. At the cap a 100 x 100 hinge grid
+    ///    opened 2.06 m in 60 steps at 4 substeps and 1 iteration; at 60 Hz,
+    ///    ratio 2, 0.23 m (joints_vs_box2d --grid).
+    /// Whatever is given, the stiffness is capped at half the substep rate
+    /// (the soft step's stability limit, twice the contacts' cap).
+    std::optional<double> hertz;
+    std::optional<double> dampingRatio;
+    static constexpr double kLoopHertz = 60.0;
+    static constexpr double kLoopDampingRatio = 2.0;
+    static constexpr double kTreeDampingRatio = 1.0;
 };
 
 /// The joint's accumulated impulses (its warm start), keyed by its entity.
@@ -99,10 +121,31 @@ void setImpulses(JointConstraint& joint, const JointImpulse& impulses);
 void prepareJoints(std::span<JointConstraint> joints, std::span<const collision::SolverBody> bodies,
                    std::span<const Vec2> centres, std::span<const double> angles);
 void warmStartJoints(std::span<JointConstraint> joints, std::span<collision::SolverBody> bodies);
-/// One Gauss-Seidel pass over the joints; `soft` is the rigid joints'
-/// softness (used in biased passes only).
+/// One Gauss-Seidel pass over the joints; `soft` is the rigid rows'
+/// softness (used in biased passes only), `directSoft` that of the rows
+/// (limits) of joints in an exactly solved tree.
 void solveJoints(std::span<JointConstraint> joints, std::span<collision::SolverBody> bodies, double h,
-                 const collision::Softness& soft, bool useBias);
+                 const collision::Softness& soft, const collision::Softness& directSoft, bool useBias);
+
+/// Implicit geometric stiffness of the point joints (hinge, weld): a joint
+/// force F at anchor r turns with its body, so the torque r x F changes by
+/// -(r . F) per radian of turn: a body pulled outward at its anchors (a
+/// link in a taut chain) has a rotational stiffness k = sum of r . F. A
+/// light link under a heavy load then rings at sqrt(k / I), far above what
+/// a substep resolves (1000:1 at 240 Hz: sqrt(k/I) h is about 2, the
+/// semi-implicit step's limit), and the chain shakes itself apart. Taking
+/// that stiffness implicitly (backward Euler: (I + h^2 k) dw = h torque)
+/// is the same as giving each such body the inertia I + h^2 k for the
+/// substep: it damps only those modes (h^2 k is 0.1% of I for a 1 kg link
+/// under its own weight at 240 Hz) and vanishes as h -> 0. F is taken from
+/// the accumulated impulses of the last substep (F h = impulse), so
+/// h^2 k = h (r . impulse). Compression (k < 0) is left alone: lowering
+/// the inertia would destabilise. Sets bodies' invInertia until
+/// restoreInertia() (CollisionSystem: for the whole step); `saved` receives
+/// (solver body, original invInertia); `scratch` is all zero between calls.
+void stiffenRotation(std::span<const JointConstraint> joints, std::span<collision::SolverBody> bodies, double h,
+                     std::vector<std::pair<std::uint32_t, double>>& saved, std::vector<double>& scratch);
+void restoreInertia(std::span<collision::SolverBody> bodies, std::span<const std::pair<std::uint32_t, double>> saved);
 
 /// The joint's pull on b (newtons) and torque on b (N*m) over the last
 /// substep of length h, from the accumulated impulses; a gets the opposite.

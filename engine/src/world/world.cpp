@@ -188,6 +188,11 @@ Result<World> World::build(const Scene& scene) {
         return Error{"world.sleep_velocity: expected a finite number >= 0, got " + format(ws.sleepVelocity)};
     if (!(ws.sleepTime >= 0.0) || !std::isfinite(ws.sleepTime))
         return Error{"world.sleep_time: expected a finite number >= 0, got " + format(ws.sleepTime)};
+    // Scenes built in code reach here unchecked by the loader: same words.
+    if (ws.jointHz && !(*ws.jointHz > 0.0 && *ws.jointHz <= 1e6))
+        return Error{"world.joint_hz: expected a number in (0, 1e+06], got " + format(*ws.jointHz)};
+    if (ws.jointDampingRatio && !(*ws.jointDampingRatio >= 0.0 && *ws.jointDampingRatio <= 1e3))
+        return Error{"world.joint_damping_ratio: expected a number in [0, 1000], got " + format(*ws.jointDampingRatio)};
 
     const Registry& reg = scene.registry;
     const std::vector<Entity>& order = reg.entities();
@@ -366,6 +371,8 @@ Result<World> World::build(const Scene& scene) {
     const double substepLength = ws.dt / double(w.settings.substeps);
     if (w.collision) {
         w.collision->settings().iterations = w.settings.solverIterations;
+        if (ws.jointHz) w.collision->jointSettings().hertz = *ws.jointHz;
+        if (ws.jointDampingRatio) w.collision->jointSettings().dampingRatio = *ws.jointDampingRatio;
         w.collision->settings().restitutionThreshold =
             ws.restitutionThreshold ? *ws.restitutionThreshold
                                     : derivedRestitutionThreshold(length(ws.gravity), substepLength);

@@ -1,0 +1,92 @@
+#pragma once
+// Exact solve of the rigid joints whose bodies form a tree (Baraff, "Linear-
+// time dynamics using Lagrange multipliers", 1996), inside the soft step.
+//
+// Gauss-Seidel passes a joint's impulse on to its neighbours one joint per
+// pass. Along a chain with a heavy end that takes far more passes than a
+// substep has: the light links cannot carry the heavy body's pull in two
+// passes and the chain opens. A group of joints whose dynamic bodies form a
+// tree (no loop among dynamic bodies; joints to static bodies or the world
+// never make a loop) is solved here instead, all its rows at once:
+//
+//   (J M^-1 J^T + gamma D) dlambda = -(J v + bias + gamma D lambda)
+//
+// J the rows' Jacobian at the current rotation, D the block diagonal of
+// J M^-1 J^T (each joint's own effective mass), lambda the accumulated
+// impulses. With gamma = impulseScale / massScale and bias = biasRate * C
+// of the soft step this is the point the soft Gauss-Seidel iteration
+// converges to (each joint's row: J v + bias + (1/c) K lambda = 0), reached
+// in one solve; the relax pass (gamma = 0, no bias) is the rigid solve.
+// The matrix of a tree factors without fill when eliminated leaves first;
+// Eigen's sparse LDL^T with its minimum-degree ordering finds that order,
+// so the cost is linear in the joints. The pattern is analysed once; each
+// pass factors the values (twice a substep: biased and relax) and each
+// iteration solves. Groups of a few rows are factored dense instead.
+// After the relax pass, project() moves each group's positions back onto
+// its joints by the part of each error past a slop (see the .cpp).
+// Groups, their order and every factorisation depend only on the joints'
+// order and the state, so the same input gives the same bits, and a saved
+// and reloaded world (its impulses in solver_state) continues exactly.
+//
+// Rows solved here: a hinge's point (2 rows) and a rigid weld's angle and
+// point (3 rows). Limits, motors, sliders, distances, ropes, springs and
+// every joint of a group with a loop (a grid, a closed linkage) stay in the
+// Gauss-Seidel passes (joint_solver.hpp), which run first in each iteration.
+
+#include "joints/joint_solver.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace stepwise::joints {
+
+class DirectJoints {
+public:
+    DirectJoints();
+    ~DirectJoints();
+    DirectJoints(DirectJoints&&) noexcept;
+    DirectJoints& operator=(DirectJoints&&) noexcept;
+
+    /// Groups the joints (once per set of joints), marks the joints it
+    /// solves (`JointConstraint::direct`) and factors each awake group at the
+    /// bodies' current rotation. `soft`: the rigid joints' softness; `biased`:
+    /// the biased passes (soft) or the relax pass (rigid).
+    void factor(std::span<JointConstraint> joints, std::span<const collision::SolverBody> bodies,
+                const collision::Softness& soft, bool biased);
+    /// One exact solve of every awake group's rows against the current
+    /// velocities, after factor() in the same pass.
+    void solve(std::span<JointConstraint> joints, std::span<collision::SolverBody> bodies);
+    /// After the relax pass (factor(..., false) at the substep's end pose):
+    /// one exact projection of the groups' positions onto their joints,
+    /// x += M^-1 J^T dl with (J M^-1 J^T) dl = -C', C' each joint's error
+    /// beyond the slop (0.5 mm; 0.002 rad for a weld's angle). Velocities
+    /// are left alone (a split impulse), so the correction adds no momentum
+    /// and no kinetic energy. Writes each moved solver body's displacement (m) and
+    /// turn (rad) into `moves` (sized to the bodies, zeroed here) and lists
+    /// the moved bodies in `moved`; the caller moves its state.
+    struct Move {
+        Vec2 dp;
+        double dq = 0.0;
+    };
+    void project(std::span<const JointConstraint> joints, std::span<const collision::SolverBody> bodies,
+                 std::vector<Move>& moves, std::vector<std::uint32_t>& moved);
+    /// Forgets the grouping (the joints changed).
+    void reset() { built_ = false; }
+    /// Joints solved here, for tests and the docs' measurements.
+    std::size_t directJointCount() const { return directCount_; }
+
+private:
+    struct Group;  // Eigen's types stay in the .cpp (the engine links Eigen privately)
+    void build(std::span<JointConstraint> joints, std::span<const collision::SolverBody> bodies);
+
+    bool built_ = false;
+    std::size_t builtFor_ = 0;
+    std::size_t directCount_ = 0;
+    std::vector<std::unique_ptr<Group>> groups_;
+    double gamma_ = 0.0, biasRate_ = 0.0;
+    bool biased_ = false;
+};
+
+} // namespace stepwise::joints

@@ -1,0 +1,386 @@
+// Hard cases for joints at a level's defaults and across substeps: chains
+// with a heavy end (mass ratio 1 to 1000), long chains (2 to 40 links), and
+// a swinging chain's energy. Every bound here is one a designer would see:
+// a joint that opens by more than about 1% of a link is visible, and a
+// pendulum that gains energy swings ever higher.
+
+#include "stepwise/components.hpp"
+#include "stepwise/scene_io.hpp"
+#include "stepwise/world.hpp"
+#include "world/world_internals.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+#include <string>
+
+namespace {
+
+using namespace stepwise;
+
+constexpr double kLink = 0.5;  // m, each link's length (boxes 0.5 x 0.05 m)
+
+std::string num(double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    return s.str();
+}
+
+/// `links` boxes hinged end to end, the first to the world at the origin,
+/// laid out horizontally (released from rest, they swing down). Every link
+/// is 1 kg but the last, which is `lastMass`. `substeps` 0 leaves substeps
+/// and iterations to the engine (a level that does not give them).
+Scene chain(int links, double lastMass, int substeps) {
+    std::ostringstream s;
+    s << R"({"world": {"gravity": {"x": 0, "y": -9.81}, "dt": 0.016666666666666666)";
+    if (substeps > 0) s << R"(, "substeps": )" << substeps;
+    s << R"(}, "entities": [)";
+    for (int i = 0; i < links; ++i) {
+        const double m = i == links - 1 ? lastMass : 1.0;
+        s << (i ? ",\n" : "") << R"({"name": "link)" << i << R"(", "position": {"x": )" << num((i + 0.5) * kLink)
+          << R"(, "y": 0}, "mass": )" << num(m) << R"(, "box": {"width": )" << num(kLink) << R"(, "height": )"
+          << num(kLink * 0.1) << "}}";
+    }
+    for (int i = 0; i < links; ++i) {
+        s << R"(, {"name": "pin)" << i << R"(", "joint": {"type": "hinge", "a": "link)" << i << "\"";
+        if (i > 0) s << R"(, "b": "link)" << (i - 1) << "\"";
+        s << R"(, "anchor": {"x": )" << num(i * kLink) << R"(, "y": 0}}})";
+    }
+    s << "]}";
+    Result<Scene> scene = parseScene(s.str(), "chain.json");
+    EXPECT_TRUE(scene) << (scene ? "" : scene.error());
+    return scene ? std::move(*scene) : Scene{};
+}
+
+struct ChainRun {
+    double largest = std::numeric_limits<double>::infinity();  ///< largest joint separation over the run, m
+    double energyRise = std::numeric_limits<double>::infinity();  ///< largest total energy above the start, J
+    double energyScale = 1.0;  ///< J: the chain's largest kinetic energy, for relative bounds
+    int substeps = 0, iterations = 0;  ///< what ran
+};
+
+/// Steps `steps` times (sleeping off: a swinging chain must not be frozen
+/// by an accident of timing) and measures the opening and the energy.
+ChainRun run(Scene scene, int steps) {
+    scene.world.sleep = false;
+    ChainRun out;
+    Result<World> built = World::build(scene);
+    EXPECT_TRUE(built) << (built ? "" : built.error());
+    if (!built) return out;
+    World& w = *built;
+    out.substeps = w.settings().substeps;
+    out.iterations = w.settings().solverIterations;
+    const double start = w.energy().total();
+    out.largest = 0.0;
+    out.energyRise = -std::numeric_limits<double>::infinity();
+    out.energyScale = 0.0;
+    for (int i = 0; i < steps; ++i) {
+        const Result<void> stepped = w.step();
+        EXPECT_TRUE(stepped) << stepped.error();
+        if (!stepped) {
+            out.largest = out.energyRise = std::numeric_limits<double>::infinity();
+            return out;
+        }
+        for (const JointRecord& r : w.joints()) out.largest = std::max(out.largest, r.separation);
+        const EnergyReport e = w.energy();
+        out.energyRise = std::max(out.energyRise, e.total() - start);
+        out.energyScale = std::max(out.energyScale, e.kinetic);
+    }
+    return out;
+}
+
+// ------------------------------------------------------------ mass ratio
+
+/// Ten links, the last `ratio` times heavier, released horizontally, 5 s.
+/// At the defaults the bound is the one the issue asks for (half of Box2D
+/// v3's 4 cm on the 1000:1 chain) and 1% of a link below 1000:1; with the
+/// substeps fixed, 1% of a link from 2 substeps up, 2% at 1 substep (a
+/// single 60 Hz substep caps the joints' correction at 30 Hz).
+struct MassCase {
+    double ratio;
+    int substeps;  // 0: the defaults
+};
+
+class HardJointsMassRatio : public ::testing::TestWithParam<MassCase> {};
+
+TEST_P(HardJointsMassRatio, ChainWithAHeavyEndStaysJoined) {
+    const MassCase c = GetParam();
+    const ChainRun r = run(chain(10, c.ratio, c.substeps), 300);
+    std::printf("mass ratio %6g, substeps %d (ran %d x %d iterations): largest opening %.3f mm\n", c.ratio,
+                c.substeps, r.substeps, r.iterations, 1e3 * r.largest);
+    double bound = c.substeps == 1 ? 0.02 * kLink : 0.01 * kLink;
+    if (c.substeps == 0 && c.ratio >= 1000.0) bound = 0.02;  // 2 cm: half of Box2D v3.1.1's 4 cm
+    EXPECT_LT(r.largest, bound) << "mass ratio " << c.ratio << ", substeps " << c.substeps;
+}
+
+std::vector<MassCase> massCases() {
+    std::vector<MassCase> out;
+    for (double ratio : {1.0, 10.0, 100.0, 1000.0})
+        for (int substeps : {0, 1, 2, 4, 8}) out.push_back({ratio, substeps});
+    return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(Sweep, HardJointsMassRatio, ::testing::ValuesIn(massCases()),
+                         [](const ::testing::TestParamInfo<MassCase>& p) {
+                             return "ratio" + std::to_string(int(p.param.ratio)) + "_substeps" +
+                                    (p.param.substeps ? std::to_string(p.param.substeps) : "Default");
+                         });
+
+/// The other way to build it: light links hanging straight down from a
+/// pin, a heavy ball (radius 0.3 m, `ratio` kg) on the last one, all
+/// swinging at 4 m/s at the bottom. The links stand in one column, so the
+/// engine's choice of substeps sees a stack there (4 substeps here).
+Scene hangingChain(int links, double ratio) {
+    std::ostringstream s;
+    s << R"({"world": {"gravity": {"x": 0, "y": -9.81}, "dt": 0.016666666666666666}, "entities": [)";
+    const double length = links * kLink + 0.3;
+    for (int i = 0; i < links; ++i) {
+        const double y = -(i + 0.5) * kLink;
+        s << (i ? ",\n" : "") << R"({"name": "link)" << i << R"(", "position": {"x": 0, "y": )" << num(y)
+          << R"(}, "velocity": {"x": )" << num(4.0 * (i + 0.5) * kLink / length) << R"(, "y": 0}, "mass": 1, "box": {"width": )"
+          << num(kLink * 0.1) << R"(, "height": )" << num(kLink) << "}}";
+    }
+    s << R"(, {"name": "weight", "position": {"x": 0, "y": )" << num(-length) << R"(}, "velocity": {"x": 4, "y": 0}, "mass": )"
+      << num(ratio) << R"(, "radius": 0.3})";
+    for (int i = 0; i < links; ++i) {
+        s << R"(, {"name": "pin)" << i << R"(", "joint": {"type": "hinge", "a": "link)" << i << "\"";
+        if (i > 0) s << R"(, "b": "link)" << (i - 1) << "\"";
+        s << R"(, "anchor": {"x": 0, "y": )" << num(-i * kLink) << "}}}";
+    }
+    s << R"(, {"name": "hook", "joint": {"type": "hinge", "a": "weight", "b": "link)" << (links - 1)
+      << R"(", "anchor": {"x": 0, "y": )" << num(-links * kLink) << "}}}";
+    s << "]}";
+    Result<Scene> scene = parseScene(s.str(), "hanging.json");
+    EXPECT_TRUE(scene) << (scene ? "" : scene.error());
+    return scene ? std::move(*scene) : Scene{};
+}
+
+TEST(HardJointsMassRatioHanging, HeavyWeightOnAHangingChainSwingsJoined) {
+    for (double ratio : {1.0, 10.0, 100.0, 1000.0}) {
+        const ChainRun r = run(hangingChain(10, ratio), 300);
+        std::printf("hanging chain, weight %g kg (ran %d x %d): largest opening %.3f mm, energy rise %.3g J of %.3g J\n",
+                    ratio, r.substeps, r.iterations, 1e3 * r.largest, r.energyRise, r.energyScale);
+        EXPECT_LT(r.largest, ratio >= 1000.0 ? 0.02 : 0.01 * kLink) << "weight " << ratio << " kg";
+        EXPECT_LT(r.energyRise, 0.005 * r.energyScale) << "weight " << ratio << " kg";
+    }
+}
+
+// ---------------------------------------------------------- chain length
+
+/// 2 to 40 equal links released horizontally, 5 s, at the defaults and at
+/// fixed substeps: the largest opening stays under 1% of a link (2% at one
+/// substep, as above).
+struct LengthCase {
+    int links;
+    int substeps;  // 0: the defaults
+};
+
+class HardJointsChainLength : public ::testing::TestWithParam<LengthCase> {};
+
+TEST_P(HardJointsChainLength, LongChainStaysJoined) {
+    const LengthCase c = GetParam();
+    const ChainRun r = run(chain(c.links, 1.0, c.substeps), 300);
+    std::printf("%2d links, substeps %d (ran %d x %d iterations): largest opening %.3f mm\n", c.links, c.substeps,
+                r.substeps, r.iterations, 1e3 * r.largest);
+    const double bound = c.substeps == 1 ? 0.02 * kLink : 0.01 * kLink;
+    EXPECT_LT(r.largest, bound) << c.links << " links, substeps " << c.substeps;
+}
+
+std::vector<LengthCase> lengthCases() {
+    std::vector<LengthCase> out;
+    for (int links : {2, 5, 10, 20, 40})
+        for (int substeps : {0, 1, 2, 4, 8}) out.push_back({links, substeps});
+    return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(Sweep, HardJointsChainLength, ::testing::ValuesIn(lengthCases()),
+                         [](const ::testing::TestParamInfo<LengthCase>& p) {
+                             return std::to_string(p.param.links) + "links_substeps" +
+                                    (p.param.substeps ? std::to_string(p.param.substeps) : "Default");
+                         });
+
+// ----------------------------------------------------------------- energy
+
+/// A swinging chain may lose energy (the soft correction, the relax pass and
+/// the projection damp it) but must never gain: its total energy stays at
+/// or below the start, within 0.5% of the largest kinetic energy it reaches
+/// (a short chain's energy oscillates a little, as a symplectic step's
+/// does: +0.40% at most, a double pendulum at 4 substeps).
+struct EnergyCase {
+    int links;
+    double ratio;
+    int substeps;  // 0: the defaults
+};
+
+class HardJointsEnergy : public ::testing::TestWithParam<EnergyCase> {};
+
+TEST_P(HardJointsEnergy, SwingingChainCreatesNoEnergy) {
+    const EnergyCase c = GetParam();
+    const ChainRun r = run(chain(c.links, c.ratio, c.substeps), 600);
+    std::printf("%2d links, ratio %g, substeps %d: energy rise %.4g J of %.4g J kinetic (%.3f%%)\n", c.links, c.ratio,
+                c.substeps, r.energyRise, r.energyScale, 100.0 * r.energyRise / r.energyScale);
+    EXPECT_LT(r.energyRise, 0.005 * r.energyScale) << c.links << " links, ratio " << c.ratio;
+}
+
+std::vector<EnergyCase> energyCases() {
+    std::vector<EnergyCase> out;
+    for (int links : {2, 3, 5, 10, 20, 40})
+        for (double ratio : {1.0, 10.0, 100.0, 1000.0})
+            for (int substeps : {0, 1, 2, 4, 8}) out.push_back({links, ratio, substeps});
+    return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(Sweep, HardJointsEnergy, ::testing::ValuesIn(energyCases()),
+                         [](const ::testing::TestParamInfo<EnergyCase>& p) {
+                             return std::to_string(p.param.links) + "links_ratio" +
+                                    std::to_string(int(p.param.ratio)) + "_substeps" +
+                                    (p.param.substeps ? std::to_string(p.param.substeps) : "Default");
+                         });
+
+// ------------------------------------------------------- what is solved how
+
+/// A chain is a tree: every hinge is solved exactly (direct_joints.hpp). A
+/// closed loop of links is not, and stays in the Gauss-Seidel passes.
+TEST(HardJointsSolver, TreesAreSolvedDirectlyAndLoopsIteratively) {
+    {
+        Result<World> w = World::build(chain(10, 1.0, 4));
+        ASSERT_TRUE(w);
+        ASSERT_TRUE(w->step());
+        EXPECT_EQ(internals(*w).collision->directJoints().directJointCount(), 10u);
+    }
+    {
+        Scene scene = chain(4, 1.0, 4);
+        // Close the loop: the last link's free end pinned to the first link.
+        Result<Scene> closed = parseScene(
+            R"({"entities": [{"name": "a", "position": {"x": 0, "y": 0}, "radius": 0.1},
+                             {"name": "b", "position": {"x": 1, "y": 0}, "radius": 0.1},
+                             {"name": "c", "position": {"x": 1, "y": 1}, "radius": 0.1},
+                             {"name": "p", "joint": {"type": "hinge", "a": "a", "b": "b", "anchor": {"x": 0.5, "y": 0}}},
+                             {"name": "q", "joint": {"type": "hinge", "a": "b", "b": "c", "anchor": {"x": 1, "y": 0.5}}},
+                             {"name": "r", "joint": {"type": "hinge", "a": "c", "b": "a", "anchor": {"x": 0.5, "y": 0.5}}}]})",
+            "loop.json");
+        ASSERT_TRUE(closed) << closed.error();
+        Result<World> w = World::build(*closed);
+        ASSERT_TRUE(w) << w.error();
+        ASSERT_TRUE(w->step());
+        EXPECT_EQ(internals(*w).collision->directJoints().directJointCount(), 0u);
+    }
+}
+
+// ----------------------------------------------------- the world settings
+
+/// joint_hz and joint_damping_ratio: saved and loaded, refused out of range
+/// with the JSON Pointer and the range.
+TEST(HardJointsSettings, JointSoftnessRoundTripsAndIsRangeChecked) {
+    const std::string text =
+        R"({"world": {"joint_hz": 60, "joint_damping_ratio": 2}, "entities": [{"name": "a", "position": {"x": 0, "y": 0}},
+            {"name": "pin", "joint": {"type": "hinge", "a": "a", "anchor": {"x": 0, "y": 1}}}]})";
+    Result<Scene> scene = parseScene(text, "soft.json");
+    ASSERT_TRUE(scene) << scene.error();
+    ASSERT_TRUE(scene->world.jointHz.has_value());
+    EXPECT_EQ(*scene->world.jointHz, 60.0);
+    EXPECT_EQ(*scene->world.jointDampingRatio, 2.0);
+    const std::string saved = sceneToJsonText(*scene);
+    EXPECT_NE(saved.find("\"joint_hz\": 60"), std::string::npos) << saved;
+    EXPECT_NE(saved.find("\"joint_damping_ratio\": 2"), std::string::npos) << saved;
+    Result<Scene> again = parseScene(saved, "again.json");
+    ASSERT_TRUE(again) << again.error();
+    EXPECT_EQ(again->world, scene->world);
+
+    Result<Scene> plain = parseScene(R"({"entities": []})", "plain.json");
+    ASSERT_TRUE(plain);
+    EXPECT_FALSE(plain->world.jointHz.has_value());
+    EXPECT_EQ(sceneToJsonText(*plain).find("joint_hz"), std::string::npos) << "absent stays absent";
+
+    const auto refusal = [](const std::string& world) {
+        Result<Scene> s = parseScene(R"({"world": )" + world + R"(, "entities": []})", "bad.json");
+        return s ? std::string("(loaded)") : s.error();
+    };
+    EXPECT_NE(refusal(R"({"joint_hz": 0})").find("/world/joint_hz: expected a number in (0, 1e+06], got 0"), std::string::npos)
+        << refusal(R"({"joint_hz": 0})");
+    EXPECT_NE(refusal(R"({"joint_hz": -5})").find("/world/joint_hz"), std::string::npos);
+    EXPECT_NE(refusal(R"({"joint_damping_ratio": -1})").find("/world/joint_damping_ratio: expected a number in [0, 1000]"),
+              std::string::npos)
+        << refusal(R"({"joint_damping_ratio": -1})");
+    EXPECT_NE(refusal(R"({"joint_hz": "stiff"})").find("/world/joint_hz"), std::string::npos);
+
+    // A scene built in code is checked by World::build in the same words.
+    Scene coded = *scene;
+    coded.world.jointDampingRatio = -1.0;
+    Result<World> w = World::build(coded);
+    ASSERT_FALSE(w);
+    EXPECT_NE(w.error().find("world.joint_damping_ratio"), std::string::npos) << w.error();
+}
+
+// ------------------------------------------------------------ the hinge grid
+
+/// Box2D v3's joint_grid benchmark at a smaller size: n x n circles (radius
+/// 0.4 m, 1 m apart) each hinged to its right and lower neighbours at the
+/// midpoints, the middle seven of the top row static (joints between two of
+/// them left out: Stepwise refuses a static-to-static joint). Full size and
+/// timing: bench/collision/joints_vs_box2d.cpp --grid.
+Scene hingeGrid(int n, int substeps, int iterations) {
+    Scene scene;
+    scene.world.gravity = {0.0, -10.0};
+    scene.world.substeps = substeps;
+    scene.world.solverIterations = iterations;
+    scene.world.sleep = false;
+    Registry& r = scene.registry;
+    std::vector<Entity> bodies;
+    for (int k = 0; k < n; ++k)
+        for (int i = 0; i < n; ++i) {
+            const Entity e = r.create();
+            r.emplace<Position>(e, Position{{double(k), -double(i)}});
+            r.emplace<Radius>(e, Radius{0.4});
+            const bool anchor = k >= n / 2 - 3 && k <= n / 2 + 3 && i == 0;
+            if (anchor) r.emplace<Static>(e, Static{true});
+            else r.emplace<Mass>(e, Mass{0.16 * 3.141592653589793});
+            const auto hinge = [&](Entity a, Vec2 localA, Vec2 localB) {
+                if (r.has<Static>(a) && anchor) return;
+                Joint j;
+                j.type = "hinge";
+                j.a = a;
+                j.b = e;
+                j.localA = localA;
+                j.localB = localB;
+                j.referenceAngle = 0.0;
+                r.emplace<Joint>(r.create(), j);
+            };
+            if (i > 0) hinge(bodies.back(), {0.0, -0.5}, {0.0, 0.5});
+            if (k > 0) hinge(bodies[bodies.size() - std::size_t(n)], {0.5, 0.0}, {-0.5, 0.0});
+            bodies.push_back(e);
+        }
+    return scene;
+}
+
+/// At Box2D v3's settings (4 substeps, 1 iteration) the grid, which has
+/// loops and so is solved by Gauss-Seidel, holds: it hangs and sways, and
+/// no joint opens past a tenth of the spacing. With the rigid joints as
+/// stiff as the substep allows (the softness trees get), it opened 2.06 m
+/// in 60 steps at full size: the loop default is what holds it.
+TEST(HardJointsGrid, HingeGridHoldsAtOneIteration) {
+    const Scene scene = hingeGrid(30, 4, 1);
+    const ChainRun r = run(scene, 120);
+    std::printf("30 x 30 hinge grid, 4 substeps x 1 iteration: largest opening %.1f mm\n", 1e3 * r.largest);
+    EXPECT_LT(r.largest, 0.1);
+    EXPECT_EQ(r.substeps, 4);
+}
+
+/// The world's joint_hz reaches the solver: a much softer correction lets
+/// the grid (Gauss-Seidel rows) sag open further.
+TEST(HardJointsSettings, SofterJointsOpenMore) {
+    Scene stiff = hingeGrid(12, 4, 2);
+    Scene soft = stiff;
+    soft.world.jointHz = 2.0;
+    soft.world.jointDampingRatio = 1.0;
+    const ChainRun a = run(stiff, 120), b = run(soft, 120);
+    std::printf("12 x 12 grid at 4 substeps: default %.3f mm, joint_hz 2: %.3f mm\n", 1e3 * a.largest, 1e3 * b.largest);
+    EXPECT_GT(b.largest, 2.0 * a.largest);
+}
+
+} // namespace
