@@ -672,15 +672,9 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // only stops approaches. Otherwise each contact's push (up to
     // pushMaxVelocity) adds up along the crowd and flings its edge out at
     // tens of m/s. Ordinary scenes have no crowd and are unchanged.
-    // Every pass runs the colours in the same order. Alternating the
-    // direction between passes (the biased pass forwards, the relax pass
-    // backwards) undid part of each pass's friction at one iteration: a
-    // 100-row pyramid at 4 substeps and 1 iteration slid its top 0.97 m
-    // sideways in 500 steps and kept 76 J; in one direction, 0.10 m and 8 J
-    // (40 rows: 7 mm and 0.8 J against under 0.1 mm and 1e-5 J).
-    constexpr bool reverse = false;
+    bool reverse = false;
     if (jointed) directJoints_.factor(joints_, bodies_, directSoft, true);
-    for (int it = 0; it < settings_.iterations; ++it) {
+    for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse) {
         if (jointed) {
             joints::solveJoints(joints_, bodies_, h, jointSoft, directSoft, true);
             directJoints_.solve(joints_, bodies_);
@@ -725,7 +719,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         b.dp = centreOfMass(i, std::span<const Vec2>(x.data(), x.size())) - stepStart_[i];
     }
     if (jointed) directJoints_.factor(joints_, bodies_, directSoft, false);
-    for (int it = 0; it < settings_.relaxIterations; ++it) {
+    for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse) {
         if (jointed) {
             joints::solveJoints(joints_, bodies_, h, jointSoft, directSoft, false);
             directJoints_.solve(joints_, bodies_);
