@@ -179,7 +179,14 @@ std::string sceneJsonSchema() {
         {"description", "what the solver carries between steps, written with a running state (stepwise run --out, the "
                         "editor's Save simulation state) so that a resumed run is bit-identical; absent: a cold start"},
         {"additionalProperties", false},
-        {"properties", Json{{"contacts", Json{{"type", "array"}, {"items", contact}}},
+        {"properties", Json{{"chosen", Json{{"type", "object"},
+                                            {"description", "the substeps and solver_iterations the engine chose for a "
+                                                            "level that leaves them out, run again on resume"},
+                                            {"additionalProperties", false},
+                                            {"required", Json::array({"substeps", "solver_iterations"})},
+                                            {"properties", Json{{"substeps", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}},
+                                                                {"solver_iterations", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}}}}}},
+                            {"contacts", Json{{"type", "array"}, {"items", contact}}},
                             {"joints", Json{{"type", "array"}, {"items", joint}}},
                             {"bodies", Json{{"type", "array"}, {"items", bodySleep}}}}}};
 

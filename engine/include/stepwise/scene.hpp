@@ -122,12 +122,25 @@ struct BodySleep {
 /// file's optional `solver_state` section (an addition to the format).
 /// Per-body solver state (sleep timers, ...) goes here next to `contacts`,
 /// keyed by entity the same way.
+/// The substeps and solver iterations the engine chose for a level that
+/// leaves them out, recorded by a run so that its resume runs the same
+/// (`solver_state.chosen`). A level that gives a setting keeps its own.
+struct ChosenSettings {
+    int substeps = 1;
+    int solverIterations = 8;
+
+    friend bool operator==(const ChosenSettings&, const ChosenSettings&) = default;
+};
+
 struct SolverState {
     std::vector<ContactImpulse> contacts;  ///< warm start, sorted by the solver's key
     std::vector<JointImpulse> joints;      ///< joints' warm start, in scene order
     std::vector<BodySleep> bodies;         ///< sleep timers and sleeping islands, in body (scene) order
+    /// Set when the engine chose the substeps or iterations (the level left
+    /// them out): World::build runs these instead of choosing again.
+    std::optional<ChosenSettings> chosen;
 
-    bool empty() const { return contacts.empty() && joints.empty() && bodies.empty(); }
+    bool empty() const { return contacts.empty() && joints.empty() && bodies.empty() && !chosen; }
     friend bool operator==(const SolverState&, const SolverState&) = default;
 };
 

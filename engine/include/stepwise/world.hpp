@@ -147,27 +147,60 @@ struct WorldState {
 };
 
 /// What the engine runs when a level gives no `substeps` (and no
-/// `solver_iterations`): enough substeps for the deepest pile the scene can
-/// build to rest with its deepest overlap under 1% of a body's diameter
-/// (expectedPileOverlap), at most 16. See docs (collide.md).
+/// `solver_iterations`), decided from the scene's structure alone (its
+/// bodies, shapes, masses, joints and gravity; never where the dynamic bodies
+/// are now), so that a run saved and resumed chooses what the long run chose.
+/// The fewest substeps (1, 2, 4, 8 or 16) that hold:
+///  * the pile: the deepest the dynamic shapes can pile (a heap on open
+///    ground, or N / floor(W / d) rows in a container W wide), its deepest
+///    overlap under 1% of a diameter (expectedPileOverlap, mass ratio
+///    included);
+///  * the load: the contact under the bottom body, under 1% of a diameter
+///    and 10% of the thinnest static support's thickness (strong gravity);
+///  * the joints: the heaviest group of jointed bodies (its mass over its
+///    lightest body's), its expected widest opening under 1% of a link.
+/// Contacts stop stiffening past 4 substeps at 60 Hz (contactHertz), so a
+/// contact rule that cannot hold stops where more substeps stop helping.
+/// docs/collisions.md "Substeps when the level gives none".
 struct ContactSettingsChoice {
     int substeps = 1;
     int iterations = 8;        ///< 8 at 1 substep (the old default), else 2
     int stackDepth = 0;        ///< bodies in the deepest column the scene can pile up
     double diameter = 0.0;     ///< metres, the median dynamic shape's size
     double gravity = 0.0;      ///< m/s^2, |world.gravity|
+    double massRatio = 1.0;    ///< heaviest / lightest dynamic shape that can pile
+    double support = 0.0;      ///< m, thinnest static support along gravity (0: none)
+    int jointBodies = 0;       ///< dynamic bodies in the most loaded jointed group
+    double jointLoad = 0.0;    ///< that group's mass over its lightest body's
+    double linkSize = 0.0;     ///< m, the median size of that group's bodies
+    int pileSubsteps = 1;      ///< what each rule alone needs
+    int loadSubsteps = 1;
+    int jointSubsteps = 1;
+    /// "20 jointed bodies (load 20:1); pile 12 deep": what made the choice.
+    std::string reason() const;
 };
 ContactSettingsChoice chooseContactSettings(const Scene& scene);
 /// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
 /// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
 /// compresses by load / (m_n omega^2), omega = 2 pi min(60 Hz, 1 / (4 h)),
-/// with a factor measured on the 30-row pile (docs: collide.md).
-double expectedPileOverlap(int depth, double gravity, double h);
+/// with a factor measured on the 30-row pile (docs: collide.md). The lowest
+/// contact between bodies carries (depth - 1) heavy bodies on a light one:
+/// load (depth - 1) M g over m_n = m M / (m + M), i.e. (depth - 1)(1 + R)
+/// m_n g with R = M / m (2 (depth - 1) for equal bodies).
+double expectedPileOverlap(int depth, double gravity, double h, double massRatio = 1.0);
+/// Expected overlap (m) of the contact under the bottom body of a pile
+/// `depth` deep on static ground: load ((depth - 1) R + 1) m g over m_n = m.
+double expectedSupportOverlap(int depth, double gravity, double h, double massRatio = 1.0);
+/// Expected widest opening (m) of the joints of a group of `bodies` jointed
+/// bodies whose mass is `load` times its lightest body's, under `gravity`,
+/// at substeps of `h` s: the rigid joints' softness is capped at half the
+/// substep rate, and the pull is fitted to chains of hinged boxes released
+/// level (world_collisions.cpp; docs/collisions.md).
+double expectedJointStretch(int bodies, double load, double gravity, double h);
 /// world.restitution_threshold when the level gives none: four times the
 /// speed gravity adds in one substep (m/s), so resting contacts never bounce
 /// and, with zero gravity, every approach does.
 double derivedRestitutionThreshold(double gravity, double h);
-
 /// A warning before playing: the level's own substeps let its deepest pile
 /// sink into itself by more than 2% of a diameter.
 struct PileHint {
@@ -225,6 +258,19 @@ public:
     Result<void> reload(const Scene& scene);
 
     const WorldSettings& settings() const;
+    /// Where the running substeps and solver iterations came from.
+    enum class SettingsSource {
+        Given,     ///< the level gives both
+        Chosen,    ///< chosen now from the scene's structure (chooseContactSettings)
+        Recorded,  ///< the choice a run recorded in the file (solver_state.chosen)
+    };
+    SettingsSource settingsSource() const;
+    /// The structural choice for this scene (also when the level gives the
+    /// settings: pileHint() compares against it).
+    const ContactSettingsChoice& settingsChoice() const;
+    /// One line for `stepwise validate`: "substeps 4, solver_iterations 2
+    /// (chosen: 20 jointed bodies (load 20:1); pile 12 deep)".
+    std::string settingsSummary() const;
     /// Changes the integrator by name (one of integratorNames()).
     Result<void> setIntegrator(std::string_view name);
     /// Moves the fixed end of a spring whose second end is fixed (an

@@ -60,8 +60,9 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t b) {
 }
 } // namespace
 
-bool SleepIslands::advanceTimers(std::span<const double> speed, const double* x, std::span<const double> angle,
-                                 double dt) {
+bool SleepIslands::advanceTimers(std::span<const double> speed, const double* x, const double* v,
+                                 std::span<const double> angle, double dt,
+                                 const std::function<double(std::size_t)>& fieldAccel) {
     if (!enabled) return false;
     bool ready = false;
     const double limit = driftLimit();
@@ -83,17 +84,50 @@ bool SleepIslands::advanceTimers(std::span<const double> speed, const double* x,
             const double drift = std::max(std::hypot(px - a[0], py - a[1]), extent[b] * std::abs(pa - a[2]));
             if (drift <= limit) {
                 timer[b] += dt;
+                if (timer[b] >= readyAt && speedingUp(b, x, v, fieldAccel)) {
+                    restartHere(b, px, py, pa);
+                    continue;
+                }
                 ready = ready || timer[b] >= readyAt;
                 continue;
             }
         }
-        a[0] = px;
-        a[1] = py;
-        a[2] = pa;
-        anchored[b] = 1;
-        timer[b] = 0.0;
+        restartHere(b, px, py, pa);
     }
     return ready;
+}
+
+void SleepIslands::restartHere(std::size_t b, double px, double py, double pa) {
+    double* a = &anchor[3 * b];
+    a[0] = px;
+    a[1] = py;
+    a[2] = pa;
+    anchored[b] = 1;
+    timer[b] = 0.0;
+}
+
+bool SleepIslands::speedingUp(std::size_t b, const double* x, const double* v,
+                              const std::function<double(std::size_t)>& fieldAccel) const {
+    // The window's mean acceleration from where it began (d = x - anchor)
+    // and the velocity now, over T = timer: a constant acceleration from
+    // velocity u gives d = u T + a T^2 / 2 and v = u + a T, so
+    // a = 2 (v - d / T) / T. Over a whole window a resting body's jitter
+    // averages out, while a box on a gentle frictionless slope shows g sin.
+    const double T = timer[b];
+    if (!(T > 0.0)) return false;
+    const double* a0 = &anchor[3 * b];
+    const double vx = v[2 * b], vy = v[2 * b + 1];
+    const double ax = 2.0 * (vx - (x[2 * b] - a0[0]) / T) / T, ay = 2.0 * (vy - (x[2 * b + 1] - a0[1]) / T) / T;
+    // Slowing down is coming to rest (friction, drag): only an acceleration
+    // along the motion, or from rest, keeps a body from sleeping.
+    if (ax * vx + ay * vy < 0.0) return false;
+    const double accel = std::hypot(ax, ay);
+    if (accel > accelerationLimit()) return true;
+    if (!(accel > 0.0)) return false;
+    // Under a weak field (a far attractor) every acceleration is small: a
+    // body is held only when its net acceleration is small next to the
+    // field's pull, as it is for a body resting on the ground.
+    return accel > 0.5 * fieldAccel(b);
 }
 
 std::vector<std::uint32_t> SleepIslands::fallAsleep(std::span<const std::pair<std::uint32_t, std::uint32_t>> edges) {

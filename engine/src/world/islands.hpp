@@ -21,7 +21,9 @@
 // (`solver_state.bodies`) carry them, so resume and step back stay exact.
 
 #include <cstddef>
+#include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -61,8 +63,17 @@ struct SleepIslands {
     /// After a step: the timers of the awake bodies (speed[b] = |v| +
     /// extent |omega|, m/s; read for awake bodies only) advance by dt or
     /// reset. True when some timer reached `time`: then fallAsleep() is due.
-    /// `x`: positions (x0, y0, x1, ...), `angle`: per body, rad.
-    bool advanceTimers(std::span<const double> speed, const double* x, std::span<const double> angle, double dt);
+    /// `x`, `v`: positions and velocities (x0, y0, x1, ...), `angle`: per
+    /// body, rad. `fieldAccel(b)`: the magnitude of the field forces'
+    /// acceleration on body b (gravity, attractors), m/s^2, asked only of a
+    /// body whose window is long enough to sleep and that still speeds up.
+    bool advanceTimers(std::span<const double> speed, const double* x, const double* v, std::span<const double> angle,
+                       double dt, const std::function<double(std::size_t)>& fieldAccel);
+    /// m/s^2: a still body whose net acceleration over its window (forces
+    /// and contact impulses together) exceeds this is not at rest, however
+    /// slowly it moves yet: a tenth of sleep_velocity gained per sleep_time
+    /// (0.01 m/s^2 by default, a frictionless slope of 0.06 degrees).
+    double accelerationLimit() const { return 0.1 * velocity / std::max(time, 1e-300); }
     /// m: how far a still body may drift from its anchor, a tenth of what
     /// sleep_velocity covers in sleep_time (2.5 mm by default); a body
     /// creeping slower than a tenth of sleep_velocity may still sleep.
@@ -72,6 +83,12 @@ struct SleepIslands {
         timer[b] = 0.0;
         anchored[b] = 0;
     }
+    /// Starts body b's still window at (px, py, pa).
+    void restartHere(std::size_t b, double px, double py, double pa);
+    /// Whether body b, still for a whole window, still gains speed: its net
+    /// acceleration does not balance (see advanceTimers).
+    bool speedingUp(std::size_t b, const double* x, const double* v,
+                    const std::function<double(std::size_t)>& fieldAccel) const;
     /// Builds the islands of the awake bodies from `edges` (pairs of
     /// bodies) and puts to sleep every island whose bodies have all been
     /// still for `time`. Returns the bodies that fell asleep, ascending.

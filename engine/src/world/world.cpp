@@ -41,6 +41,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <unordered_map>
 
@@ -359,10 +360,22 @@ Result<World> World::build(const Scene& scene) {
     if (!jointProblem.empty()) return Error{jointProblem};
     // Settings the level left to the engine (world.hpp: chooseContactSettings,
     // derivedRestitutionThreshold); settings() reports what runs.
+    // A run that saved its state recorded what it ran (solver_state.chosen):
+    // that is kept, so a resume steps exactly as the long run (bodies that
+    // came or went since would not change it).
     const ContactSettingsChoice choice = chooseContactSettings(scene);
     w.contactChoice = choice;
-    if (ws.substeps == 0) w.settings.substeps = choice.substeps;
-    if (ws.solverIterations == 0) w.settings.solverIterations = ws.substeps == 0 ? choice.iterations : 8;
+    const std::optional<ChosenSettings> recorded = scene.solverState ? scene.solverState->chosen : std::nullopt;
+    if (recorded && (recorded->substeps < 1 || recorded->solverIterations < 1))
+        return Error{"solver_state.chosen: substeps and solver_iterations must be integers >= 1"};
+    if (ws.substeps == 0) w.settings.substeps = recorded ? recorded->substeps : choice.substeps;
+    if (ws.solverIterations == 0)
+        w.settings.solverIterations = recorded ? recorded->solverIterations : ws.substeps == 0 ? choice.iterations : 8;
+    w.substepsGiven = ws.substeps != 0;
+    w.iterationsGiven = ws.solverIterations != 0;
+    w.settingsSource = ws.substeps != 0 && ws.solverIterations != 0 ? World::SettingsSource::Given
+                       : recorded                                     ? World::SettingsSource::Recorded
+                                                                      : World::SettingsSource::Chosen;
     const double substepLength = ws.dt / double(w.settings.substeps);
     if (w.collision) {
         w.collision->settings().iterations = w.settings.solverIterations;
@@ -701,8 +714,28 @@ SolverState WorldState::solverState() const {
 SolverState World::solverState() const {
     const WorldImpl& w = *impl_;
     const SleepArrays sleep{w.sleep.timer, w.sleep.island, w.sleep.anchor, w.sleep.anchored};
-    if (!w.collision) return entityKeyed(*w.layout, {}, {}, sleep);
-    return entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision), sleep);
+    SolverState state = w.collision ? entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision), sleep)
+                                    : entityKeyed(*w.layout, {}, {}, sleep);
+    // What the engine chose is part of the run: a resume must not choose again.
+    if (w.settingsSource != SettingsSource::Given)
+        state.chosen = ChosenSettings{w.settings.substeps, w.settings.solverIterations};
+    return state;
+}
+
+World::SettingsSource World::settingsSource() const { return impl_->settingsSource; }
+const ContactSettingsChoice& World::settingsChoice() const { return impl_->contactChoice; }
+
+std::string World::settingsSummary() const {
+    const WorldImpl& w = *impl_;
+    std::string line = "substeps " + std::to_string(w.settings.substeps) + " (";
+    if (w.substepsGiven) line += "given by the level";
+    else if (w.settingsSource == SettingsSource::Recorded)
+        line += "recorded by the run that saved this file; chosen afresh: " + std::to_string(w.contactChoice.substeps) +
+                ", " + w.contactChoice.reason();
+    else line += "chosen: " + w.contactChoice.reason();
+    line += "), solver_iterations " + std::to_string(w.settings.solverIterations);
+    if (w.iterationsGiven) line += " (given by the level)";
+    return line;
 }
 
 void World::setSolverState(const SolverState& state) {
@@ -731,6 +764,25 @@ void World::setSolverState(const SolverState& state) {
                 w.sleep.island[body->second] = std::int32_t(label->second);
         }
         w.sleep.refresh();
+        // Saved state reproduces a run; it never holds a body the sleep rule
+        // would not have put to sleep. A body moved or pushed by hand in the
+        // file (faster than sleep_velocity, or further than the drift limit
+        // from where its still window began) wakes its island.
+        const double* px = w.xs();
+        const double* pv = w.vs();
+        for (const std::uint32_t b : std::vector<std::uint32_t>(w.sleep.sleeping)) {
+            if (w.sleep.island[b] < 0) continue;  // woken with an earlier body of its island
+            const std::int32_t c = w.colliderOfBody[b];
+            const double spin = c >= 0 ? w.collision->angularVelocity(std::size_t(c)) : 0.0;
+            const double angle = c >= 0 ? w.collision->angle(std::size_t(c)) : 0.0;
+            const double speed = std::hypot(pv[2 * b], pv[2 * b + 1]) + w.sleep.extent[b] * std::abs(spin);
+            const double* a = &w.sleep.anchor[3 * b];
+            const double drift = w.sleep.anchored[b]
+                                     ? std::max(std::hypot(px[2 * b] - a[0], px[2 * b + 1] - a[1]),
+                                                w.sleep.extent[b] * std::abs(angle - a[2]))
+                                     : std::numeric_limits<double>::infinity();
+            if (!(speed <= w.sleep.velocity) || !(drift <= w.sleep.driftLimit())) w.sleep.wake(b);
+        }
         w.sleepChanged();
         w.sleptUnder = w.settings;  // a resume steps on under the settings it is given
     }
@@ -973,9 +1025,15 @@ std::vector<StiffnessHint> World::stiffnessHints() const {
 std::optional<PileHint> World::pileHint() const {
     const WorldImpl& w = *impl_;
     const ContactSettingsChoice& c = w.contactChoice;
+    // Only a setting the level gave can be at fault: the engine's own
+    // choice (fresh or recorded) is what the rule allows.
+    if (w.settingsSource != SettingsSource::Given && w.settings.substeps >= c.substeps) return std::nullopt;
     if (!w.collision || c.stackDepth < 2 || !(c.diameter > 0.0)) return std::nullopt;
     const double limit = 0.02 * c.diameter;  // the pile goal: overlap under 2% of a diameter
     const int substeps = w.settings.substeps;
+    // Equal bodies: the warning's model is the one measured on the 30-row
+    // pile; the choice also weighs the mass ratio (a heavy body on a light
+    // one), so it never gets less than this asks for.
     const double overlap = expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(substeps));
     if (!(overlap > limit)) return std::nullopt;
     PileHint hint;
