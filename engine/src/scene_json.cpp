@@ -441,8 +441,8 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
         }
         if (key == "bodies") {
             // Sleep timers and islands (an addition): "body" is required.
-            static constexpr std::array<std::string_view, 5> kBodyKeys{"body", "sleep_time", "still_at", "still_angle",
-                                                                       "island"};
+            static constexpr std::array<std::string_view, 6> kBodyKeys{"body", "sleep_time", "still_at", "still_angle",
+                                                                       "still_velocity", "island"};
             std::unordered_set<Entity> seenBodies;
             const auto dynamicAt = [&](const Json& ref, const std::string& fa) {
                 const Entity e = entityAt(ref, fa);
@@ -465,6 +465,8 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
                                   b.stillAt = readVector(fv, fa);
                               } else if (field == "still_angle") {
                                   b.stillAngle = readNumber(fv, fa, NumberRange{});
+                              } else if (field == "still_velocity") {
+                                  b.stillVelocity = readVector(fv, fa);
                               } else {
                                   b.island = dynamicAt(fv, fa);
                               }
@@ -976,6 +978,9 @@ void appendSolverState(const SolverState& state, const Registry& registry, std::
         if (b.stillAt)
             out += ", \"still_at\": {\"x\": " + number(b.stillAt->x) + ", \"y\": " + number(b.stillAt->y) +
                    "}, \"still_angle\": " + number(b.stillAngle);
+        if (b.stillAt && b.stillVelocity)
+            out += ", \"still_velocity\": {\"x\": " + number(b.stillVelocity->x) + ", \"y\": " +
+                   number(b.stillVelocity->y) + "}";
         if (!b.island.isNull())
             if (const std::optional<std::string> island = ref(b.island, dynamic(b.island))) out += ", \"island\": " + *island;
         out += "}";

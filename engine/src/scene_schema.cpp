@@ -173,6 +173,8 @@ std::string sceneJsonSchema() {
                             {"still_at", Json{{"$ref", "#/$defs/vector"},
                                               {"description", "where its still window began, m"}}},
                             {"still_angle", Json{{"type", "number"}, {"description", "its angle then, rad"}}},
+                            {"still_velocity", Json{{"$ref", "#/$defs/vector"},
+                                                    {"description", "its velocity at the window's middle (latest until then), m/s; absent: its velocity now"}}},
                             {"island", entityRef}}}};
     Json solverState = Json{
         {"type", "object"},

@@ -112,6 +112,10 @@ struct BodySleep {
     /// Asleep: the island's label, one of its bodies (the first in scene
     /// order); the island wakes as a whole. Null: awake.
     Entity island;
+    /// Its velocity at the window's middle (m/s; until then, its latest):
+    /// the acceleration that keeps a body awake is measured from it.
+    /// Absent (a file from before it was kept): the body's velocity.
+    std::optional<Vec2> stillVelocity;
 
     friend bool operator==(const BodySleep&, const BodySleep&) = default;
 };

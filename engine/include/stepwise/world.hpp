@@ -135,7 +135,7 @@ struct WorldState {
     std::vector<JointImpulse> joints;          ///< every joint's accumulated impulses, in layout.joints order
     std::vector<double> sleepTimer;            ///< bodies: seconds still (world.sleep_time)
     std::vector<std::int32_t> sleepIsland;     ///< bodies: -1 awake, else the sleeping island's first body
-    std::vector<double> sleepAnchor;           ///< bodies: where the still window began (x, y m, angle rad)
+    std::vector<double> sleepAnchor;           ///< bodies: where the still window began (x, y m, angle rad, vx, vy m/s)
     std::vector<std::uint8_t> sleepAnchored;   ///< bodies: 1 while a still window runs
     /// Heap bytes held (the layout, shared, not counted).
     std::size_t bytes() const;

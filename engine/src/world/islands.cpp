@@ -8,7 +8,7 @@ namespace stepwise::detail {
 
 void SleepIslands::resize(std::size_t bodies) {
     timer.assign(bodies, 0.0);
-    anchor.assign(3 * bodies, 0.0);
+    anchor.assign(kAnchorStride * bodies, 0.0);
     anchored.assign(bodies, 0);
     island.assign(bodies, -1);
     asleep.assign(bodies, 0);
@@ -76,7 +76,7 @@ bool SleepIslands::advanceTimers(std::span<const double> speed, const double* x,
             restart(b);
             continue;
         }
-        double* a = &anchor[3 * b];
+        const double* a = &anchor[kAnchorStride * b];
         const double px = x[2 * b], py = x[2 * b + 1], pa = angle[b];
         // The window counts the time between still observations, so one
         // still step never sleeps a body, however long dt is.
@@ -84,40 +84,51 @@ bool SleepIslands::advanceTimers(std::span<const double> speed, const double* x,
             const double drift = std::max(std::hypot(px - a[0], py - a[1]), extent[b] * std::abs(pa - a[2]));
             if (drift <= limit) {
                 timer[b] += dt;
-                if (timer[b] >= readyAt && speedingUp(b, x, v, fieldAccel)) {
-                    restartHere(b, px, py, pa);
+                // The acceleration is judged over the window's second half:
+                // the first half lets a transient pass (a wake, an
+                // integrator switched at rest).
+                if (timer[b] < 0.5 * readyAt) {
+                    double* av = &anchor[kAnchorStride * b];
+                    av[3] = v[2 * b];
+                    av[4] = v[2 * b + 1];
+                }
+                if (timer[b] >= readyAt && speedingUp(b, v, fieldAccel)) {
+                    restartHere(b, px, py, pa, &v[2 * b]);
                     continue;
                 }
                 ready = ready || timer[b] >= readyAt;
                 continue;
             }
         }
-        restartHere(b, px, py, pa);
+        restartHere(b, px, py, pa, &v[2 * b]);
     }
     return ready;
 }
 
-void SleepIslands::restartHere(std::size_t b, double px, double py, double pa) {
-    double* a = &anchor[3 * b];
+void SleepIslands::restartHere(std::size_t b, double px, double py, double pa, const double* v) {
+    double* a = &anchor[kAnchorStride * b];
     a[0] = px;
     a[1] = py;
     a[2] = pa;
+    a[3] = v[0];
+    a[4] = v[1];
     anchored[b] = 1;
     timer[b] = 0.0;
 }
 
-bool SleepIslands::speedingUp(std::size_t b, const double* x, const double* v,
+bool SleepIslands::speedingUp(std::size_t b, const double* v,
                               const std::function<double(std::size_t)>& fieldAccel) const {
-    // The window's mean acceleration from where it began (d = x - anchor)
-    // and the velocity now, over T = timer: a constant acceleration from
-    // velocity u gives d = u T + a T^2 / 2 and v = u + a T, so
-    // a = 2 (v - d / T) / T. Over a whole window a resting body's jitter
-    // averages out, while a box on a gentle frictionless slope shows g sin.
-    const double T = timer[b];
+    // The mean acceleration over the window's second half: the velocity's
+    // change since its middle (anchor[3..4], kept up to then), over about
+    // half a window. A resting body's jitter averages out (and a velocity
+    // an integrator reports off by a constant, as velocity Verlet's half
+    // kick at rest, cancels), while a box on a gentle frictionless slope
+    // shows g sin(theta).
+    const double T = timer[b] - 0.5 * readyAt;
     if (!(T > 0.0)) return false;
-    const double* a0 = &anchor[3 * b];
+    const double* a0 = &anchor[kAnchorStride * b];
     const double vx = v[2 * b], vy = v[2 * b + 1];
-    const double ax = 2.0 * (vx - (x[2 * b] - a0[0]) / T) / T, ay = 2.0 * (vy - (x[2 * b + 1] - a0[1]) / T) / T;
+    const double ax = (vx - a0[3]) / T, ay = (vy - a0[4]) / T;
     // Slowing down is coming to rest (friction, drag): only an acceleration
     // along the motion, or from rest, keeps a body from sleeping.
     if (ax * vx + ay * vy < 0.0) return false;

@@ -30,6 +30,9 @@
 
 namespace stepwise::detail {
 
+/// Doubles per body in SleepIslands::anchor: x, y, angle, vx, vy.
+inline constexpr std::size_t kAnchorStride = 5;
+
 struct SleepIslands {
     bool enabled = false;
     double velocity = 0.05;  ///< m/s, world.sleep_velocity
@@ -37,8 +40,9 @@ struct SleepIslands {
 
     // Per dynamic body (state-vector order).
     std::vector<double> timer;          ///< s spent still since `anchor` (frozen while asleep)
-    /// Where the body was when its still window began: x, y (m) and angle
-    /// (rad), three per body; valid while anchored[b]. A body that drifts
+    /// Where the body was when its still window began: x, y (m), angle
+    /// (rad), and its velocity x, y (m/s) at the window's middle (the
+    /// latest until then), kAnchorStride per body; valid while anchored[b]. A body that drifts
     /// further than driftLimit() from it starts its window again, so a body
     /// gliding slowly through space (or rolling along a floor) never sleeps.
     std::vector<double> anchor;
@@ -69,8 +73,9 @@ struct SleepIslands {
     /// body whose window is long enough to sleep and that still speeds up.
     bool advanceTimers(std::span<const double> speed, const double* x, const double* v, std::span<const double> angle,
                        double dt, const std::function<double(std::size_t)>& fieldAccel);
-    /// m/s^2: a still body whose net acceleration over its window (forces
-    /// and contact impulses together) exceeds this is not at rest, however
+    /// m/s^2: a still body whose net acceleration over its window (its
+    /// velocity's change since the window began over the window's length:
+    /// forces and contact impulses together) exceeds this is not at rest, however
     /// slowly it moves yet: a tenth of sleep_velocity gained per sleep_time
     /// (0.01 m/s^2 by default, a frictionless slope of 0.06 degrees).
     double accelerationLimit() const { return 0.1 * velocity / std::max(time, 1e-300); }
@@ -83,11 +88,12 @@ struct SleepIslands {
         timer[b] = 0.0;
         anchored[b] = 0;
     }
-    /// Starts body b's still window at (px, py, pa).
-    void restartHere(std::size_t b, double px, double py, double pa);
+    /// Starts body b's still window at position (px, py), angle pa and
+    /// velocity `v` (the body's pair).
+    void restartHere(std::size_t b, double px, double py, double pa, const double* v);
     /// Whether body b, still for a whole window, still gains speed: its net
     /// acceleration does not balance (see advanceTimers).
-    bool speedingUp(std::size_t b, const double* x, const double* v,
+    bool speedingUp(std::size_t b, const double* v,
                     const std::function<double(std::size_t)>& fieldAccel) const;
     /// Builds the islands of the awake bodies from `edges` (pairs of
     /// bodies) and puts to sleep every island whose bodies have all been

@@ -684,8 +684,10 @@ SolverState entityKeyed(const WorldLayout& layout, std::span<const CachedImpulse
         BodySleep entry{layout.bodies[b], sleep.timer[b], std::nullopt, 0.0,
                         sleep.island[b] >= 0 ? layout.bodies[std::size_t(sleep.island[b])] : Entity{}};
         if (sleep.anchored[b]) {
-            entry.stillAt = Vec2{sleep.anchor[3 * b], sleep.anchor[3 * b + 1]};
-            entry.stillAngle = sleep.anchor[3 * b + 2];
+            const double* a = &sleep.anchor[detail::kAnchorStride * b];
+            entry.stillAt = Vec2{a[0], a[1]};
+            entry.stillAngle = a[2];
+            entry.stillVelocity = Vec2{a[3], a[4]};
         }
         state.bodies.push_back(entry);
     }
@@ -752,10 +754,13 @@ void World::setSolverState(const SolverState& state) {
             if (body == bodyOf.end()) continue;  // no longer a dynamic body
             w.sleep.timer[body->second] = s.sleepTime;
             if (s.stillAt) {
-                double* a = &w.sleep.anchor[3 * body->second];
+                double* a = &w.sleep.anchor[detail::kAnchorStride * body->second];
                 a[0] = s.stillAt->x;
                 a[1] = s.stillAt->y;
                 a[2] = s.stillAngle;
+                const double* v = w.vs() + 2 * body->second;
+                a[3] = s.stillVelocity ? s.stillVelocity->x : v[0];
+                a[4] = s.stillVelocity ? s.stillVelocity->y : v[1];
                 w.sleep.anchored[body->second] = 1;
             }
             const auto label = s.island.isNull() ? bodyOf.end() : bodyOf.find(s.island);
@@ -776,7 +781,7 @@ void World::setSolverState(const SolverState& state) {
             const double spin = c >= 0 ? w.collision->angularVelocity(std::size_t(c)) : 0.0;
             const double angle = c >= 0 ? w.collision->angle(std::size_t(c)) : 0.0;
             const double speed = std::hypot(pv[2 * b], pv[2 * b + 1]) + w.sleep.extent[b] * std::abs(spin);
-            const double* a = &w.sleep.anchor[3 * b];
+            const double* a = &w.sleep.anchor[detail::kAnchorStride * b];
             const double drift = w.sleep.anchored[b]
                                      ? std::max(std::hypot(px[2 * b] - a[0], px[2 * b + 1] - a[1]),
                                                 w.sleep.extent[b] * std::abs(angle - a[2]))
@@ -845,7 +850,7 @@ Result<void> World::restoreState(const WorldState& s) {
     WorldImpl& w = *impl_;
     if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout) || s.joints.size() != w.layout->joints.size() ||
         s.sleepTimer.size() != w.bodyEntity.size() || s.sleepIsland.size() != w.bodyEntity.size() ||
-        s.sleepAnchor.size() != 3 * w.bodyEntity.size() || s.sleepAnchored.size() != w.bodyEntity.size())
+        s.sleepAnchor.size() != detail::kAnchorStride * w.bodyEntity.size() || s.sleepAnchored.size() != w.bodyEntity.size())
         return Error{"the snapshot was taken from a world with other bodies or shapes"};
     std::copy(s.x.begin(), s.x.end(), w.x[w.current].begin());
     std::copy(s.v.begin(), s.v.end(), w.v[w.current].begin());
