@@ -22,8 +22,9 @@ struct WorldSettings {
     std::string integrator = "semi_implicit_euler";
     double dt = 1.0 / 60.0;                  ///< seconds per step
     /// Each step is `substeps` steps of dt/substeps. 0: not given (a file
-    /// without the key); World::build then chooses from the scene
-    /// (chooseSubsteps in world.hpp), and a save writes no key.
+    /// without the key); World::build then chooses from the scene's
+    /// structure (chooseContactSettings in world.hpp) or runs the choice a
+    /// saved run recorded (SolverState::chosen), and a save writes no key.
     int substeps = 0;
     double time = 0.0;                       ///< simulated seconds so far
     /// Contact solver velocity iterations (addition). 0: not given; World::build

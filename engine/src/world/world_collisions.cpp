@@ -431,7 +431,8 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene) {
         }
     }
     choice.support = std::isfinite(thinnest) ? thinnest : 0.0;
-    if (!sizes.empty() && (floor || !walls.empty())) {
+    // Without gravity nothing piles up, whatever the geometry.
+    if (choice.gravity > 0.0 && !sizes.empty() && (floor || !walls.empty())) {
         choice.diameter = median(sizes);
         choice.massRatio = heaviestMass / lightest;
         const double d = choice.diameter;
