@@ -115,6 +115,11 @@ using test::withoutSleepLines;
 /// first), and again when sleeping came (on by default): the saved world gained three lines and
 /// the pile sleeps within the 4 s; with sleep off, every earlier value is
 /// reproduced exactly (WithSleepOffEveryHashRecordedBeforeSleepingHolds).
+/// implicit_euler re-recorded when a body had to stop speeding up (net
+/// acceleration under 1 mm/s^2) to sleep: the row of c0..c3 and b0 on the
+/// floor, pulled by the attractor, sleeps 4 steps later (c2 was still
+/// changing speed in its first window), and ends under 1 micrometre from
+/// where it slept before; every other integrator's bytes are unchanged.
 const std::map<std::string, std::uint64_t> kRecorded = {
     {"explicit_euler", 0xf31589ae39fe671cull},
     {"semi_implicit_euler", 0xf9f540e3891bc804ull},
@@ -122,7 +127,7 @@ const std::map<std::string, std::uint64_t> kRecorded = {
     {"trapezoid", 0x1ff248cb7c7fdb34ull},
     {"rk4", 0xe1088f0e0edf2b81ull},
     {"velocity_verlet", 0x96a15a0a79c34f65ull},
-    {"implicit_euler", 0x9158109d7ecb381aull},
+    {"implicit_euler", 0xbcf68088b5c6214dull},
     {"implicit_midpoint", 0xf1c605c478e260f2ull},
     {"dopri5", 0x484e19c5a65c7c27ull},
 };

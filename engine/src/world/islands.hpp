@@ -76,9 +76,10 @@ struct SleepIslands {
     /// m/s^2: a still body whose net acceleration over its window (its
     /// velocity's change since the window began over the window's length:
     /// forces and contact impulses together) exceeds this is not at rest, however
-    /// slowly it moves yet: a tenth of sleep_velocity gained per sleep_time
-    /// (0.01 m/s^2 by default, a frictionless slope of 0.06 degrees).
-    double accelerationLimit() const { return 0.1 * velocity / std::max(time, 1e-300); }
+    /// slowly it moves yet: a hundredth of sleep_velocity gained per
+    /// sleep_time (1 mm/s^2 by default, a frictionless slope of 0.006
+    /// degrees; a settled pile's bodies change speed far less).
+    double accelerationLimit() const { return 0.01 * velocity / std::max(time, 1e-300); }
     /// m: how far a still body may drift from its anchor, a tenth of what
     /// sleep_velocity covers in sleep_time (2.5 mm by default); a body
     /// creeping slower than a tenth of sleep_velocity may still sleep.
