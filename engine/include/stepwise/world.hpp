@@ -151,10 +151,10 @@ struct WorldState {
 /// bodies, shapes, masses, joints and gravity; never where the dynamic bodies
 /// are now), so that a run saved and resumed chooses what the long run chose.
 /// The fewest substeps (1, 2, 4, 8 or 16) that hold:
-///  * the pile: the deepest the dynamic shapes can pile (a heap on open
-///    ground, or N / floor(W / d) rows in a container W wide), its deepest
-///    overlap under 1% of a diameter (expectedPileOverlap, mass ratio
-///    included);
+///  * the pile: the deepest the N dynamic shapes can pile (a heap k deep,
+///    k (k + 1) / 2 >= N, no wider than floor(W / d) bodies on ground W
+///    wide, or ceil(N / floor(W / d)) full rows), its deepest overlap under
+///    1% of a diameter (expectedPileOverlap, mass ratio included);
 ///  * the load: the contact under the bottom body, under 1% of a diameter
 ///    and 10% of the thinnest static support's thickness (strong gravity);
 ///  * the joints: the heaviest group of jointed bodies (its mass over its
