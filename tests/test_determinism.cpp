@@ -113,7 +113,7 @@ const std::map<std::string, std::uint64_t> kRecorded = {
     {"trapezoid", 0x23df2a5faba01da7ull},
     {"rk4", 0xc59d4208657fa8b7ull},
     {"velocity_verlet", 0xb8d2ab69c1e25919ull},
-    {"implicit_euler", 0x16bdfb50d104daa7ull},
+    {"implicit_euler", 0x76371fb42ac9898cull},
     {"implicit_midpoint", 0x7e92a485d6dfac42ull},
     {"dopri5", 0xb7e4615bc2980d13ull},
 };

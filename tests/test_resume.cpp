@@ -389,7 +389,10 @@ TEST(Resume, BadSolverStateIsRefusedWithWhereAndWhat) {
          "t.json: error: /solver_state/contacts/0: missing \"tangent_impulse\""},
         {R"({"impulses": []})",
          "t.json: error: /solver_state/impulses: unknown key \"impulses\" in solver_state. Known keys: contacts, joints, "
-         "bodies"},
+         "bodies, chosen"},
+        {R"({"chosen": {"substeps": 0, "solver_iterations": 2}})",
+         "t.json: error: /solver_state/chosen/substeps: expected an integer in [1, 1000], got 0"},
+        {R"({"chosen": {"substeps": 4}})", "t.json: error: /solver_state/chosen: missing \"solver_iterations\""},
         {R"([])",
          "t.json: error: /solver_state: expected an object {\"contacts\": [...], \"joints\": [...], \"bodies\": "
          "[...]}, got an empty array"},

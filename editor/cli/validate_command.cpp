@@ -74,6 +74,12 @@ void addValidateCommand(CLI::App& app, int& exitCode) {
             summary += "; systems: " + (systems.empty() ? std::string("none") : systems) + "; integrator " +
                        scene->world.integrator;
             std::cout << summary << "\n";
+            // What substeps and iterations the contacts and joints run, and
+            // why: a scene without them has nothing the choice affects.
+            bool contactsOrJoints = false;
+            for (std::string_view s : world->activeSystems())
+                contactsOrJoints = contactsOrJoints || s == "collisions" || s == "joints";
+            if (contactsOrJoints) std::cout << *level << ": " << world->settingsSummary() << "\n";
             for (const StiffnessHint& hint : world->stiffnessHints())
                 std::cerr << *level << ": warning: " << hint.message() << "\n";
             if (const std::optional<PileHint> pile = world->pileHint())

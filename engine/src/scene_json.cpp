@@ -406,8 +406,22 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
     SolverState state;
     for (const auto& [key, value] : v.items()) {
         const std::string at = child(pointer, key);
-        if (key != "contacts" && key != "joints" && key != "bodies")
-            refuse(at, "unknown key \"" + key + "\" in solver_state. Known keys: contacts, joints, bodies");
+        if (key != "contacts" && key != "joints" && key != "bodies" && key != "chosen")
+            refuse(at, "unknown key \"" + key + "\" in solver_state. Known keys: contacts, joints, bodies, chosen");
+        if (key == "chosen") {
+            // The substeps and iterations the engine chose for the run that
+            // wrote this file; both required.
+            static constexpr std::array<std::string_view, 2> kChosenKeys{"substeps", "solver_iterations"};
+            ChosenSettings chosen;
+            readEntry(value, at, "the engine's chosen settings", kChosenKeys, kChosenKeys.size(),
+                      [&](const std::string& field, const Json& fv, const std::string& fa) {
+                          const int count = int(readInteger(fv, fa, 1, 1000));
+                          if (field == "substeps") chosen.substeps = count;
+                          else chosen.solverIterations = count;
+                      });
+            state.chosen = chosen;
+            continue;
+        }
         if (!value.is_array()) refuse(at, "expected an array of " + key + ", got " + describeFound(value));
         if (key == "contacts") {
             state.contacts.reserve(value.size());
@@ -427,8 +441,8 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
         }
         if (key == "bodies") {
             // Sleep timers and islands (an addition): "body" is required.
-            static constexpr std::array<std::string_view, 5> kBodyKeys{"body", "sleep_time", "still_at", "still_angle",
-                                                                       "island"};
+            static constexpr std::array<std::string_view, 6> kBodyKeys{"body", "sleep_time", "still_at", "still_angle",
+                                                                       "still_velocity", "island"};
             std::unordered_set<Entity> seenBodies;
             const auto dynamicAt = [&](const Json& ref, const std::string& fa) {
                 const Entity e = entityAt(ref, fa);
@@ -451,6 +465,8 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
                                   b.stillAt = readVector(fv, fa);
                               } else if (field == "still_angle") {
                                   b.stillAngle = readNumber(fv, fa, NumberRange{});
+                              } else if (field == "still_velocity") {
+                                  b.stillVelocity = readVector(fv, fa);
                               } else {
                                   b.island = dynamicAt(fv, fa);
                               }
@@ -911,7 +927,11 @@ void appendSolverState(const SolverState& state, const Registry& registry, std::
     };
     const auto number = [](double v) { return Json(v).dump(); };
     out.erase(out.size() - 2);  // "\n}"
-    out += ",\n  \"solver_state\": {\n    \"contacts\": [";
+    out += ",\n  \"solver_state\": {\n";
+    if (state.chosen)
+        out += "    \"chosen\": {\"substeps\": " + std::to_string(state.chosen->substeps) +
+               ", \"solver_iterations\": " + std::to_string(state.chosen->solverIterations) + "},\n";
+    out += "    \"contacts\": [";
     bool first = true;
     for (const ContactImpulse& c : state.contacts) {
         const std::optional<std::string> a = ref(c.a, collides(registry, c.a)), b = ref(c.b, collides(registry, c.b));
@@ -958,6 +978,9 @@ void appendSolverState(const SolverState& state, const Registry& registry, std::
         if (b.stillAt)
             out += ", \"still_at\": {\"x\": " + number(b.stillAt->x) + ", \"y\": " + number(b.stillAt->y) +
                    "}, \"still_angle\": " + number(b.stillAngle);
+        if (b.stillAt && b.stillVelocity)
+            out += ", \"still_velocity\": {\"x\": " + number(b.stillVelocity->x) + ", \"y\": " +
+                   number(b.stillVelocity->y) + "}";
         if (!b.island.isNull())
             if (const std::optional<std::string> island = ref(b.island, dynamic(b.island))) out += ", \"island\": " + *island;
         out += "}";

@@ -173,13 +173,22 @@ std::string sceneJsonSchema() {
                             {"still_at", Json{{"$ref", "#/$defs/vector"},
                                               {"description", "where its still window began, m"}}},
                             {"still_angle", Json{{"type", "number"}, {"description", "its angle then, rad"}}},
+                            {"still_velocity", Json{{"$ref", "#/$defs/vector"},
+                                                    {"description", "its velocity at the window's middle (latest until then), m/s; absent: its velocity now"}}},
                             {"island", entityRef}}}};
     Json solverState = Json{
         {"type", "object"},
         {"description", "what the solver carries between steps, written with a running state (stepwise run --out, the "
                         "editor's Save simulation state) so that a resumed run is bit-identical; absent: a cold start"},
         {"additionalProperties", false},
-        {"properties", Json{{"contacts", Json{{"type", "array"}, {"items", contact}}},
+        {"properties", Json{{"chosen", Json{{"type", "object"},
+                                            {"description", "the substeps and solver_iterations the engine chose for a "
+                                                            "level that leaves them out, run again on resume"},
+                                            {"additionalProperties", false},
+                                            {"required", Json::array({"substeps", "solver_iterations"})},
+                                            {"properties", Json{{"substeps", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}},
+                                                                {"solver_iterations", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}}}}}},
+                            {"contacts", Json{{"type", "array"}, {"items", contact}}},
                             {"joints", Json{{"type", "array"}, {"items", joint}}},
                             {"bodies", Json{{"type", "array"}, {"items", bodySleep}}}}}};
 

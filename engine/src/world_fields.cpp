@@ -26,7 +26,8 @@ std::vector<WorldFieldInfo> buildTable() {
         {makeField<&WorldSettings::dt>("dt", {0.0, 10.0, true}, "s", "seconds per step")},
         {makeField<&WorldSettings::substeps>("substeps", {1.0, 1000.0}, "",
                                              "each step is substeps steps of dt/substeps; absent: chosen from "
-                                             "the scene (the deepest pile it can hold)"),
+                                             "the scene's structure (its pile, load and joints) and recorded "
+                                             "in a saved run's solver_state.chosen"),
          true},
         {makeField<&WorldSettings::time>("time", {}, "s", "simulated seconds so far")},
         {makeField<&WorldSettings::solverIterations>("solver_iterations", {1.0, 1000.0}, "",

@@ -22,8 +22,9 @@ struct WorldSettings {
     std::string integrator = "semi_implicit_euler";
     double dt = 1.0 / 60.0;                  ///< seconds per step
     /// Each step is `substeps` steps of dt/substeps. 0: not given (a file
-    /// without the key); World::build then chooses from the scene
-    /// (chooseSubsteps in world.hpp), and a save writes no key.
+    /// without the key); World::build then chooses from the scene's
+    /// structure (chooseContactSettings in world.hpp) or runs the choice a
+    /// saved run recorded (SolverState::chosen), and a save writes no key.
     int substeps = 0;
     double time = 0.0;                       ///< simulated seconds so far
     /// Contact solver velocity iterations (addition). 0: not given; World::build
@@ -120,6 +121,10 @@ struct BodySleep {
     /// Asleep: the island's label, one of its bodies (the first in scene
     /// order); the island wakes as a whole. Null: awake.
     Entity island;
+    /// Its velocity at the window's middle (m/s; until then, its latest):
+    /// the acceleration that keeps a body awake is measured from it.
+    /// Absent (a file from before it was kept): the body's velocity.
+    std::optional<Vec2> stillVelocity;
 
     friend bool operator==(const BodySleep&, const BodySleep&) = default;
 };
@@ -130,12 +135,25 @@ struct BodySleep {
 /// file's optional `solver_state` section (an addition to the format).
 /// Per-body solver state (sleep timers, ...) goes here next to `contacts`,
 /// keyed by entity the same way.
+/// The substeps and solver iterations the engine chose for a level that
+/// leaves them out, recorded by a run so that its resume runs the same
+/// (`solver_state.chosen`). A level that gives a setting keeps its own.
+struct ChosenSettings {
+    int substeps = 1;
+    int solverIterations = 8;
+
+    friend bool operator==(const ChosenSettings&, const ChosenSettings&) = default;
+};
+
 struct SolverState {
     std::vector<ContactImpulse> contacts;  ///< warm start, sorted by the solver's key
     std::vector<JointImpulse> joints;      ///< joints' warm start, in scene order
     std::vector<BodySleep> bodies;         ///< sleep timers and sleeping islands, in body (scene) order
+    /// Set when the engine chose the substeps or iterations (the level left
+    /// them out): World::build runs these instead of choosing again.
+    std::optional<ChosenSettings> chosen;
 
-    bool empty() const { return contacts.empty() && joints.empty() && bodies.empty(); }
+    bool empty() const { return contacts.empty() && joints.empty() && bodies.empty() && !chosen; }
     friend bool operator==(const SolverState&, const SolverState&) = default;
 };
 

@@ -135,7 +135,7 @@ struct WorldState {
     std::vector<JointImpulse> joints;          ///< every joint's accumulated impulses, in layout.joints order
     std::vector<double> sleepTimer;            ///< bodies: seconds still (world.sleep_time)
     std::vector<std::int32_t> sleepIsland;     ///< bodies: -1 awake, else the sleeping island's first body
-    std::vector<double> sleepAnchor;           ///< bodies: where the still window began (x, y m, angle rad)
+    std::vector<double> sleepAnchor;           ///< bodies: where the still window began (x, y m, angle rad, vx, vy m/s)
     std::vector<std::uint8_t> sleepAnchored;   ///< bodies: 1 while a still window runs
     /// Heap bytes held (the layout, shared, not counted).
     std::size_t bytes() const;
@@ -147,27 +147,50 @@ struct WorldState {
 };
 
 /// What the engine runs when a level gives no `substeps` (and no
-/// `solver_iterations`): enough substeps for the deepest pile the scene can
-/// build to rest with its deepest overlap under 1% of a body's diameter
-/// (expectedPileOverlap), at most 16. See docs (collide.md).
+/// `solver_iterations`), decided from the scene's structure alone (its
+/// bodies, shapes, masses, joints and gravity; never where the dynamic bodies
+/// are now), so that a run saved and resumed chooses what the long run chose.
+/// The fewest substeps (1, 2, 4, 8 or 16) that hold:
+///  * the pile: the deepest the N dynamic shapes can pile (a heap k deep,
+///    k (k + 1) / 2 >= N, no wider than floor(W / d) bodies on ground W
+///    wide, or ceil(N / floor(W / d)) full rows), its deepest overlap under
+///    1% of a diameter (expectedPileOverlap, mass ratio included);
+///  * the load: the contact under the bottom body, under 1% of a diameter
+///    and 10% of the thinnest static support's thickness (strong gravity);
+///  * the joints: the heaviest group of jointed bodies (its mass over its
+///    lightest body's), its expected widest opening under 1% of a link.
+/// Contacts stop stiffening past 4 substeps at 60 Hz (contactHertz), so a
+/// contact rule that cannot hold stops where more substeps stop helping.
+/// docs/collisions.md "Substeps when the level gives none".
 struct ContactSettingsChoice {
     int substeps = 1;
     int iterations = 8;        ///< 8 at 1 substep (the old default), else 2
     int stackDepth = 0;        ///< bodies in the deepest column the scene can pile up
     double diameter = 0.0;     ///< metres, the median dynamic shape's size
     double gravity = 0.0;      ///< m/s^2, |world.gravity|
+    double massRatio = 1.0;    ///< heaviest / lightest dynamic shape that can pile
+    double support = 0.0;      ///< m, thinnest static support along gravity (0: none)
+    int pileSubsteps = 1;      ///< what each rule alone needs
+    int loadSubsteps = 1;
+    /// "pile 12 deep ...": what made the choice.
+    std::string reason() const;
 };
 ContactSettingsChoice chooseContactSettings(const Scene& scene);
 /// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
 /// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
 /// compresses by load / (m_n omega^2), omega = 2 pi min(60 Hz, 1 / (4 h)),
-/// with a factor measured on the 30-row pile (docs: collide.md).
-double expectedPileOverlap(int depth, double gravity, double h);
+/// with a factor measured on the 30-row pile (docs: collide.md). The lowest
+/// contact between bodies carries (depth - 1) heavy bodies on a light one:
+/// load (depth - 1) M g over m_n = m M / (m + M), i.e. (depth - 1)(1 + R)
+/// m_n g with R = M / m (2 (depth - 1) for equal bodies).
+double expectedPileOverlap(int depth, double gravity, double h, double massRatio = 1.0);
+/// Expected overlap (m) of the contact under the bottom body of a pile
+/// `depth` deep on static ground: load ((depth - 1) R + 1) m g over m_n = m.
+double expectedSupportOverlap(int depth, double gravity, double h, double massRatio = 1.0);
 /// world.restitution_threshold when the level gives none: four times the
 /// speed gravity adds in one substep (m/s), so resting contacts never bounce
 /// and, with zero gravity, every approach does.
 double derivedRestitutionThreshold(double gravity, double h);
-
 /// A warning before playing: the level's own substeps let its deepest pile
 /// sink into itself by more than 2% of a diameter.
 struct PileHint {
@@ -225,6 +248,19 @@ public:
     Result<void> reload(const Scene& scene);
 
     const WorldSettings& settings() const;
+    /// Where the running substeps and solver iterations came from.
+    enum class SettingsSource {
+        Given,     ///< the level gives both
+        Chosen,    ///< chosen now from the scene's structure (chooseContactSettings)
+        Recorded,  ///< the choice a run recorded in the file (solver_state.chosen)
+    };
+    SettingsSource settingsSource() const;
+    /// The structural choice for this scene (also when the level gives the
+    /// settings: pileHint() compares against it).
+    const ContactSettingsChoice& settingsChoice() const;
+    /// One line for `stepwise validate`: "substeps 4, solver_iterations 2
+    /// (chosen: 20 jointed bodies (load 20:1); pile 12 deep)".
+    std::string settingsSummary() const;
     /// Changes the integrator by name (one of integratorNames()).
     Result<void> setIntegrator(std::string_view name);
     /// Moves the fixed end of a spring whose second end is fixed (an

@@ -8,7 +8,7 @@ namespace stepwise::detail {
 
 void SleepIslands::resize(std::size_t bodies) {
     timer.assign(bodies, 0.0);
-    anchor.assign(3 * bodies, 0.0);
+    anchor.assign(kAnchorStride * bodies, 0.0);
     anchored.assign(bodies, 0);
     island.assign(bodies, -1);
     asleep.assign(bodies, 0);
@@ -60,8 +60,9 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t b) {
 }
 } // namespace
 
-bool SleepIslands::advanceTimers(std::span<const double> speed, const double* x, std::span<const double> angle,
-                                 double dt) {
+bool SleepIslands::advanceTimers(std::span<const double> speed, const double* x, const double* v,
+                                 std::span<const double> angle, double dt,
+                                 const std::function<double(std::size_t)>& fieldAccel) {
     if (!enabled) return false;
     bool ready = false;
     const double limit = driftLimit();
@@ -75,7 +76,7 @@ bool SleepIslands::advanceTimers(std::span<const double> speed, const double* x,
             restart(b);
             continue;
         }
-        double* a = &anchor[3 * b];
+        const double* a = &anchor[kAnchorStride * b];
         const double px = x[2 * b], py = x[2 * b + 1], pa = angle[b];
         // The window counts the time between still observations, so one
         // still step never sleeps a body, however long dt is.
@@ -83,17 +84,61 @@ bool SleepIslands::advanceTimers(std::span<const double> speed, const double* x,
             const double drift = std::max(std::hypot(px - a[0], py - a[1]), extent[b] * std::abs(pa - a[2]));
             if (drift <= limit) {
                 timer[b] += dt;
+                // The acceleration is judged over the window's second half:
+                // the first half lets a transient pass (a wake, an
+                // integrator switched at rest).
+                if (timer[b] < 0.5 * readyAt) {
+                    double* av = &anchor[kAnchorStride * b];
+                    av[3] = v[2 * b];
+                    av[4] = v[2 * b + 1];
+                }
+                if (timer[b] >= readyAt && speedingUp(b, v, fieldAccel)) {
+                    restartHere(b, px, py, pa, &v[2 * b]);
+                    continue;
+                }
                 ready = ready || timer[b] >= readyAt;
                 continue;
             }
         }
-        a[0] = px;
-        a[1] = py;
-        a[2] = pa;
-        anchored[b] = 1;
-        timer[b] = 0.0;
+        restartHere(b, px, py, pa, &v[2 * b]);
     }
     return ready;
+}
+
+void SleepIslands::restartHere(std::size_t b, double px, double py, double pa, const double* v) {
+    double* a = &anchor[kAnchorStride * b];
+    a[0] = px;
+    a[1] = py;
+    a[2] = pa;
+    a[3] = v[0];
+    a[4] = v[1];
+    anchored[b] = 1;
+    timer[b] = 0.0;
+}
+
+bool SleepIslands::speedingUp(std::size_t b, const double* v,
+                              const std::function<double(std::size_t)>& fieldAccel) const {
+    // The mean acceleration over the window's second half: the velocity's
+    // change since its middle (anchor[3..4], kept up to then), over about
+    // half a window. A resting body's jitter averages out (and a velocity
+    // an integrator reports off by a constant, as velocity Verlet's half
+    // kick at rest, cancels), while a box on a gentle frictionless slope
+    // shows g sin(theta).
+    const double T = timer[b] - 0.5 * readyAt;
+    if (!(T > 0.0)) return false;
+    const double* a0 = &anchor[kAnchorStride * b];
+    const double vx = v[2 * b], vy = v[2 * b + 1];
+    const double ax = (vx - a0[3]) / T, ay = (vy - a0[4]) / T;
+    // Slowing down is coming to rest (friction, drag): only an acceleration
+    // along the motion, or from rest, keeps a body from sleeping.
+    if (ax * vx + ay * vy < 0.0) return false;
+    const double accel = std::hypot(ax, ay);
+    if (accel > accelerationLimit()) return true;
+    if (!(accel > 0.0)) return false;
+    // Under a weak field (a far attractor) every acceleration is small: a
+    // body is held only when its net acceleration is small next to the
+    // field's pull, as it is for a body resting on the ground.
+    return accel > 0.5 * fieldAccel(b);
 }
 
 std::vector<std::uint32_t> SleepIslands::fallAsleep(std::span<const std::pair<std::uint32_t, std::uint32_t>> edges) {

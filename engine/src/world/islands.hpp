@@ -21,12 +21,17 @@
 // (`solver_state.bodies`) carry them, so resume and step back stay exact.
 
 #include <cstddef>
+#include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <utility>
 #include <vector>
 
 namespace stepwise::detail {
+
+/// Doubles per body in SleepIslands::anchor: x, y, angle, vx, vy.
+inline constexpr std::size_t kAnchorStride = 5;
 
 struct SleepIslands {
     bool enabled = false;
@@ -35,8 +40,9 @@ struct SleepIslands {
 
     // Per dynamic body (state-vector order).
     std::vector<double> timer;          ///< s spent still since `anchor` (frozen while asleep)
-    /// Where the body was when its still window began: x, y (m) and angle
-    /// (rad), three per body; valid while anchored[b]. A body that drifts
+    /// Where the body was when its still window began: x, y (m), angle
+    /// (rad), and its velocity x, y (m/s) at the window's middle (the
+    /// latest until then), kAnchorStride per body; valid while anchored[b]. A body that drifts
     /// further than driftLimit() from it starts its window again, so a body
     /// gliding slowly through space (or rolling along a floor) never sleeps.
     std::vector<double> anchor;
@@ -61,8 +67,19 @@ struct SleepIslands {
     /// After a step: the timers of the awake bodies (speed[b] = |v| +
     /// extent |omega|, m/s; read for awake bodies only) advance by dt or
     /// reset. True when some timer reached `time`: then fallAsleep() is due.
-    /// `x`: positions (x0, y0, x1, ...), `angle`: per body, rad.
-    bool advanceTimers(std::span<const double> speed, const double* x, std::span<const double> angle, double dt);
+    /// `x`, `v`: positions and velocities (x0, y0, x1, ...), `angle`: per
+    /// body, rad. `fieldAccel(b)`: the magnitude of the field forces'
+    /// acceleration on body b (gravity, attractors), m/s^2, asked only of a
+    /// body whose window is long enough to sleep and that still speeds up.
+    bool advanceTimers(std::span<const double> speed, const double* x, const double* v, std::span<const double> angle,
+                       double dt, const std::function<double(std::size_t)>& fieldAccel);
+    /// m/s^2: a still body whose net acceleration over its window (its
+    /// velocity's change since the window began over the window's length:
+    /// forces and contact impulses together) exceeds this is not at rest, however
+    /// slowly it moves yet: a hundredth of sleep_velocity gained per
+    /// sleep_time (1 mm/s^2 by default, a frictionless slope of 0.006
+    /// degrees; a settled pile's bodies change speed far less).
+    double accelerationLimit() const { return 0.01 * velocity / std::max(time, 1e-300); }
     /// m: how far a still body may drift from its anchor, a tenth of what
     /// sleep_velocity covers in sleep_time (2.5 mm by default); a body
     /// creeping slower than a tenth of sleep_velocity may still sleep.
@@ -72,6 +89,13 @@ struct SleepIslands {
         timer[b] = 0.0;
         anchored[b] = 0;
     }
+    /// Starts body b's still window at position (px, py), angle pa and
+    /// velocity `v` (the body's pair).
+    void restartHere(std::size_t b, double px, double py, double pa, const double* v);
+    /// Whether body b, still for a whole window, still gains speed: its net
+    /// acceleration does not balance (see advanceTimers).
+    bool speedingUp(std::size_t b, const double* v,
+                    const std::function<double(std::size_t)>& fieldAccel) const;
     /// Builds the islands of the awake bodies from `edges` (pairs of
     /// bodies) and puts to sleep every island whose bodies have all been
     /// still for `time`. Returns the bodies that fell asleep, ascending.

@@ -41,6 +41,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <unordered_map>
 
@@ -364,10 +365,22 @@ Result<World> World::build(const Scene& scene) {
     if (!jointProblem.empty()) return Error{jointProblem};
     // Settings the level left to the engine (world.hpp: chooseContactSettings,
     // derivedRestitutionThreshold); settings() reports what runs.
+    // A run that saved its state recorded what it ran (solver_state.chosen):
+    // that is kept, so a resume steps exactly as the long run (bodies that
+    // came or went since would not change it).
     const ContactSettingsChoice choice = chooseContactSettings(scene);
     w.contactChoice = choice;
-    if (ws.substeps == 0) w.settings.substeps = choice.substeps;
-    if (ws.solverIterations == 0) w.settings.solverIterations = ws.substeps == 0 ? choice.iterations : 8;
+    const std::optional<ChosenSettings> recorded = scene.solverState ? scene.solverState->chosen : std::nullopt;
+    if (recorded && (recorded->substeps < 1 || recorded->solverIterations < 1))
+        return Error{"solver_state.chosen: substeps and solver_iterations must be integers >= 1"};
+    if (ws.substeps == 0) w.settings.substeps = recorded ? recorded->substeps : choice.substeps;
+    if (ws.solverIterations == 0)
+        w.settings.solverIterations = recorded ? recorded->solverIterations : ws.substeps == 0 ? choice.iterations : 8;
+    w.substepsGiven = ws.substeps != 0;
+    w.iterationsGiven = ws.solverIterations != 0;
+    w.settingsSource = ws.substeps != 0 && ws.solverIterations != 0 ? World::SettingsSource::Given
+                       : recorded                                     ? World::SettingsSource::Recorded
+                                                                      : World::SettingsSource::Chosen;
     const double substepLength = ws.dt / double(w.settings.substeps);
     if (w.collision) {
         w.collision->settings().iterations = w.settings.solverIterations;
@@ -678,8 +691,10 @@ SolverState entityKeyed(const WorldLayout& layout, std::span<const CachedImpulse
         BodySleep entry{layout.bodies[b], sleep.timer[b], std::nullopt, 0.0,
                         sleep.island[b] >= 0 ? layout.bodies[std::size_t(sleep.island[b])] : Entity{}};
         if (sleep.anchored[b]) {
-            entry.stillAt = Vec2{sleep.anchor[3 * b], sleep.anchor[3 * b + 1]};
-            entry.stillAngle = sleep.anchor[3 * b + 2];
+            const double* a = &sleep.anchor[detail::kAnchorStride * b];
+            entry.stillAt = Vec2{a[0], a[1]};
+            entry.stillAngle = a[2];
+            entry.stillVelocity = Vec2{a[3], a[4]};
         }
         state.bodies.push_back(entry);
     }
@@ -708,8 +723,28 @@ SolverState WorldState::solverState() const {
 SolverState World::solverState() const {
     const WorldImpl& w = *impl_;
     const SleepArrays sleep{w.sleep.timer, w.sleep.island, w.sleep.anchor, w.sleep.anchored};
-    if (!w.collision) return entityKeyed(*w.layout, {}, {}, sleep);
-    return entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision), sleep);
+    SolverState state = w.collision ? entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision), sleep)
+                                    : entityKeyed(*w.layout, {}, {}, sleep);
+    // What the engine chose is part of the run: a resume must not choose again.
+    if (w.settingsSource != SettingsSource::Given)
+        state.chosen = ChosenSettings{w.settings.substeps, w.settings.solverIterations};
+    return state;
+}
+
+World::SettingsSource World::settingsSource() const { return impl_->settingsSource; }
+const ContactSettingsChoice& World::settingsChoice() const { return impl_->contactChoice; }
+
+std::string World::settingsSummary() const {
+    const WorldImpl& w = *impl_;
+    std::string line = "substeps " + std::to_string(w.settings.substeps) + " (";
+    if (w.substepsGiven) line += "given by the level";
+    else if (w.settingsSource == SettingsSource::Recorded)
+        line += "recorded by the run that saved this file; chosen afresh: " + std::to_string(w.contactChoice.substeps) +
+                ", " + w.contactChoice.reason();
+    else line += "chosen: " + w.contactChoice.reason();
+    line += "), solver_iterations " + std::to_string(w.settings.solverIterations);
+    if (w.iterationsGiven) line += " (given by the level)";
+    return line;
 }
 
 void World::setSolverState(const SolverState& state) {
@@ -726,10 +761,13 @@ void World::setSolverState(const SolverState& state) {
             if (body == bodyOf.end()) continue;  // no longer a dynamic body
             w.sleep.timer[body->second] = s.sleepTime;
             if (s.stillAt) {
-                double* a = &w.sleep.anchor[3 * body->second];
+                double* a = &w.sleep.anchor[detail::kAnchorStride * body->second];
                 a[0] = s.stillAt->x;
                 a[1] = s.stillAt->y;
                 a[2] = s.stillAngle;
+                const double* v = w.vs() + 2 * body->second;
+                a[3] = s.stillVelocity ? s.stillVelocity->x : v[0];
+                a[4] = s.stillVelocity ? s.stillVelocity->y : v[1];
                 w.sleep.anchored[body->second] = 1;
             }
             const auto label = s.island.isNull() ? bodyOf.end() : bodyOf.find(s.island);
@@ -738,6 +776,25 @@ void World::setSolverState(const SolverState& state) {
                 w.sleep.island[body->second] = std::int32_t(label->second);
         }
         w.sleep.refresh();
+        // Saved state reproduces a run; it never holds a body the sleep rule
+        // would not have put to sleep. A body moved or pushed by hand in the
+        // file (faster than sleep_velocity, or further than the drift limit
+        // from where its still window began) wakes its island.
+        const double* px = w.xs();
+        const double* pv = w.vs();
+        for (const std::uint32_t b : std::vector<std::uint32_t>(w.sleep.sleeping)) {
+            if (w.sleep.island[b] < 0) continue;  // woken with an earlier body of its island
+            const std::int32_t c = w.colliderOfBody[b];
+            const double spin = c >= 0 ? w.collision->angularVelocity(std::size_t(c)) : 0.0;
+            const double angle = c >= 0 ? w.collision->angle(std::size_t(c)) : 0.0;
+            const double speed = std::hypot(pv[2 * b], pv[2 * b + 1]) + w.sleep.extent[b] * std::abs(spin);
+            const double* a = &w.sleep.anchor[detail::kAnchorStride * b];
+            const double drift = w.sleep.anchored[b]
+                                     ? std::max(std::hypot(px[2 * b] - a[0], px[2 * b + 1] - a[1]),
+                                                w.sleep.extent[b] * std::abs(angle - a[2]))
+                                     : std::numeric_limits<double>::infinity();
+            if (!(speed <= w.sleep.velocity) || !(drift <= w.sleep.driftLimit())) w.sleep.wake(b);
+        }
         w.sleepChanged();
         w.sleptUnder = w.settings;  // a resume steps on under the settings it is given
     }
@@ -800,7 +857,7 @@ Result<void> World::restoreState(const WorldState& s) {
     WorldImpl& w = *impl_;
     if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout) || s.joints.size() != w.layout->joints.size() ||
         s.sleepTimer.size() != w.bodyEntity.size() || s.sleepIsland.size() != w.bodyEntity.size() ||
-        s.sleepAnchor.size() != 3 * w.bodyEntity.size() || s.sleepAnchored.size() != w.bodyEntity.size())
+        s.sleepAnchor.size() != detail::kAnchorStride * w.bodyEntity.size() || s.sleepAnchored.size() != w.bodyEntity.size())
         return Error{"the snapshot was taken from a world with other bodies or shapes"};
     std::copy(s.x.begin(), s.x.end(), w.x[w.current].begin());
     std::copy(s.v.begin(), s.v.end(), w.v[w.current].begin());
@@ -980,9 +1037,15 @@ std::vector<StiffnessHint> World::stiffnessHints() const {
 std::optional<PileHint> World::pileHint() const {
     const WorldImpl& w = *impl_;
     const ContactSettingsChoice& c = w.contactChoice;
+    // Only a setting the level gave can be at fault: the engine's own
+    // choice (fresh or recorded) is what the rule allows.
+    if (w.settingsSource != SettingsSource::Given && w.settings.substeps >= c.substeps) return std::nullopt;
     if (!w.collision || c.stackDepth < 2 || !(c.diameter > 0.0)) return std::nullopt;
     const double limit = 0.02 * c.diameter;  // the pile goal: overlap under 2% of a diameter
     const int substeps = w.settings.substeps;
+    // Equal bodies: the warning's model is the one measured on the 30-row
+    // pile; the choice also weighs the mass ratio (a heavy body on a light
+    // one), so it never gets less than this asks for.
     const double overlap = expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(substeps));
     if (!(overlap > limit)) return std::nullopt;
     PileHint hint;

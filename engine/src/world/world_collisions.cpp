@@ -3,12 +3,12 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
-#include <cmath>
-#include <unordered_map>
-
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <unordered_map>
 
 namespace stepwise::detail {
 
@@ -178,61 +178,275 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
 
 namespace stepwise {
 
-double expectedPileOverlap(int depth, double gravity, double h) {
-    // A resting soft contact compresses by load / (m_n omega^2). In a pile
-    // `depth` bodies deep the lowest contacts between bodies carry about
-    // depth * m g with m_n = m / 2. kMeasured folds in what the model leaves
-    // out (contacts share the load unevenly, a few iterations do not fully
-    // converge); measured on the 30-row, 300-circle pile (docs: collide.md).
-    constexpr double kMeasured = 1.0;
-    constexpr double kPi = 3.14159265358979323846;
-    if (depth < 2 || !(gravity > 0.0) || !(h > 0.0)) return 0.0;
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// omega^2 of the resting soft contact at substeps of h seconds.
+double contactOmega2(double h) {
     const double hertz = std::min(collision::SolverSettings{}.contactHertz, 0.25 / h);
     const double omega = 2.0 * kPi * hertz;
-    return kMeasured * 2.0 * double(depth - 1) * gravity / (omega * omega);
+    return omega * omega;
+}
+
+/// A shape's extent along `dir` (unit): its half-width there, metres.
+double halfExtentAlong(const Registry& reg, Entity e, Vec2 dir) {
+    const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
+    const double c = std::cos(angle), s = std::sin(angle);
+    // dir in the body's frame
+    const Vec2 local{c * dir.x + s * dir.y, -s * dir.x + c * dir.y};
+    if (const Radius* r = reg.tryGet<Radius>(e)) return r->value;
+    if (const Box* b = reg.tryGet<Box>(e)) return 0.5 * (b->width * std::abs(local.x) + b->height * std::abs(local.y));
+    if (const Polygon* p = reg.tryGet<Polygon>(e)) {
+        double lo = 0.0, hi = 0.0;
+        bool first = true;
+        for (const Vec2& v : p->vertices) {
+            const double d = dot(v, local);
+            lo = first ? d : std::min(lo, d);
+            hi = first ? d : std::max(hi, d);
+            first = false;
+        }
+        return 0.5 * (hi - lo);
+    }
+    return 0.0;
+}
+
+/// A shape's centre offset along `dir` from its position (polygons are
+/// not centred on it), metres.
+double centreAlong(const Registry& reg, Entity e, Vec2 dir) {
+    const Polygon* p = reg.tryGet<Polygon>(e);
+    if (!p || p->vertices.empty()) return 0.0;
+    const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
+    const double c = std::cos(angle), s = std::sin(angle);
+    const Vec2 local{c * dir.x + s * dir.y, -s * dir.x + c * dir.y};
+    double lo = dot(p->vertices[0], local), hi = lo;
+    for (const Vec2& v : p->vertices) {
+        lo = std::min(lo, dot(v, local));
+        hi = std::max(hi, dot(v, local));
+    }
+    return 0.5 * (lo + hi);
+}
+
+std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t b) {
+    while (parent[b] != b) {
+        parent[b] = parent[parent[b]];
+        b = parent[b];
+    }
+    return b;
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+    return v[v.size() / 2];
+}
+
+std::string number(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", v);
+    return text;
+}
+
+} // namespace
+
+double expectedPileOverlap(int depth, double gravity, double h, double massRatio) {
+    // A resting soft contact compresses by load / (m_n omega^2). In a pile
+    // `depth` bodies deep the lowest contacts between bodies carry about
+    // (depth - 1) heavy bodies on a light one (world.hpp). kMeasured folds in
+    // what the model leaves out (contacts share the load unevenly, a few
+    // iterations do not fully converge); measured on the 30-row, 300-circle
+    // pile (docs: collide.md).
+    constexpr double kMeasured = 1.0;
+    if (depth < 2 || !(gravity > 0.0) || !(h > 0.0)) return 0.0;
+    const double ratio = std::max(1.0, massRatio);
+    return kMeasured * double(depth - 1) * (1.0 + ratio) * gravity / contactOmega2(h);
+}
+
+double expectedSupportOverlap(int depth, double gravity, double h, double massRatio) {
+    if (depth < 1 || !(gravity > 0.0) || !(h > 0.0)) return 0.0;
+    const double ratio = std::max(1.0, massRatio);
+    return (double(depth - 1) * ratio + 1.0) * gravity / contactOmega2(h);
 }
 
 double derivedRestitutionThreshold(double gravity, double h) { return 4.0 * gravity * h; }
 
+std::string ContactSettingsChoice::reason() const {
+    std::string out;
+    const auto add = [&](const std::string& part) { out += (out.empty() ? "" : "; ") + part; };
+    // The rules that set the choice, and the pile's depth whenever there is one.
+    if (stackDepth >= 2)
+        add("pile " + std::to_string(stackDepth) + " deep" +
+            (massRatio > 1.0 ? ", mass ratio " + number(massRatio) + ":1" : std::string()));
+    if (loadSubsteps > 1 && loadSubsteps == substeps)
+        add("load " + number(gravity) + " m/s^2 on " + number(diameter) + " m bodies" +
+            (support > 0.0 ? ", supports " + number(support) + " m thick" : std::string()));
+    if (substeps == 1) add(out.empty() ? "nothing in the scene needs more" : "nothing needs more");
+    return out;
+}
+
 ContactSettingsChoice chooseContactSettings(const Scene& scene) {
     ContactSettingsChoice choice;
     const Registry& reg = scene.registry;
+    const auto& order = reg.entities();
     choice.gravity = length(scene.world.gravity);
-    // The deepest pile: dynamic shapes binned into columns one median
-    // diameter wide across the direction of gravity; the fullest column is
-    // how deep they can pile if they all come to rest.
-    std::vector<std::pair<double, double>> shapes;  // (position across gravity, size) in metres
     const Vec2 down = choice.gravity > 0.0 ? scene.world.gravity / choice.gravity : Vec2{0.0, -1.0};
     const Vec2 across{-down.y, down.x};
-    for (const Entity e : reg.entities()) {
+    const auto isStatic = [&](Entity e) {
         const Static* st = reg.tryGet<Static>(e);
-        const Position* p = reg.tryGet<Position>(e);
-        if ((st && st->value) || !p) continue;
-        double size = 0.0;
-        if (const Radius* r = reg.tryGet<Radius>(e)) size = 2.0 * r->value;
-        else if (const Box* b = reg.tryGet<Box>(e)) size = std::max(b->width, b->height);
-        else continue;
-        shapes.emplace_back(dot(p->value, across), size);
+        return st && st->value;
+    };
+    const auto hasShape = [&](Entity e) {
+        return reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e);
+    };
+    const auto dynamic = [&](Entity e) { return reg.alive(e) && reg.has<Position>(e) && !isStatic(e); };
+    const auto massOf = [&](Entity e) { return reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0; };
+    const auto sizeOf = [&](Entity e) {
+        return hasShape(e) ? 2.0 * std::max(halfExtentAlong(reg, e, across), halfExtentAlong(reg, e, down))
+                           : 2.0 * detail::kShapelessRadius;
+    };
+
+    // Joint groups: dynamic bodies joined by joints (union-find in scene
+    // order), and whether a group hangs from a static body or the world
+    // (such a group does not pile).
+    std::unordered_map<std::uint32_t, std::uint32_t> slot;  // entity index -> dense index
+    std::vector<Entity> bodies;
+    for (const Entity e : order)
+        if (dynamic(e)) {
+            slot.emplace(e.index, std::uint32_t(bodies.size()));
+            bodies.push_back(e);
+        }
+    std::vector<std::uint32_t> parent(bodies.size());
+    for (std::uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+    std::vector<std::uint8_t> jointed(bodies.size(), 0), anchored(bodies.size(), 0);
+    for (const Entity e : order) {
+        const Joint* j = reg.tryGet<Joint>(e);
+        if (!j) continue;
+        const bool da = !j->a.isNull() && dynamic(j->a), db = !j->b.isNull() && dynamic(j->b);
+        if (da) jointed[slot[j->a.index]] = 1;
+        if (db) jointed[slot[j->b.index]] = 1;
+        if (da && db) {
+            const std::uint32_t ra = findRoot(parent, slot[j->a.index]), rb = findRoot(parent, slot[j->b.index]);
+            if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+        } else if (da || db) {
+            anchored[slot[da ? j->a.index : j->b.index]] = 1;
+        }
     }
-    if (shapes.empty()) return choice;
+    std::vector<std::uint8_t> groupAnchored(bodies.size(), 0);
+    for (std::uint32_t i = 0; i < bodies.size(); ++i)
+        if (jointed[i]) groupAnchored[findRoot(parent, i)] |= anchored[i];
+    // The pile: dynamic shapes that are free to come to rest on each other
+    // (a group hanging from the world does not pile).
     std::vector<double> sizes;
-    for (const auto& s : shapes) sizes.push_back(s.second);
-    std::nth_element(sizes.begin(), sizes.begin() + std::ptrdiff_t(sizes.size() / 2), sizes.end());
-    choice.diameter = sizes[sizes.size() / 2];
-    std::map<long long, int> columns;
-    for (const auto& s : shapes) ++columns[(long long)std::floor(s.first / choice.diameter)];
-    for (const auto& [column, count] : columns) choice.stackDepth = std::max(choice.stackDepth, count);
-    // The fewest substeps (up to 16) that keep the pile's overlap under 1%
-    // of a diameter; beyond 4 substeps at 60 Hz the contact stiffness stops
-    // growing (SolverSettings::contactHertz), so more would only cost.
-    const double dt = scene.world.dt;
-    for (int s = 1; s <= 16; s *= 2) {
-        choice.substeps = s;
-        if (expectedPileOverlap(choice.stackDepth, choice.gravity, dt / double(s)) <= 0.01 * choice.diameter) break;
-        if (s > 1 && expectedPileOverlap(choice.stackDepth, choice.gravity, dt / double(s)) ==
-                         expectedPileOverlap(choice.stackDepth, choice.gravity, dt / double(2 * s)))
-            break;
+    double lightest = 0.0, heaviestMass = 0.0;
+    for (std::uint32_t i = 0; i < bodies.size(); ++i) {
+        if (!hasShape(bodies[i])) continue;
+        if (jointed[i] && groupAnchored[findRoot(parent, i)]) continue;
+        sizes.push_back(sizeOf(bodies[i]));
+        const double m = massOf(bodies[i]);
+        lightest = sizes.size() == 1 ? m : std::min(lightest, m);
+        heaviestMass = std::max(heaviestMass, m);
     }
+    // What holds them up: static shapes and planes. A wide one is a floor,
+    // a tall one a wall; walls across the widest floor cut it into bays,
+    // and the widest bay a body fits in is the container's width (planes
+    // facing each other bound it exactly).
+    struct Interval {
+        double lo, hi;
+    };
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    std::optional<Interval> floor;
+    std::vector<Interval> walls;
+    double left = -kInf, right = kInf;  // plane walls: the side bodies stay on
+    double thinnest = kInf;
+    for (const Entity e : order) {
+        if (const Plane* p = reg.tryGet<Plane>(e)) {
+            const double len = length(p->normal);
+            if (!(len > 0.0)) continue;
+            const Vec2 n = p->normal / len;
+            const double up = -dot(n, down), side = dot(n, across);
+            if (up > 0.7) {
+                floor = Interval{-kInf, kInf};
+            } else if (std::abs(side) > 0.7) {
+                const double at = p->offset / side;  // where the wall crosses the across axis
+                if (side > 0.0) left = std::max(left, at);
+                else right = std::min(right, at);
+            }
+            continue;
+        }
+        if (!hasShape(e) || !isStatic(e) || !reg.has<Position>(e)) continue;
+        const Vec2 pos = reg.tryGet<Position>(e)->value;
+        const double halfAcross = halfExtentAlong(reg, e, across), halfDown = halfExtentAlong(reg, e, down);
+        const double c = dot(pos, across) + centreAlong(reg, e, across);
+        const Interval span{c - halfAcross, c + halfAcross};
+        thinnest = std::min(thinnest, 2.0 * halfDown);
+        if (halfAcross >= halfDown) {
+            if (!floor || span.hi - span.lo > floor->hi - floor->lo) floor = span;
+        } else {
+            walls.push_back(span);
+        }
+    }
+    choice.support = std::isfinite(thinnest) ? thinnest : 0.0;
+    // Without gravity nothing piles up, whatever the geometry.
+    if (choice.gravity > 0.0 && !sizes.empty() && (floor || !walls.empty())) {
+        choice.diameter = median(sizes);
+        choice.massRatio = heaviestMass / lightest;
+        const double d = choice.diameter;
+        Interval ground = floor ? *floor : Interval{-kInf, kInf};
+        ground.lo = std::max(ground.lo, left);
+        ground.hi = std::min(ground.hi, right);
+        std::sort(walls.begin(), walls.end(), [](const Interval& a, const Interval& b) { return a.lo < b.lo; });
+        double widestBay = 0.0, widestFiniteBay = 0.0, from = ground.lo;
+        for (const Interval& w : walls) {
+            if (w.hi <= ground.lo || w.lo >= ground.hi) continue;
+            const double bay = w.lo - from;
+            widestBay = std::max(widestBay, bay);
+            if (std::isfinite(bay) && bay >= d) widestFiniteBay = std::max(widestFiniteBay, bay);
+            from = std::max(from, w.hi);
+        }
+        const double last = ground.hi - from;
+        widestBay = std::max(widestBay, last);
+        if (std::isfinite(last) && last >= d) widestFiniteBay = std::max(widestFiniteBay, last);
+        const double width = widestFiniteBay > 0.0 ? widestFiniteBay : widestBay;
+        const long long n = (long long)sizes.size();
+        // A heap on open ground: rows of 1, 2, 3 ... bodies, k deep for
+        // k (k + 1) / 2 >= n. On ground `width` wide, rows hold at most
+        // floor(width / d): the heap is no wider than that, and the bodies
+        // fill ceil(n / per row) full rows.
+        long long heap = 1;
+        while (heap * (heap + 1) / 2 < n) ++heap;
+        long long depth = heap;
+        if (std::isfinite(width) && d > 0.0) {
+            const long long perRow = std::max(1LL, (long long)std::floor(width / d));
+            depth = std::max((n + perRow - 1) / perRow, std::min(heap, perRow));
+        }
+        choice.stackDepth = int(std::min<long long>(depth, 1'000'000));
+    }
+
+    // The fewest substeps (up to 16) that hold every rule.
+    const double dt = scene.world.dt;
+    const auto pileHolds = [&](int s) {
+        return expectedPileOverlap(choice.stackDepth, choice.gravity, dt / s, choice.massRatio) <= 0.01 * choice.diameter;
+    };
+    const auto loadHolds = [&](int s) {
+        if (choice.stackDepth < 1) return true;
+        double limit = 0.01 * choice.diameter;
+        if (choice.support > 0.0) limit = std::min(limit, 0.1 * choice.support);
+        return expectedSupportOverlap(choice.stackDepth, choice.gravity, dt / s, choice.massRatio) <= limit;
+    };
+    // A contact rule that cannot hold stops where more substeps stop
+    // stiffening the contacts (contactHertz's cap).
+    const auto contactsSaturated = [&](int s) { return contactOmega2(dt / s) == contactOmega2(dt / (2 * s)); };
+    const auto fewest = [&](const auto& holds, bool contact) {
+        int s = 1;
+        for (; s < 16; s *= 2)
+            if (holds(s) || (contact && contactsSaturated(s))) break;
+        return s;
+    };
+    choice.pileSubsteps = fewest(pileHolds, true);
+    choice.loadSubsteps = fewest(loadHolds, true);
+    // Joints add no rule: the joint solver holds chains and other trees
+    // exactly at any substep count (direct_joints.hpp).
+    choice.substeps = std::max(choice.pileSubsteps, choice.loadSubsteps);
     choice.iterations = choice.substeps == 1 ? 8 : 2;
     return choice;
 }

@@ -52,6 +52,8 @@ public:
     /// rotation of the bodies that have shapes: only contacts make torque.
     std::unique_ptr<collision::CollisionSystem> collision;
     ContactSettingsChoice contactChoice;  ///< the scene's deepest pile (pileHint) and the engine's choice
+    World::SettingsSource settingsSource = World::SettingsSource::Given;  ///< where substeps came from
+    bool substepsGiven = false, iterationsGiven = false;  ///< by the level's world object
     std::vector<double> collisionAngleBackup, collisionSpinBackup;  ///< undo after a divergence
     bool profiling = true;
     /// Entities of the state arrays (saveState/restoreState); set by build.

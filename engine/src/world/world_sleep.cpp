@@ -42,7 +42,11 @@ void WorldImpl::updateSleep(const double* startX, const double* startV) {
     angle.assign(n, 0.0);
     for (std::size_t b = 0; b < n; ++b)
         if (colliderOfBody[b] >= 0) angle[b] = collision->angle(std::size_t(colliderOfBody[b]));
-    if (!sleep.advanceTimers(speed, px, angle, settings.dt)) return;
+    const auto fieldAccel = [&](std::size_t b) {
+        const Vec2 g = model.fieldAt(px[2 * b], px[2 * b + 1], std::uint32_t(b), px);
+        return std::hypot(g.x, g.y);
+    };
+    if (!sleep.advanceTimers(speed, px, pv, angle, settings.dt, fieldAccel)) return;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
     for (const detail::SpringData& s : model.springs)
         if (s.b != detail::kNoBody) edges.emplace_back(s.a, s.b);

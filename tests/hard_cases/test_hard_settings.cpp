@@ -1,0 +1,414 @@
+// The engine's own choice of substeps and solver iterations (a level that
+// leaves them out): decided from the scene's structure, recorded in a saved
+// run's solver_state, and said by `stepwise validate`. Every test sweeps a
+// parameter and asserts a rule, a measured bound or an exact line.
+
+#include "stepwise/components.hpp"
+#include "stepwise/scene_io.hpp"
+#include "stepwise/world.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using namespace stepwise;
+
+namespace {
+
+std::string num(double v) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return text;
+}
+
+Scene parse(const std::string& text) {
+    Result<Scene> s = parseScene(text, "t.json");
+    if (!s) throw std::runtime_error(s.error());
+    return std::move(*s);
+}
+
+World build(const Scene& s) {
+    Result<World> w = World::build(s);
+    if (!w) throw std::runtime_error(w.error());
+    w->setProfiling(false);
+    return std::move(*w);
+}
+
+std::vector<fs::path> shippedLevels() {
+    std::vector<fs::path> out;
+    for (const auto& entry : fs::directory_iterator(fs::path(STEPWISE_SOURCE_DIR) / "levels"))
+        if (entry.path().extension() == ".json" && entry.path().filename() != "scene.schema.json")
+            out.push_back(entry.path());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+/// The scene as `stepwise run --out` writes it: state and solver state.
+std::string savedText(const World& world, Scene scene) {
+    world.writeBack(scene);
+    scene.solverState.reset();
+    SolverState solver = world.solverState();
+    if (!solver.empty()) scene.solverState = std::move(solver);
+    return sceneToJsonText(scene);
+}
+
+/// n + m straight steps against n steps, save as text, parse, m steps: the
+/// two saved texts (every number round-trips to its double) must be equal.
+void expectResumeExact(const Scene& scene, std::uint64_t n, std::uint64_t m, const std::string& label) {
+    World straight = build(scene);
+    ASSERT_TRUE(advance(straight, n + m).ok()) << label;
+    World first = build(scene);
+    ASSERT_TRUE(advance(first, n).ok()) << label;
+    Scene reloaded = parse(savedText(first, scene));
+    World second = build(reloaded);
+    EXPECT_EQ(second.settings().substeps, straight.settings().substeps) << label;
+    EXPECT_EQ(second.settings().solverIterations, straight.settings().solverIterations) << label;
+    ASSERT_TRUE(advance(second, m).ok()) << label;
+    EXPECT_EQ(savedText(second, reloaded), savedText(straight, scene)) << label << ": resumed run differs";
+}
+
+/// `links` boxes 0.5 m long, hinged end to end, the first to the world, laid
+/// out level (released horizontally). Settings left to the engine.
+std::string chainLevel(int links, double gravity = 9.81, double lastMass = 1.0) {
+    std::ostringstream s;
+    s << R"({"world": {"gravity": {"x": 0, "y": )" << num(-gravity) << R"(}}, "entities": [)";
+    for (int i = 0; i < links; ++i)
+        s << (i ? ",\n" : "") << R"({"name": "link)" << i << R"(", "position": {"x": )" << num((i + 0.5) * 0.5)
+          << R"(, "y": 0}, "mass": )" << num(i == links - 1 ? lastMass : 1.0)
+          << R"(, "box": {"width": 0.5, "height": 0.05}})";
+    for (int i = 0; i < links; ++i) {
+        s << R"(, {"name": "pin)" << i << R"(", "joint": {"type": "hinge", "a": "link)" << i << "\"";
+        if (i > 0) s << R"(, "b": "link)" << (i - 1) << "\"";
+        s << R"(, "anchor": {"x": )" << num(i * 0.5) << R"(, "y": 0}}})";
+    }
+    s << "]}";
+    return s.str();
+}
+
+/// A ball (1 m) resting on a static box `thickness` thick, under `gravity`.
+std::string ballOnShelf(double gravity, double thickness) {
+    return R"({"world": {"gravity": {"x": 0, "y": )" + num(-gravity) + R"(}}, "entities": [
+        {"name": "shelf", "position": {"x": 0, "y": )" + num(-0.5 * thickness) + R"(}, "static": true,
+         "box": {"width": 4, "height": )" + num(thickness) + R"(}},
+        {"name": "ball", "position": {"x": 0, "y": 0.5}, "radius": 0.5, "mass": 1}]})";
+}
+
+/// `rows` rows of 10 circles (0.5 m) in a container 5.2 m wide (the
+/// tall-pile test's box), scattered over x by `scatter` m: where they are
+/// must not change the choice.
+std::string pileLevel(int rows, double scatter, double gravity = 10.0) {
+    std::ostringstream s;
+    s << R"({"world": {"gravity": {"x": 0, "y": )" << num(-gravity) << R"(}}, "entities": [
+        {"position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 8, "height": 1}},
+        {"position": {"x": -3.1, "y": 10}, "static": true, "box": {"width": 1, "height": 22}},
+        {"position": {"x": 3.1, "y": 10}, "static": true, "box": {"width": 1, "height": 22}})";
+    for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < 10; ++c) {
+            const double x = -2.3 + 0.51 * c + scatter * std::sin(1.7 * (r * 10 + c));
+            s << R"(, {"position": {"x": )" << num(x) << R"(, "y": )" << num(0.3 + 0.52 * r)
+              << R"(}, "radius": 0.25, "friction": 0.6})";
+        }
+    s << "]}";
+    return s.str();
+}
+
+int fewestHolding(const std::function<bool(int)>& holds) {
+    for (int s = 1; s < 16; s *= 2)
+        if (holds(s)) return s;
+    return 16;
+}
+
+struct Cli {
+    int exitCode = 0;
+    std::string out;
+};
+
+Cli runCli(const std::string& args) {
+    const std::string line = std::string(STEPWISE_BINARY) + " " + args + " 2>/dev/null";
+    Cli r;
+    FILE* pipe = ::popen(line.c_str(), "r");
+    if (!pipe) return r;
+    char buffer[4096];
+    while (std::fgets(buffer, sizeof buffer, pipe)) r.out += buffer;
+    const int status = ::pclose(pipe);
+    r.exitCode = WEXITSTATUS(status);
+    return r;
+}
+
+std::string readText(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+fs::path tempFile(const std::string& name) {
+    return fs::path(::testing::TempDir()) / ("hard_settings_" + std::to_string(::getpid()) + "_" + name);
+}
+
+} // namespace
+
+// ---- resume: what the engine chose is what a resumed run runs --------------
+
+TEST(HardSettings, EveryShippedLevelResumesBitForBitAsGivenAndWithoutSettings) {
+    for (const fs::path& level : shippedLevels()) {
+        Result<Scene> given = loadSceneFile(level);
+        ASSERT_TRUE(given) << given.error();
+        expectResumeExact(*given, 20, 40, level.filename().string() + " (its own settings)");
+        // The same level leaving substeps and iterations to the engine.
+        Scene chosen = std::move(*given);
+        chosen.world.substeps = 0;
+        chosen.world.solverIterations = 0;
+        expectResumeExact(chosen, 20, 40, level.filename().string() + " (settings left to the engine)");
+    }
+}
+
+TEST(HardSettings, GeneratedLevelsWithoutSettingsResumeBitForBit) {
+    for (const int links : {3, 20}) expectResumeExact(parse(chainLevel(links)), 30, 45, "chain " + std::to_string(links));
+    for (const double g : {9.81, 1000.0}) expectResumeExact(parse(ballOnShelf(g, 0.1)), 30, 45, "shelf g " + num(g));
+    for (const int rows : {2, 12}) expectResumeExact(parse(pileLevel(rows, 0.0)), 25, 50, "pile " + std::to_string(rows));
+}
+
+TEST(HardSettings, RunOutThenRunEqualsOneLongRunThroughTheCli) {
+    // The reported case: `run A --steps 20 --out B; run B --steps 40` against
+    // `run A --steps 60`, on a pile whose engine choice would differ if made
+    // again from where the bodies lie after 20 steps.
+    for (const int rows : {6, 12}) {
+        const fs::path a = tempFile("a" + std::to_string(rows) + ".json"), b = tempFile("b.json"),
+                       c = tempFile("c.json"), d = tempFile("d.json");
+        std::ofstream(a) << pileLevel(rows, 0.0);
+        ASSERT_EQ(runCli("run " + a.string() + " --steps 60 --out " + c.string()).exitCode, 0);
+        ASSERT_EQ(runCli("run " + a.string() + " --steps 20 --out " + b.string()).exitCode, 0);
+        ASSERT_EQ(runCli("run " + b.string() + " --steps 40 --out " + d.string()).exitCode, 0);
+        const std::string straight = readText(c), resumed = readText(d);
+        EXPECT_EQ(resumed, straight) << rows << " rows";
+        // The file leaves substeps to the engine and records what it chose.
+        EXPECT_EQ(straight.find("\"substeps\": "), straight.find("\"chosen\": {\"substeps\": ") + 11) << straight.substr(0, 400);
+        for (const fs::path& p : {a, b, c, d}) fs::remove(p);
+    }
+}
+
+TEST(HardSettings, SavedRunRecordsTheChoiceAndAFreshLevelDoesNot) {
+    const Scene level = parse(pileLevel(12, 0.0));
+    EXPECT_EQ(sceneToJsonText(level).find("substeps"), std::string::npos) << "an authored level stays without them";
+    World w = build(level);
+    ASSERT_TRUE(advance(w, 5).ok());
+    const std::string saved = savedText(w, level);
+    EXPECT_NE(saved.find("\"chosen\": {\"substeps\": 4, \"solver_iterations\": 2}"), std::string::npos) << saved.substr(0, 300);
+    const Scene back = parse(saved);
+    EXPECT_EQ(back.world.substeps, 0) << "recorded in solver_state, not as the level's own setting";
+    ASSERT_TRUE(back.solverState && back.solverState->chosen);
+    EXPECT_EQ(back.solverState->chosen->substeps, 4);
+    // The recorded choice wins over a fresh one: a level edited to need
+    // fewer substeps still resumes with what the run ran.
+    Scene edited = back;
+    edited.solverState->chosen->substeps = 2;
+    EXPECT_EQ(build(edited).settings().substeps, 2);
+    EXPECT_EQ(build(edited).settingsSource(), World::SettingsSource::Recorded);
+    // A level's own setting wins over a record.
+    edited.world.substeps = 3;
+    EXPECT_EQ(build(edited).settings().substeps, 3);
+    // A level that gives both records nothing.
+    Scene given = level;
+    given.world.substeps = 8;
+    given.world.solverIterations = 4;
+    World g = build(given);
+    ASSERT_TRUE(advance(g, 5).ok());
+    EXPECT_FALSE(g.solverState().chosen);
+}
+
+TEST(HardSettings, ChoiceDependsOnStructureNotOnWhereBodiesAre) {
+    for (const int rows : {2, 6, 12, 30}) {
+        const Scene neat = parse(pileLevel(rows, 0.0));
+        const Scene scattered = parse(pileLevel(rows, 0.2));
+        const ContactSettingsChoice a = chooseContactSettings(neat), b = chooseContactSettings(scattered);
+        EXPECT_EQ(a.substeps, b.substeps) << rows;
+        EXPECT_EQ(a.stackDepth, b.stackDepth) << rows;
+        // And after the pile has fallen and settled for a while.
+        World w = build(neat);
+        ASSERT_TRUE(advance(w, 120).ok());
+        Scene after = neat;
+        w.writeBack(after);
+        EXPECT_EQ(chooseContactSettings(after).substeps, a.substeps) << rows;
+        EXPECT_EQ(chooseContactSettings(after).stackDepth, a.stackDepth) << rows;
+    }
+}
+
+// ---- the rule: pile, load, joints ------------------------------------------
+
+TEST(HardSettings, PileDepthIsRowsOfTheContainerAndSubstepsHoldItUnderOnePercent) {
+    for (const int rows : {1, 2, 4, 8, 12, 20, 30}) {
+        const ContactSettingsChoice c = chooseContactSettings(parse(pileLevel(rows, 0.0)));
+        // 10 circles fit across the 5.2 m bay; a heap of 10 n bodies on open
+        // ground would be k deep with k (k + 1) / 2 >= 10 n, and in the bay
+        // no wider than 10.
+        int heap = 1;
+        while (heap * (heap + 1) / 2 < 10 * rows) ++heap;
+        EXPECT_EQ(c.stackDepth, std::max(rows, std::min(heap, 10))) << rows;
+        EXPECT_DOUBLE_EQ(c.diameter, 0.5);
+        const int expected = fewestHolding([&](int s) {
+            return expectedPileOverlap(c.stackDepth, 10.0, (1.0 / 60.0) / s) <= 0.005 &&
+                   expectedSupportOverlap(c.stackDepth, 10.0, (1.0 / 60.0) / s) <= 0.005;
+        });
+        // Past 4 substeps at 60 Hz the contacts stop stiffening: the choice
+        // stops there.
+        EXPECT_EQ(c.substeps, std::min(expected, 4)) << rows << " rows: " << c.reason();
+    }
+    // Measured: the 20-row pile settles with its deepest overlap under 2% of
+    // a diameter at the engine's choice.
+    World w = build(parse(pileLevel(20, 0.0)));
+    double deepest = 0.0;
+    for (int i = 0; i < 480; ++i) {
+        ASSERT_TRUE(w.step());
+        if (i >= 420)
+            for (const ContactRecord& c : w.contacts()) deepest = std::max(deepest, c.depth);
+    }
+    EXPECT_LT(deepest, 0.02 * 0.5) << "substeps " << w.settings().substeps;
+}
+
+TEST(HardSettings, HeavyLoadOnAThinShelfGetsTheSubstepsThatHoldIt) {
+    struct Case {
+        double gravity;
+        int substeps;
+    };
+    // g / omega^2 at 1 substep (15 Hz) is 1.1 mm per 9.81 m/s^2; the limit
+    // is 1% of the ball (10 mm) and 10% of a 0.1 m shelf (10 mm).
+    for (const Case k : {Case{9.81, 1}, Case{50.0, 1}, Case{100.0, 2}, Case{400.0, 4}, Case{1000.0, 4}}) {
+        const Scene scene = parse(ballOnShelf(k.gravity, 0.1));
+        const ContactSettingsChoice c = chooseContactSettings(scene);
+        EXPECT_EQ(c.substeps, k.substeps) << "g " << k.gravity << ": " << c.reason();
+        // Measured: the ball rests on the shelf, never through it, sinking
+        // less than the rule's limit.
+        World w = build(scene);
+        EXPECT_EQ(w.settings().substeps, k.substeps);
+        double lowest = 1e9, deepest = 0.0;
+        for (int i = 0; i < 240; ++i) {
+            ASSERT_TRUE(w.step());
+            Scene now = scene;
+            w.writeBack(now);
+            for (const Entity e : now.registry.entities())
+                if (const Radius* r = now.registry.tryGet<Radius>(e); r)
+                    lowest = std::min(lowest, now.registry.tryGet<Position>(e)->value.y);
+            for (const ContactRecord& cr : w.contacts()) deepest = std::max(deepest, cr.depth);
+        }
+        EXPECT_GT(lowest, 0.5 - 0.01) << "g " << k.gravity << ": the ball sank to " << lowest;
+        EXPECT_LT(deepest, 0.01) << "g " << k.gravity;
+    }
+}
+
+namespace {
+/// The widest joint opening over a 2 s swing from level, metres.
+double widestOpening(Scene scene, int substeps) {
+    scene.world.substeps = substeps;
+    scene.world.solverIterations = substeps == 1 ? 8 : 2;
+    World w = build(scene);
+    double widest = 0.0;
+    for (int i = 0; i < 120; ++i) {
+        if (!w.step()) return 1e9;
+        for (const JointRecord& j : w.joints()) widest = std::max(widest, j.separation);
+    }
+    return widest;
+}
+} // namespace
+
+// Joints add no substeps: the joint solver holds a chain (a tree of
+// joints) exactly, so at the engine's choice, one substep, a chain of
+// hinged boxes of any length and a heavy last link keeps its joints within
+// 1% of a link, as it does at more substeps.
+TEST(HardSettings, ChainOfHingedBoxesNeedsNoExtraSubsteps) {
+    struct Case {
+        int links;
+        double lastMass;
+    };
+    for (const Case k : {Case{1, 1.0}, Case{2, 1.0}, Case{3, 1.0}, Case{5, 1.0}, Case{10, 1.0}, Case{20, 1.0},
+                         Case{40, 1.0}, Case{10, 50.0}}) {
+        const Scene scene = parse(chainLevel(k.links, 9.81, k.lastMass));
+        const ContactSettingsChoice c = chooseContactSettings(scene);
+        const std::string label = std::to_string(k.links) + " links, last " + num(k.lastMass) + " kg";
+        EXPECT_EQ(c.substeps, 1) << label << ": " << c.reason();
+        EXPECT_EQ(build(scene).settings().substeps, 1) << label;
+        for (const int substeps : {1, 2, 4, 8})
+            EXPECT_LT(widestOpening(scene, substeps), 0.01 * 0.5) << label << " at " << substeps << " substeps";
+    }
+}
+
+TEST(HardSettings, ASceneWithNothingHardStaysAtOneSubstepAndEightIterations) {
+    for (const std::string& text :
+         {std::string(R"({"entities": [{"position": {"x": 0, "y": 0}, "radius": 0.5}]})"),
+          ballOnShelf(9.81, 1.0),
+          std::string(R"({"world": {"gravity": {"x": 0, "y": 0}}, "entities": [
+              {"position": {"x": 0, "y": 0}, "radius": 0.5}, {"position": {"x": 2, "y": 0}, "radius": 0.5}]})")}) {
+        const Scene scene = parse(text);
+        const World w = build(scene);
+        EXPECT_EQ(w.settings().substeps, 1) << text;
+        EXPECT_EQ(w.settings().solverIterations, 8) << text;
+        EXPECT_FALSE(w.pileHint()) << text;
+    }
+}
+
+// ---- what validate says ----------------------------------------------------
+
+TEST(HardSettings, ValidateSaysWhatItChoseAndWhy) {
+    const fs::path chain = tempFile("chain.json"), shelf = tempFile("shelf.json"), pile = tempFile("pile.json"),
+                   given = tempFile("given.json"), resumed = tempFile("resumed.json");
+    std::ofstream(chain) << chainLevel(20);
+    std::ofstream(shelf) << ballOnShelf(1000.0, 0.1);
+    std::ofstream(pile) << pileLevel(12, 0.0);
+    {
+        Scene g = parse(pileLevel(12, 0.0));
+        g.world.substeps = 4;
+        g.world.solverIterations = 2;
+        std::ofstream(given) << sceneToJsonText(g);
+    }
+    const auto secondLine = [](const std::string& out) {
+        const std::size_t nl = out.find('\n');
+        return nl == std::string::npos ? std::string() : out.substr(nl + 1);
+    };
+    EXPECT_EQ(secondLine(runCli("validate " + chain.string()).out),
+              chain.string() + ": substeps 1 (chosen: nothing in the scene needs more), solver_iterations 8\n");
+    EXPECT_EQ(secondLine(runCli("validate " + shelf.string()).out),
+              shelf.string() + ": substeps 4 (chosen: load 1000 m/s^2 on 1 m bodies, supports 0.1 m thick), "
+                               "solver_iterations 2\n");
+    EXPECT_EQ(secondLine(runCli("validate " + pile.string()).out),
+              pile.string() + ": substeps 4 (chosen: pile 12 deep), solver_iterations 2\n");
+    EXPECT_EQ(secondLine(runCli("validate " + given.string()).out),
+              given.string() + ": substeps 4 (given by the level), solver_iterations 2 (given by the level)\n");
+    ASSERT_EQ(runCli("run " + pile.string() + " --steps 10 --out " + resumed.string()).exitCode, 0);
+    EXPECT_EQ(secondLine(runCli("validate " + resumed.string()).out),
+              resumed.string() + ": substeps 4 (recorded by the run that saved this file; chosen afresh: 4, pile 12 "
+                                 "deep), solver_iterations 2\n");
+    for (const fs::path& p : {chain, shelf, pile, given, resumed}) fs::remove(p);
+}
+
+TEST(HardSettings, ARecordedChoiceRaisesNoWarning) {
+    // The pile warning is about a level's own substeps; the engine's choice,
+    // fresh or recorded, is what the rule allows.
+    for (const int rows : {12, 30}) {
+        const fs::path level = tempFile("warn.json"), out = tempFile("warn_out.json");
+        std::ofstream(level) << pileLevel(rows, 0.0);
+        ASSERT_EQ(runCli("run " + level.string() + " --steps 30 --out " + out.string()).exitCode, 0);
+        for (const fs::path& p : {level, out}) {
+            const std::string line = std::string(STEPWISE_BINARY) + " validate " + p.string() + " 2>&1 >/dev/null";
+            FILE* pipe = ::popen(line.c_str(), "r");
+            ASSERT_NE(pipe, nullptr);
+            std::string err;
+            char buffer[512];
+            while (std::fgets(buffer, sizeof buffer, pipe)) err += buffer;
+            ::pclose(pipe);
+            EXPECT_EQ(err, "") << rows << " rows, " << p;
+        }
+        fs::remove(level);
+        fs::remove(out);
+    }
+}
+
