@@ -170,7 +170,9 @@ struct ContactSettingsChoice {
     double gravity = 0.0;      ///< m/s^2, |world.gravity|
     double massRatio = 1.0;    ///< heaviest / lightest dynamic shape that can pile
     double support = 0.0;      ///< m, thinnest static support along gravity (0: none)
-    int pileSubsteps = 1;      ///< what each rule alone needs
+    int columnHeight = 0;      ///< flat-faced bodies in the fullest column as placed
+    double columnWidth = 0.0;  ///< m, the median flat-faced body's size
+    int pileSubsteps = 1;      ///< what each rule alone needs (the pile's and the column's)
     int loadSubsteps = 1;
     /// "pile 12 deep ...": what made the choice.
     std::string reason() const;

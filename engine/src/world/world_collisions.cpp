@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <optional>
 #include <unordered_map>
 
@@ -277,6 +278,7 @@ std::string ContactSettingsChoice::reason() const {
     if (stackDepth >= 2)
         add("pile " + std::to_string(stackDepth) + " deep" +
             (massRatio > 1.0 ? ", mass ratio " + number(massRatio) + ":1" : std::string()));
+    if (columnHeight > stackDepth) add("stack " + std::to_string(columnHeight) + " high");
     if (loadSubsteps > 1 && loadSubsteps == substeps)
         add("load " + number(gravity) + " m/s^2 on " + number(diameter) + " m bodies" +
             (support > 0.0 ? ", supports " + number(support) + " m thick" : std::string()));
@@ -345,6 +347,29 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene) {
         const double m = massOf(bodies[i]);
         lightest = sizes.size() == 1 ? m : std::min(lightest, m);
         heaviestMass = std::max(heaviestMass, m);
+    }
+    // Columns: flat-faced bodies (boxes, polygons) stand on one another as
+    // placed, where circles roll off into a heap. The fullest column, in
+    // bins one median flat body wide across gravity, is how tall a stack
+    // the scene has. (A resumed run uses its recorded choice, so where the
+    // bodies are now only matters for a level as authored.)
+    {
+        std::vector<std::pair<double, double>> flat;  // (position across gravity, size)
+        for (std::uint32_t i = 0; i < bodies.size(); ++i) {
+            const Entity e = bodies[i];
+            if (!(reg.has<Box>(e) || reg.has<Polygon>(e))) continue;
+            if (jointed[i] && groupAnchored[findRoot(parent, i)]) continue;
+            flat.emplace_back(dot(reg.tryGet<Position>(e)->value, across), sizeOf(e));
+        }
+        std::vector<double> flatSizes;
+        for (const auto& f : flat) flatSizes.push_back(f.second);
+        const double width = median(flatSizes);
+        if (width > 0.0) {
+            std::map<long long, int> columns;
+            for (const auto& f : flat) ++columns[(long long)std::floor(f.first / width)];
+            for (const auto& [column, count] : columns) choice.columnHeight = std::max(choice.columnHeight, count);
+            choice.columnWidth = width;
+        }
     }
     // What holds them up: static shapes and planes. A wide one is a floor,
     // a tall one a wall; walls across the widest floor cut it into bays,
@@ -442,7 +467,15 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene) {
             if (holds(s) || (contact && contactsSaturated(s))) break;
         return s;
     };
-    choice.pileSubsteps = fewest(pileHolds, true);
+    // A column's layers compress in series: the contact k layers down
+    // carries k bodies, so the top sinks by the sum, n (n - 1) / 2 times a
+    // layer's load overlap; it must stay under 1% of a body.
+    const auto columnHolds = [&](int s) {
+        if (choice.columnHeight < 2) return true;
+        const double n = double(choice.columnHeight);
+        return 0.5 * n * (n - 1.0) * expectedPileOverlap(2, choice.gravity, dt / s) <= 0.01 * choice.columnWidth;
+    };
+    choice.pileSubsteps = std::max(fewest(pileHolds, true), fewest(columnHolds, true));
     choice.loadSubsteps = fewest(loadHolds, true);
     // Joints add no rule: the joint solver holds chains and other trees
     // exactly at any substep count (direct_joints.hpp).
