@@ -563,7 +563,7 @@ std::vector<Case> box2dScenes(const fs::path& levels, int steps) {
                 double drift = 0.0;
                 for (std::size_t i = 0; i < b.names.size(); ++i) {
                     const std::string& n = b.names[i];
-                    if (n.ends_with("box 99.99") || n.ends_with("box 9.9"))
+                    if (n == "box 99.99" || (n.starts_with("pyramid ") && n.ends_with(" box 9.9")))
                         drift = std::max(drift, std::abs(r.final[i].p.x - b.start[i].x));
                 }
                 return Figures{drift, fmt("top drift %.3g mm, kinetic %.3g J", 1e3 * drift, kineticEnergy(b, r))};
