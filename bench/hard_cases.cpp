@@ -110,6 +110,7 @@ struct Run {
     int steps = 0;           ///< completed
     std::string diverged;    ///< the engine's message when a step failed
     double maxSpeed = 0.0;   ///< m/s, fastest body over the run
+    double maxSideways = 0.0;  ///< m/s, fastest horizontal speed over the run (gravity adds none)
     double energyGain = 0.0; ///< J, largest rise of translational kinetic + potential energy over the start
     double maxJointOpening = 0.0;   ///< m, over every joint and step
     double finalJointOpening = 0.0; ///< m, widest at the end
@@ -191,7 +192,10 @@ Run runStepwise(const Scene& level, const Bodies& bodies, int steps, const Setti
         ++out.steps;
         if (track.speed) {
             sample();
-            for (const Vec2& x : v) out.maxSpeed = std::max(out.maxSpeed, length(x));
+            for (const Vec2& x : v) {
+                out.maxSpeed = std::max(out.maxSpeed, length(x));
+                out.maxSideways = std::max(out.maxSideways, std::abs(x.x));
+            }
             out.energyGain = std::max(out.energyGain, translationalEnergy(bodies, p, v, g) - startEnergy);
         }
         if (track.joints) {
@@ -265,7 +269,10 @@ Run runBox2d(const Scene& scene, const Bodies& bodies, int steps, int substeps, 
         ++out.steps;
         if (track.speed) {
             sample();
-            for (const Vec2& x : v) out.maxSpeed = std::max(out.maxSpeed, length(x));
+            for (const Vec2& x : v) {
+                out.maxSpeed = std::max(out.maxSpeed, length(x));
+                out.maxSideways = std::max(out.maxSideways, std::abs(x.x));
+            }
             out.energyGain = std::max(out.energyGain, translationalEnergy(bodies, p, v, g) - startEnergy);
         }
         if (track.joints) {
@@ -481,7 +488,9 @@ Case stackOf10() {
 Case crowd(int n) {
     Case c;
     c.panel = c.name = "crowd of " + std::to_string(n) + " at one point";
-    c.errorLabel = "fastest body, m/s";
+    // Sideways: the fall alone reaches 9.7 m/s at the floor, so the
+    // horizontal speed is what the push-out gives.
+    c.errorLabel = "fastest horizontal speed, m/s";
     Scene& s = c.scene = baseWorld();
     addStatic(s, {0.0, -0.5}, 400.0, 1.0, 0.6);
     for (int i = 0; i < n; ++i) {
@@ -496,7 +505,8 @@ Case crowd(int n) {
     c.box2d = n <= 1000;
     c.box2dSweep = n <= 64;
     c.measure = [](const Bodies&, const Run& r) {
-        return Figures{r.maxSpeed, fmt("fastest %.3g m/s, energy gained %.3g J", r.maxSpeed, r.energyGain)};
+        return Figures{r.maxSideways, fmt("sideways %.3g m/s, fastest %.3g m/s, energy gained %.3g J", r.maxSideways,
+                                          r.maxSpeed, r.energyGain)};
     };
     return c;
 }
