@@ -4,7 +4,7 @@
 // velocity and 3 position iterations, sleeping off) run in the same process
 // on the same scenes. Times are the median of the per-step times of a run.
 //
-//   hard_cases [--quick] [--steps N] [--out DIR] [--only NAME] [--levels DIR] [--write-levels DIR]
+//   hard_cases [--quick] [--steps N] [--budget S] [--out DIR] [--only NAME] [--levels DIR] [--write-levels DIR]
 //
 // --out writes hard_cases.md, hard_cases.csv and the plot hard_cases.png
 // (gnuplot, as the other reports). --only runs the cases whose name holds
@@ -12,7 +12,9 @@
 // bench/levels); --write-levels writes them there from bench/box2d_scenes.cpp
 // and stops. --quick runs a fifth of the steps and leaves out the largest
 // crowd: a check that the harness works, not figures to quote. --steps runs
-// every case for N steps (while tuning one scene).
+// every case for N steps (while tuning one scene). --budget caps each run's
+// wall-clock time (default 90 s); a run that reaches it, or whose joints
+// open by more than 1 km, stops and says so.
 
 #include "box2d_scenes.hpp"
 #include "generated_scenes.hpp"
@@ -93,6 +95,13 @@ Bodies bodiesOf(const Scene& scene) {
 
 // ---------------------------------------------------------------- runs
 
+/// Wall-clock seconds a run may take (--budget): a scene that blows up can
+/// make each step cost seconds (its bounding boxes span kilometres), and
+/// the report must finish. A run stopped by it says so in its figures.
+double g_budgetSeconds = 90.0;
+/// Metres: a joint open this wide has blown up; the run stops there.
+constexpr double kBlownUp = 1000.0;
+
 /// What the per-step measures follow (each costs a pass over the bodies or
 /// joints after every step, outside the timed step).
 struct Track {
@@ -109,6 +118,7 @@ struct Run {
     double msPerStep = 0.0;  ///< median of the steps' times
     int steps = 0;           ///< completed
     std::string diverged;    ///< the engine's message when a step failed
+    std::string stopped;     ///< why the run stopped early without failing (budget, blown up)
     double maxSpeed = 0.0;   ///< m/s, fastest body over the run
     double maxSideways = 0.0;  ///< m/s, fastest horizontal speed over the run (gravity adds none)
     double energyGain = 0.0; ///< J, largest rise of translational kinetic + potential energy over the start
@@ -117,6 +127,13 @@ struct Run {
     double deepestContact = 0.0;    ///< m, the engine's own deepest contact at the end
     std::vector<BodyState> final;   ///< Bodies order
 };
+
+std::string stopReason(std::chrono::steady_clock::time_point runStart, const Run& run) {
+    if (run.maxJointOpening > kBlownUp) return "blew up: a joint opened over 1 km";
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - runStart).count() > g_budgetSeconds)
+        return "stopped by the " + std::to_string(int(g_budgetSeconds)) + " s budget";
+    return {};
+}
 
 double median(std::vector<double> v) {
     if (v.empty()) return kNaN;
@@ -181,6 +198,7 @@ Run runStepwise(const Scene& level, const Bodies& bodies, int steps, const Setti
     }
     std::vector<double> times;
     times.reserve(std::size_t(steps));
+    const auto runStart = std::chrono::steady_clock::now();
     for (int i = 0; i < steps; ++i) {
         const auto start = std::chrono::steady_clock::now();
         const Result<void> r = world.step();
@@ -190,6 +208,10 @@ Run runStepwise(const Scene& level, const Bodies& bodies, int steps, const Setti
             break;
         }
         ++out.steps;
+        if (const std::string why = stopReason(runStart, out); !why.empty()) {
+            out.stopped = why;
+            break;
+        }
         if (track.speed) {
             sample();
             for (const Vec2& x : v) {
@@ -262,11 +284,16 @@ Run runBox2d(const Scene& scene, const Bodies& bodies, int steps, int substeps, 
     const float h = float(scene.world.dt) / float(substeps);
     std::vector<double> times;
     times.reserve(std::size_t(steps));
+    const auto runStart = std::chrono::steady_clock::now();
     for (int i = 0; i < steps; ++i) {
         const auto start = std::chrono::steady_clock::now();
         for (int s = 0; s < substeps; ++s) world.Step(h, 8, 3);
         times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         ++out.steps;
+        if (const std::string why = stopReason(runStart, out); !why.empty()) {
+            out.stopped = why;
+            break;
+        }
         if (track.speed) {
             sample();
             for (const Vec2& x : v) {
@@ -746,12 +773,13 @@ int main(int argc, char** argv) {
         if (arg == "--quick") quick = true;
         else if (arg == "--out" && i + 1 < argc) out = argv[++i];
         else if (arg == "--only" && i + 1 < argc) only = argv[++i];
+        else if (arg == "--budget" && i + 1 < argc && std::atof(argv[i + 1]) > 0) g_budgetSeconds = std::atof(argv[++i]);
         else if (arg == "--steps" && i + 1 < argc && std::atoi(argv[i + 1]) > 0) stepsOverride = std::atoi(argv[++i]);
         else if (arg == "--levels" && i + 1 < argc) levels = argv[++i];
         else if (arg == "--write-levels" && i + 1 < argc) writeLevels = argv[++i];
         else {
             std::cerr << "hard_cases: unknown argument \"" << arg
-                      << "\"; usage: hard_cases [--quick] [--steps N] [--out DIR] [--only NAME] [--levels DIR] [--write-levels DIR]\n";
+                      << "\"; usage: hard_cases [--quick] [--steps N] [--budget S] [--out DIR] [--only NAME] [--levels DIR] [--write-levels DIR]\n";
             return 2;
         }
     }
@@ -796,9 +824,17 @@ int main(int argc, char** argv) {
             row.error = run.diverged.empty() ? f.error : kNaN;
             row.detail = f.detail;
         }
+        if (!run.stopped.empty()) {
+            row.detail = run.stopped + " after " + std::to_string(run.steps) + " steps; " + row.detail;
+            if (run.stopped.starts_with("blew")) row.error = kNaN;
+        }
         if (!run.diverged.empty())
             row.detail = "failed after " + std::to_string(run.steps) + " steps (" + run.diverged.substr(0, 120) +
                          ")" + (row.detail.empty() ? "" : "; then " + row.detail);
+        // The figures go into Markdown and CSV cells: an engine's message
+        // may hold neither a line break, a cell separator nor a quote.
+        for (char& ch : row.detail)
+            if (ch == '\n' || ch == '|' || ch == '"') ch = ch == '|' ? '/' : ch == '"' ? '\'' : ' ';
         std::printf("| %s | %s | %s | %.4g | %s | %s |\n", c.name.c_str(), engine.c_str(), setting.c_str(), row.ms,
                     num(row.error).c_str(), row.detail.c_str());
         std::fflush(stdout);
