@@ -737,7 +737,8 @@ bool writePlot(const fs::path& dir, const std::vector<Row>& rows, const std::vec
        << "set multiplot layout " << rowsOfPanels << "," << columns
        << " title 'Hard cases: error against median ms/step (Stepwise fixed substeps x 1 iteration: solid, labels = "
           "substeps; Stepwise defaults: square; Box2D 2.4.1, 8+3 iterations: dashed). Sweeps: worst error, slowest step'\n"
-       << "set grid\nset logscale x\nset xlabel 'ms per step'\nset key top right font ',8'\n";
+       << "set grid\nset logscale x\nset format x '%g'\nset format y '%g'\nset xlabel 'ms per step'\n"
+       << "set key top right font ',8'\n";
     for (const std::string& panel : panels) {
         const int b = firstBlock[panel];
         const std::string file = (dir / "hard_cases.dat").string();
