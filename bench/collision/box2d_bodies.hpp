@@ -54,4 +54,28 @@ inline b2Body* createBox2dBody(b2World& world, const Registry& r, Entity e) {
     return body;
 }
 
+/// A b2RevoluteJoint for Stepwise hinge `j` (the same anchors, reference
+/// angle, limits and motor) between the bodies made for its ends;
+/// `worldBody` stands for the world when `j.b` is null.
+inline b2Joint* createBox2dHinge(b2World& world, const Joint& j, b2Body* a, b2Body* b) {
+    b2RevoluteJointDef def;
+    def.bodyA = a;
+    def.bodyB = b;
+    def.localAnchorA.Set(float(j.localA.x), float(j.localA.y));
+    def.localAnchorB.Set(float(j.localB.x), float(j.localB.y));
+    def.referenceAngle = float(j.referenceAngle.value_or(0.0));
+    def.collideConnected = j.collideConnected;
+    if (j.lower || j.upper) {
+        def.enableLimit = true;
+        def.lowerAngle = float(j.lower.value_or(-1e9));
+        def.upperAngle = float(j.upper.value_or(1e9));
+    }
+    if (j.maxMotorTorque) {
+        def.enableMotor = true;
+        def.motorSpeed = float(j.motorSpeed.value_or(0.0));
+        def.maxMotorTorque = float(*j.maxMotorTorque);
+    }
+    return world.CreateJoint(&def);
+}
+
 } // namespace stepwise::bench

@@ -1,0 +1,400 @@
+#include "box2d_scenes.hpp"
+
+#include "stepwise/components.hpp"
+
+#include <cmath>
+#include <optional>
+
+namespace stepwise::bench {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+const Rgb kGrey{0.36, 0.40, 0.47};
+
+Rgb palette(int i) {
+    static const Rgb colours[] = {{0.96, 0.65, 0.36}, {0.42, 0.74, 0.87}, {0.55, 0.82, 0.55},
+                                  {0.93, 0.49, 0.55}, {0.78, 0.64, 0.92}, {0.98, 0.86, 0.42}};
+    return colours[i % 6];
+}
+
+/// Box2D v3's defaults for a world: gravity -10, and the step its benchmark
+/// runs (60 Hz, 4 substeps, one relaxed iteration each, no sleeping).
+Scene v3World() {
+    Scene s;
+    s.world.gravity = {0.0, -10.0};
+    s.world.dt = 1.0 / 60.0;
+    s.world.substeps = 4;
+    s.world.solverIterations = 1;
+    s.world.sleep = false;
+    return s;
+}
+
+Entity body(Scene& s, std::string name, Vec2 p, double friction, Rgb colour) {
+    Registry& r = s.registry;
+    const Entity e = r.create();
+    r.emplace<Name>(e, Name{std::move(name)});
+    r.emplace<Position>(e, Position{p});
+    r.emplace<Friction>(e, Friction{friction});
+    r.emplace<Color>(e, Color{colour});
+    return e;
+}
+
+/// A static box (Box2D's ground shapes: boxes, segments and chain links).
+Entity staticBox(Scene& s, std::string name, Vec2 p, double w, double h, double friction = 0.6, double angle = 0.0) {
+    const Entity e = body(s, std::move(name), p, friction, kGrey);
+    s.registry.emplace<Static>(e, Static{true});
+    s.registry.emplace<Box>(e, Box{w, h});
+    if (angle != 0.0) s.registry.emplace<Angle>(e, Angle{angle});
+    return e;
+}
+
+/// A dynamic box of Box2D's density (mass = density * area, as b2ShapeDef).
+Entity dynamicBox(Scene& s, std::string name, Vec2 p, double w, double h, double density, double friction, Rgb c) {
+    const Entity e = body(s, std::move(name), p, friction, c);
+    s.registry.emplace<Box>(e, Box{w, h});
+    s.registry.emplace<Mass>(e, Mass{density * w * h});
+    return e;
+}
+
+Entity dynamicCircle(Scene& s, std::string name, Vec2 p, double r, double density, double friction, Rgb c) {
+    const Entity e = body(s, std::move(name), p, friction, c);
+    s.registry.emplace<Radius>(e, Radius{r});
+    s.registry.emplace<Mass>(e, Mass{density * kPi * r * r});
+    return e;
+}
+
+void hinge(Scene& s, std::string name, Entity a, std::optional<Entity> b, Vec2 localA, Vec2 localB) {
+    Registry& r = s.registry;
+    const Entity e = r.create();
+    r.emplace<Name>(e, Name{std::move(name)});
+    Joint j;
+    j.type = "hinge";
+    j.a = a;
+    if (b) j.b = *b;
+    j.localA = localA;
+    j.localB = localB;
+    j.referenceAngle = 0.0;
+    r.emplace<Joint>(e, j);
+}
+
+/// A motor hinge from `a` to the world point `pivot`.
+void motorToWorld(Scene& s, std::string name, Entity a, Vec2 aPosition, Vec2 pivot, double speed, double torque) {
+    Registry& r = s.registry;
+    const Entity e = r.create();
+    r.emplace<Name>(e, Name{std::move(name)});
+    Joint j;
+    j.type = "hinge";
+    j.a = a;
+    j.localA = pivot - aPosition;
+    j.localB = pivot;
+    j.referenceAngle = 0.0;
+    j.motorSpeed = speed;
+    j.maxMotorTorque = torque;
+    r.emplace<Joint>(e, j);
+}
+
+std::string label(const char* prefix, int a, int b) {
+    std::string s = prefix;
+    s += std::to_string(a);
+    s += '.';
+    s += std::to_string(b);
+    return s;
+}
+
+// CreateJointGrid: 100 x 100 circles (r 0.4, density 1) 1 m apart, each
+// hinged to its neighbour above and to its left; seven bodies of the top
+// row (the middle ones) are static.
+Scene jointGrid() {
+    Scene s = v3World();
+    const int n = 100;
+    std::vector<Entity> bodies;
+    std::vector<bool> fixed;
+    for (int k = 0; k < n; ++k) {
+        for (int i = 0; i < n; ++i) {
+            const bool isStatic = k >= n / 2 - 3 && k <= n / 2 + 3 && i == 0;
+            const Entity e = dynamicCircle(s, label("node ", k, i), {double(k), -double(i)}, 0.4, 1.0, 0.6,
+                                           isStatic ? kGrey : palette(k + i));
+            if (isStatic) {
+                s.registry.remove<Mass>(e);
+                s.registry.emplace<Static>(e, Static{true});
+            }
+            // Two static ends make no constraint (Box2D keeps such joints
+            // and solves nothing; the format refuses them).
+            if (i > 0 && !(isStatic && fixed.back()))
+                hinge(s, label("v ", k, i), bodies.back(), e, {0.0, -0.5}, {0.0, 0.5});
+            if (k > 0 && !(isStatic && fixed[bodies.size() - n]))
+                hinge(s, label("h ", k, i), bodies[bodies.size() - n], e, {0.5, 0.0}, {-0.5, 0.0});
+            bodies.push_back(e);
+            fixed.push_back(isStatic);
+        }
+    }
+    s.view = View{{50.0, -50.0}, 6.0};
+    return s;
+}
+
+// CreateLargePyramid: 100 boxes at the base, 1 m squares of density 1 set
+// edge to edge (no gap) on a 200 x 2 m ground.
+Scene largePyramid() {
+    Scene s = v3World();
+    staticBox(s, "ground", {0.0, -1.0}, 200.0, 2.0);
+    const int base = 100;
+    int index = 0;
+    for (int i = 0; i < base; ++i)
+        for (int j = i; j < base; ++j)
+            dynamicBox(s, label("box ", i, j), {(i + 1.0) * 0.5 + (j - i) - 0.5 * base, i + 0.5}, 1.0, 1.0, 1.0, 0.6,
+                       palette(index++));
+    s.view = View{{0.0, 50.0}, 6.5};
+    return s;
+}
+
+// CreateManyPyramids: 20 x 20 pyramids of base 10 (1 m boxes), each row on
+// its own 220 m ground segment, rows 11 m apart.
+Scene manyPyramids() {
+    Scene s = v3World();
+    const int base = 10, rows = 20, columns = 20;
+    const double extent = 0.5;
+    const double groundDeltaY = 2.0 * extent * (base + 1.0);
+    const double groundWidth = 2.0 * extent * columns * (base + 1.0);
+    // A segment has no thickness; a 0.2 m box whose top is the segment.
+    for (int i = 0; i < rows; ++i)
+        staticBox(s, "ground " + std::to_string(i), {0.0, i * groundDeltaY - 0.1}, groundWidth, 0.2);
+    const double baseWidth = 2.0 * extent * base;
+    int index = 0;
+    for (int row = 0; row < rows; ++row) {
+        const double baseY = row * groundDeltaY;
+        for (int column = 0; column < columns; ++column) {
+            const double centerX = -0.5 * groundWidth + column * (baseWidth + 2.0 * extent) + 2.0 * extent;
+            const std::string prefix = label("pyramid ", row, column);
+            for (int i = 0; i < base; ++i)
+                for (int j = i; j < base; ++j)
+                    dynamicBox(s, prefix + label(" box ", i, j),
+                               {(i + 1.0) * extent + 2.0 * (j - i) * extent + centerX - 0.5, (2.0 * i + 1.0) * extent + baseY},
+                               1.0, 1.0, 1.0, 0.6, palette(index++));
+        }
+    }
+    s.view = View{{0.0, 110.0}, 3.0};
+    return s;
+}
+
+/// A ragdoll of levels/ragdoll.json's proportions (10 boxes and a circle
+/// head, hinged with its limits) standing in for Box2D's 11-capsule human.
+void ragdoll(Scene& s, const std::string& prefix, Vec2 at) {
+    struct Part {
+        const char* name;
+        Vec2 offset;  // from the torso's centre
+        double w, h, mass;
+    };
+    static const Part parts[] = {
+        {"torso", {0.0, 0.0}, 0.45, 0.8, 20.0},        {"upper arm L", {-0.36, 0.15}, 0.14, 0.45, 2.0},
+        {"lower arm L", {-0.36, -0.3}, 0.12, 0.45, 1.5}, {"upper arm R", {0.36, 0.15}, 0.14, 0.45, 2.0},
+        {"lower arm R", {0.36, -0.3}, 0.12, 0.45, 1.5},  {"thigh L", {-0.12, -0.65}, 0.18, 0.5, 6.0},
+        {"shin L", {-0.12, -1.15}, 0.15, 0.5, 4.0},      {"thigh R", {0.12, -0.65}, 0.18, 0.5, 6.0},
+        {"shin R", {0.12, -1.15}, 0.15, 0.5, 4.0},
+    };
+    std::vector<Entity> e;
+    for (const Part& p : parts)
+        e.push_back(dynamicBox(s, prefix + p.name, at + p.offset, p.w, p.h, p.mass / (p.w * p.h), 0.6,
+                               palette(int(e.size()))));
+    const Entity head = dynamicCircle(s, prefix + "head", at + Vec2{0.0, 0.6}, 0.22, 4.0 / (kPi * 0.22 * 0.22), 0.6,
+                                      {0.93, 0.76, 0.6});
+    struct Link {
+        const char* name;
+        int a, b;  // indices into e; -1: the head
+        Vec2 localA, localB;
+        double lower, upper;
+    };
+    static const Link links[] = {
+        {"neck", 0, -1, {0.0, 0.4}, {0.0, -0.2}, -0.5, 0.5},
+        {"shoulder L", 0, 1, {-0.36, 0.35}, {0.0, 0.2}, -2.5, 1.0},
+        {"elbow L", 1, 2, {0.0, -0.22}, {0.0, 0.23}, 0.0, 2.4},
+        {"shoulder R", 0, 3, {0.36, 0.35}, {0.0, 0.2}, -1.0, 2.5},
+        {"elbow R", 3, 4, {0.0, -0.22}, {0.0, 0.23}, -2.4, 0.0},
+        {"hip L", 0, 5, {-0.12, -0.4}, {0.0, 0.25}, -1.6, 0.6},
+        {"knee L", 5, 6, {0.0, -0.25}, {0.0, 0.25}, 0.0, 2.2},
+        {"hip R", 0, 7, {0.12, -0.4}, {0.0, 0.25}, -1.6, 0.6},
+        {"knee R", 7, 8, {0.0, -0.25}, {0.0, 0.25}, 0.0, 2.2},
+    };
+    for (const Link& l : links) {
+        Registry& r = s.registry;
+        const Entity j = r.create();
+        r.emplace<Name>(j, Name{prefix + l.name});
+        Joint joint;
+        joint.type = "hinge";
+        joint.a = e[std::size_t(l.a)];
+        joint.b = l.b < 0 ? head : e[std::size_t(l.b)];
+        joint.localA = l.localA;
+        joint.localB = l.localB;
+        joint.referenceAngle = 0.0;
+        joint.lower = l.lower;
+        joint.upper = l.upper;
+        r.emplace<Joint>(j, joint);
+    }
+}
+
+// CreateRain: five floors 45 m apart, each a row of 501 static 0.5 m boxes;
+// above each floor, 40 columns of groups of five ragdolls 0.5 m apart.
+// Box2D adds a column every 8 steps and then recycles the oldest; here all
+// 200 groups are there from the first step.
+Scene rain() {
+    Scene s = v3World();
+    const int rows = 5, columns = 40, groupSize = 5, gridCount = 500;
+    const double grid = 0.5;
+    for (int i = 0; i < rows; ++i)
+        for (int j = 0; j <= gridCount; ++j)
+            staticBox(s, label("floor ", i, j), {-0.5 * gridCount * grid + j * grid, 45.0 * i}, grid, grid);
+    const double span = gridCount * grid;
+    const double groupDistance = span / columns;
+    for (int row = 0; row < rows; ++row)
+        for (int column = 0; column < columns; ++column) {
+            Vec2 at{-0.5 * span + groupDistance * (column + 0.5), 40.0 + 45.0 * row};
+            for (int k = 0; k < groupSize; ++k) {
+                ragdoll(s, label("human ", row, column) + "." + std::to_string(k) + " ", at);
+                at.x += 0.5;
+            }
+        }
+    s.view = View{{0.0, 90.0}, 2.5};
+    return s;
+}
+
+// CreateSmash: no gravity; an 8 m box of density 8 at 40 m/s into a block
+// of 120 x 80 boxes of 0.4 m (density 1), set edge to edge.
+Scene smash() {
+    Scene s = v3World();
+    s.world.gravity = {0.0, 0.0};
+    const Entity ram = dynamicBox(s, "ram", {-20.0, 0.0}, 8.0, 8.0, 8.0, 0.6, palette(0));
+    s.registry.emplace<Velocity>(ram, Velocity{{40.0, 0.0}});
+    const double d = 0.4;
+    const int columns = 120, rows = 80;
+    for (int i = 0; i < columns; ++i)
+        for (int j = 0; j < rows; ++j)
+            dynamicBox(s, label("brick ", i, j), {i * d + 30.0, (j - rows / 2.0) * d}, d, d, 1.0, 0.6, palette(i + j + 1));
+    s.view = View{{20.0, 0.0}, 9.0};
+    return s;
+}
+
+// CreateSpinner: a drum of radius 40 m (a 360-point chain loop, friction
+// 0.1) with a 0.8 x 40 m bar rounded by 0.2 m (friction 0) turned at 5 rad/s
+// by an unlimited motor about (0, 12), and 6,076 bodies (capsules, circles
+// and squares in turn, density 0.25, friction 0.1, restitution 0.1).
+Scene spinner() {
+    Scene s = v3World();
+    const int points = 360;
+    const Vec2 centre{0.0, 32.0};
+    const double radius = 40.0, thickness = 1.0;
+    const double step = 2.0 * kPi / points;
+    // Each chain segment as a static box just outside the circle, a little
+    // longer than the segment so that neighbours close the gap at its joint.
+    const double segment = 2.0 * radius * std::sin(0.5 * step);
+    for (int i = 0; i < points; ++i) {
+        const double mid = (i + 0.5) * step;
+        const double out = radius * std::cos(0.5 * step) + 0.5 * thickness;
+        staticBox(s, "drum " + std::to_string(i), centre + Vec2{out * std::cos(mid), out * std::sin(mid)},
+                  segment + 0.1, thickness, 0.1, mid + 0.5 * kPi);
+    }
+    const Vec2 pivot{0.0, 12.0};
+    // The rounded box's outline as a box 0.2 m larger each side; its mass
+    // is the rounded shape's (0.8 x 40 + perimeter x 0.2 + pi 0.2^2).
+    const Entity bar = body(s, "spinner", pivot, 0.0, palette(3));
+    s.registry.emplace<Box>(bar, Box{1.2, 40.4});
+    s.registry.emplace<Mass>(bar, Mass{0.8 * 40.0 + 2.0 * (0.8 + 40.0) * 0.2 + kPi * 0.04});
+    // FLT_MAX in Box2D: far beyond any torque the bodies can resist.
+    motorToWorld(s, "spinner motor", bar, pivot, pivot, 5.0, 1e10);
+    const double density = 0.25;
+    // The capsule (segment -0.25..0.25, radius 0.25) as an octagon: its
+    // straight sides and, at each end, the cap through -90, -30, 30, 90 degrees.
+    Polygon capsule;
+    capsule.vertices.clear();
+    const double c30 = 0.25 * std::cos(kPi / 6.0), s30 = 0.125;
+    for (Vec2 v : {Vec2{0.25, -0.25}, Vec2{0.25 + c30, -s30}, Vec2{0.25 + c30, s30}, Vec2{0.25, 0.25},
+                   Vec2{-0.25, 0.25}, Vec2{-0.25 - c30, s30}, Vec2{-0.25 - c30, -s30}, Vec2{-0.25, -0.25}})
+        capsule.vertices.push_back(v);
+    const double capsuleArea = 0.5 * 0.5 + kPi * 0.25 * 0.25;  // the true capsule's mass
+    const int count = 2 * 3038;
+    double x = -23.0, y = 2.0;
+    for (int i = 0; i < count; ++i) {
+        const std::string name = "body " + std::to_string(i);
+        switch (i % 3) {
+        case 0: {
+            const Entity e = body(s, name, {x, y}, 0.1, palette(i));
+            s.registry.emplace<Polygon>(e, capsule);
+            s.registry.emplace<Mass>(e, Mass{density * capsuleArea});
+            s.registry.emplace<Restitution>(e, Restitution{0.1});
+            break;
+        }
+        case 1:
+            s.registry.emplace<Restitution>(dynamicCircle(s, name, {x, y}, 0.35, density, 0.1, palette(i)),
+                                            Restitution{0.1});
+            break;
+        default:
+            s.registry.emplace<Restitution>(dynamicBox(s, name, {x, y}, 0.7, 0.7, density, 0.1, palette(i)),
+                                            Restitution{0.1});
+            break;
+        }
+        x += 0.5;
+        if (x >= 23.0) {
+            x = -23.0;
+            y += 0.5;
+        }
+    }
+    s.view = View{{0.0, 32.0}, 8.0};
+    return s;
+}
+
+// CreateTumbler: a 20 m square box of four 1 m walls (density 50) turned
+// at 25 degrees/s by a motor (1e8 N m) about (0, 10), holding 45 x 45 boxes
+// of 0.25 m (density 1) 0.4 m apart.
+Scene tumbler() {
+    Scene s = v3World();
+    const Vec2 pivot{0.0, 10.0};
+    const double speed = 25.0 * kPi / 180.0;
+    // One compound body in Box2D; here four bodies, each on its own motor
+    // about the same pivot. The top and bottom walls end at the side walls'
+    // inner faces so that the walls do not overlap one another; each keeps
+    // the mass of Box2D's wall (1 x 20 m at density 50).
+    struct Wall {
+        const char* name;
+        Vec2 offset;
+        double w, h;
+    };
+    const Wall walls[] = {{"wall right", {10.0, 0.0}, 1.0, 20.0},
+                          {"wall left", {-10.0, 0.0}, 1.0, 20.0},
+                          {"wall top", {0.0, 10.0}, 19.0, 1.0},
+                          {"wall bottom", {0.0, -10.0}, 19.0, 1.0}};
+    for (const Wall& w : walls) {
+        const Entity e = body(s, w.name, pivot + w.offset, 0.6, kGrey);
+        s.registry.emplace<Box>(e, Box{w.w, w.h});
+        s.registry.emplace<Mass>(e, Mass{50.0 * 20.0});
+        motorToWorld(s, std::string(w.name) + " motor", e, pivot + w.offset, pivot, speed, 1e8);
+    }
+    const int grid = 45;
+    double y = -0.2 * grid + 10.0;
+    int index = 0;
+    for (int i = 0; i < grid; ++i) {
+        double x = -0.2 * grid;
+        for (int j = 0; j < grid; ++j) {
+            dynamicBox(s, label("box ", i, j), {x, y}, 0.25, 0.25, 1.0, 0.6, palette(index++));
+            x += 0.4;
+        }
+        y += 0.4;
+    }
+    s.view = View{{0.0, 10.0}, 14.0};
+    return s;
+}
+
+} // namespace
+
+std::vector<Box2dScene> box2dBenchmarkScenes() {
+    std::vector<Box2dScene> out;
+    out.push_back({"joint_grid", jointGrid()});
+    out.push_back({"large_pyramid", largePyramid()});
+    out.push_back({"many_pyramids", manyPyramids()});
+    out.push_back({"rain", rain()});
+    out.push_back({"smash", smash()});
+    out.push_back({"spinner", spinner()});
+    out.push_back({"tumbler", tumbler()});
+    return out;
+}
+
+} // namespace stepwise::bench
