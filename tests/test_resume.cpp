@@ -8,6 +8,8 @@
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -44,12 +46,7 @@ Scene load(const fs::path& p) {
     return std::move(*s);
 }
 
-World build(const Scene& s) {
-    Result<World> w = World::build(s);
-    if (!w) throw std::runtime_error(w.error());
-    w->setProfiling(false);
-    return std::move(*w);
-}
+constexpr auto build = &test::buildWorld;
 
 /// The scene as `stepwise run --out` writes it: state and solver state.
 std::string savedText(const World& world, Scene scene, bool withSolverState = true) {

@@ -18,6 +18,11 @@
 
 #include <gtest/gtest.h>
 
+#include "stepwise/scene_io.hpp"
+#include "stepwise/world.hpp"
+
+#include <stdexcept>
+
 // Memory measurements (peak RSS, mallinfo2) mean nothing under
 // AddressSanitizer: its quarantine holds freed memory and it replaces malloc.
 #if defined(__SANITIZE_ADDRESS__)
@@ -126,6 +131,28 @@ inline std::string killWhileWorking(const std::function<bool()>& warmUp, const s
     if (!(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL))
         return "the child ended by itself (a failed step exits 1), status " + std::to_string(status);
     return "";
+}
+
+/// A number written so that it reads back to the same double.
+inline std::string exactNumber(double v) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return text;
+}
+
+/// A level parsed from text; throws (failing the test) if it is refused.
+inline Scene parseLevel(const std::string& text) {
+    Result<Scene> s = parseScene(text, "t.json");
+    if (!s) throw std::runtime_error(s.error());
+    return std::move(*s);
+}
+
+/// A World built from `s`, without the step clock; throws if refused.
+inline World buildWorld(const Scene& s) {
+    Result<World> w = World::build(s);
+    if (!w) throw std::runtime_error(w.error());
+    w->setProfiling(false);
+    return std::move(*w);
 }
 
 } // namespace stepwise::test

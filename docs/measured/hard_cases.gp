@@ -2,9 +2,9 @@ set terminal pngcairo size 1800,1520 font 'DejaVu Sans,10' noenhanced
 set output 'docs/measured/hard_cases.png'
 set multiplot layout 4,4 title 'Hard cases: error against median ms/step (Stepwise fixed substeps x 1 iteration: solid, labels = substeps; Stepwise defaults: square; Box2D 2.4.1, 8+3 iterations: dashed). Sweeps: worst error, slowest step'
 set grid
+set logscale x
 set format x '%g'
 set format y '%g'
-set logscale x
 set xlabel 'ms per step'
 set key top right font ',8'
 set logscale y

@@ -7,6 +7,8 @@
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
 
+#include "../test_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,24 +24,11 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 constexpr double kDt = 1.0 / 60.0;
 
-std::string num(double v) {
-    char text[40];
-    std::snprintf(text, sizeof text, "%.17g", v);
-    return text;
-}
+constexpr auto num = &test::exactNumber;
 
-Scene parse(const std::string& text) {
-    Result<Scene> s = parseScene(text, "t.json");
-    if (!s) throw std::runtime_error(s.error());
-    return std::move(*s);
-}
+constexpr auto parse = &test::parseLevel;
 
-World build(const Scene& s) {
-    Result<World> w = World::build(s);
-    if (!w) throw std::runtime_error(w.error());
-    w->setProfiling(false);
-    return std::move(*w);
-}
+constexpr auto build = &test::buildWorld;
 
 Entity named(const Scene& s, const std::string& name) {
     for (const Entity e : s.registry.entities())
