@@ -150,6 +150,17 @@ double translationalEnergy(const Bodies& b, const std::vector<Vec2>& p, const st
 
 /// The settings a run uses: the engine's choice (substeps 0: as the
 /// level's defaults, sleeping as the engine's default), or fixed.
+/// The run's fastest body, fastest sideways speed and largest energy gain
+/// so far, updated from one step's positions `p` and velocities `v`.
+void recordMotion(Run& out, const Bodies& bodies, const std::vector<Vec2>& p, const std::vector<Vec2>& v, Vec2 g,
+                  double startEnergy) {
+    for (const Vec2& x : v) {
+        out.maxSpeed = std::max(out.maxSpeed, length(x));
+        out.maxSideways = std::max(out.maxSideways, std::abs(x.x));
+    }
+    out.energyGain = std::max(out.energyGain, translationalEnergy(bodies, p, v, g) - startEnergy);
+}
+
 struct Setting {
     std::string label;  ///< "default", "1", "2", "4", "8"
     int substeps = 0;   ///< 0: the engine's choice
@@ -214,11 +225,7 @@ Run runStepwise(const Scene& level, const Bodies& bodies, int steps, const Setti
         }
         if (track.speed) {
             sample();
-            for (const Vec2& x : v) {
-                out.maxSpeed = std::max(out.maxSpeed, length(x));
-                out.maxSideways = std::max(out.maxSideways, std::abs(x.x));
-            }
-            out.energyGain = std::max(out.energyGain, translationalEnergy(bodies, p, v, g) - startEnergy);
+            recordMotion(out, bodies, p, v, g, startEnergy);
         }
         if (track.joints) {
             double widest = 0.0;
@@ -296,11 +303,7 @@ Run runBox2d(const Scene& scene, const Bodies& bodies, int steps, int substeps, 
         }
         if (track.speed) {
             sample();
-            for (const Vec2& x : v) {
-                out.maxSpeed = std::max(out.maxSpeed, length(x));
-                out.maxSideways = std::max(out.maxSideways, std::abs(x.x));
-            }
-            out.energyGain = std::max(out.energyGain, translationalEnergy(bodies, p, v, g) - startEnergy);
+            recordMotion(out, bodies, p, v, g, startEnergy);
         }
         if (track.joints) {
             double widest = 0.0;
@@ -559,8 +562,8 @@ Case pile300() {
 }
 
 /// Box2D v3.1.1's figures for its benchmark scenes on this machine (one
-/// thread, median ms/step), and Stepwise's at v3's settings, as the issue
-/// measured them; the report prints them next to its own.
+/// thread, median ms/step), and Stepwise's at v3's settings measured
+/// before the hard cases were fixed; the report prints them next to its own.
 struct Reference {
     const char* scene;
     double v3Ms;
@@ -873,7 +876,7 @@ int main(int argc, char** argv) {
           "one run each. A run stops early, and says so, when it reaches the wall-clock budget or a joint opens "
           "by more than 1 km.\n\n"
        << "![hard cases](hard_cases.png)\n\n";
-    // Box2D's benchmark scenes side by side, with the issue's figures.
+    // Box2D's benchmark scenes side by side, with the reference figures.
     md << "## Box2D's benchmark scenes\n\n"
        << "| scene | Stepwise at v3's settings (4 substeps, 1 iteration), ms | Stepwise defaults, ms | Box2D 2.4.1 "
           "(1 x 8+3 iterations), ms | Box2D v3.1.1, ms (reference) | Stepwise at v3's settings, ms (reference) | "

@@ -11,6 +11,8 @@
 #include "stepwise/world.hpp"
 #include "world/world_internals.hpp"
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -346,13 +348,8 @@ TEST(CollisionHard, ValidateAndRunWarnAboutThePileBeforePlaying) {
     const std::string path = ::testing::TempDir() + "collide_tall_pile_1.json";
     ASSERT_TRUE(saveSceneFile(s, path));
     for (const char* command : {"validate", "run --steps 1"}) {
-        const std::string line = std::string(STEPWISE_BINARY) + " " + command + " '" + path + "' 2>&1 >/dev/null";
-        FILE* pipe = ::popen(line.c_str(), "r");
-        ASSERT_NE(pipe, nullptr);
-        std::string err;
-        char buffer[512];
-        while (std::fgets(buffer, sizeof buffer, pipe)) err += buffer;
-        ::pclose(pipe);
+        const std::string err =
+            test::runCommand(std::string(STEPWISE_BINARY) + " " + command + " '" + path + "' 2>&1 >/dev/null").out;
         EXPECT_NE(err.find("warning: piles up to 30 bodies deep: expected sinkage "), std::string::npos) << command << ": " << err;
         EXPECT_NE(err.find(" substeps would hold it under 2%"), std::string::npos) << command << ": " << err;
     }

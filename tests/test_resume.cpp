@@ -31,14 +31,7 @@ namespace {
 
 constexpr std::uint64_t kSteps = 100;
 
-std::vector<fs::path> shippedLevels() {
-    std::vector<fs::path> out;
-    for (const auto& entry : fs::directory_iterator(fs::path(STEPWISE_SOURCE_DIR) / "levels"))
-        if (entry.path().extension() == ".json" && entry.path().filename() != "scene.schema.json")
-            out.push_back(entry.path());
-    std::sort(out.begin(), out.end());
-    return out;
-}
+using test::shippedLevels;
 
 Scene load(const fs::path& p) {
     Result<Scene> s = loadSceneFile(p);

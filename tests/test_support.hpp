@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -153,6 +155,32 @@ inline World buildWorld(const Scene& s) {
     if (!w) throw std::runtime_error(w.error());
     w->setProfiling(false);
     return std::move(*w);
+}
+
+/// Every level in levels/ (not the schema), sorted by path.
+inline std::vector<std::filesystem::path> shippedLevels() {
+    std::vector<std::filesystem::path> out;
+    for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels"))
+        if (entry.path().extension() == ".json" && entry.path().filename() != "scene.schema.json")
+            out.push_back(entry.path());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+/// A shell command line's exit code and what it printed on standard
+/// output (redirect stderr in the line to read it instead).
+struct CommandResult {
+    int exitCode = -1;
+    std::string out;
+};
+inline CommandResult runCommand(const std::string& line) {
+    CommandResult r;
+    FILE* pipe = ::popen(line.c_str(), "r");
+    if (!pipe) return r;
+    char buffer[4096];
+    while (std::fgets(buffer, sizeof buffer, pipe)) r.out += buffer;
+    r.exitCode = WEXITSTATUS(::pclose(pipe));
+    return r;
 }
 
 } // namespace stepwise::test

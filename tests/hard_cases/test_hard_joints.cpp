@@ -97,8 +97,8 @@ ChainRun run(Scene scene, int steps) {
 // ------------------------------------------------------------ mass ratio
 
 /// Ten links, the last `ratio` times heavier, released horizontally, 5 s.
-/// At the defaults the bound is the one the issue asks for (half of Box2D
-/// v3's 4 cm on the 1000:1 chain) and 1% of a link below 1000:1; with the
+/// At the defaults the bound is half of Box2D v3's 4 cm on the 1000:1
+/// chain and 1% of a link below 1000:1; with the
 /// substeps fixed, 1% of a link from 2 substeps up, 2% at 1 substep (a
 /// single 60 Hz substep caps the joints' correction at 30 Hz).
 struct MassCase {

@@ -33,14 +33,7 @@ constexpr auto parse = &test::parseLevel;
 
 constexpr auto build = &test::buildWorld;
 
-std::vector<fs::path> shippedLevels() {
-    std::vector<fs::path> out;
-    for (const auto& entry : fs::directory_iterator(fs::path(STEPWISE_SOURCE_DIR) / "levels"))
-        if (entry.path().extension() == ".json" && entry.path().filename() != "scene.schema.json")
-            out.push_back(entry.path());
-    std::sort(out.begin(), out.end());
-    return out;
-}
+using test::shippedLevels;
 
 /// The scene as `stepwise run --out` writes it: state and solver state.
 std::string savedText(const World& world, Scene scene) {
@@ -117,29 +110,12 @@ int fewestHolding(const std::function<bool(int)>& holds) {
     return 16;
 }
 
-struct Cli {
-    int exitCode = 0;
-    std::string out;
-};
 
-Cli runCli(const std::string& args) {
-    const std::string line = std::string(STEPWISE_BINARY) + " " + args + " 2>/dev/null";
-    Cli r;
-    FILE* pipe = ::popen(line.c_str(), "r");
-    if (!pipe) return r;
-    char buffer[4096];
-    while (std::fgets(buffer, sizeof buffer, pipe)) r.out += buffer;
-    const int status = ::pclose(pipe);
-    r.exitCode = WEXITSTATUS(status);
-    return r;
+test::CommandResult runCli(const std::string& args) {
+    return test::runCommand(std::string(STEPWISE_BINARY) + " " + args + " 2>/dev/null");
 }
 
-std::string readText(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+constexpr auto readText = &test::readFile;
 
 fs::path tempFile(const std::string& name) {
     return fs::path(::testing::TempDir()) / ("hard_settings_" + std::to_string(::getpid()) + "_" + name);
@@ -387,13 +363,8 @@ TEST(HardSettings, ARecordedChoiceRaisesNoWarning) {
         std::ofstream(level) << pileLevel(rows, 0.0);
         ASSERT_EQ(runCli("run " + level.string() + " --steps 30 --out " + out.string()).exitCode, 0);
         for (const fs::path& p : {level, out}) {
-            const std::string line = std::string(STEPWISE_BINARY) + " validate " + p.string() + " 2>&1 >/dev/null";
-            FILE* pipe = ::popen(line.c_str(), "r");
-            ASSERT_NE(pipe, nullptr);
-            std::string err;
-            char buffer[512];
-            while (std::fgets(buffer, sizeof buffer, pipe)) err += buffer;
-            ::pclose(pipe);
+            const std::string err =
+                test::runCommand(std::string(STEPWISE_BINARY) + " validate " + p.string() + " 2>&1 >/dev/null").out;
             EXPECT_EQ(err, "") << rows << " rows, " << p;
         }
         fs::remove(level);

@@ -188,7 +188,7 @@ template <int Points, bool UseBias>
             // why).
             const D4 vn = (((v.vBx - v.vAx) * nx + (v.vBy - v.vAy) * ny) + v.wB * load(p.rnB)) - v.wA * load(p.rnA);
             const M4 rigid =
-                !(separation > -rigidDepth) | !((separation + vn / splat(args.invH)) > -(rigidDepth + rigidDepth));
+                (!(separation > -rigidDepth)) | (!((separation + vn / splat(args.invH)) > -(rigidDepth + rigidDepth)));
             const D4 toDepth = separation + rigidDepth;
             const D4 rigidBias = toDepth > zero ? toDepth * splat(args.invH)
                                                 : maxOf(biasRate * toDepth, splat(-args.pushMaxVelocity));

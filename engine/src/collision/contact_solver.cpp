@@ -1,6 +1,5 @@
 #include "collision/contact_solver.hpp"
 
-#include "collision/position_correction.hpp"  // currentSeparation
 
 #include <algorithm>
 #include <bit>
@@ -33,6 +32,13 @@ inline double effectiveMass(const SolverBody& a, const SolverBody& b, double arm
     return k > 0.0 ? 1.0 / k : 0.0;
 }
 } // namespace
+
+double currentSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c, const ContactPoint& p) {
+    // A round side turns under its contact point (ContactConstraint::roundA).
+    const Rot qA = c.roundA ? Rot{} : a.dq, qB = c.roundB ? Rot{} : b.dq;
+    return dot(b.dp - a.dp, c.normal) + (qB.c * p.dnB + qB.s * p.rnB) - (qA.c * p.dnA + qA.s * p.rnA) +
+           p.adjustedSeparation;
+}
 
 Softness Softness::make(double hertz, double dampingRatio, double h) {
     if (hertz == 0.0) return {0.0, 1.0, 0.0};

@@ -116,6 +116,10 @@ struct SolverSettings {
     bool simd = true;
 };
 
+/// The separation of point `p` of contact `c` at the bodies' current dp, dq
+/// (metres, negative when overlapping).
+double currentSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c, const ContactPoint& p);
+
 /// Prepares masses, the block solve's 2x2 systems and adjusted separations
 /// (once per step, after the narrow phase).
 void prepareContacts(std::span<ContactConstraint> contacts, std::span<const ContactDetail> details,

@@ -13,13 +13,6 @@ inline Rot turnedBy(Rot q, double angle) {
 }
 } // namespace
 
-double currentSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c, const ContactPoint& p) {
-    // A round side turns under its contact point (ContactConstraint::roundA).
-    const Rot qA = c.roundA ? Rot{} : a.dq, qB = c.roundB ? Rot{} : b.dq;
-    return dot(b.dp - a.dp, c.normal) + (qB.c * p.dnB + qB.s * p.rnB) - (qA.c * p.dnA + qA.s * p.rnA) +
-           p.adjustedSeparation;
-}
-
 bool correctPositions(std::span<const ContactConstraint> contacts, std::span<SolverBody> bodies,
                       std::span<const std::uint8_t> crowd, const PositionCorrectionSettings& settings,
                       PositionCorrectionScratch& scratch) {

@@ -50,8 +50,4 @@ bool correctPositions(std::span<const ContactConstraint> contacts, std::span<Sol
                       std::span<const std::uint8_t> crowd, const PositionCorrectionSettings& settings,
                       PositionCorrectionScratch& scratch);
 
-/// The separation of point `p` of contact `c` at the bodies' current dp, dq
-/// (metres, negative when overlapping).
-double currentSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c, const ContactPoint& p);
-
 } // namespace stepwise::collision
