@@ -669,7 +669,8 @@ std::string measuredOn(int argc, char** argv) {
             cpu = line.substr(line.find(':') + 2);
             break;
         }
-    std::string command = "hard_cases";
+    // `stepwise bench hard-cases` starts this program; the table names that.
+    std::string command = "stepwise bench hard-cases";
     for (int i = 1; i < argc; ++i) command.append(" ").append(argv[i]);
     return "Measured " + std::string(when) + " on " + cpu + " (" + std::to_string(std::thread::hardware_concurrency()) +
            " hardware threads) by `" + command + "`.";
@@ -866,7 +867,7 @@ int main(int argc, char** argv) {
         csv << '"' << r.name << "\",\"" << r.panel << "\",\"" << r.engine << "\"," << r.setting << "," << num(r.ms)
             << "," << num(r.error) << ",\"" << r.errorLabel << "\",\"" << r.detail << "\"\n";
     md << "# Hard cases: error against time\n\n" << measuredOn(argc, argv) << "\n\n"
-       << "Written by `build/bench/hard_cases --out docs/measured` (see docs/performance.md, \"Hard cases\"). "
+       << "Written by `stepwise bench hard-cases --out docs/measured` (see docs/performance.md, \"Hard cases\"). "
           "Stepwise runs each case at its defaults (the level's own step settings removed: the engine chooses "
           "substeps and iterations, and sleeping is on) and at substeps 1, 2, 4 and 8 of one iteration each with "
           "sleeping off; Box2D 2.4.1 runs in the same process with 8 velocity and 3 position iterations per call and "

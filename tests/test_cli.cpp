@@ -421,10 +421,10 @@ Outcome stepwiseUnprivileged(const std::string& args, const fs::path& errFile) {
 TEST_F(Cli, BenchBadArgumentsExitTwoNamingTheArgument) {
     Outcome o = stepwise("bench");
     EXPECT_EQ(o.exitCode, 2);
-    EXPECT_EQ(o.err, "stepwise: error: bench: expected a report to run: accuracy (see stepwise bench --help)\n");
+    EXPECT_EQ(o.err, "stepwise: error: bench: expected a report to run: accuracy or hard-cases (see stepwise bench --help)\n");
     o = stepwise("bench frob");
     EXPECT_EQ(o.exitCode, 2);
-    EXPECT_EQ(o.err, "stepwise: error: bench: unknown report \"frob\"; expected one of: accuracy\n");
+    EXPECT_EQ(o.err, "stepwise: error: bench: unknown report \"frob\"; expected one of: accuracy, hard-cases\n");
     o = stepwise("bench accuracy --quick");
     EXPECT_EQ(o.exitCode, 2);
     EXPECT_EQ(o.err.rfind("--out is required\n", 0), 0u) << o.err;
@@ -462,8 +462,39 @@ TEST_F(Cli, BenchBadArgumentsExitTwoNamingTheArgument) {
     EXPECT_EQ(std::distance(fs::directory_iterator(reportDir), fs::directory_iterator()), 1) << "nothing else written";
 }
 
+// `bench hard-cases` runs the hard-cases program of the same build and
+// writes its three files; a short run of one case holds each setting's row.
+TEST_F(Cli, BenchHardCasesWritesTheReportOfTheCasesAsked) {
+#ifndef STEPWISE_HAS_HARD_CASES
+    GTEST_SKIP() << "configured with STEPWISE_BUILD_BENCH=OFF: no hard-cases program";
+#endif
+    const fs::path out = dir_ / "hard";
+    Outcome o = stepwise("bench hard-cases --only 'disc w0 -20' --steps 4 --out " + out.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, "stepwise: error: --out: " + out.string() + " is not an existing folder\n");
+    EXPECT_FALSE(fs::exists(out));
+    o = stepwise("bench hard-cases --steps 0 --out " + dir_.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err.rfind("--steps: Value 0 not in range 1 to 1000000", 0), 0u) << o.err;
+
+    fs::create_directory(out);
+    o = stepwise("bench hard-cases --only 'disc w0 -20' --steps 4 --out " + out.string());
+    ASSERT_EQ(o.exitCode, 0) << o.err;
+    EXPECT_NE(o.out.find("wrote " + (out / "hard_cases.md").string()), std::string::npos) << o.out;
+    const std::string csv = readFile(out / "hard_cases.csv");
+    for (const char* row : {"\"disc w0 -20 rad/s\",\"disc spun onto the floor\",\"Stepwise default\",default,",
+                            "\"disc w0 -20 rad/s\",\"disc spun onto the floor\",\"Stepwise\",1,",
+                            "\"disc w0 -20 rad/s\",\"disc spun onto the floor\",\"Stepwise\",8,",
+                            "\"disc w0 -20 rad/s\",\"disc spun onto the floor\",\"Box2D 2.4.1\",1,"})
+        EXPECT_NE(csv.find(row), std::string::npos) << row << " in\n" << csv;
+    EXPECT_EQ(csv.find("disc w0 -5 "), std::string::npos) << "only the case asked for";
+    const std::string md = readFile(out / "hard_cases.md");
+    EXPECT_NE(md.find("by `stepwise bench hard-cases"), std::string::npos) << md.substr(0, 400);
+    EXPECT_TRUE(fs::file_size(out / "hard_cases.png") > 1000);
+}
+
 TEST_F(Cli, RenderAndBenchHaveHelp) {
-    for (const char* sub : {"render", "bench", "bench accuracy"}) {
+    for (const char* sub : {"render", "bench", "bench accuracy", "bench hard-cases"}) {
         Outcome o = stepwise(std::string(sub) + " --help");
         EXPECT_EQ(o.exitCode, 0) << sub;
         EXPECT_NE(o.out.find("Usage:"), std::string::npos) << sub << ": " << o.out;
