@@ -1,6 +1,6 @@
 # Fails when a source file under DIR includes a header matching FORBIDDEN
 # (a regular expression on the quoted or bracketed name). Keeps the layers
-# apart: the editor model (editor/app) and the view data (editor/view) are
+# apart: the editor model (editor/app) and the view data (render/view) are
 # built and tested without GL, SDL, ImGui or the renderer.
 #   cmake -DDIR=editor/app -DFORBIDDEN="^(render/|GL/|SDL|imgui)" -P check_includes.cmake
 get_filename_component(DIR "${DIR}" ABSOLUTE)

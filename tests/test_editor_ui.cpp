@@ -2,7 +2,7 @@
 // on the CPU, so what a panel draws can be checked directly), and a whole
 // editor frame through OSMesa.
 
-#include "render/offscreen.hpp"
+#include "offscreen.hpp"
 #include "ui/editor_ui.hpp"
 #include "ui/session.hpp"
 

@@ -1,5 +1,5 @@
 // Renderer unit tests that need no GL context: overlay parsing, camera
-// fitting, batching and arrow scales (editor/render/frame.hpp).
+// fitting, batching and arrow scales (render/frame.hpp).
 
 #include "frame.hpp"
 

@@ -1,7 +1,7 @@
 // Screenshot regression tests (ctest label `screenshot`).
 //
 // Every level in levels/ is rendered with the fixed recipe in
-// editor/render/screenshot.hpp and compared with screenshots/<level>.png.
+// render/screenshot.hpp and compared with screenshots/<level>.png.
 // Regenerate the goldens (after a deliberate visual change, and look at
 // them) with:
 //     cmake --build build --target update-goldens

@@ -12,7 +12,7 @@
 #include "app/tools/tools.hpp"
 #include "app/view_camera.hpp"
 
-#include "view/frame_input.hpp"
+#include "frame_input.hpp"
 
 #include "stepwise/component_table.hpp"
 

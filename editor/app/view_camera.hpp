@@ -5,7 +5,7 @@
 /// world metres (y up). Uses the renderer's Camera so what the tools hit is
 /// exactly what the renderer drew.
 
-#include "view/camera.hpp"
+#include "camera.hpp"
 #include "stepwise/vec2.hpp"
 
 namespace stepwise::editor {

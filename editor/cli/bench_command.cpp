@@ -1,5 +1,5 @@
 // stepwise bench accuracy [--quick] --out DIR: the speed-against-error
-// report (editor/report): accuracy.csv, accuracy.md and the work-precision
+// report (bench/report): accuracy.csv, accuracy.md and the work-precision
 // plot accuracy.png.
 // stepwise bench hard-cases [--quick] [--only NAME] [--steps N] --out DIR:
 // the hard-cases report, error against ms/step with Box2D 2.4.1 as the peer.

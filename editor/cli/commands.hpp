@@ -5,6 +5,9 @@
 namespace CLI {
 class App;
 }
+namespace stepwise::ui {
+struct EditOptions;
+}
 
 namespace stepwise::cli {
 
@@ -18,11 +21,15 @@ enum ExitCode : int {
 
 void addValidateCommand(CLI::App& app, int& exitCode);
 void addRunCommand(CLI::App& app, int& exitCode);
-/// `stepwise bench accuracy`: the speed-against-error report (editor/report).
+/// `stepwise bench`: the speed-against-error report (bench/report) and the
+/// hard-cases report (bench/hard_cases).
 void addBenchCommand(CLI::App& app, int& exitCode);
 void addRenderCommand(CLI::App& app, int& exitCode);
 void addSchemaCommand(CLI::App& app, int& exitCode);
 /// `stepwise edit [LEVEL]`: the editor (SDL2 window, or headless with --script/--screenshot).
 void addEditCommand(CLI::App& app, int& exitCode);
+/// `stepwise edit` headless (OSMesa): replays --script, then --bench-frames,
+/// then writes --screenshot. Returns the process exit code.
+int runScripted(const ui::EditOptions& o, int width, int height);
 
 } // namespace stepwise::cli

@@ -7,17 +7,19 @@
 #include "cli/cli_common.hpp"
 #include "cli/option_checks.hpp"
 #include "cli/commands.hpp"
-#include "cli/edit_run.hpp"
+#include "ui/edit_run.hpp"
 
 #include "app/document.hpp"
 #include "platform/sdl_window.hpp"
-#include "view/overlay_set.hpp"
+#include "overlay_set.hpp"
 
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 
 namespace stepwise::cli {
+
+using ui::EditOptions;
 
 namespace {
 
@@ -70,7 +72,14 @@ void addEditCommand(CLI::App& app, int& exitCode) {
                         "default.json")
                            .string();
         const bool headless = o->headless || !o->script.empty() || !o->screenshot.empty();
-        exitCode = headless ? runScripted(*o, w, h) : platform::runWindow(*o, w, h);
+        if (headless) {
+            exitCode = runScripted(*o, w, h);
+        } else if (Result<void> ran = platform::runWindow(*o, w, h); !ran) {
+            reportError(ran.error());
+            exitCode = kExitFailure;
+        } else {
+            exitCode = kExitOk;
+        }
     });
 }
 

@@ -4,13 +4,13 @@
 
 #include "cli/cli_common.hpp"
 #include "cli/commands.hpp"
-#include "cli/edit_run.hpp"
+#include "ui/edit_run.hpp"
 
 #include "app/scene_edit.hpp"
 #include "app/script.hpp"
 #include "app/script_actions.hpp"
-#include "render/image.hpp"
-#include "render/offscreen.hpp"
+#include "image.hpp"
+#include "offscreen.hpp"
 #include "ui/session.hpp"
 
 #include "stepwise/scene_io.hpp"
@@ -27,6 +27,11 @@
 #include <sstream>
 
 namespace stepwise::cli {
+
+using ui::EditOptions;
+using ui::FrameTimes;
+using ui::kFrameSeconds;
+using ui::writeDebugState;
 
 namespace {
 

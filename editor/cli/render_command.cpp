@@ -6,7 +6,7 @@
 #include "cli/option_checks.hpp"
 #include "cli/commands.hpp"
 
-#include "render/offscreen.hpp"
+#include "offscreen.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"

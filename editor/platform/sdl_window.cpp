@@ -2,9 +2,6 @@
 
 #include "platform/sdl_window.hpp"
 
-#include "cli/cli_common.hpp"
-#include "cli/commands.hpp"
-
 #include "app/events.hpp"
 #include "app/scene_edit.hpp"
 #include "ui/session.hpp"
@@ -17,13 +14,10 @@
 
 namespace stepwise::platform {
 
-using cli::EditOptions;
-using cli::FrameTimes;
 using editor::benchScene;
-using cli::kExitFailure;
-using cli::kExitOk;
-using cli::reportError;
-using cli::writeDebugState;
+using ui::EditOptions;
+using ui::FrameTimes;
+using ui::writeDebugState;
 using editor::InputEvent;
 using editor::Key;
 
@@ -67,22 +61,19 @@ std::uint8_t modsFromSdl(Uint16 m) {
 
 } // namespace
 
-int runWindow(const EditOptions& o, int width, int height) {
-    if (SDL_Init(SDL_INIT_VIDEO | SDL_INIT_TIMER) != 0) {
-        reportError(std::string("cannot start SDL video (is there a display? use --script/--screenshot for headless "
-                                "runs): ") + SDL_GetError());
-        return kExitFailure;
-    }
+Result<void> runWindow(const EditOptions& o, int width, int height) {
+    if (SDL_Init(SDL_INIT_VIDEO | SDL_INIT_TIMER) != 0)
+        return Error{std::string("cannot start SDL video (is there a display? use --script/--screenshot for headless "
+                                 "runs): ") + SDL_GetError()};
     // With no display, Debian's SDL 2.26 does not fail: it falls back to its
     // invisible "offscreen" driver, and the editor would run a window nobody
     // can see until it is killed. Such a driver is honoured only when asked
     // for by name (SDL_VIDEODRIVER).
     const char* driver = SDL_GetCurrentVideoDriver();
     if (driver && (!std::strcmp(driver, "offscreen") || !std::strcmp(driver, "dummy")) && !SDL_getenv("SDL_VIDEODRIVER")) {
-        reportError(std::string("cannot start SDL video (is there a display? use --script/--screenshot for headless "
-                                "runs): SDL found no display, only its \"") + driver + "\" driver");
         SDL_Quit();
-        return kExitFailure;
+        return Error{std::string("cannot start SDL video (is there a display? use --script/--screenshot for headless "
+                                 "runs): SDL found no display, only its \"") + driver + "\" driver"};
     }
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_PROFILE_MASK, SDL_GL_CONTEXT_PROFILE_CORE);
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 3);
@@ -92,16 +83,16 @@ int runWindow(const EditOptions& o, int width, int height) {
     SDL_Window* window = SDL_CreateWindow("Stepwise", SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, width, height,
                                           SDL_WINDOW_OPENGL | SDL_WINDOW_RESIZABLE);
     if (!window) {
-        reportError(std::string("cannot open a window: ") + SDL_GetError());
+        Error e{std::string("cannot open a window: ") + SDL_GetError()};
         SDL_Quit();
-        return kExitFailure;
+        return e;
     }
     SDL_GLContext context = SDL_GL_CreateContext(window);
     if (!context) {
-        reportError(std::string("cannot create an OpenGL 3.3 core context: ") + SDL_GetError());
+        Error e{std::string("cannot create an OpenGL 3.3 core context: ") + SDL_GetError()};
         SDL_DestroyWindow(window);
         SDL_Quit();
-        return kExitFailure;
+        return e;
     }
     SDL_GL_MakeCurrent(window, context);
     SDL_GL_SetSwapInterval(o.noVsync || o.benchFrames > 0 ? 0 : 1);
@@ -112,13 +103,12 @@ int runWindow(const EditOptions& o, int width, int height) {
     so.builtinFont = o.builtinFont;
     so.dpiScale = std::clamp(dpi / 96.0f, 1.0f, 3.0f);
     if (!o.configDir.empty()) so.configDir = o.configDir;
-    int code = kExitOk;
+    Result<void> outcome;
     {
         Result<std::unique_ptr<ui::Session>> created =
             ui::Session::create([](const char* n) { return SDL_GL_GetProcAddress(n); }, so);
         if (!created) {
-            reportError(created.error());
-            code = kExitFailure;
+            outcome = Error{created.error()};
         } else {
             ui::Session& session = **created;
             editor::Editor& ed = session.editor();
@@ -225,7 +215,7 @@ int runWindow(const EditOptions& o, int width, int height) {
     SDL_GL_DeleteContext(context);
     SDL_DestroyWindow(window);
     SDL_Quit();
-    return code;
+    return outcome;
 }
 
 } // namespace stepwise::platform

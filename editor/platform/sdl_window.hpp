@@ -4,12 +4,14 @@
 /// events translated to the editor's InputEvents, real-time frames, vsync.
 /// The only file that knows SDL.
 
-#include "cli/edit_run.hpp"
+#include "ui/edit_run.hpp"
+
+#include "stepwise/result.hpp"
 
 namespace stepwise::platform {
 
-/// Opens the window and runs the editor until it quits. Returns the process
-/// exit code (failures to open a display or a context are reported).
-int runWindow(const cli::EditOptions& o, int width, int height);
+/// Opens the window and runs the editor until it quits. Fails, saying why,
+/// when there is no display or no OpenGL 3.3 context.
+Result<void> runWindow(const ui::EditOptions& o, int width, int height);
 
 } // namespace stepwise::platform

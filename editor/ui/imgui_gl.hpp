@@ -6,7 +6,7 @@
 /// its entry points through the context's own GetProcAddress (as the scene
 /// renderer does), so the window and the headless screenshot share one path.
 
-#include "render/gl_api.hpp"
+#include "gl_api.hpp"
 #include "stepwise/result.hpp"
 
 #include <cstdint>

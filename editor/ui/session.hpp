@@ -7,8 +7,8 @@
 /// a script replays exactly what a person's input does.
 
 #include "app/editor.hpp"
-#include "render/image.hpp"
-#include "render/renderer.hpp"
+#include "image.hpp"
+#include "renderer.hpp"
 #include "ui/editor_ui.hpp"
 
 #include <deque>

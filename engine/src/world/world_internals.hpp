@@ -1,7 +1,7 @@
 #pragma once
 // The one door into a World's internals, for code that measures the engine
 // from outside it: the tests, the benchmarks (bench/) and the accuracy report
-// (editor/report). They time or compare the force model, the state arrays
+// (bench/report). They time or compare the force model, the state arrays
 // and the collision system on their own, which the public World API does not
 // expose (and should not: an application has no use for them). Reached
 // through the stepwise_engine_internal include path; nothing else includes

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-namespace stepwise::cli {
+namespace stepwise::ui {
 
 struct EditOptions {
     std::string level;
@@ -37,24 +37,21 @@ constexpr double kFrameSeconds = 1.0 / 60.0;  // scripted frames: fixed, so runs
 
 /// Writes the editor's state (mode, time, steps, viewport, camera, the first
 /// 64 positions) as JSON, atomically, for tests that watch a running editor.
-void writeDebugState(const std::string& path, ui::Session& session, std::uint64_t frame);
+void writeDebugState(const std::string& path, Session& session, std::uint64_t frame);
 
 struct FrameTimes {
     std::vector<double> ms;
-    ui::UiState::FrameParts sum;  ///< the parts summed over the recorded frames
-    ui::UiState::FrameParts last; ///< the last recorded frame's parts
+    UiState::FrameParts sum;  ///< the parts summed over the recorded frames
+    UiState::FrameParts last; ///< the last recorded frame's parts
     /// CPU seconds of the whole process (every thread: the editor's and the
     /// rasteriser's) at the first and the last add(). On a shared machine
     /// the CPU time a frame takes moves less than its wall time.
     double processCpuStart = -1.0, processCpuLast = 0.0;
 
-    void add(double frameMs, const ui::UiState::FrameParts& parts);
+    void add(double frameMs, const UiState::FrameParts& parts);
     /// Prints the mean, median, p95 and max frame time and where a frame goes.
     void report(const char* what, std::size_t bodies) const;
 };
 
-/// Headless (OSMesa): replays --script, then --bench-frames, then writes
-/// --screenshot. Returns the process exit code.
-int runScripted(const EditOptions& o, int width, int height);
 
-} // namespace stepwise::cli
+} // namespace stepwise::ui

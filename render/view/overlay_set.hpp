@@ -1,6 +1,6 @@
 #pragma once
 /// \file overlay_set.hpp
-/// Which debug views a frame shows. Part of the view library (editor/view):
+/// Which debug views a frame shows. Part of the view library (render/view):
 /// what the renderer draws and the editor model holds, with no GL, so the
 /// editor model (editor/app) needs no renderer. The namespace stays
 /// `render` because these types are the renderer's input vocabulary.

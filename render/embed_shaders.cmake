@@ -2,7 +2,7 @@
 # needs no source tree at run time (a fresh clone or an installed binary
 # works the same). Run as: cmake -DOUT=file.cpp -DSHADER_DIR=dir
 # "-DSHADERS=a.vert;b.frag" -P embed_shaders.cmake
-set(text "// Generated from shaders/ by editor/render/embed_shaders.cmake. Do not edit.\n")
+set(text "// Generated from shaders/ by render/embed_shaders.cmake. Do not edit.\n")
 string(APPEND text "#include \"shader_sources.hpp\"\n\nnamespace stepwise::render {\n\n")
 string(APPEND text "const std::vector<ShaderSource>& shaderSources() {\n    static const std::vector<ShaderSource> sources = {\n")
 foreach(name IN LISTS SHADERS)

@@ -1,6 +1,4 @@
-#include "cli/edit_run.hpp"
-
-#include "cli/cli_common.hpp"
+#include "ui/edit_run.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
@@ -15,7 +13,7 @@
 #include <numeric>
 #include <sstream>
 
-namespace stepwise::cli {
+namespace stepwise::ui {
 
 void writeDebugState(const std::string& path, ui::Session& session, std::uint64_t frame) {
     editor::Editor& ed = session.editor();
@@ -98,4 +96,4 @@ void FrameTimes::report(const char* what, std::size_t bodies) const {
     std::printf("  viewport, last frame: %zu instances in %d draw calls\n", last.instances, last.drawCalls);
 }
 
-} // namespace stepwise::cli
+} // namespace stepwise::ui
