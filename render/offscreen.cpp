@@ -33,14 +33,15 @@ Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int widthPx
                            OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 3,
                            OSMESA_CONTEXT_MINOR_VERSION, 3,    0};
     r->context_->context = OSMesaCreateContextAttribs(attribs, nullptr);
-    if (!r->context_->context) return Error{"cannot create an OSMesa OpenGL 3.3 core context"};
+    if (!r->context_->context)
+        return Error{"cannot create an OSMesa OpenGL 3.3 core context", "", ErrorKind::Environment};
     r->context_->buffer.assign(std::size_t(widthPx) * std::size_t(heightPx) * 4, 0);
     if (!OSMesaMakeCurrent(r->context_->context, r->context_->buffer.data(), GL_UNSIGNED_BYTE, widthPx, heightPx))
-        return Error{"cannot make the OSMesa context current"};
+        return Error{"cannot make the OSMesa context current", "", ErrorKind::Environment};
     r->width_ = widthPx;
     r->height_ = heightPx;
     Result<std::unique_ptr<Renderer>> renderer = Renderer::create(osmesaProc);
-    if (!renderer) return Error{renderer.error()};
+    if (!renderer) return Error{renderer.error(), "", ErrorKind::Environment};
     r->renderer_ = std::move(*renderer);
     return r;
 }

@@ -216,7 +216,7 @@ TEST(PolygonTool, ClickedVerticesMakeTheirConvexHullAsOneUndoStep) {
     // The preview is the hull, counter-clockwise, with the cursor (inside) adding nothing.
     const std::vector<Vec2> preview = f.ed.polygonPreview();
     ASSERT_EQ(preview.size(), 4u);
-    EXPECT_EQ(polygonProblem(preview), "");
+    EXPECT_EQ(polygonProblem(preview), std::nullopt);
     ASSERT_TRUE(f.ed.handleShortcut(Key::Enter, 0));
     ASSERT_EQ(f.ed.doc.scene.registry.size(), n + 1);
     const Entity e = f.ed.doc.scene.registry.entities().back();

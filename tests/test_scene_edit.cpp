@@ -58,7 +58,7 @@ TEST(Inspector, CopyEntityIsTableDrivenAndExact) {
 TEST(PolygonTool, ConvexHullIsCounterClockwiseWithoutCollinearPoints) {
     const std::vector<Vec2> hull = convexHull({{0, 0}, {1, 0}, {2, 0}, {2, 2}, {1, 1}, {0, 2}, {0, 0}, {1, 2}});
     ASSERT_EQ(hull.size(), 4u);
-    EXPECT_EQ(polygonProblem(hull), "");
+    EXPECT_EQ(polygonProblem(hull), std::nullopt);
     EXPECT_EQ(convexHull({{0, 0}, {1, 1}, {2, 2}}).size(), 2u);
 }
 

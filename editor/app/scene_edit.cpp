@@ -127,12 +127,9 @@ std::string fieldPath(const ComponentInfo& component, std::string_view key) {
     return out;
 }
 
-/// A component finish() message ("FIELD: why" or ": why") as "component.field: why".
-std::string finishMessage(const ComponentInfo& component, const std::string& why) {
-    const auto colon = why.find(':');
-    const std::string key = colon == std::string::npos ? std::string() : why.substr(0, colon);
-    const std::string rest = colon == std::string::npos ? why : why.substr(std::min(why.size(), colon + 2));
-    return fieldPath(component, key) + ": " + rest;
+/// A component finish() refusal as "component.field: why".
+std::string finishMessage(const ComponentInfo& component, const Error& why) {
+    return fieldPath(component, why.where) + ": " + why.message;
 }
 
 } // namespace
@@ -167,7 +164,7 @@ std::optional<Error> checkEdited(Scene& scene, const std::vector<Entity>& entiti
                     return Error{"\"" + displayName(reg, e) + "\" " + fieldPath(info, f.key) + why->message.substr(f.key.size())};
             if (info.finish)
                 if (std::optional<Error> why = info.finish(c))
-                    return Error{"\"" + displayName(reg, e) + "\" " + finishMessage(info, why->message)};
+                    return Error{"\"" + displayName(reg, e) + "\" " + finishMessage(info, *why)};
         }
     }
     if (std::optional<Error> problem = checkSceneRelations(scene)) return Error{describeRefusal(scene, problem->message, context)};
@@ -516,16 +513,16 @@ std::vector<Vec2> regularPolygon(int sides, double radius, double angle) {
 Entity addPolygon(Scene& scene, const std::vector<Vec2>& worldVertices, std::string* problem) {
     // The position is the centroid, so the centre of mass is the position
     // and the outline is stored about it.
-    if (std::string why = polygonProblem(worldVertices); !why.empty()) {
-        if (problem) *problem = "polygon" + why.substr(why.find(':'));
+    if (std::optional<Error> why = polygonProblem(worldVertices)) {
+        if (problem) *problem = "polygon: " + why->message;
         return {};
     }
     const Vec2 centroid = polygonMassProperties(worldVertices).centroid;
     Polygon poly;
     poly.vertices.clear();
     for (const Vec2 v : worldVertices) poly.vertices.push_back(v - centroid);
-    if (std::string why = polygonProblem(poly.vertices); !why.empty()) {  // rounding can merge tiny edges
-        if (problem) *problem = "polygon" + why.substr(why.find(':'));
+    if (std::optional<Error> why = polygonProblem(poly.vertices)) {  // rounding can merge tiny edges
+        if (problem) *problem = "polygon: " + why->message;
         return {};
     }
     const Entity e = newBody(scene, "polygon", centroid, Rgb{0.62, 0.55, 0.95});

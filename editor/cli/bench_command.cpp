@@ -60,8 +60,8 @@ void addHardCasesCommand(CLI::App& bench, int& exitCode) {
         std::vector<OutputFile> outputs;
         for (const char* name : {"hard_cases.csv", "hard_cases.md", "hard_cases.png"})
             outputs.push_back({"--out", (std::filesystem::path(options->out) / name).string()});
-        if (std::string problem = checkOutputs({}, outputs); !problem.empty()) {
-            std::cerr << problem << "\n";
+        if (Result<void> checked = checkOutputs({}, outputs); !checked) {
+            reportOutputProblem(checked.failure());
             exitCode = kExitBadInput;
             return;
         }
@@ -122,8 +122,8 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
         std::vector<OutputFile> outputs;
         for (const char* name : {"accuracy.csv", "accuracy.md", "accuracy.png"})
             outputs.push_back({"--out", (options->out / name).string()});
-        if (std::string problem = checkOutputs({}, outputs); !problem.empty()) {
-            std::cerr << problem << "\n";
+        if (Result<void> checked = checkOutputs({}, outputs); !checked) {
+            reportOutputProblem(checked.failure());
             exitCode = kExitBadInput;
             return;
         }

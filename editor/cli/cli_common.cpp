@@ -61,7 +61,7 @@ bool fileIdentity(const std::string& path, std::tuple<dev_t, ino_t, std::string>
 
 } // namespace
 
-std::string checkOutputs(const std::vector<std::string>& inputs, const std::vector<OutputFile>& outputs) {
+Result<void> checkOutputs(const std::vector<std::string>& inputs, const std::vector<OutputFile>& outputs) {
     using Identity = std::tuple<dev_t, ino_t, std::string>;
     std::vector<std::pair<Identity, std::string>> inputIds;
     for (const std::string& in : inputs) {
@@ -71,21 +71,27 @@ std::string checkOutputs(const std::vector<std::string>& inputs, const std::vect
     std::vector<std::pair<Identity, const OutputFile*>> seen;
     for (const OutputFile& out : outputs) {
         // The saver's own message, as a failed save prints it.
-        if (std::string problem = checkWritableTarget(out.path); !problem.empty()) return problem;
+        if (std::string problem = checkWritableTarget(out.path); !problem.empty())
+            return Error{problem, "", ErrorKind::Io};
         Identity id;
         if (!fileIdentity(out.path, id)) continue;  // checkWritableTarget said why already
         for (const auto& [inputId, name] : inputIds)
             if (inputId == id)
-                return "stepwise: error: " + out.option + ": " + out.path + " is the input " + name +
-                       "; refusing to replace it (give the output another name)";
+                return Error{out.path + " is the input " + name + "; refusing to replace it (give the output another name)",
+                             out.option};
         for (const auto& [otherId, other] : seen)
             if (otherId == id)
-                return "stepwise: error: " + out.option + ": " + out.path + " is the same file as " + other->option + " " +
-                       other->path +
-                       "; give each output its own file";
+                return Error{out.path + " is the same file as " + other->option + " " + other->path +
+                                 "; give each output its own file",
+                             out.option};
         seen.emplace_back(id, &out);
     }
     return {};
+}
+
+void reportOutputProblem(const Error& problem) {
+    if (problem.kind == ErrorKind::Io) std::cerr << problem.message << "\n";
+    else reportError(problem.text());
 }
 
 } // namespace stepwise::cli

@@ -1,6 +1,7 @@
 #pragma once
 // Helpers shared by the subcommands.
 
+#include "stepwise/result.hpp"
 #include "stepwise/scene.hpp"
 
 #include <optional>
@@ -31,9 +32,14 @@ struct OutputFile {
 /// written (checkWritableTarget), none is one of `inputs` and no two are the
 /// same file. Files are compared by identity (device and inode; for a file
 /// not yet there, its folder's identity and its name), not by spelling:
-/// "t.csv", "./t.csv" and a hard link are the same file. Returns "" or the
-/// line to print on stderr ("PATH: error: cannot write: REASON", as a
-/// failed save prints it, or "stepwise: error: --trace: ...").
-std::string checkOutputs(const std::vector<std::string>& inputs, const std::vector<OutputFile>& outputs);
+/// "t.csv", "./t.csv" and a hard link are the same file. A file that cannot
+/// be written fails with kind Io; a clash with the input or another output
+/// with kind BadInput, `where` the option.
+Result<void> checkOutputs(const std::vector<std::string>& inputs, const std::vector<OutputFile>& outputs);
+
+/// Prints a checkOutputs refusal on stderr: a file that cannot be written as
+/// a failed save prints it ("PATH: error: cannot write: REASON", kind Io),
+/// an output that clashes with another as "stepwise: error: OPTION: ...".
+void reportOutputProblem(const Error& problem);
 
 } // namespace stepwise::cli

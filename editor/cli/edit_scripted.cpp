@@ -102,8 +102,8 @@ int runScripted(const EditOptions& o, int width, int height) {
         // Every output before the first frame: writable (the saver's own
         // check, so a read-only or missing target is refused up front),
         // not an input, not another output.
-        if (std::string problem = checkOutputs(inputs, outputs); !problem.empty()) {
-            std::cerr << problem << "\n";
+        if (Result<void> checked = checkOutputs(inputs, outputs); !checked) {
+            reportOutputProblem(checked.failure());
             return kExitBadInput;
         }
     }

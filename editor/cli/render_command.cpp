@@ -129,9 +129,10 @@ int render(const RenderOptions& o) {
         // Every frame's file before any step: writable, not the level.
         std::vector<OutputFile> outputs;
         for (int frame = 0; frame < o.frames; ++frame) outputs.push_back({"--out", frameName(o.out, frame, o.frames)});
-        if (std::string problem = checkOutputs({o.level}, outputs); !problem.empty()) {
-            if (problem.rfind("stepwise: error: ", 0) == 0) std::cerr << problem << "\n";
-            else reportError("--out: " + problem);
+        if (Result<void> checked = checkOutputs({o.level}, outputs); !checked) {
+            // A frame that cannot be written is named as --out's.
+            if (checked.failure().kind == ErrorKind::Io) reportError("--out: " + checked.failure().message);
+            else reportOutputProblem(checked.failure());
             return kExitBadInput;
         }
     }
@@ -174,7 +175,8 @@ int render(const RenderOptions& o) {
     Result<std::unique_ptr<render::OffscreenRenderer>> offscreen = render::OffscreenRenderer::create(o.width, o.height);
     if (!offscreen) {
         reportError(offscreen.error());
-        return offscreen.error().find("image size") != std::string::npos ? kExitBadInput : kExitFailure;
+        // A size the user gave is bad input; a machine without the context is not.
+        return offscreen.failure().kind == ErrorKind::BadInput ? kExitBadInput : kExitFailure;
     }
     render::OffscreenRenderer& headless = **offscreen;
 

@@ -163,8 +163,8 @@ int run(const RunOptions& options) {
     if (options.out) outputs.push_back({"--out", *options.out});
     if (options.trace) outputs.push_back({"--trace", *options.trace});
     if (options.contacts) outputs.push_back({"--contacts", *options.contacts});
-    if (std::string problem = checkOutputs({options.level}, outputs); !problem.empty()) {
-        std::cerr << problem << "\n";
+    if (Result<void> checked = checkOutputs({options.level}, outputs); !checked) {
+        reportOutputProblem(checked.failure());
         return kExitBadInput;
     }
     for (std::string problem : {checkOutputSpace(options.trace, "--trace", options.steps, kMinTraceRowBytes),

@@ -61,7 +61,7 @@ std::optional<Error> finishPlane(void* component) {
     // hypot, not sqrt(x*x + y*y): a normal of 1e200 would overflow to inf
     // and normalise to (0, 0).
     const double len = std::hypot(plane.normal.x, plane.normal.y);
-    if (!(len > 1e-12)) return Error{"normal: expected a non-zero vector, got {\"x\": 0, \"y\": 0}"};
+    if (!(len > 1e-12)) return Error{"expected a non-zero vector, got {\"x\": 0, \"y\": 0}", "normal"};
     // A normal that is already unit length up to rounding is kept bit for
     // bit. Dividing it by its own rounded length would move its last bits on
     // every load, so load -> save -> load -> save would not give the same
@@ -71,8 +71,9 @@ std::optional<Error> finishPlane(void* component) {
     // same half-plane after normalising n by scaling d with it.
     const double offset = plane.offset / len;
     if (!std::isfinite(offset))
-        return Error{"offset: expected an offset that stays finite once the normal is normalised (offset / |normal|), "
-               "got " + describeNumber(plane.offset) + " with |normal| = " + describeNumber(len)};
+        return Error{"expected an offset that stays finite once the normal is normalised (offset / |normal|), got " +
+                         describeNumber(plane.offset) + " with |normal| = " + describeNumber(len),
+                     "offset"};
     plane.normal = plane.normal / len;
     plane.offset = offset;
     return {};
@@ -85,24 +86,23 @@ constexpr double kMaxSpeed = 1e150;
 std::optional<Error> finishVelocity(void* component) {
     const Vec2 v = static_cast<Velocity*>(component)->value;
     if (std::abs(v.x) > kMaxSpeed || std::abs(v.y) > kMaxSpeed)
-        return Error{": expected a speed up to 1e150 m/s in each axis (beyond it the kinetic energy m*v^2/2 overflows), "
+        return Error{"expected a speed up to 1e150 m/s in each axis (beyond it the kinetic energy m*v^2/2 overflows), "
                "got {\"x\": " + describeNumber(v.x) + ", \"y\": " + describeNumber(v.y) + "}"};
     return {};
 }
 
 std::optional<Error> finishPolygon(void* component) {
-    const std::string problem = polygonProblem(static_cast<Polygon*>(component)->vertices);
-    if (problem.empty()) return {};
-    // polygonProblem says "INDEX: why" or ": why"; the field is "vertices".
-    return Error{problem[0] == ':' ? "vertices" + problem : "vertices/" + problem};
+    std::optional<Error> problem = polygonProblem(static_cast<Polygon*>(component)->vertices);
+    if (!problem) return {};
+    return problem->within("vertices");
 }
 
 std::optional<Error> finishSpring(void* component) {
     auto& spring = *static_cast<Spring*>(component);
-    if (spring.a.isNull()) return Error{"a: expected the name of an entity, got nothing"};
+    if (spring.a.isNull()) return Error{"expected the name of an entity, got nothing", "a"};
     if (spring.b.isNull() == !spring.anchor.has_value()) {
-        return Error{spring.b.isNull() ? ": expected either \"b\" (an entity name) or \"anchor\" (a point), got neither"
-                                 : ": expected either \"b\" or \"anchor\", got both"};
+        return Error{spring.b.isNull() ? "expected either \"b\" (an entity name) or \"anchor\" (a point), got neither"
+                                       : "expected either \"b\" or \"anchor\", got both"};
     }
     // a == b is checked with the names at hand: checkSceneRelations.
     return {};
@@ -113,23 +113,25 @@ constexpr std::string_view kJointTypes[] = {"hinge", "slider", "weld", "distance
 std::optional<Error> finishJoint(void* component) {
     auto& joint = *static_cast<Joint*>(component);
     if (joint.type.empty())
-        return Error{"type: expected one of hinge, slider, weld, distance, rope, got nothing"};
+        return Error{"expected one of hinge, slider, weld, distance, rope, got nothing", "type"};
     if (std::find(std::begin(kJointTypes), std::end(kJointTypes), joint.type) == std::end(kJointTypes)) {
-        std::string message = "type: expected one of hinge, slider, weld, distance, rope, got \"" + joint.type + "\"";
+        std::string message = "expected one of hinge, slider, weld, distance, rope, got \"" + joint.type + "\"";
         if (auto guess = closestName(joint.type, kJointTypes)) message += "; did you mean \"" + std::string(*guess) + "\"?";
-        return Error{message};
+        return Error{message, "type"};
     }
-    if (joint.a.isNull()) return Error{"a: expected the name of a body, got nothing"};
+    if (joint.a.isNull()) return Error{"expected the name of a body, got nothing", "a"};
     if (joint.lower && joint.upper && *joint.lower > *joint.upper)
-        return Error{"lower: expected at most upper (" + describeNumber(*joint.upper) + "), got " + describeNumber(*joint.lower)};
+        return Error{"expected at most upper (" + describeNumber(*joint.upper) + "), got " + describeNumber(*joint.lower),
+                     "lower"};
     return {};
 }
 
 std::optional<Error> finishBoid(void* component) {
     auto& boid = *static_cast<Boid*>(component);
     if (boid.separationRadius > boid.neighborRadius)
-        return Error{"separation_radius: expected at most neighbor_radius (" +
-               std::to_string(boid.neighborRadius) + "), got " + std::to_string(boid.separationRadius)};
+        return Error{"expected at most neighbor_radius (" + std::to_string(boid.neighborRadius) + "), got " +
+                         std::to_string(boid.separationRadius),
+                     "separation_radius"};
     return {};
 }
 

@@ -19,11 +19,11 @@ std::string pointText(Vec2 p) {
 
 } // namespace
 
-std::string polygonProblem(const std::vector<Vec2>& v) {
+std::optional<Error> polygonProblem(const std::vector<Vec2>& v) {
     const std::size_t n = v.size();
-    if (n < 3 || n > 8) return ": expected 3 to 8 vertices, got " + std::to_string(n);
+    if (n < 3 || n > 8) return Error{"expected 3 to 8 vertices, got " + std::to_string(n)};
     for (const Vec2& p : v)
-        if (!isFinite(p)) return ": expected finite vertices";
+        if (!isFinite(p)) return Error{"expected finite vertices"};
     // Tolerances are relative to the polygon's size, so a 1 mm triangle and a
     // 1 km one are judged alike. extent: the largest coordinate span, metres.
     Vec2 lo = v[0], hi = v[0];
@@ -38,8 +38,9 @@ std::string polygonProblem(const std::vector<Vec2>& v) {
     for (std::size_t j = 1; j < n; ++j)
         for (std::size_t i = 0; i < j; ++i)
             if (length(v[j] - v[i]) <= samePoint)
-                return std::to_string(j) + ": vertex " + std::to_string(j) + " " + pointText(v[j]) +
-                       " is the same point as vertex " + std::to_string(i) + "; a polygon needs distinct vertices";
+                return Error{"vertex " + std::to_string(j) + " " + pointText(v[j]) + " is the same point as vertex " +
+                                 std::to_string(i) + "; a polygon needs distinct vertices",
+                             std::to_string(j)};
     // All on one line: no area, so no mass distribution and no inside.
     std::size_t far = 1;
     for (std::size_t k = 2; k < n; ++k)
@@ -47,22 +48,24 @@ std::string polygonProblem(const std::vector<Vec2>& v) {
     const Vec2 axis = v[far] - v[0];
     double offLine = 0.0;
     for (const Vec2& p : v) offLine = std::max(offLine, std::abs(cross(axis, p - v[0])) / length(axis));
-    if (offLine <= 1e-9 * extent) return ": the vertices lie on one line, so the polygon has no area";
+    if (offLine <= 1e-9 * extent) return Error{"the vertices lie on one line, so the polygon has no area"};
     double twiceArea = 0.0;
     for (std::size_t i = 1; i + 1 < n; ++i) twiceArea += cross(v[i] - v[0], v[i + 1] - v[0]);
     if (twiceArea < 0.0)
-        return ": the vertices run clockwise; list them counter-clockwise (reverse the list)";
+        return Error{"the vertices run clockwise; list them counter-clockwise (reverse the list)"};
     // Each corner must turn left: sin of the turn below 1e-9 is a straight
     // corner (a vertex on the line between its neighbours), negative a dent.
     for (std::size_t i = 0; i < n; ++i) {
         const Vec2 before = v[i] - v[(i + n - 1) % n], after = v[(i + 1) % n] - v[i];
         const double turn = cross(before, after);
         if (std::abs(turn) <= 1e-9 * length(before) * length(after))
-            return std::to_string(i) + ": vertex " + std::to_string(i) + " " + pointText(v[i]) +
-                   " lies on the straight line between its neighbours; remove it";
+            return Error{"vertex " + std::to_string(i) + " " + pointText(v[i]) +
+                             " lies on the straight line between its neighbours; remove it",
+                         std::to_string(i)};
         if (turn < 0.0)
-            return std::to_string(i) + ": not convex: the outline turns clockwise at vertex " + std::to_string(i) +
-                   " " + pointText(v[i]) + "; a polygon shape must be convex (split the shape into convex pieces)";
+            return Error{"not convex: the outline turns clockwise at vertex " + std::to_string(i) + " " +
+                             pointText(v[i]) + "; a polygon shape must be convex (split the shape into convex pieces)",
+                         std::to_string(i)};
     }
     // Left turns everywhere but wound round more than once (a star drawn
     // without lifting the pen): some vertex lies outside some edge.
@@ -71,8 +74,9 @@ std::string polygonProblem(const std::vector<Vec2>& v) {
         for (std::size_t k = 0; k < n; ++k) {
             if (k == i || k == (i + 1) % n) continue;
             if (cross(edge, v[k] - a) <= 0.0)
-                return std::to_string(k) + ": not convex: the outline crosses itself (vertex " + std::to_string(k) +
-                       " is not inside edge " + std::to_string(i) + "-" + std::to_string((i + 1) % n) + ")";
+                return Error{"not convex: the outline crosses itself (vertex " + std::to_string(k) +
+                                 " is not inside edge " + std::to_string(i) + "-" + std::to_string((i + 1) % n) + ")",
+                             std::to_string(k)};
         }
     }
     return {};

@@ -290,16 +290,14 @@ void readComponent(const ComponentInfo& info, const Json& value, Registry& regis
     }
     if (info.finish) {
         if (const std::optional<Error> refused = info.finish(component)) {
-            const std::string& problem = refused->message;
-            const auto colon = problem.find(':');
-            // WHERE may go deeper than one field ("vertices/3").
+            // `where` may go deeper than one field ("vertices/3").
             std::string at = pointer;
-            for (std::size_t from = 0; from < colon;) {
-                const std::size_t slash = std::min(problem.find('/', from), colon);
-                at = child(at, problem.substr(from, slash - from));
+            for (std::size_t from = 0; from < refused->where.size();) {
+                const std::size_t slash = std::min(refused->where.find('/', from), refused->where.size());
+                at = child(at, refused->where.substr(from, slash - from));
                 from = slash + 1;
             }
-            refuse(at, (info.finishNamesEntity ? entity + ": " : std::string()) + problem.substr(colon + 2));
+            refuse(at, (info.finishNamesEntity ? entity + ": " : std::string()) + refused->message);
         }
     }
 }

@@ -10,6 +10,7 @@
 /// the collision stages.
 
 #include "stepwise/entity.hpp"
+#include "stepwise/result.hpp"
 #include "stepwise/vec2.hpp"
 
 #include <optional>
@@ -47,10 +48,10 @@ struct Polygon {
     std::vector<Vec2> vertices{{-0.5, -0.25}, {0.5, -0.25}, {0.0, 0.5}};
 };
 
-/// "" when `vertices` is a valid polygon shape, else why not, as
-/// "INDEX: message" (INDEX the offending vertex, or empty for the whole
-/// list). The loader, the world and the editor all ask this one function.
-std::string polygonProblem(const std::vector<Vec2>& vertices);
+/// Nothing when `vertices` is a valid polygon shape, else why not; the
+/// error's `where` is the offending vertex's index, or empty for the whole
+/// list. The loader, the world and the editor all ask this one function.
+std::optional<Error> polygonProblem(const std::vector<Vec2>& vertices);
 
 /// Area (m^2), centroid (metres, in the vertices' frame) and the second
 /// moment of area about the centroid (m^4) of a valid polygon. Moment of

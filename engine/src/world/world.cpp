@@ -351,11 +351,10 @@ Result<World> World::build(const Scene& scene) {
     for (std::size_t i = 0; i < order.size(); ++i) {
         const Polygon* poly = reg.tryGet<Polygon>(order[i]);
         if (!poly) continue;
-        if (std::string problem = polygonProblem(poly->vertices); !problem.empty()) {
+        if (std::optional<Error> problem = polygonProblem(poly->vertices)) {
             const Name* pname = reg.tryGet<Name>(order[i]);
-            const auto colon = problem.find(':');
-            return Error{entityLabel(i, pname ? &pname->value : nullptr) + ": polygon.vertices" +
-                         (colon == 0 ? "" : "[" + problem.substr(0, colon) + "]") + problem.substr(colon)};
+            return Error{problem->message, entityLabel(i, pname ? &pname->value : nullptr) + ": polygon.vertices" +
+                                               (problem->where.empty() ? "" : "[" + problem->where + "]")};
         }
     }
 
