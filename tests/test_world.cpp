@@ -5,6 +5,7 @@
 #include "physics_scenes.hpp"
 
 #include "stepwise/scene_io.hpp"
+#include "stepwise/world_fields.hpp"
 #include "world/world_internals.hpp"
 
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -108,6 +110,39 @@ TEST(World, CollisionStagesRunOnlyWhenTheSceneHasShapes) {
     w->writeBack(after);
     EXPECT_NEAR(after.registry.tryGet<Position>(ball)->value.y, 0.5, 0.01);
     EXPECT_NEAR(after.registry.tryGet<Position>(ball)->value.x, 0.0, 1e-12);
+}
+
+// A scene made in code is held to the settings table's ranges, in the
+// words the loader writes after /world/KEY (WorldFields.
+// EveryOutOfRangeSettingIsRefusedAtItsPointer): one check, not two. A cap
+// that guards input only is not held against it.
+TEST(World, EveryOutOfRangeSettingIsRefusedWithTheTablesWords) {
+    for (const WorldFieldInfo& info : worldFieldTable()) {
+        const NumberRange& r = info.field.range;
+        if (!std::isfinite(r.max)) continue;
+        const std::string key(info.field.key);
+        Scene s = emptyScene("semi_implicit_euler", 1.0 / 60.0, {0.0, -9.81});
+        void* member = info.field.address(&s.world);
+        switch (info.field.kind) {
+        case FieldKind::Number: *static_cast<double*>(member) = r.max + 1; break;
+        case FieldKind::OptionalNumber: *static_cast<std::optional<double>*>(member) = r.max + 1; break;
+        case FieldKind::Integer: *static_cast<int*>(member) = int(r.max + 1); break;
+        default: FAIL() << key << ": a bounded setting of another kind";
+        }
+        Result<World> w = World::build(s);
+        if (info.maxGuardsInputOnly) {
+            EXPECT_TRUE(w) << key << ": " << w.error();
+            continue;
+        }
+        ASSERT_FALSE(w) << key;
+        EXPECT_EQ(w.error(), "world." + key + ": expected " + r.describe(info.field.kind == FieldKind::Integer) +
+                                 ", got " + formatNumber(r.max + 1));
+    }
+    Scene s = emptyScene("semi_implicit_euler", 1.0 / 60.0, {0.0, -9.81});
+    s.world.integrator = "rk5";
+    Result<World> w = World::build(s);
+    ASSERT_FALSE(w);
+    EXPECT_EQ(w.error().rfind("world.integrator: expected one of explicit_euler, ", 0), 0u) << w.error();
 }
 
 TEST(World, DivergenceNamesStepEntityAndQuantityAndKeepsState) {

@@ -6,6 +6,8 @@
 
 #include "field_builder.hpp"
 
+#include <limits>
+
 
 namespace stepwise {
 
@@ -19,11 +21,16 @@ std::vector<WorldFieldInfo> buildTable() {
     integrator.choices = integratorNames();
     // Ranges: dt up to 10 s and counts up to 1000 are far past any useful
     // level; they only keep a typo (dt 1e9, 1e9 substeps) from freezing a run.
+    // Two of those caps hold for input only (maxGuardsInputOnly): a scene made
+    // in code may step longer (implicit methods are tested at dt = 100 s), and
+    // dopri5 proposes up to five times its step, which a World takes back
+    // when it is reloaded.
     return {
         {makeField<&WorldSettings::gravity>("gravity", {}, "m/s^2", "applied to every dynamic body")},
         {makeField<&WorldSettings::G>("G", {}, "N*m^2/kg^2", "gravitational constant for attractors")},
         {integrator},
-        {makeField<&WorldSettings::dt>("dt", {0.0, 10.0, true}, "s", "seconds per step")},
+        {.field = makeField<&WorldSettings::dt>("dt", {0.0, 10.0, true}, "s", "seconds per step"),
+         .maxGuardsInputOnly = true},
         {makeField<&WorldSettings::substeps>("substeps", {1.0, 1000.0}, "",
                                              "each step is substeps steps of dt/substeps; absent: chosen from "
                                              "the scene's structure (its pile, load and joints) and recorded "
@@ -43,10 +50,11 @@ std::vector<WorldFieldInfo> buildTable() {
         {makeField<&WorldSettings::theta>("theta", {0.0, 1.0}, "",
                                           "Barnes-Hut opening angle for attractors; 0 = exact pairwise sums, larger is faster "
                                           "and less exact (small scenes are summed exactly whatever theta says)")},
-        {makeField<&WorldSettings::adaptiveStep>("adaptive_step", {0.0, 10.0}, "s",
-                                                 "dopri5's proposed next internal step, saved for exact resume; "
-                                                 "absent: none yet"),
-         true},
+        {.field = makeField<&WorldSettings::adaptiveStep>("adaptive_step", {0.0, 10.0}, "s",
+                                                          "dopri5's proposed next internal step, saved for exact "
+                                                          "resume; absent: none yet"),
+         .optional = true,
+         .maxGuardsInputOnly = true},
         {makeField<&WorldSettings::sleep>("sleep", {}, "",
                                           "islands of bodies that stay still for sleep_time sleep (cost nothing) "
                                           "until touched or edited")},
@@ -92,6 +100,18 @@ std::vector<std::string_view> worldFieldNames() {
     std::vector<std::string_view> names;
     for (const WorldFieldInfo& info : worldFieldTable()) names.push_back(info.field.key);
     return names;
+}
+
+std::optional<Error> worldSettingsProblem(const WorldSettings& settings) {
+    for (const WorldFieldInfo& info : worldFieldTable()) {
+        if (info.isUnset(settings)) continue;
+        FieldInfo field = info.field;
+        if (info.maxGuardsInputOnly) field.range.max = std::numeric_limits<double>::infinity();
+        const void* member = field.address(const_cast<WorldSettings*>(&settings));
+        if (std::optional<std::string> problem = fieldValueProblem(field, member))
+            return Error{"world." + std::string(field.key) + ": " + *problem};
+    }
+    return std::nullopt;
 }
 
 } // namespace stepwise

@@ -9,8 +9,10 @@
 /// `address`, so it is written in one place.
 
 #include "stepwise/component_table.hpp"
+#include "stepwise/result.hpp"
 #include "stepwise/scene.hpp"
 
+#include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -27,6 +29,11 @@ struct WorldFieldInfo {
     /// value must be in `field.range`. OptionalNumber fields are optional by
     /// their kind (nullopt = not given).
     bool optional = false;
+    /// The range's max only keeps a typo in a file or an edit (dt 1e9) from
+    /// freezing a run: the loader and the World panel hold to it, but a
+    /// scene made in code may go past it (worldSettingsProblem checks the
+    /// rest of the range).
+    bool maxGuardsInputOnly = false;
 
     /// True when `settings` holds "not given" for an optional field.
     bool isUnset(const WorldSettings& settings) const;
@@ -40,5 +47,13 @@ const WorldFieldInfo* findWorldField(std::string_view key);
 
 /// Every key, in table order.
 std::vector<std::string_view> worldFieldNames();
+
+/// The first setting, in table order, whose value its row refuses
+/// (fieldValueProblem), as "world.KEY: expected ..., got ..." (the words the
+/// loader writes after /world/KEY and the World panel after "world."), or
+/// nothing. Optional settings left unset are not checked, nor the max of a
+/// row that guards input only. World::build checks with it, so a scene made
+/// in code is held to the file's ranges but for those caps.
+std::optional<Error> worldSettingsProblem(const WorldSettings& settings);
 
 } // namespace stepwise

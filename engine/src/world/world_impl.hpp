@@ -15,6 +15,12 @@
 
 namespace stepwise {
 
+namespace detail {
+/// "entity 3", or "entity 3 (\"ball\")" when it has a name: how the World's
+/// messages name an entity, by its place in the scene's order.
+std::string entityLabel(std::size_t index, const std::string* name);
+} // namespace detail
+
 class WorldImpl {
 public:
     WorldSettings settings;
