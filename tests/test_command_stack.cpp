@@ -48,6 +48,78 @@ TEST(CommandStack, EditThatChangesNothingIsNotRecorded) {
     EXPECT_FALSE(stack.canUndo());
 }
 
+// The stack records what an edit reaches, not a copy of the scene: an edit
+// that gives up after creating, changing and destroying entities leaves the
+// scene and its handles as they were.
+TEST(CommandStack, AnEditThatGivesUpLeavesNoTrace) {
+    Fixture f("pile.json");
+    Scene& scene = f.ed.doc.scene;
+    const std::string original = textOf(scene);
+    const Registry::Slots slots = scene.registry.slots();
+    const std::vector<Entity> before = scene.registry.entities();
+    ASSERT_GE(before.size(), 3u);
+    CommandStack stack;
+    EXPECT_FALSE(stack.apply(scene, "give up", [&](Scene& s) {
+        addCircle(s, {1.0, 2.0}, 0.5);
+        s.registry.tryGet<Position>(before[0])->value.x += 3.0;
+        (void)s.registry.destroy(before[1]);
+        s.registry.reorder(before[2], 0);
+        s.world.G = 7.0;
+        return false;
+    }));
+    EXPECT_EQ(textOf(scene), original);
+    EXPECT_TRUE(scene.registry.slots() == slots) << "the same handles, free list and order";
+    EXPECT_FALSE(stack.canUndo());
+
+}
+
+TEST(CommandStack, AnEditKeepsOnlyTheEntitiesWhoseComponentsChanged) {
+    Fixture f("pile.json");
+    Scene& scene = f.ed.doc.scene;
+    const std::string original = textOf(scene);
+    const std::vector<Entity> all = scene.registry.entities();
+    ASSERT_GE(all.size(), 2000u);
+    CommandStack stack;
+    // Every body reached through a mutable pointer, one written: the record
+    // holds that body (about 1 KiB with the command's own fields); one of
+    // every body reached would be 2,000 x 2 encodings, over 100 KiB.
+    ASSERT_TRUE(stack.apply(scene, "move one", [&](Scene& s) {
+        for (Entity e : all)
+            if (Position* p = s.registry.tryGet<Position>(e); p && e == all[1]) p->value.y += 1.5;
+        return true;
+    }));
+    EXPECT_LT(stack.bytes(), 4096u);
+    const std::string moved = textOf(scene);
+    EXPECT_NE(moved, original);
+    EXPECT_FALSE(stack.undo(scene).empty());
+    EXPECT_EQ(textOf(scene), original);
+    EXPECT_FALSE(stack.redo(scene).empty());
+    EXPECT_EQ(textOf(scene), moved);
+}
+
+// Replacing the whole scene (recover unsaved changes) is one undoable step
+// like any other.
+TEST(CommandStack, ReplacingTheWholeSceneUndoesToTheSameBytesAndHandles) {
+    Fixture f("course_notes.json");
+    Scene& scene = f.ed.doc.scene;
+    const std::string original = textOf(scene);
+    const Registry::Slots slots = scene.registry.slots();
+    Scene other;
+    addCircle(other, {4.0, 5.0}, 0.25);
+    const std::string replaced = textOf(other);
+    CommandStack stack;
+    ASSERT_TRUE(stack.apply(scene, "replace", [&](Scene& s) {
+        s = other;
+        return true;
+    }));
+    EXPECT_EQ(textOf(scene), replaced);
+    (void)stack.undo(scene);
+    EXPECT_EQ(textOf(scene), original);
+    EXPECT_TRUE(scene.registry.slots() == slots);
+    (void)stack.redo(scene);
+    EXPECT_EQ(textOf(scene), replaced);
+}
+
 TEST(CommandStack, CapacityDropsOldest) {
     Scene s;
     CommandStack stack(3);

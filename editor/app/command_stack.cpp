@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <unordered_set>
 
 namespace stepwise::editor {
 
@@ -133,6 +134,60 @@ void compose(std::optional<std::pair<T, T>>& earlier, const std::optional<std::p
     else earlier = later;
 }
 
+/// Whether `e` is alive in a slot table taken earlier.
+bool aliveIn(const Registry::Slots& slots, Entity e) {
+    return e.index < slots.generations.size() && slots.alive[e.index] && slots.generations[e.index] == e.generation;
+}
+
+/// Keeps, while one edit runs, each entity's components as they were when
+/// the edit first reached for them, and the slot table before its first
+/// change: what the undo record needs, and all that is copied. An edit that
+/// moves one body of a large level costs that body, not the level.
+class EditJournal final : public RegistryObserver {
+public:
+    explicit EditJournal(Registry& registry) : registry_(registry) { registry_.setObserver(this); }
+    ~EditJournal() { registry_.setObserver(nullptr); }
+    EditJournal(const EditJournal&) = delete;
+    EditJournal& operator=(const EditJournal&) = delete;
+
+    void beforeEntityChange(const Registry& registry, Entity e) override {
+        if (!seen_.insert(key(e)).second) return;
+        // Created during this edit: it was not there before.
+        const bool existed = !slots_ || aliveIn(*slots_, e);
+        changes_.push_back({e, existed ? encodeEntity(registry, e) : std::string(), {}});
+    }
+    void beforeSlotsChange(const Registry& registry) override {
+        if (!slots_) slots_ = registry.slots();
+    }
+
+    /// What the edit changed: the entities whose components differ now, and
+    /// the slot table if it does. Ends the journal's watch.
+    CommandStack::Delta finish() {
+        registry_.setObserver(nullptr);
+        CommandStack::Delta d;
+        for (CommandStack::Delta::EntityChange& c : changes_) {
+            c.after = encodeEntity(registry_, c.entity);
+            if (c.before != c.after) d.entities.push_back(std::move(c));
+        }
+        if (slots_) {
+            Registry::Slots now = registry_.slots();
+            // Created and never touched (no components): still a change.
+            for (const Entity e : now.order)
+                if (!aliveIn(*slots_, e) && !seen_.count(key(e))) d.entities.push_back({e, std::string(), encodeEntity(registry_, e)});
+            if (!(now == *slots_)) d.slots.emplace(std::move(*slots_), std::move(now));
+        }
+        d.entities.shrink_to_fit();
+        return d;
+    }
+
+private:
+    static std::uint64_t key(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
+    Registry& registry_;
+    std::unordered_set<std::uint64_t> seen_;
+    std::vector<CommandStack::Delta::EntityChange> changes_;
+    std::optional<Registry::Slots> slots_;
+};
+
 } // namespace
 
 std::size_t CommandStack::Delta::bytes() const {
@@ -147,26 +202,6 @@ std::size_t CommandStack::Delta::bytes() const {
         for (const std::optional<SolverState>* s : {&solver->first, &solver->second})
             if (*s) n += (*s)->contacts.capacity() * sizeof(ContactImpulse) + (*s)->joints.capacity() * sizeof(JointImpulse);
     return n;
-}
-
-CommandStack::Delta CommandStack::diff(const Scene& before, const Scene& after) {
-    Delta d;
-    const Registry& b = before.registry;
-    const Registry& a = after.registry;
-    Registry::Slots slotsBefore = b.slots(), slotsAfter = a.slots();
-    if (!(slotsBefore == slotsAfter)) d.slots.emplace(std::move(slotsBefore), std::move(slotsAfter));
-    for (const Entity e : b.entities()) {
-        std::string was = encodeEntity(b, e), now = encodeEntity(a, e);
-        if (was != now) d.entities.push_back({e, std::move(was), std::move(now)});
-    }
-    for (const Entity e : a.entities())
-        if (!b.alive(e)) d.entities.push_back({e, std::string(), encodeEntity(a, e)});
-    d.entities.shrink_to_fit();
-    setIfChanged(d.world, before.world, after.world);
-    setIfChanged(d.view, before.view, after.view);
-    setIfChanged(d.solver, before.solverState, after.solverState);
-    setIfChanged(d.version, before.version, after.version);
-    return d;
 }
 
 void CommandStack::apply(Scene& scene, const Delta& d, bool forward) {
@@ -187,12 +222,23 @@ bool CommandStack::apply(Scene& scene, std::string label, const std::function<bo
                          std::uint64_t mergeKey) {
     const bool merging = open_ && mergeKey != 0 && cursor_ == commands_.size() && cursor_ > 0 &&
                          commands_[cursor_ - 1].mergeKey == mergeKey;
-    Scene before = scene;
-    if (!edit(scene)) {
-        scene = std::move(before);  // an edit that gave up must leave no trace
+    // The scene's small parts are copied whole; its entities only as the
+    // edit reaches them (EditJournal).
+    const WorldSettings worldBefore = scene.world;
+    const std::optional<View> viewBefore = scene.view;
+    const std::optional<SolverState> solverBefore = scene.solverState;
+    const int versionBefore = scene.version;
+    EditJournal journal(scene.registry);
+    const bool kept = edit(scene);
+    Delta change = journal.finish();
+    setIfChanged(change.world, worldBefore, scene.world);
+    setIfChanged(change.view, viewBefore, scene.view);
+    setIfChanged(change.solver, solverBefore, scene.solverState);
+    setIfChanged(change.version, versionBefore, scene.version);
+    if (!kept) {
+        apply(scene, change, false);  // an edit that gave up must leave no trace
         return false;
     }
-    Delta change = diff(before, scene);
     if (merging) {
         // The command keeps its original "before"; only "after" moves on.
         Command& top = commands_[cursor_ - 1];

@@ -5,12 +5,10 @@
 /// changed: each touched entity's components before and after (encoded
 /// through the component table), the slot table when entities came or went
 /// (so undo brings back the very same handles), and the world settings,
-/// view and solver state when they changed. Undo and redo restore the same
-/// bytes, as whole-scene snapshots did, for a fraction of the memory: moving
-/// one body of a 2,000-body level keeps about 200 bytes instead of two
-/// copies of the scene (docs/incoming/state.md has the figures). A copy of
-/// the scene still exists while one edit runs (an edit that gives up must
-/// leave no trace, and the diff needs both sides).
+/// view and solver state when they changed. The registry tells apply() which
+/// entities the edit reaches (RegistryObserver), so an edit costs what it
+/// touches, not the size of the level: moving one body of a 20,000-body
+/// level encodes that body and copies nothing else.
 ///
 /// Coalescing: edits that carry the same non-zero `mergeKey` while the top
 /// command is still open (a drag in progress, a slider being dragged) fold
@@ -83,8 +81,6 @@ public:
         std::optional<std::pair<int, int>> version;
         std::size_t bytes() const;
     };
-    /// The difference between two scenes (entities matched by handle).
-    static Delta diff(const Scene& before, const Scene& after);
     /// Turns the scene on one side of `delta` into the other (forward:
     /// before -> after).
     static void apply(Scene& scene, const Delta& delta, bool forward);

@@ -14,6 +14,7 @@
 #include <memory>
 #include <tuple>
 #include <utility>
+#include <type_traits>
 #include <vector>
 
 namespace stepwise {
@@ -93,14 +94,51 @@ private:
 
 } // namespace detail
 
+class Registry;
+
+/// Told before a registry changes, so that an observer can keep what was
+/// there: the editor's undo records the entities an edit touches without
+/// copying or comparing the rest. Mutable access counts as a change (a
+/// pointer from tryGet may be written through), so an observer may hear of
+/// entities that end up unchanged.
+class RegistryObserver {
+public:
+    /// Before `e`'s components change (e is alive).
+    virtual void beforeEntityChange(const Registry& registry, Entity e) = 0;
+    /// Before the slot table or the scene order changes (create, destroy,
+    /// reorder, setSlots, assignment).
+    virtual void beforeSlotsChange(const Registry& registry) = 0;
+
+protected:
+    ~RegistryObserver() = default;
+};
+
 /// Owns entities and their components. Copyable (deep copy), which the
-/// editor's undo snapshots and the "reset to edited scene" rely on.
+/// editor's "reset to edited scene" relies on. An observer (setObserver)
+/// belongs to the registry object, not its contents: assignment keeps it.
 class Registry {
 public:
     Registry() = default;
-    Registry(const Registry& other) { *this = other; }
+    Registry(const Registry& other) { copyFrom(other); }
     Registry& operator=(const Registry& other) {
         if (this == &other) return *this;
+        beforeReplace();
+        copyFrom(other);
+        return *this;
+    }
+    Registry(Registry&& other) noexcept { moveFrom(std::move(other)); }
+    Registry& operator=(Registry&& other) noexcept {
+        if (this == &other) return *this;
+        beforeReplace();
+        moveFrom(std::move(other));
+        return *this;
+    }
+
+    /// Tells `observer` (or nobody, for nullptr) of every change from now on.
+    void setObserver(RegistryObserver* observer) { observer_ = observer; }
+
+private:
+    void copyFrom(const Registry& other) {
         generations_ = other.generations_;
         alive_ = other.alive_;
         freeList_ = other.freeList_;
@@ -108,13 +146,31 @@ public:
         pools_.clear();
         pools_.reserve(other.pools_.size());
         for (const auto& pool : other.pools_) pools_.push_back(pool ? pool->clone() : nullptr);
-        return *this;
     }
-    Registry(Registry&&) noexcept = default;
-    Registry& operator=(Registry&&) noexcept = default;
+    void moveFrom(Registry&& other) noexcept {
+        generations_ = std::move(other.generations_);
+        alive_ = std::move(other.alive_);
+        freeList_ = std::move(other.freeList_);
+        order_ = std::move(other.order_);
+        pools_ = std::move(other.pools_);
+    }
+    /// Every entity and the slot table are about to be replaced.
+    void beforeReplace() {
+        if (!observer_) return;
+        observer_->beforeSlotsChange(*this);
+        for (const Entity e : order_) observer_->beforeEntityChange(*this, e);
+    }
+    void beforeChange(Entity e) {
+        if (observer_ && alive(e)) observer_->beforeEntityChange(*this, e);
+    }
+    void beforeSlotsChange() {
+        if (observer_) observer_->beforeSlotsChange(*this);
+    }
 
+public:
     /// Makes a new entity, appended to the scene order.
     Entity create() {
+        beforeSlotsChange();
         std::uint32_t index;
         if (!freeList_.empty()) {
             index = freeList_.back();
@@ -140,6 +196,8 @@ public:
     /// scene order is kept stable for saving.
     bool destroy(Entity e) {
         if (!alive(e)) return false;
+        beforeChange(e);
+        beforeSlotsChange();
         for (auto& pool : pools_)
             if (pool) pool->erase(e.index);
         alive_[e.index] = false;
@@ -158,6 +216,7 @@ public:
     void reorder(Entity e, std::size_t position) {
         auto it = std::find(order_.begin(), order_.end(), e);
         if (it == order_.end()) return;
+        beforeSlotsChange();
         order_.erase(it);
         order_.insert(order_.begin() + std::ptrdiff_t(std::min(position, order_.size())), e);
     }
@@ -167,6 +226,7 @@ public:
     template <class T>
     T& emplace(Entity e, T value = T{}) {
         assert(alive(e));
+        beforeChange(e);
         return pool<T>().set(e.index, std::move(value));
     }
 
@@ -174,7 +234,9 @@ public:
     template <class T>
     T* tryGet(Entity e) {
         auto* p = findPool<T>();
-        return p && alive(e) ? p->find(e.index) : nullptr;
+        T* found = p && alive(e) ? p->find(e.index) : nullptr;
+        if (found && observer_) observer_->beforeEntityChange(*this, e);
+        return found;
     }
     template <class T>
     const T* tryGet(Entity e) const {
@@ -189,6 +251,7 @@ public:
     bool remove(Entity e) {
         auto* p = findPool<T>();
         if (!p || !alive(e) || !p->contains(e.index)) return false;
+        beforeChange(e);
         p->erase(e.index);
         return true;
     }
@@ -231,6 +294,7 @@ public:
     /// Replaces the slot table. Remove the components of every entity that
     /// `s` does not keep alive first: pools are not touched here.
     void setSlots(Slots s) {
+        beforeSlotsChange();
         generations_ = std::move(s.generations);
         alive_ = std::move(s.alive);
         freeList_ = std::move(s.freeList);
@@ -276,6 +340,7 @@ private:
             if (!(self.template findPool<First>()->contains(index) &&
                   (self.template findPool<Rest>()->contains(index) && ...)))
                 continue;
+            if constexpr (!std::is_const_v<Self>) self.beforeChange(self.handleAt(index));
             fn(self.handleAt(index), *self.template findPool<First>()->find(index),
                *self.template findPool<Rest>()->find(index)...);
         }
@@ -292,6 +357,7 @@ private:
     std::vector<std::uint32_t> freeList_;
     std::vector<Entity> order_;
     std::vector<std::unique_ptr<detail::PoolBase>> pools_;
+    RegistryObserver* observer_ = nullptr;
 };
 
 } // namespace stepwise
