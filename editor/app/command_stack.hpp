@@ -6,11 +6,10 @@
 /// through the component table), the slot table when entities came or went
 /// (so undo brings back the very same handles), and the world settings,
 /// view and solver state when they changed. Undo and redo restore the same
-/// bytes, as whole-scene snapshots did, for a fraction of the memory: moving
-/// one body of a 2,000-body level keeps about 200 bytes instead of two
-/// copies of the scene (docs/incoming/state.md has the figures). A copy of
-/// the scene still exists while one edit runs (an edit that gives up must
-/// leave no trace, and the diff needs both sides).
+/// bytes for memory in proportion to the edit, not to the scene (docs/
+/// editor.md, "Undo and redo", has the figures). A copy of the scene exists
+/// while one edit runs (an edit that gives up must leave no trace, and the
+/// diff needs both sides).
 ///
 /// Coalescing: edits that carry the same non-zero `mergeKey` while the top
 /// command is still open (a drag in progress, a slider being dragged) fold

@@ -181,7 +181,8 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene);
 /// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
 /// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
 /// compresses by load / (m_n omega^2), omega = 2 pi min(60 Hz, 1 / (4 h)),
-/// with a factor measured on the 30-row pile (docs: collide.md). The lowest
+/// with a factor measured on the 30-row pile (docs/collisions.md, "Substeps
+/// when the level gives none"). The lowest
 /// contact between bodies carries (depth - 1) heavy bodies on a light one:
 /// load (depth - 1) M g over m_n = m M / (m + M), i.e. (depth - 1)(1 + R)
 /// m_n g with R = M / m (2 (depth - 1) for equal bodies).
