@@ -348,7 +348,7 @@ std::optional<std::string_view> closestName(std::string_view name,
     std::size_t bestDistance = std::max<std::size_t>(2, name.size() / 3) + 1;
     for (std::string_view c : candidates) {
         // The distance is at least the difference in length: skip before
-        // the O(|name| |c|) table (a 10 MB unknown name took seconds).
+        // the O(|name| |c|) table (a 10 MB unknown name would take seconds).
         const std::size_t lengthGap = name.size() > c.size() ? name.size() - c.size() : c.size() - name.size();
         if (lengthGap >= bestDistance) continue;
         const std::size_t d = editDistance(name, c);

@@ -134,7 +134,7 @@ private:
 /// nlohmann's DOM builder (the one Json::parse uses) with the loader's
 /// rules checked on the way. Not nlohmann's parser callback: after every
 /// value it scans the whole enclosing array for a discarded element, so
-/// 1,000,001 entities took 3 minutes to refuse (quadratic). This handler
+/// refusing 1,000,001 entities takes 3 minutes (quadratic). This handler
 /// forwards to the plain DOM builder, which is linear.
 class CheckedDomBuilder {
 public:

@@ -899,8 +899,8 @@ std::string completeJoint(const Registry& registry, Joint& joint) {
 Result<Scene> parseScene(std::string_view text, std::string_view sourceName, const LoadLimits& limits) {
     Result<Scene> scene = parseSceneUnchecked(text, sourceName, limits);
     // Escaped first, then cut: escaping control bytes as \xNN makes a
-    // message up to four times longer, so cutting first let it pass the
-    // 4,096-byte bound (found by fuzzing: 4,977 bytes).
+    // message up to four times longer, so cutting first would let it pass
+    // the 4,096-byte bound (a fuzzed key: 4,977 bytes).
     if (!scene) return Error{detail::shortenForMessage(printableMessage(scene.error()))};
     return scene;
 }

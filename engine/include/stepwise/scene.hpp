@@ -108,7 +108,7 @@ struct JointImpulse {
     friend bool operator==(const JointImpulse&, const JointImpulse&) = default;
 };
 
-/// One dynamic body's sleep state (an addition): how long it has been
+/// One dynamic body's sleep state: how long it has been
 /// still, where that began, and the island it sleeps in. Awake bodies with
 /// no still window have no entry.
 struct BodySleep {
@@ -123,7 +123,7 @@ struct BodySleep {
     Entity island;
     /// Its velocity at the window's middle (m/s; until then, its latest):
     /// the acceleration that keeps a body awake is measured from it.
-    /// Absent (a file from before it was kept): the body's velocity.
+    /// Absent (a file that does not record it): the body's velocity.
     std::optional<Vec2> stillVelocity;
 
     friend bool operator==(const BodySleep&, const BodySleep&) = default;
