@@ -142,9 +142,9 @@ TEST(World, DivergenceNamesStepEntityAndQuantityAndKeepsState) {
 }
 
 // A step that diverges leaves the whole carried state as it was, the
-// solver's too: before, the failed step's contact cache and joint impulses
-// stayed in place and warmed the next step (a retry after an edit, a reload
-// keeping the warm start), so the World was not "as before that step".
+// solver's too: the failed step's contact cache and joint impulses must not
+// stay in place and warm the next step (a retry after an edit, a reload
+// keeping the warm start), or the World is not "as before that step".
 TEST(World, DivergenceLeavesTheWarmStartAndJointImpulsesAsTheyWere) {
     // A ball resting on a floor (contact impulses), a swinging pendulum
     // (joint impulses), and a shapeless body at 1e308 m/s that overflows in
