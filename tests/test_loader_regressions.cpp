@@ -168,7 +168,7 @@ TEST(LoaderRegressions, OnlyEntitiesCountTowardsTheEntityLimit) {
     EXPECT_EQ(r.error(), "t.json: error: more than 1 entities; the limit is 1");
 }
 
-// docs/format.md: "JSON nested deeper than 16 levels is refused". Counted
+// docs/format.md, "Limits": nesting deeper than 16 levels is refused. Counted
 // exactly (not by enclosing containers, which lets 17 pass): 16 levels reach
 // the ordinary checks, 17 are refused while parsing.
 TEST(LoaderRegressions, TheDepthLimitIsSixteenLevels) {

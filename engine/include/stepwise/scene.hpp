@@ -48,7 +48,8 @@ struct WorldSettings {
     /// Sleeping (Box2D's islands): dynamic bodies connected by touching
     /// contacts, springs and joints sleep as a whole when every one of them
     /// stays under sleepVelocity for sleepTime seconds; asleep, they cost
-    /// almost nothing until something touches or edits them (docs/physics.md).
+    /// almost nothing until something touches or edits them (docs/collisions.md,
+    /// "Sleeping").
     bool sleep = true;
     /// m/s: a body is "still" while |v| + r_max |omega| (the speed of its
     /// fastest point, r_max its farthest point from the centre of mass)

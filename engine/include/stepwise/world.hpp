@@ -297,7 +297,7 @@ public:
     /// (drag, spring damping, boids) act on bodies, not on a probe.
     Vec2 probeForce(Vec2 point, Vec2 velocity = {}) const;
 
-    /// Sleeping (world.sleep; docs/physics.md "Sleeping"): whether dynamic
+    /// Sleeping (world.sleep; docs/collisions.md "Sleeping"): whether dynamic
     /// body `body` sleeps, how many do, and their entities.
     bool asleep(std::size_t body) const;
     std::size_t sleepingBodyCount() const;
