@@ -574,8 +574,9 @@ TEST_F(Cli, EditWithNoDisplaySaysSoAndExitsOne) {
 
 // ---- outputs ---------------------------------------------------------
 
-// `--out missing/o.json --trace t.csv --contacts c.jsonl` ran the whole
-// simulation, wrote t.csv and c.jsonl, then failed on --out with exit 2.
+// `--out missing/o.json --trace t.csv --contacts c.jsonl` fails on --out
+// before the first step, with exit 2, and writes neither t.csv nor c.jsonl
+// (not the whole simulation first, and then fail).
 TEST_F(Cli, EveryOutputIsCheckedBeforeSteppingAndNothingIsWrittenOnExitTwo) {
     const fs::path file = write("forces.json", kForces), trace = dir_ / "t.csv", contacts = dir_ / "c.jsonl";
     Outcome o = stepwise("run " + file.string() + " --steps 5 --out " + (dir_ / "missing" / "o.json").string() +
@@ -795,9 +796,10 @@ TEST_F(Cli, ALongRunShowsProgressOnATerminal) {
 // ---- silent wrong answers -----------------------------------------
 
 // implicit_euler with one spring of k >= 1e25 (m = 1) and an unconnected
-// falling body kept every body where it started, exit 0; at k = 1e100 the
-// spring ended 96 km long (implicit_midpoint: 1e12 m). The failed or
-// inaccurate solve is refused now, naming the bodies of its system only.
+// falling body: the factorisation fails, and taken anyway the step would
+// keep every body where it started; at k = 1e100 the solve "succeeds" and
+// the spring would end 96 km long (implicit_midpoint: 1e12 m). The failed
+// or inaccurate solve is refused, naming the bodies of its system only.
 TEST_F(Cli, AnImplicitSolveThatFailsOrLosesAccuracyExitsThreeNamingItsBodies) {
     for (const char* k : {"1e25", "1e100"})
         for (const char* integrator : {"implicit_euler", "implicit_midpoint"}) {

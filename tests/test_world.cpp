@@ -304,10 +304,10 @@ TEST(WorldCli, ExplicitBlowUpOnStiffChainExitsThree) {
 } // namespace
 
 // A spring of k = 1e25 on 1 kg bodies makes M + h^2 K singular in
-// doubles (the masses are lost to rounding). The factorisation failed and
-// the step kept v1 = v0 for every body, a free falling one too, reporting
-// success. Refused now, like a non-finite value: the state stays at the
-// start of the step and the message names the spring's bodies only.
+// doubles (the masses are lost to rounding). The factorisation fails, and
+// a step that kept v1 = v0 for every body (a free falling one too) would
+// report success. It is refused, like a non-finite value: the state stays
+// at the start of the step and the message names the spring's bodies only.
 TEST(World, AFailedImplicitSolveIsRefusedAndNamesOnlyItsBodies) {
     for (const char* k : {"1e25", "1e100"})
         for (const char* integrator : {"implicit_euler", "implicit_midpoint"}) {

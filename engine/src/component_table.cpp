@@ -65,7 +65,7 @@ std::optional<Error> finishPlane(void* component) {
     // A normal that is already unit length up to rounding is kept bit for
     // bit. Dividing it by its own rounded length would move its last bits on
     // every load, so load -> save -> load -> save would not give the same
-    // bytes: {1, 2} did. 8 ulp covers the rounding of n / |n|.
+    // bytes ({1, 2} would not). 8 ulp covers the rounding of n / |n|.
     if (std::abs(len - 1.0) <= 8.0 * std::numeric_limits<double>::epsilon()) return {};
     // The offset is measured along the normal as written (n.p >= d); keep the
     // same half-plane after normalising n by scaling d with it.

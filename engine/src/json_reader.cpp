@@ -87,7 +87,7 @@ constexpr std::size_t kMaxSectionValues = 10'000;
 
 /// A limit passed or a rule broken while parsing: thrown by the handler,
 /// caught in parseLevelJson. `offset` is where (npos: the message has no
-/// place, as the entity and depth limits never had).
+/// place, as for the entity and depth limits).
 struct Stop {
     std::string message;
     std::size_t offset = std::string_view::npos;

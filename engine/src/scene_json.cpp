@@ -570,7 +570,7 @@ void writeJson(const Json& v, int indent, std::string& out) {
 /// Refusals are printed on a terminal and shown in the editor: one line of
 /// valid UTF-8. The parser's messages quote the bytes it stopped at, which
 /// may be any bytes of a broken file, and keys may hold escaped control
-/// characters; such bytes are shown as \xNN (found by fuzzing).
+/// characters; such bytes are shown as \xNN.
 std::string printableMessage(std::string_view message) {
     std::string out;
     out.reserve(message.size());

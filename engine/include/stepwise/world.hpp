@@ -164,7 +164,7 @@ struct WorldState {
 /// docs/collisions.md "Substeps when the level gives none".
 struct ContactSettingsChoice {
     int substeps = 1;
-    int iterations = 8;        ///< 8 at 1 substep (the old default), else 2
+    int iterations = 8;        ///< 8 at 1 substep, else 2
     int stackDepth = 0;        ///< bodies in the deepest column the scene can pile up
     double diameter = 0.0;     ///< metres, the median dynamic shape's size
     double gravity = 0.0;      ///< m/s^2, |world.gravity|
