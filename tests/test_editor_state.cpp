@@ -145,7 +145,7 @@ TEST(EditorState, TheStepBackHistoryHoldsStatesNotScenes) {
     EXPECT_LT(bytes, 100 * (oneState + 1024) + 3 * sceneEstimate) << bytes;
     std::cout << "pile.json (" << entities << " entities, " << f.ed.sim.world()->solverState().contacts.size()
               << " cached contact points): largest state " << oneState / 1024 << " KiB; history of 100 steps "
-              << bytes / 1024 << " KiB; a scene per step (old history, estimated) " << 100 * sceneEstimate / 1024
+              << bytes / 1024 << " KiB; a scene per step (estimated) " << 100 * sceneEstimate / 1024
               << " KiB\n";
 }
 
@@ -238,9 +238,8 @@ TEST(EditorState, AThousandEditsOfA2000BodyLevelHoldWhatChangedOnly) {
     }
     std::cout << "1,000 edits of pile.json (" << f.ed.doc.scene.registry.size() << " entities): undo holds "
               << held / 1024 << " KiB (stack's own count " << f.ed.commands.bytes() / 1024
-              << " KiB); one scene copy is " << perScene / 1024 << " KiB, so two per command held "
-              << 2 * 256 * perScene / (1024 * 1024) << " MiB for the 256 kept before ("
-              << 2 * 1000 * perScene / (1024 * 1024) << " MiB for 1,000)\n";
+              << " KiB); one scene copy is " << perScene / 1024 << " KiB, so two per command would hold "
+              << 2 * 1000 * perScene / (1024 * 1024) << " MiB for 1,000\n";
     EXPECT_LT(held, std::size_t(1) << 20) << "1,000 one-body edits should hold well under 1 MiB";
     EXPECT_LT(held * 100, 2 * 256 * perScene);
 
