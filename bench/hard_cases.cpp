@@ -561,9 +561,10 @@ Case pile300() {
     return c;
 }
 
-/// Box2D v3.1.1's figures for its benchmark scenes on this machine (one
-/// thread, median ms/step), and Stepwise's at v3's settings measured
-/// before the hard cases were fixed; the report prints them next to its own.
+/// Reference figures the report prints next to its own (one thread, median
+/// ms/step, taken in one sitting on the 2-core VM): Box2D v3.1.1's for its
+/// benchmark scenes (v3 is not linked here), and Stepwise's at v3's settings
+/// from a build without the hard-case rules, as a baseline.
 struct Reference {
     const char* scene;
     double v3Ms;
@@ -624,7 +625,7 @@ std::vector<Case> box2dScenes(const fs::path& levels, int steps) {
             };
         } else if (name == "spinner") {
             c.errorLabel = "deepest contact overlap, m";
-            // Box2D 2.4.1 took over a second a step here (100 steps in more
+            // Box2D 2.4.1 takes over a second a step here (100 steps in more
             // than three minutes on the 2-core VM): left out.
             c.box2d = false;
             c.measure = [](const Bodies& b, const Run& r) {

@@ -136,9 +136,9 @@ std::string formatLength(double metres) {
 
 /// A set of entity handles as a table by index (0: absent, else the
 /// handle's generation + 1), so a lookup is one load and filling it
-/// allocates once. An unordered_set allocated and freed a node per entity:
-/// for a settled pile's 2,000 sleeping bodies that was 2,000 mallocs and
-/// frees a frame, more of the editor's frame than any overlay's drawing.
+/// allocates once. An unordered_set allocates and frees a node per entity:
+/// for a settled pile's 2,000 sleeping bodies, 2,000 mallocs and frees a
+/// frame, more of the editor's frame than any overlay's drawing.
 class EntityTable {
 public:
     void insert(Entity e) {
@@ -161,9 +161,9 @@ public:
         : out_(out), in_(input), options_(options), scene_(*input.scene), w_(w), h_(h),
           ppm_(input.camera.pixelsPerMetre(h)),
           // 1.5 pixels per font unit from a 360 px image up to 700 (capitals
-          // about 10 px tall, like the editor's 13 px UI font): one unit was
-          // 7 px print in the editor's viewport and the 960x540 renders.
-          // From 700 px, whole units as before (2 at 720 and 1080).
+          // about 10 px tall, like the editor's 13 px UI font; one unit would
+          // print 7 px in the editor's viewport and the 960x540 renders).
+          // From 700 px, whole units (2 at 720 and 1080).
           textScale_(h < 360 ? 1.0 : h < 700 ? 1.5 : double(h / 700 + 1)),
           arrowRef_(0.06 * h) {
         for (Entity e : input.selection) selected_.insert(e);
@@ -202,7 +202,7 @@ private:
     // one after another. A stage that alternates kinds per item (a contact
     // is an arrow and a dot, an anchored spring a pin and segments) would
     // otherwise start a new batch, one draw call, per item: 2,000 contacts
-    // made 4,000 draw calls, 13 ms a frame on llvmpipe.
+    // would make 4,000 draw calls, 13 ms a frame on llvmpipe.
     std::vector<float>& batch(BatchKind kind, bool plain = false) {
         for (Batch& b : layer_)
             if (b.kind == kind && b.plain == plain) return b.data;

@@ -29,7 +29,7 @@ struct Attribute {
 /// Copies each of `count` records of `Stride` floats four times, one per
 /// quad corner. A size fixed at compile time makes each copy a few vector
 /// moves; memcpy with a run-time size of a few dozen bytes is a library
-/// call per corner (46,000 a frame in the editor's bench), which cost more
+/// call per corner (46,000 a frame in the editor's bench), which costs more
 /// than the copying.
 template <std::size_t Stride>
 void expandToCorners(const float* src, float* dst, std::size_t count) {

@@ -329,8 +329,8 @@ TEST_F(Cli, ValidateAndSchemaBadArguments) {
     EXPECT_EQ(o.err, (file / "s.json").string() + ": error: cannot write: Not a directory\n");
     o = stepwise("schema --out " + dir_.string());
     EXPECT_EQ(o.exitCode, 2);
-    // (Found by the check before writing now, in the words of the other
-    // unwritable targets; the rename used to find it.)
+    // (Found by the check before writing, in the words of the other
+    // unwritable targets, not by the rename.)
     EXPECT_EQ(o.err, dir_.string() + ": error: cannot write: Is a directory\n");
     EXPECT_EQ(readFile(file), "keep");
     EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1) << "a temporary was left";
@@ -446,7 +446,7 @@ TEST_F(Cli, BenchBadArgumentsExitTwoNamingTheArgument) {
     EXPECT_FALSE(fs::exists(dir_ / "r"));
     // A report file the user may not replace (0444, as an unprivileged
     // user): refused before measuring, in the words of every other output,
-    // and kept. It was overwritten after the whole run.
+    // and kept, not overwritten after the whole run.
     fs::permissions(dir_, fs::perms::all);
     const fs::path reportDir = dir_ / "report";
     fs::create_directory(reportDir);
@@ -556,7 +556,7 @@ TEST_F(Cli, ClockwisePolygonExitsTwoNamingTheEntityAndLeavesTheOutputAlone) {
 }
 
 // With no display the window must not start: Debian's SDL falls back to an
-// invisible "offscreen" driver, and the editor used to run there until
+// invisible "offscreen" driver, where the editor would run unseen until
 // killed. `timeout` turns such a hang into exit code 124.
 TEST_F(Cli, EditWithNoDisplaySaysSoAndExitsOne) {
     const fs::path err = dir_ / "stderr.txt";
@@ -574,8 +574,9 @@ TEST_F(Cli, EditWithNoDisplaySaysSoAndExitsOne) {
 
 // ---- outputs ---------------------------------------------------------
 
-// `--out missing/o.json --trace t.csv --contacts c.jsonl` ran the whole
-// simulation, wrote t.csv and c.jsonl, then failed on --out with exit 2.
+// `--out missing/o.json --trace t.csv --contacts c.jsonl` fails on --out
+// before the first step, with exit 2, and writes neither t.csv nor c.jsonl
+// (not the whole simulation first, and then fail).
 TEST_F(Cli, EveryOutputIsCheckedBeforeSteppingAndNothingIsWrittenOnExitTwo) {
     const fs::path file = write("forces.json", kForces), trace = dir_ / "t.csv", contacts = dir_ / "c.jsonl";
     Outcome o = stepwise("run " + file.string() + " --steps 5 --out " + (dir_ / "missing" / "o.json").string() +
@@ -593,8 +594,8 @@ TEST_F(Cli, EveryOutputIsCheckedBeforeSteppingAndNothingIsWrittenOnExitTwo) {
         EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
 }
 
-// A diverging run wrote its trace (and contacts) and said "no output
-// written"; exit 3 now writes nothing at all.
+// A diverging run exits 3 and writes nothing at all: no trace, no
+// contacts, as its "no output written" says.
 TEST_F(Cli, ADivergedRunWritesNoOutputAtAll) {
     const fs::path file = write("stiff.json", R"({"world": {"gravity": {"x": 0, "y": 0}, "dt": 0.1, "integrator": "explicit_euler"},
       "entities": [{"name": "bob", "position": {"x": 1.5, "y": 0}},
@@ -650,8 +651,8 @@ TEST_F(Cli, AnOutputThatIsTheInputOrAnotherOutputIsRefusedBeforeStepping) {
     EXPECT_EQ(readFile(file), text);
 }
 
-// A render sequence that diverged left the frames before the divergence:
-// now every frame waits in a temporary until the whole run succeeded.
+// A render sequence that diverges leaves no frames before the divergence:
+// every frame waits in a temporary until the whole run succeeded.
 TEST_F(Cli, ARenderSequenceThatDivergesWritesNoFrame) {
     const fs::path file = write("stiff.json", R"({"world": {"gravity": {"x": 0, "y": 0}, "dt": 0.1, "integrator": "explicit_euler"},
       "entities": [{"name": "bob", "position": {"x": 1.5, "y": 0}},
@@ -664,8 +665,9 @@ TEST_F(Cli, ARenderSequenceThatDivergesWritesNoFrame) {
 }
 
 
-// A read-only output (0444, as an unprivileged user) was replaced through
-// the atomic rename, which needs only the folder's permission.
+// A read-only output (0444, as an unprivileged user) is refused and kept:
+// the atomic rename needs only the folder's permission, so the file's mode
+// is checked first.
 TEST_F(Cli, AReadOnlyOutputIsRefusedAndKept) {
     fs::permissions(dir_, fs::perms::all);  // the folder is writable: only the file's mode refuses
     const fs::path file = write("forces.json", kForces);
@@ -678,10 +680,10 @@ TEST_F(Cli, AReadOnlyOutputIsRefusedAndKept) {
     EXPECT_EQ(readFile(out), "read-only\n");
 }
 
-// `edit --screenshot` checked only that the folder existed: a read-only
-// screenshot was replaced at the end through the rename, after the whole
-// script had run. Now it is refused before the first frame, in the words of
-// every other unwritable output, and kept.
+// `edit --screenshot` checks the file, not only its folder: a read-only
+// screenshot would otherwise be replaced at the end through the rename,
+// after the whole script had run. It is refused before the first frame, in
+// the words of every other unwritable output, and kept.
 TEST_F(Cli, EditRefusesAnUnwritableScreenshotBeforeItStarts) {
     fs::permissions(dir_, fs::perms::all);
     const fs::path file = write("forces.json", kForces);
@@ -699,8 +701,8 @@ TEST_F(Cli, EditRefusesAnUnwritableScreenshotBeforeItStarts) {
     EXPECT_FALSE(fs::exists(dir_ / "missing"));
 }
 
-// The trace was held in memory to the end: 1e6 steps made a 95 MB file and
-// 178 MB resident. Streamed now: 100 times the steps, about the same peak.
+// The trace is streamed, not held in memory to the end (1e6 steps make a
+// 95 MB file): 100 times the steps, about the same peak.
 TEST_F(Cli, TheTraceIsStreamedSoMemoryStaysFlat) {
 #ifdef STEPWISE_UNDER_ASAN
     GTEST_SKIP() << "AddressSanitizer keeps freed memory in quarantine, so peak RSS says nothing about streaming; the release stage measures it";
@@ -714,10 +716,10 @@ TEST_F(Cli, TheTraceIsStreamedSoMemoryStaysFlat) {
     EXPECT_LT(many - few, long(size / 1024 / 4)) << few << " KiB for 2,000 steps, " << many << " KiB for 200,000";
 }
 
-// `--dt nan` blamed the file ("L.json: cannot simulate: world.dt ... got
-// nan"), `--dt 0` printed DBL_MAX in 309 digits, `--dt 1e-320` (inside the
-// documented (0, 10]) was refused and `--out ""` gave ": error: ..." with no
-// name.
+// A bad argument is blamed on the argument, not the file ("L.json: cannot
+// simulate: world.dt ... got nan"), in plain words (not DBL_MAX in 309
+// digits); `--dt 1e-320`, inside the documented (0, 10], is accepted; and
+// `--out ""` names the option (not ": error: ...").
 TEST_F(Cli, BadArgumentsNameTheArgument) {
     const fs::path file = write("forces.json", kForces);
     for (const char* dt : {"nan", "0", "-1", "inf", "11", "1e999", "abc"}) {
@@ -740,9 +742,9 @@ TEST_F(Cli, BadArgumentsNameTheArgument) {
     EXPECT_EQ(o.err.substr(0, o.err.find('\n')), "--out: expected a file name, got \"\"");
 }
 
-// `--steps 1000000000000000000` ran until killed, silently. A trace that
-// cannot fit on the disk is refused up front; a long run says how long it
-// will take; Ctrl-C stops it and writes nothing.
+// `--steps 1000000000000000000` must not run silently until killed. A trace
+// that cannot fit on the disk is refused up front; a long run says how long
+// it will take; Ctrl-C stops it and writes nothing.
 TEST_F(Cli, AnEndlessRunIsBoundedEstimatedAndInterruptible) {
     const fs::path file = write("forces.json", kForces);
     Outcome o = stepwise("run " + file.string() + " --steps 1000000000000000000 --trace " + (dir_ / "t.csv").string());
@@ -794,9 +796,10 @@ TEST_F(Cli, ALongRunShowsProgressOnATerminal) {
 // ---- silent wrong answers -----------------------------------------
 
 // implicit_euler with one spring of k >= 1e25 (m = 1) and an unconnected
-// falling body kept every body where it started, exit 0; at k = 1e100 the
-// spring ended 96 km long (implicit_midpoint: 1e12 m). The failed or
-// inaccurate solve is refused now, naming the bodies of its system only.
+// falling body: the factorisation fails, and taken anyway the step would
+// keep every body where it started; at k = 1e100 the solve "succeeds" and
+// the spring would end 96 km long (implicit_midpoint: 1e12 m). The failed
+// or inaccurate solve is refused, naming the bodies of its system only.
 TEST_F(Cli, AnImplicitSolveThatFailsOrLosesAccuracyExitsThreeNamingItsBodies) {
     for (const char* k : {"1e25", "1e100"})
         for (const char* integrator : {"implicit_euler", "implicit_midpoint"}) {

@@ -1,8 +1,8 @@
 // Collision cases off the tuned path: fast crowds, one huge
 // shape, bodies started at one point, tunnelling from rest, slow elastic
-// impacts, tall piles at the user's settings. Each test failed before the
-// fix it covers. No test reads a clock: cost is asserted as work done (pairs,
-// overlap tests), speed is in bench/ (docs/incoming/collide.md).
+// impacts, tall piles at the user's settings. Each test fails without the
+// rule it covers. No test reads a clock: cost is asserted as work done
+// (pairs, overlap tests), speed is in bench/ (docs/performance.md).
 
 #include "collision/collision_system.hpp"
 #include "generated_scenes.hpp"
@@ -131,7 +131,7 @@ TEST(CollisionHard, CrowdAtOnePointIsBoundedAndSpreadsWithoutExploding) {
     // Crowded bodies take the push as a position correction (split
     // impulse); the rim, in ordinary cells, still gets velocity pushes that
     // add up: measured 17.7 m/s with 4 partners in Z-order (35 m/s with 16
-    // partners by x, 87 m/s before the split impulse).
+    // partners by x, 87 m/s without the split impulse).
     EXPECT_GT(spread, 5.0);
     EXPECT_LT(fastest, 25.0);
     // Spread in two dimensions, not along one line.
@@ -144,9 +144,9 @@ TEST(CollisionHard, CrowdAtOnePointIsBoundedAndSpreadsWithoutExploding) {
 }
 
 TEST(CollisionHard, TwentyThousandAtOnePointKeepFewPairsPerBodyAndDoNotFling) {
-    // 10,000 at one point ended in bad_alloc; the first bound kept
-    // 16 pairs per body (320,000 manifolds here, 819 MB for 100,000) and let
-    // the rim fly out at 29 m/s within 20 steps. Now each crowded box pairs
+    // Every pair in one cell: 10,000 at one point end in bad_alloc. 16
+    // pairs per body: 320,000 manifolds here (819 MB for 100,000), and the
+    // rim flies out at 29 m/s within 20 steps. So each crowded box pairs
     // with its next 4 in Z-order: about 4 manifolds per body, the memory and
     // time of a step in proportion (bench: --crowd 100000).
     const int n = 20000;
@@ -168,7 +168,8 @@ TEST(CollisionHard, TwentyThousandAtOnePointKeepFewPairsPerBodyAndDoNotFling) {
         reachX = std::max(reachX, std::abs(p.x));
         reachY = std::max(reachY, std::abs(p.y));
     }
-    // Measured: radius 1.9 m, fastest 2.9 m/s (before: 6.7 m and 29 m/s).
+    // Measured: radius 1.9 m, fastest 2.9 m/s (6.7 m and 29 m/s with 16
+    // pairs per body).
     EXPECT_GT(radius, 1.0);
     EXPECT_LT(fastest, 5.0);
     EXPECT_GT(std::min(reachX, reachY), 0.5 * std::max(reachX, reachY));  // in 2D, not along a line

@@ -135,8 +135,9 @@ TEST(CommandStack, CapacityDropsOldest) {
 
 TEST(CommandStack, UndoOfADeletedPolygonRestoresItsVertices) {
     // The undo record of an entity is written field by field from the
-    // component table; a vertex list (and an integer) had no case there, so
-    // an undone delete brought a polygon back with no vertices.
+    // component table; every kind needs its case there (a vertex list and
+    // an integer too), or an undone delete brings a polygon back with no
+    // vertices.
     Fixture f("default.json");
     Entity polygon;
     ASSERT_TRUE(f.ed.applyEdit("add", [&](Scene& s) {

@@ -148,9 +148,10 @@ TEST(Files, SaveAsRemovesTheOldPathsRecoveryCopy) {
 
 TEST(Files, AutosaveKilledAtRandomPointsLeavesAWholeRecoveryFile) {
     // 120 kills in the release stage. Under AddressSanitizer each kill forks
-    // the instrumented process and autosaves 2,000 bodies, so 120 took 164 s,
-    // the longest test in CI by far; 24 kills there still run every path of
-    // the save under the sanitizer, and the release stage keeps the 120.
+    // the instrumented process and autosaves 2,000 bodies, so 120 take about
+    // 164 s, the longest test in CI by far; 24 kills there still run every
+    // path of the save under the sanitizer, and the release stage keeps the
+    // 120.
 #ifdef STEPWISE_UNDER_ASAN
     constexpr int kKills = 24;
 #else

@@ -107,8 +107,8 @@ bool waitFor(const std::function<bool()>& condition, std::chrono::milliseconds t
 
 int freeDisplay() {
     // Start the search at a number of this process's own: ctest -j runs the
-    // e2e tests side by side, and two that both took the first free number
-    // (:90) shared one X server and drove each other's windows.
+    // e2e tests side by side, and two that both take the first free number
+    // (:90) share one X server and drive each other's windows.
     for (int k = 0; k < 110; ++k) {
         const int n = 90 + int((unsigned(::getpid()) + unsigned(k) * 7u) % 110u);
         if (!fs::exists("/tmp/.X" + std::to_string(n) + "-lock") && !fs::exists("/tmp/.X11-unix/X" + std::to_string(n)))

@@ -130,7 +130,7 @@ TEST(EditorScreenshotDetects, AMovedBodyFailsTheComparison) {
 // renderer alone draws a whole image. The two must agree pixel for pixel
 // (within the golden tolerance) for the same level, camera and size, at any
 // window size: a shader that measures from the window instead of the
-// rectangle (planes were drawn 254 px low at 1280x800) fails here, even when
+// rectangle (it draws planes 254 px low at 1280x800) fails here, even if
 // the editor's own goldens were recorded with the fault.
 
 namespace {

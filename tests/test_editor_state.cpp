@@ -57,9 +57,9 @@ std::string straightRun(const std::string& level, int steps) {
 
 } // namespace
 
-// In default.json, step 60, step 30, step back 30, step 30
-// ended up to 0.1 mm off the first pass (the World was rebuilt from the
-// scene on step back and the warm start dropped). Failed before.
+// In default.json, step 60, step 30, step back 30, step 30 replays the
+// first pass bit for bit: step back restores the warm start too (a World
+// rebuilt from the scene, warm start dropped, ends up to 0.1 mm off).
 TEST(EditorState, StepBackThenStepReplaysTheFirstPassBitForBitWithContacts) {
     // bridge and car: joints too (their impulses are part of the state).
     for (const char* level : {"default.json", "pile.json", "ramp_friction.json", "pyramid.json", "bridge.json", "car.json"}) {
@@ -86,9 +86,9 @@ TEST(EditorState, StepBackRestoresTheExactEarlierBytes) {
     EXPECT_TRUE(f.stateText() == at40);
 }
 
-// An edit while paused used to rebuild the World and drop the warm start:
-// an edit that changes nothing physical (a colour) then changed the run.
-// Now the live World is recompiled in place and keeps it. Failed before.
+// An edit while paused recompiles the live World in place and keeps the
+// warm start, so an edit that changes nothing physical (a colour) does not
+// change the run (a rebuilt World, warm start dropped, would).
 TEST(EditorState, AnEditWhilePausedKeepsTheWarmStart) {
     Fixture f("default.json");
     f.step(60);
@@ -145,7 +145,7 @@ TEST(EditorState, TheStepBackHistoryHoldsStatesNotScenes) {
     EXPECT_LT(bytes, 100 * (oneState + 1024) + 3 * sceneEstimate) << bytes;
     std::cout << "pile.json (" << entities << " entities, " << f.ed.sim.world()->solverState().contacts.size()
               << " cached contact points): largest state " << oneState / 1024 << " KiB; history of 100 steps "
-              << bytes / 1024 << " KiB; a scene per step (old history, estimated) " << 100 * sceneEstimate / 1024
+              << bytes / 1024 << " KiB; a scene per step (estimated) " << 100 * sceneEstimate / 1024
               << " KiB\n";
 }
 
@@ -204,8 +204,8 @@ TEST(EditorState, ScriptedStepBackAndReplaySaveTheSameBytes) {
 
 // Undo stores what changed, not two whole scenes per edit. A
 // thousand edits (each moves one body) of a 2,000-body level; heap in use
-// measured with mallinfo2. The old stack held two copies of the scene per
-// command (and dropped all but the last 256 commands).
+// measured with mallinfo2 (two copies of this scene per command would be
+// over half a MiB an edit).
 TEST(EditorState, AThousandEditsOfA2000BodyLevelHoldWhatChangedOnly) {
 #ifdef STEPWISE_UNDER_ASAN
     GTEST_SKIP() << "AddressSanitizer replaces malloc, so mallinfo2 reports nothing; the release stage measures it";
@@ -238,9 +238,8 @@ TEST(EditorState, AThousandEditsOfA2000BodyLevelHoldWhatChangedOnly) {
     }
     std::cout << "1,000 edits of pile.json (" << f.ed.doc.scene.registry.size() << " entities): undo holds "
               << held / 1024 << " KiB (stack's own count " << f.ed.commands.bytes() / 1024
-              << " KiB); one scene copy is " << perScene / 1024 << " KiB, so two per command held "
-              << 2 * 256 * perScene / (1024 * 1024) << " MiB for the 256 kept before ("
-              << 2 * 1000 * perScene / (1024 * 1024) << " MiB for 1,000)\n";
+              << " KiB); one scene copy is " << perScene / 1024 << " KiB, so two per command would hold "
+              << 2 * 1000 * perScene / (1024 * 1024) << " MiB for 1,000\n";
     EXPECT_LT(held, std::size_t(1) << 20) << "1,000 one-body edits should hold well under 1 MiB";
     EXPECT_LT(held * 100, 2 * 256 * perScene);
 

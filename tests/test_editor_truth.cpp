@@ -147,10 +147,10 @@ TEST(ForceOverlay, BothModesAreOfferedAndTheLegendSaysWhichIsShown) {
 
 TEST(ForceFieldOverlay, GravityStaysVisibleNextToAStrongAttractor) {
     // Gravity plus a static attractor whose pull is 190 g at the grid sample
-    // nearest to it and g at 35 m. The field's reference used to be the
-    // median of the samples above 1% of the largest: gravity's samples fell
-    // under that cut, the attractor's set the reference, and gravity's
-    // arrows shrank to 2-3 px dots.
+    // nearest to it and g at 35 m. With the field's reference the median of
+    // the samples above 1% of the largest, gravity's samples would fall
+    // under that cut, the attractor's would set the reference, and gravity's
+    // arrows would shrink to 2-3 px dots.
     Scene s;
     s.world.gravity = {0.0, -kG};
     const Entity sun = s.registry.create();
@@ -190,8 +190,8 @@ TEST(ForceFieldOverlay, GravityStaysVisibleNextToAStrongAttractor) {
 TEST(Legend, TextIsReadableInTheEditorsViewport) {
     // The editor's viewport at 1280x800 is about 715x475 px. The HUD text
     // (caption, scale bar, legend) is drawn last: its tallest stroke is the
-    // height of a capital. It was 7 px; the UI's 13 px font has capitals of
-    // about 10 px.
+    // height of a capital, about as tall as the UI's 13 px font's capitals
+    // (about 10 px), not 7 px.
     RestingCrate c;
     FrameInput in;
     in.scene = &c.scene;

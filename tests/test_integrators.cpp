@@ -404,12 +404,13 @@ TEST(Dopri5, KeplerEccentricity09ClosesWithinOneMicrometreAtTolerance1e10) {
     Scene s = k.scene("dopri5", k.period() / 60);
     s.world.tolerance = 1e-10;
     World w = buildOrDie(s);
-    long internal = 0, rejected = 0;
+    long internal = 0, rejected = 0, evaluations = 0;
     int busiestFrame = 0, quietestFrame = 1 << 30;
     for (int i = 0; i < 60; ++i) {
         ASSERT_TRUE(w.step().ok());
         internal += w.lastStats().internalSteps;
         rejected += w.lastStats().rejectedSteps;
+        evaluations += w.lastStats().forceEvaluations;
         busiestFrame = std::max(busiestFrame, w.lastStats().internalSteps);
         quietestFrame = std::min(quietestFrame, w.lastStats().internalSteps);
     }
@@ -420,8 +421,15 @@ TEST(Dopri5, KeplerEccentricity09ClosesWithinOneMicrometreAtTolerance1e10) {
     // frames) than near aphelion, and each is counted.
     EXPECT_GT(internal, 60);
     EXPECT_GT(busiestFrame, 4 * quietestFrame) << "busiest " << busiestFrame << ", quietest " << quietestFrame;
+    // Every attempt, accepted or rejected, costs six evaluations, plus one
+    // per frame for the first stage: the counts add up over the whole orbit.
     EXPECT_EQ(w.lastStats().forceEvaluations, 1 + 6 * (w.lastStats().internalSteps + w.lastStats().rejectedSteps));
-    EXPECT_GE(rejected, 0);
+    EXPECT_EQ(evaluations, 60 + 6 * (internal + rejected)) << internal << " accepted, " << rejected << " rejected";
+    // The step grows through the slow half of the orbit and overshoots on
+    // the way into perihelion, so the controller rejects a few steps
+    // (measured 3 of 319); the safety factor keeps them rare.
+    EXPECT_GE(rejected, 1) << "no step rejected: the error estimate or the count is not working";
+    EXPECT_LE(rejected, internal / 20) << internal << " accepted, " << rejected << " rejected";
 }
 
 TEST(Dopri5, ErrorFollowsTheTolerance) {

@@ -1,7 +1,7 @@
-// Findings of the loader fuzzer and of a review of bad input, each
-// kept as an exact-message or exact-bytes test, plus a replay of every file
-// in tests/fuzz/corpus/ through the fuzzer's own property, so the findings stay
-// fixed in the ordinary gcc build too.
+// Bad input the loader must handle (from the loader fuzzer and a review of
+// bad input), each as an exact-message or exact-bytes test, plus a replay of
+// every file in tests/fuzz/corpus/ through the fuzzer's own property, so the
+// ordinary gcc build checks them too.
 
 #include "fuzz/scene_loader_property.hpp"
 
@@ -42,9 +42,9 @@ std::string saveLoadSave(std::string_view text, std::string* first = nullptr) {
 
 } // namespace
 
-// Fuzzer finding 1 (first minute): the JSON parser quotes the bytes it gave
-// up at, so a broken file's non-UTF-8 bytes went straight into the message
-// (and from there into the terminal and the editor's UI).
+// The JSON parser quotes the bytes it gave up at: a broken file's non-UTF-8
+// bytes are escaped before they reach the message (and from there the
+// terminal and the editor's UI).
 TEST(LoaderRegressions, BytesThatAreNotUtf8AreEscapedInTheMessage) {
     EXPECT_EQ(refusal("{\"entities\": [\xff]}"),
               "t.json:1:15: error: syntax error while parsing value - invalid literal; last read: '\"entities\": "
@@ -80,8 +80,8 @@ TEST(LoaderRegressions, ALongFoundValueIsCutBetweenCharacters) {
               "t.json: error: /entities/0/mass: expected a number > 0, got " + expected + "...");
 }
 
-// Review finding: a plane normal was divided by its own rounded length on
-// every load, so {1, 2} moved in its last bit between the first and the
+// A plane normal is normalised once: divided by its own rounded length on
+// every load, {1, 2} would move in its last bit between the first and the
 // second save, breaking "load, save, load, save gives identical bytes".
 TEST(LoaderRegressions, APlaneNormalIsNormalisedOnceAndThenKeptBitForBit) {
     std::string first;
@@ -92,8 +92,8 @@ TEST(LoaderRegressions, APlaneNormalIsNormalisedOnceAndThenKeptBitForBit) {
     EXPECT_NE(first.find(R"("offset": 0.22360679774997896)"), std::string::npos) << first;
 }
 
-// Review finding: |n| was sqrt(x*x + y*y), which overflows for a normal of
-// 1e200: the plane became {0, 0} (saved, it no longer loads).
+// |n| as sqrt(x*x + y*y) overflows for a normal of 1e200 and would make the
+// plane {0, 0} (which, saved, no longer loads): hypot does not.
 TEST(LoaderRegressions, AHugePlaneNormalIsNormalisedWithoutOverflow) {
     Result<Scene> scene = parseScene(R"({"entities": [{"plane": {"normal": {"x": 1e200, "y": 1e200}, "offset": 3}}]})", "t.json");
     ASSERT_TRUE(scene) << scene.error();
@@ -102,16 +102,16 @@ TEST(LoaderRegressions, AHugePlaneNormalIsNormalisedWithoutOverflow) {
     EXPECT_EQ(plane->offset, 3.0 / std::hypot(1e200, 1e200));
 }
 
-// Review finding: an offset that overflows once divided by a tiny normal's
-// length became inf, saved as null.
+// An offset that overflows once divided by a tiny normal's length would
+// become inf, saved as null: refused.
 TEST(LoaderRegressions, APlaneOffsetThatOverflowsWhenNormalisedIsRefused) {
     EXPECT_EQ(refusal(R"({"entities": [{"plane": {"normal": {"x": 1e-11, "y": 0}, "offset": 1e300}}]})"),
               "t.json: error: /entities/0/plane/offset: expected an offset that stays finite once the normal is "
               "normalised (offset / |normal|), got 1e+300 with |normal| = 1e-11");
 }
 
-// Review finding: a spring without rest_length whose ends are too far apart
-// got rest_length = inf, saved as null.
+// A spring without rest_length whose ends are too far apart would get
+// rest_length = inf, saved as null: refused.
 TEST(LoaderRegressions, ASpringWhoseLengthOverflowsNeedsAnExplicitRestLength) {
     EXPECT_EQ(refusal(R"({"entities": [{"name": "p", "position": {"x": -1e200, "y": 0}},
                                        {"spring": {"a": "p", "anchor": {"x": 1e200, "y": 0}}}]})"),
@@ -124,11 +124,11 @@ TEST(LoaderRegressions, ASpringWhoseLengthOverflowsNeedsAnExplicitRestLength) {
               first);
 }
 
-// Found by the CLI limit test (not reachable by the fuzzer's 64 KiB inputs):
-// nlohmann's parser callback rescans the enclosing array after every value,
-// so refusing 1,000,001 entities took 3 minutes (and loading a million,
-// as long). Linear now: ten times the entities must cost about ten times
-// the time, far from the hundred times of the quadratic parser.
+// Beyond the fuzzer's 64 KiB inputs: nlohmann's parser callback rescans the
+// enclosing array after every value, so refusing 1,000,001 entities through
+// it takes 3 minutes (and loading a million as long). The loader is linear:
+// ten times the entities must cost about ten times the time, far from the
+// hundred times of a quadratic parser.
 TEST(LoaderRegressions, RefusingTooManyEntitiesTakesLinearTime) {
     const auto timeToRefuse = [](std::size_t limit) {
         std::string text = "{\"entities\": [";
@@ -154,8 +154,8 @@ TEST(LoaderRegressions, RefusingTooManyEntitiesTakesLinearTime) {
 }
 
 // The entity limit counts the objects of the top-level "entities" array
-// only (the parser callback counted every object two levels down, so
-// "gravity" in "world" was an entity too).
+// only, not every object two levels down ("gravity" in "world" is not an
+// entity).
 TEST(LoaderRegressions, OnlyEntitiesCountTowardsTheEntityLimit) {
     LoadLimits limits;
     limits.maxEntities = 1;
@@ -168,8 +168,8 @@ TEST(LoaderRegressions, OnlyEntitiesCountTowardsTheEntityLimit) {
     EXPECT_EQ(r.error(), "t.json: error: more than 1 entities; the limit is 1");
 }
 
-// docs/format.md: "JSON nested deeper than 16 levels is refused". The callback
-// counted enclosing containers, so 17 levels passed. 16 levels now reach
+// docs/format.md, "Limits": nesting deeper than 16 levels is refused. Counted
+// exactly (not by enclosing containers, which lets 17 pass): 16 levels reach
 // the ordinary checks, 17 are refused while parsing.
 TEST(LoaderRegressions, TheDepthLimitIsSixteenLevels) {
     const auto nested = [](int levels) {  // root object + entities array + entity + (levels - 3) arrays
@@ -195,8 +195,8 @@ TEST(LoaderRegressions, EveryFileInTheFuzzCorpusSatisfiesTheFuzzersProperty) {
 
 // ---- the JSON itself -----------------------------------------------
 
-// Duplicate keys were accepted, the last one winning: a level with "mass"
-// twice loaded with the second. Refused now, naming the second by its JSON
+// Duplicate keys: nlohmann keeps the last one, so a level with "mass" twice
+// would load with the second. Refused, naming the second by its JSON
 // Pointer and place, and the first by its place.
 TEST(LoaderRegressions, DuplicateKeysAreRefusedWithThePointerOfTheSecond) {
     EXPECT_EQ(refusal(R"({"entities": [{"name": "a", "mass": 1, "mass": 2}]})"),
@@ -228,7 +228,7 @@ TEST(LoaderRegressions, DuplicateKeysAreRefusedWithThePointerOfTheSecond) {
 }
 
 // nlohmann's lexer takes a NUL byte for the end of the input, so a level
-// followed by a NUL and anything at all loaded.
+// followed by a NUL and anything at all would load: refused.
 TEST(LoaderRegressions, ANulByteAnywhereIsRefused) {
     const std::string level = "{\"entities\": []}\n";
     EXPECT_EQ(refusal(level + std::string(1, '\0') + "garbage"),
@@ -239,9 +239,9 @@ TEST(LoaderRegressions, ANulByteAnywhereIsRefused) {
               "t.json:1:26: error: a NUL byte");
 }
 
-// The entity count saw only the objects directly in "entities": every other
-// shape built its whole DOM first (60 MB of [[{}, {}, ...]] took 23 s and
-// 1.5 GB). Every value counts now, in the file and in one entity.
+// Counting only the objects directly in "entities" would let every other
+// shape build its whole DOM first (60 MB of [[{}, {}, ...]]: 23 s and
+// 1.5 GB). Every value counts, in the file and in one entity.
 TEST(LoaderRegressions, EveryJsonValueCountsTowardsTheLimits) {
     LoadLimits limits;
     limits.maxValues = 100;
@@ -302,9 +302,9 @@ TEST(LoaderRegressions, ArraysWhereObjectsBelongAreRefusedAtTheirFirstChild) {
               "t.json: error: /entities/0: expected an entity object {\"component\": value, ...}, got an empty array");
 }
 
-// A 10 MB unknown component name gave a 20 MB one-line message (the name
-// twice: in the pointer and quoted), and the "did you mean" search took
-// seconds on it. Long runs are cut in every loader message.
+// A 10 MB unknown component name would give a 20 MB one-line message (the
+// name twice: in the pointer and quoted), and the "did you mean" search
+// would take seconds on it. Long runs are cut in every loader message.
 TEST(LoaderRegressions, LongNamesAreCutInMessages) {
     const std::string name(10u << 20, 'q');
     const std::string r = refusal(R"({"entities": [{")" + name + R"(": 1}]})");
@@ -329,10 +329,10 @@ TEST(LoaderRegressions, LongNamesAreCutInMessages) {
     EXPECT_NE(cut.find("...(400 bytes)"), std::string::npos) << cut;
 }
 
-// Found by the hour-long fuzz run: a key of many short runs joined by form
-// feeds and newlines. The message was cut to 4,096 bytes and then each
-// control byte was escaped as \xNN, so it came out 4,977 bytes long. Now it
-// is escaped first and cut after, and the bound holds for any key.
+// A key of many short runs joined by form feeds and newlines (from a fuzz
+// run): cut to 4,096 bytes and then escaped as \xNN, its message would be
+// 4,977 bytes long. Escaped first and cut after, the bound holds for any
+// key.
 TEST(LoaderRegressions, EscapingControlCharactersDoesNotPushAMessagePastTheBound) {
     // Short runs (40 bytes, 100 once escaped: under the 120 that gets a run
     // cut on its own) separated by spaces, so only the whole-message bound

@@ -184,7 +184,7 @@ TEST(RenderBatching, OffscreenBodiesAreCulled) {
 
 TEST(RenderBatching, ContactMarkersAndAnchoredSpringsDoNotSplitBatches) {
     // A contact is an arrow and a dot, an anchored spring a pin and
-    // segments. Drawn item by item they used to start a new batch (a draw
+    // segments. Drawn item by item they would start a new batch (a draw
     // call) per item: 4,000 draw calls for 2,000 contacts.
     Scene scene = packedCircles(10, 20);
     const std::vector<Entity> order = scene.registry.entities();  // the floor, then c0 .. c199

@@ -91,7 +91,7 @@ TEST(SaveUnderFault, SigkillAtRandomPointsLeavesEitherTheOldOrTheNewFileNeverAPa
     // left the file unchanged and no temporary was too early, one that
     // found the file changed was too late. Both "killed with a temporary
     // half written" and "killed just after the rename" then happen many
-    // times in every run, however fast this machine is today.
+    // times in every run, however fast this machine is.
     const auto micros = [](Clock::duration d) {
         return std::chrono::duration_cast<std::chrono::microseconds>(d).count();
     };

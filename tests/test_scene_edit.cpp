@@ -137,8 +137,8 @@ TEST(WorldSettingsEdit, OutOfRangeRefusedWithTheLoadersWords) {
 }
 
 TEST(WorldSettingsEdit, AcceptsWhatTheLoaderAccepts) {
-    // 600 solver iterations load from a file; the World panel took at most
-    // 200 before it read the table.
+    // 600 solver iterations load from a file, so the World panel, which
+    // reads the same table, takes them too.
     Fixture f("default.json");
     std::optional<Error> refused;
     EXPECT_TRUE(f.ed.applyEdit("world", [&](Scene& s) {

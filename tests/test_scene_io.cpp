@@ -384,8 +384,8 @@ TEST(SceneFile, SaveIntoMissingFolderFailsCleanly) {
 
 TEST(WorldFields, SchemaWorldObjectIsTheTable) {
     // The schema's world properties are the table's rows: same keys in the
-    // same order, same kind, same bounds (solver_iterations was 1..1000 in the
-    // loader and 1..200 in the editor's World panel before the table).
+    // same order, same kind, same bounds (one table, so the loader and the
+    // editor's World panel cannot disagree on a range).
     const auto schema = nlohmann::json::parse(sceneJsonSchema());
     const auto& properties = schema["properties"]["world"]["properties"];
     ASSERT_EQ(properties.size(), worldFieldTable().size());

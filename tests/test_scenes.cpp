@@ -1,12 +1,11 @@
-// The shared scene builders (engine/scenes/generated_scenes.hpp). The benchmarks,
-// the editor's --bench-bodies level and the tests each built their own pile
-// of circles in a box before; they now share one CircleGrid with their own
-// parameters. The hashes below are of each scene's saved JSON text (every
-// position, radius, velocity, name and colour, to the last bit) as the
-// separate builders made it before they were shared, so the figures in
-// docs/performance.md and docs/collisions.md and the tests' bounds were
-// measured on exactly these scenes. A change that moves a scene must fail
-// here: re-measure what depends on it and re-record.
+// The shared scene builders (engine/scenes/generated_scenes.hpp). The
+// benchmarks, the editor's --bench-bodies level and the tests share one
+// CircleGrid, each with its own parameters. The hashes below are of each
+// scene's saved JSON text (every position, radius, velocity, name and
+// colour, to the last bit): the figures in docs/performance.md and
+// docs/collisions.md and the tests' bounds were measured on exactly these
+// scenes. A change that moves a scene must fail here: re-measure what
+// depends on it and re-record.
 
 #include "app/scene_edit.hpp"
 #include "generated_scenes.hpp"
@@ -31,8 +30,8 @@ using test::fnv1a;
 using test::hex;
 
 void expectBytes(const Scene& scene, std::uint64_t recorded, std::size_t size, const char* what) {
-    // Recorded before the writer added the world's sleep lines (the
-    // entities, whose bytes matter here, did not change).
+    // Recorded without the world's sleep lines (the entities' bytes are
+    // what matter here).
     const std::string text = test::withoutSleepLines(sceneToJsonText(scene));
     EXPECT_EQ(text.size(), size) << what;
     EXPECT_EQ(hex(fnv1a(text)), hex(recorded)) << what;

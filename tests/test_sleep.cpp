@@ -366,7 +366,7 @@ TEST(Sleep, EditsSettersAndTheMouseSpringWakeTheIslandsTheyTouch) {
 // A ball rolling at 1 cm/s toward a settled stack, 15 mm from it: rolling
 // costs no energy and the ball moves faster than the drift limit (5 mm/s),
 // so it never sleeps. The stack must sleep all the same (a speculative
-// point across the gap joins no island: it did, and a rolling trio kept
+// point across the gap joins no island: joined, a rolling trio would keep
 // pile.json's 2,000 bodies awake), and wake before the ball touches it:
 // within reach of this step: the gap the two can close in dt (relative
 // speed at either end of the step, forces included: a sleeping box is

@@ -177,9 +177,9 @@ TEST(World, DivergenceNamesStepEntityAndQuantityAndKeepsState) {
 }
 
 // A step that diverges leaves the whole carried state as it was, the
-// solver's too: before, the failed step's contact cache and joint impulses
-// stayed in place and warmed the next step (a retry after an edit, a reload
-// keeping the warm start), so the World was not "as before that step".
+// solver's too: the failed step's contact cache and joint impulses must not
+// stay in place and warm the next step (a retry after an edit, a reload
+// keeping the warm start), or the World is not "as before that step".
 TEST(World, DivergenceLeavesTheWarmStartAndJointImpulsesAsTheyWere) {
     // A ball resting on a floor (contact impulses), a swinging pendulum
     // (joint impulses), and a shapeless body at 1e308 m/s that overflows in
@@ -339,10 +339,10 @@ TEST(WorldCli, ExplicitBlowUpOnStiffChainExitsThree) {
 } // namespace
 
 // A spring of k = 1e25 on 1 kg bodies makes M + h^2 K singular in
-// doubles (the masses are lost to rounding). The factorisation failed and
-// the step kept v1 = v0 for every body, a free falling one too, reporting
-// success. Refused now, like a non-finite value: the state stays at the
-// start of the step and the message names the spring's bodies only.
+// doubles (the masses are lost to rounding). The factorisation fails, and
+// a step that kept v1 = v0 for every body (a free falling one too) would
+// report success. It is refused, like a non-finite value: the state stays
+// at the start of the step and the message names the spring's bodies only.
 TEST(World, AFailedImplicitSolveIsRefusedAndNamesOnlyItsBodies) {
     for (const char* k : {"1e25", "1e100"})
         for (const char* integrator : {"implicit_euler", "implicit_midpoint"}) {

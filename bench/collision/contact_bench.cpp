@@ -38,7 +38,7 @@ Scene sceneNamed(const std::string& name) {
     for (scenes::NamedScene& s : scenes::benchmarkScenes())
         if (s.name == name) {
             // Sleeping off, as Box2D's: every step does the full work (with
-            // sleeping on, the settled pyramid cost a fifth of a step).
+            // sleeping on, the settled pyramid costs a fifth of a step).
             s.scene.world.sleep = false;
             return std::move(s.scene);
         }

@@ -191,8 +191,8 @@ int runScripted(const EditOptions& o, int width, int height) {
                 frame();
             }
             // A whole keypress lets go of its modifiers too: a held ctrl
-            // made ImGui drop the characters of a following `text` line
-            // (after ctrl+shift+s, Save as kept its suggestion).
+            // makes ImGui drop the characters of a following `text` line
+            // (after ctrl+shift+s, Save as would keep its suggestion).
             if (c.kind == K::Key) pressMods(c.mods, false);
             break;
         }

@@ -10,13 +10,13 @@ namespace stepwise::cli {
 
 /// CLI11 check for a step count: a whole number >= 0. The message names the
 /// option and what was expected ("--steps: expected a whole number >= 0,
-/// got -5"); CLI::NonNegativeNumber printed all 309 digits of DBL_MAX as
-/// the range and called "abc" a value out of range.
+/// got -5"); CLI::NonNegativeNumber prints all 309 digits of DBL_MAX as
+/// the range and calls "abc" a value out of range.
 CLI::Validator wholeNumberAtLeastZero();
 
 /// CLI11 check for an output file option: a non-empty name ("--out:
-/// expected a file name, got \"\""; an empty name gave ": error: ..." with
-/// no name at all).
+/// expected a file name, got \"\""; unchecked, an empty name gives
+/// ": error: ..." with no name at all).
 CLI::Validator outputFileName();
 
 /// CLI11 check for --dt: a number of seconds in (0, 10], the documented

@@ -29,7 +29,8 @@ PanelRects defaultLayout(float width, float height, float scale) {
     const float status = 13.0f * scale + 10.0f;  // status bar
     float left = std::round(230.0f * scale), right = std::round(330.0f * scale);
     // A narrow window: the side panels give way so the viewport keeps 40%
-    // of the width (at 320 px wide it was pushed off the right edge).
+    // of the width (at fixed widths, a 320 px window pushes it off the
+    // right edge).
     if (width - left - right < 0.4f * width) {
         const float shrink = 0.6f * width / (left + right);
         left = std::floor(left * shrink);

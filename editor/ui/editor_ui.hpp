@@ -110,7 +110,7 @@ void applyTheme(float scale);
 /// ImGui::Begin for a panel, leaving its background out when, as of the
 /// last frame, no other window overlaps it and none is being moved or
 /// resized: the window was cleared to the same colour, and blending the
-/// panels' ~600,000 background pixels cost llvmpipe about 2 ms a frame. A
+/// panels' ~600,000 background pixels costs llvmpipe about 2 ms a frame. A
 /// panel dragged onto another has its background again from that frame.
 bool beginPanel(const char* name, bool* open, ImGuiWindowFlags flags = 0);
 

@@ -47,7 +47,7 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
         return ImGui::DragScalar(label, ImGuiDataType_Double, &v, speedFor(v), lo, hi, "%.6g");
     }
     case FieldKind::Integer: {
-        // Only world settings are integers today; 0 there is "not given"
+        // Only world settings are integers; 0 there is "not given"
         // (the engine chooses), shown as "auto" until dragged.
         int& v = std::get<int>(value);
         if (typeNow) ImGui::SetKeyboardFocusHere();
@@ -286,7 +286,7 @@ void drawInspector(UiState& ui, Editor& ed) {
                 }
                 // ImGui's drag fields take typed text only after a double
                 // click; a designer clicks once and types, and the digits
-                // then went to the tool shortcuts. A click released without
+                // would go to the tool shortcuts. A click released without
                 // a drag opens the text field on the next frame.
                 const bool numeric = f.kind == FieldKind::Number || f.kind == FieldKind::OptionalNumber ||
                                      f.kind == FieldKind::Vector || f.kind == FieldKind::OptionalVector;

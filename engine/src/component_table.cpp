@@ -65,7 +65,7 @@ std::optional<Error> finishPlane(void* component) {
     // A normal that is already unit length up to rounding is kept bit for
     // bit. Dividing it by its own rounded length would move its last bits on
     // every load, so load -> save -> load -> save would not give the same
-    // bytes: {1, 2} did. 8 ulp covers the rounding of n / |n|.
+    // bytes ({1, 2} would not). 8 ulp covers the rounding of n / |n|.
     if (std::abs(len - 1.0) <= 8.0 * std::numeric_limits<double>::epsilon()) return {};
     // The offset is measured along the normal as written (n.p >= d); keep the
     // same half-plane after normalising n by scaling d with it.
@@ -350,7 +350,7 @@ std::optional<std::string_view> closestName(std::string_view name,
     std::size_t bestDistance = std::max<std::size_t>(2, name.size() / 3) + 1;
     for (std::string_view c : candidates) {
         // The distance is at least the difference in length: skip before
-        // the O(|name| |c|) table (a 10 MB unknown name took seconds).
+        // the O(|name| |c|) table (a 10 MB unknown name would take seconds).
         const std::size_t lengthGap = name.size() > c.size() ? name.size() - c.size() : c.size() - name.size();
         if (lengthGap >= bestDistance) continue;
         const std::size_t d = editDistance(name, c);

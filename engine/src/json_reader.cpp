@@ -87,7 +87,7 @@ constexpr std::size_t kMaxSectionValues = 10'000;
 
 /// A limit passed or a rule broken while parsing: thrown by the handler,
 /// caught in parseLevelJson. `offset` is where (npos: the message has no
-/// place, as the entity and depth limits never had).
+/// place, as for the entity and depth limits).
 struct Stop {
     std::string message;
     std::size_t offset = std::string_view::npos;
@@ -134,7 +134,7 @@ private:
 /// nlohmann's DOM builder (the one Json::parse uses) with the loader's
 /// rules checked on the way. Not nlohmann's parser callback: after every
 /// value it scans the whole enclosing array for a discarded element, so
-/// 1,000,001 entities took 3 minutes to refuse (quadratic). This handler
+/// refusing 1,000,001 entities takes 3 minutes (quadratic). This handler
 /// forwards to the plain DOM builder, which is linear.
 class CheckedDomBuilder {
 public:

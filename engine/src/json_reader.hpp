@@ -19,7 +19,7 @@ using LevelJson = nlohmann::ordered_json;
 /// Parses `text` into `root`. On failure returns the whole message:
 /// "NAME:LINE:COL: error: ..." where the text has a place (syntax, a
 /// duplicate key, a NUL byte, a limit passed), else "NAME: error: ...".
-/// Rules checked on the way (README "Limits", docs/incoming/io.md):
+/// Rules checked on the way (docs/format.md, "Limits"):
 ///  - no NUL byte anywhere (nlohmann stops at one as at the end of input);
 ///  - no key twice in one object (the second is named by its JSON Pointer);
 ///  - nesting depth, entity count, JSON values in the file and in one

@@ -568,7 +568,7 @@ void writeJson(const Json& v, int indent, std::string& out) {
 /// Refusals are printed on a terminal and shown in the editor: one line of
 /// valid UTF-8. The parser's messages quote the bytes it stopped at, which
 /// may be any bytes of a broken file, and keys may hold escaped control
-/// characters; such bytes are shown as \xNN (found by fuzzing).
+/// characters; such bytes are shown as \xNN.
 std::string printableMessage(std::string_view message) {
     std::string out;
     out.reserve(message.size());
@@ -897,8 +897,8 @@ std::string completeJoint(const Registry& registry, Joint& joint) {
 Result<Scene> parseScene(std::string_view text, std::string_view sourceName, const LoadLimits& limits) {
     Result<Scene> scene = parseSceneUnchecked(text, sourceName, limits);
     // Escaped first, then cut: escaping control bytes as \xNN makes a
-    // message up to four times longer, so cutting first let it pass the
-    // 4,096-byte bound (found by fuzzing: 4,977 bytes).
+    // message up to four times longer, so cutting first would let it pass
+    // the 4,096-byte bound (a fuzzed key: 4,977 bytes).
     if (!scene) return Error{detail::shortenForMessage(printableMessage(scene.error()))};
     return scene;
 }

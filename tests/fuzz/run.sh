@@ -15,8 +15,8 @@ seconds=${1:-60}
 build=build-fuzz
 # -O2 as RelWithDebInfo has it (the executions a second are the point), but
 # line tables instead of full debug info: a report's stack still names file
-# and line, and the build costs less (world.cpp, two runs each: 19.0-23.6
-# -> 16.0-18.3 CPU s; scene_json.cpp 23.4 -> 21.9).
+# and line, and the build costs less (world.cpp 16-18 CPU s against 19-24
+# with full debug info).
 cmake -S . -B "$build" -DSTEPWISE_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG" \
   -DSTEPWISE_BUILD_TESTS=OFF -DSTEPWISE_BUILD_BENCH=OFF >/dev/null

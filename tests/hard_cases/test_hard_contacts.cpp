@@ -190,8 +190,8 @@ TEST(HardContacts, DeepPileAtAnySettingsKeepsItsBottomOnTheFloor) {
 // Bodies started on top of each other push apart by their positions: no
 // body is flung. The soft contacts push out at up to 3 m/s each (Box2D's
 // cap), and a body at the crowd's rim, out of the crowd, takes pushes from
-// a few neighbours: measured at most 11.4 m/s (300 bodies at 4 substeps),
-// where 100 bodies reached 116 m/s before crowds moved by position only.
+// a few neighbours: measured at most 11.4 m/s (300 bodies at 4 substeps);
+// moved by velocity, not by position only, 100 bodies reach 116 m/s.
 TEST(HardContacts, CrowdStartedAtOnePointSeparatesAtABoundedSpeed) {
     for (const int n : {2, 10, 64, 100, 300, 1000}) {
         for (const int substeps : {0, 1, 4}) {

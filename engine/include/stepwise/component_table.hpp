@@ -23,7 +23,7 @@ namespace stepwise {
 enum class FieldKind {
     Number,          ///< double
     /// int, a JSON integer; `range` bounds it (world settings such as
-    /// substeps: components have none today)
+    /// substeps; no component field is an integer)
     Integer,
     OptionalNumber,  ///< std::optional<double>; absent in JSON = nullopt
     Vector,          ///< Vec2, JSON {"x","y"}

@@ -122,7 +122,7 @@ struct Boid {
 };
 
 /// A constraint between two bodies, or a body and the world
-/// (SCENE_FORMAT.md, "Joints"). A joint entity has no body of its own. The
+/// (docs/joints.md, "In a level file"). A joint entity has no body of its own. The
 /// ends are entity handles, resolved from names when a file is loaded
 /// (names are used only in files), so renaming a body keeps its joints.
 /// After loading, `anchor` is consumed (turned into the locals) and

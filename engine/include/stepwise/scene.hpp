@@ -48,7 +48,8 @@ struct WorldSettings {
     /// Sleeping (Box2D's islands): dynamic bodies connected by touching
     /// contacts, springs and joints sleep as a whole when every one of them
     /// stays under sleepVelocity for sleepTime seconds; asleep, they cost
-    /// almost nothing until something touches or edits them (docs/physics.md).
+    /// almost nothing until something touches or edits them (docs/collisions.md,
+    /// "Sleeping").
     bool sleep = true;
     /// m/s: a body is "still" while |v| + r_max |omega| (the speed of its
     /// fastest point, r_max its farthest point from the centre of mass)
@@ -108,7 +109,7 @@ struct JointImpulse {
     friend bool operator==(const JointImpulse&, const JointImpulse&) = default;
 };
 
-/// One dynamic body's sleep state (an addition): how long it has been
+/// One dynamic body's sleep state: how long it has been
 /// still, where that began, and the island it sleeps in. Awake bodies with
 /// no still window have no entry.
 struct BodySleep {
@@ -123,7 +124,7 @@ struct BodySleep {
     Entity island;
     /// Its velocity at the window's middle (m/s; until then, its latest):
     /// the acceleration that keeps a body awake is measured from it.
-    /// Absent (a file from before it was kept): the body's velocity.
+    /// Absent (a file that does not record it): the body's velocity.
     std::optional<Vec2> stillVelocity;
 
     friend bool operator==(const BodySleep&, const BodySleep&) = default;

@@ -164,7 +164,7 @@ struct WorldState {
 /// docs/collisions.md "Substeps when the level gives none".
 struct ContactSettingsChoice {
     int substeps = 1;
-    int iterations = 8;        ///< 8 at 1 substep (the old default), else 2
+    int iterations = 8;        ///< 8 at 1 substep, else 2
     int stackDepth = 0;        ///< bodies in the deepest column the scene can pile up
     double diameter = 0.0;     ///< metres, the median dynamic shape's size
     double gravity = 0.0;      ///< m/s^2, |world.gravity|
@@ -181,7 +181,8 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene);
 /// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
 /// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
 /// compresses by load / (m_n omega^2), omega = 2 pi min(60 Hz, 1 / (4 h)),
-/// with a factor measured on the 30-row pile (docs: collide.md). The lowest
+/// with a factor measured on the 30-row pile (docs/collisions.md, "Substeps
+/// when the level gives none"). The lowest
 /// contact between bodies carries (depth - 1) heavy bodies on a light one:
 /// load (depth - 1) M g over m_n = m M / (m + M), i.e. (depth - 1)(1 + R)
 /// m_n g with R = M / m (2 (depth - 1) for equal bodies).
@@ -296,7 +297,7 @@ public:
     /// (drag, spring damping, boids) act on bodies, not on a probe.
     Vec2 probeForce(Vec2 point, Vec2 velocity = {}) const;
 
-    /// Sleeping (world.sleep; docs/physics.md "Sleeping"): whether dynamic
+    /// Sleeping (world.sleep; docs/collisions.md "Sleeping"): whether dynamic
     /// body `body` sleeps, how many do, and their entities.
     bool asleep(std::size_t body) const;
     std::size_t sleepingBodyCount() const;

@@ -9,8 +9,8 @@ namespace {
 /// Sorts 64-bit keys ascending, the order std::sort gives, in linear time:
 /// least-significant-digit radix sort by bytes, skipping the bytes that are
 /// the same in every key (most are: indices below 65,536, a few cells).
-/// Measured on the 2,000-circle pile: the pair and cell sorts were a fifth
-/// of the broad phase.
+/// With std::sort the pair and cell sorts take a fifth of the broad phase
+/// on the 2,000-circle pile.
 void radixSort(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch) {
     const std::size_t n = keys.size();
     if (n < 256) {
@@ -128,8 +128,8 @@ void BroadPhase::sweepAndPrune(std::span<const Aabb> boxes, std::span<const std:
         order_[j] = key;
     }
     // Sweep over a sorted, packed copy: the inner loop then reads memory in
-    // order instead of jumping through order_ (measured 3x faster on a
-    // 2,000-body pile, where each box overlaps ~36 others in x).
+    // order instead of jumping through order_ (3x faster on a 2,000-body
+    // pile, where each box overlaps ~36 others in x).
     sorted_.resize(n);
     for (std::uint32_t i = 0; i < n; ++i) {
         const std::uint32_t k = order_[i];

@@ -567,10 +567,10 @@ void CollisionSystem::addDeepOverlapsToCrowd() {
     // one's reach did not get there by the solver: they were placed so
     // (bodies started at one point, an edit, an emitter). Their push-out is
     // taken as a position change only, like a crowded cell's: summed over a
-    // few dozen such contacts, pushes of up to pushMaxVelocity each flung a
-    // hundred balls started at one point at over 100 m/s. (A tenth held the
-    // crowd's rim slower but caught bodies that an impact had packed
-    // together: Box2D's smash scene kept 0.3 m overlaps that never opened.)
+    // few dozen such contacts, pushes of up to pushMaxVelocity each would
+    // fling a hundred balls started at one point out at over 100 m/s. (A
+    // tenth would also catch bodies that an impact packs together, and
+    // Box2D's smash scene would keep 0.3 m overlaps that never open.)
     inCrowd_.assign(bodies_.size(), 0);
     for (const std::uint32_t b : crowdBodies_) inCrowd_[b] = 1;
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
@@ -605,7 +605,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         detected_ = true;
         // The joints' geometric stiffness, from the last step's impulses at
         // this step's start: once a step (it changes slowly, and a pass over
-        // every joint each substep cost as much as a Gauss-Seidel pass).
+        // every joint each substep costs as much as a Gauss-Seidel pass).
         if (!joints_.empty()) joints::stiffenRotation(joints_, bodies_, h, stiffened_, stiffenScratch_);
         // The awake solver bodies' indices side by side, for the substeps'
         // loops (a Collider is over a hundred bytes; these are twelve).
@@ -627,7 +627,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // soft constraint itself becomes unstable (Box2D v3.0's cap; v3.1
     // lowered it to an eighth). Contacts
     // with static bodies may be twice as stiff, but under the same cap:
-    // above it a heavy box on light boxes never comes to rest (measured).
+    // above it a heavy box on light boxes never comes to rest.
     const double hertz = std::min(settings_.contactHertz, 0.25 / h);
     const Softness soft = Softness::make(hertz, settings_.dampingRatio, h);
     Softness staticSoft = Softness::make(std::min(2.0 * hertz, 0.25 / h), settings_.dampingRatio, h);
@@ -655,8 +655,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         jointSettings_.dampingRatio.value_or(joints::JointSettings::kTreeDampingRatio), h);
     lastH_ = h;
     // In a crowd every pair approaches every other: the passes would run to
-    // the bound over hundreds of thousands of contacts (measured: 60% of a
-    // 2,000-body crowd's step). Two passes there; the push-apart does the rest.
+    // the bound over hundreds of thousands of contacts (60% of a 2,000-body
+    // crowd's step). Two passes there; the push-apart does the rest.
     propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, crowdBodies_.empty() ? 64 : 2,
                      impactScratch_);
     if (settings_.warmStart) {
@@ -704,8 +704,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // The impulses the biased passes added to the crowd's contacts are the
     // push-out it took as motion only: left in, the relax pass would take
     // them back from velocities they were never applied to, pulling apart
-    // bodies together (measured: 100 balls started at one point reached
-    // 160 m/s in their second step). The warm-started impulses, which the
+    // bodies together (100 balls started at one point would reach 160 m/s
+    // in their second step). The warm-started impulses, which the
     // velocities do carry, go back with the velocities.
     if (!crowdBodies_.empty()) coloured_.restoreImpulses(constraints_, inCrowd_, crowdImpulses_);
     // A body turning about a centre of mass off its position moves its

@@ -19,8 +19,8 @@ struct Rot {
     static Rot fromAngle(double angle) { return {std::cos(angle), std::sin(angle)}; }
 };
 /// The rotation by an angle x (rad) that is usually small: a body's turn
-/// since the step began, which the solver needs every substep (sincos was 8%
-/// of a 20-row pyramid's step). Below 1/16 rad, Taylor series through x^9
+/// since the step began, which the solver needs every substep (sincos would
+/// be 8% of a 20-row pyramid's step). Below 1/16 rad, Taylor series through x^9
 /// (sine) and x^8 (cosine): the first terms left out are under 2.5e-19, so
 /// only rounding separates it from libm's (within two units in the last
 /// place, tests/test_collision.cpp); no libm call, so also the same on every

@@ -237,8 +237,8 @@ void solveContacts(std::span<ContactConstraint> contacts, std::span<const std::u
         // Work on local copies of the two bodies' velocities and store them
         // once per manifold: A and B never alias, but the compiler cannot
         // know, and every point's update would otherwise go through memory
-        // before the next point reads it (measured: the solve's critical
-        // path, not its instruction count, was the cost).
+        // before the next point reads it (the solve's critical path, not its
+        // instruction count, is its cost).
         Vec2 vA = a.v, vB = b.v;
         double wA = a.w, wB = b.w;
         const double mA = a.invMass, mB = b.invMass, iA = a.invInertia, iB = b.invInertia;

@@ -122,11 +122,10 @@ std::pair<int, double> maxSeparation(const WorldPolygon& a, const WorldPolygon& 
 /// The manifold from reference face `refEdge` of `ref` and the edge of
 /// `inc` most facing it: the incident edge clipped against the reference
 /// face's side planes. Side-plane points get ids sideId + refEdge and
-/// sideId + sideStride + refEdge (boxes and polygons keep their own ranges,
-/// so box ids are what they always were).
+/// sideId + sideStride + refEdge (boxes and polygons keep their own ranges).
 /// Boxes go in as they are (four corners, a count known when compiled):
-/// copying one into a WorldPolygon wrote 264 bytes for 128 (measured on a
-/// 20-row pyramid: 30% of the box-box instructions); the arithmetic is the same.
+/// copying one into a WorldPolygon writes 264 bytes for 128 (30% of the
+/// box-box instructions on a 20-row pyramid); the arithmetic is the same.
 inline int cornerCount(const WorldPolygon& p) { return p.count; }
 constexpr int cornerCount(const BoxPolygon&) { return 4; }
 

@@ -3,15 +3,12 @@
 // state of the dynamic bodies. State arrays are plain doubles, interleaved
 // per body (x0, y0, x1, y1, ...), 2*n long: a Vec2 array without the
 // aliasing question, and the layout the springs want (one cache line holds
-// both coordinates of a body). Measured against split x[]/y[] arrays in
-// bench/stepwise_bench.cpp (Layout/*, 2-core Xeon, see
-// docs/performance.md): for the streaming Euler kernel split arrays
-// were ~30% faster while the state fits in cache (1e4-1e5 bodies) and
-// ~10% faster at 1e6 (memory-bound); for the spring pass, which gathers
-// both ends, the two were equal up to 1e5 and interleaved ~11% faster at
-// 1e6. Springs dominate every scene that has them, and the streaming
-// kernels are memory-bound where it matters, so the state stays
-// interleaved.
+// both coordinates of a body). Split x[]/y[] arrays would speed the
+// streaming Euler kernel (~30% while the state fits in cache, ~10% at 1e6
+// bodies, memory-bound), but the spring pass, which gathers both ends, is
+// ~11% faster interleaved at 1e6; springs dominate every scene that has
+// them, and the streaming kernels are memory-bound where it matters
+// (bench/stepwise_bench.cpp Layout/*, docs/performance.md, "Integrators").
 //
 // Each system appends to an acceleration array (m/s^2), never to forces, so
 // the integrators need no mass division. A system that the scene does not

@@ -38,9 +38,9 @@ constexpr double kRelaxRegularisation = 1e-9;
 /// (metres; rad for a weld's angle). A projection moves positions without
 /// turning the velocities with them, and the next substep's rows then take
 /// the velocity's component into the joint away: an inelastic loss of about
-/// (w h)^2 of the kinetic energy per substep (measured: a swinging link
-/// lost 26% of its energy in 5 s at 4 substeps when every error was
-/// projected). The soft rows keep a pendulum's error well under the slop,
+/// (w h)^2 of the kinetic energy per substep (a swinging link with every
+/// error projected loses 26% of its energy in 5 s at 4 substeps). The soft
+/// rows keep a pendulum's error well under the slop,
 /// so only a joint pulled open (a light chain whipped by a heavy end, few
 /// substeps) is projected, and only by the excess.
 constexpr double kProjectionSlop = 0.0005;

@@ -256,7 +256,7 @@ double expectedPileOverlap(int depth, double gravity, double h, double massRatio
     // (depth - 1) heavy bodies on a light one (world.hpp). kMeasured folds in
     // what the model leaves out (contacts share the load unevenly, a few
     // iterations do not fully converge); measured on the 30-row, 300-circle
-    // pile (docs: collide.md).
+    // pile (docs/collisions.md, "Substeps when the level gives none").
     constexpr double kMeasured = 1.0;
     if (depth < 2 || !(gravity > 0.0) || !(h > 0.0)) return 0.0;
     const double ratio = std::max(1.0, massRatio);
