@@ -1,12 +1,15 @@
-// Google Benchmark: what one undoable edit costs the editor as the level
-// grows. Moving one body (one step of a drag) should cost the same in a
-// level of 2,000, 20,000 or 200,000 bodies; a copy of the whole scene is
-// the peer, measured in the same run, since the cost of an edit that
-// copied the scene grows with it. Not part of ctest.
+// Google Benchmark: what one step of a drag costs the editor as the level
+// grows. Moving one body should cost the same in a level of 2,000, 20,000
+// or 200,000 bodies: in the undo stack (BM_DragOneBody; the peer is a copy
+// of the whole scene, BM_CopyScene) and, while paused, in the live World
+// too (BM_DragOneBodyWhilePaused; the peer is a rebuild of the World from
+// the scene, BM_ReloadWorld, which an edit that is not a move still costs).
+// Not part of ctest.
 //
 //   build/bench/editor_bench --benchmark_min_time=0.2
 
 #include "app/command_stack.hpp"
+#include "app/editor.hpp"
 #include "generated_scenes.hpp"
 
 #include "stepwise/components.hpp"
@@ -56,6 +59,40 @@ void BM_CopyScene(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_CopyScene)->Arg(2000)->Arg(20000)->Arg(200000)->Unit(benchmark::kMicrosecond);
+
+/// One step of a drag in the editor while the run is paused: the undo
+/// record and the live World's body, in place.
+void BM_DragOneBodyWhilePaused(benchmark::State& state) {
+    editor::Editor ed;
+    ed.doc.reset(scenes::circlesInBox(int(state.range(0))));
+    ed.stepForward();
+    const std::vector<Entity> bodies = bodiesOf(ed.doc.scene);
+    const Entity dragged = bodies[bodies.size() / 2];
+    const std::uint64_t builds = ed.sim.worldBuilds();
+    double dx = 0.0;
+    for (auto _ : state) {
+        dx += 1e-3;
+        const bool done = ed.applyEdit("drag", [&](Scene& s) {
+            s.registry.tryGet<Position>(dragged)->value.x += dx;
+            return true;
+        }, 1);
+        benchmark::DoNotOptimize(done);
+    }
+    ed.stepForward();
+    if (ed.sim.worldBuilds() != builds) state.SkipWithError("the drag rebuilt the World");
+}
+BENCHMARK(BM_DragOneBodyWhilePaused)->Arg(2000)->Arg(20000)->Arg(200000)->Unit(benchmark::kMicrosecond);
+
+/// The peer: the World rebuilt from the scene (World::reload).
+void BM_ReloadWorld(benchmark::State& state) {
+    const Scene scene = scenes::circlesInBox(int(state.range(0)));
+    Result<World> world = World::build(scene);
+    for (auto _ : state) {
+        Result<void> reloaded = world->reload(scene);
+        benchmark::DoNotOptimize(reloaded.ok());
+    }
+}
+BENCHMARK(BM_ReloadWorld)->Arg(2000)->Arg(20000)->Arg(200000)->Unit(benchmark::kMicrosecond);
 
 } // namespace
 

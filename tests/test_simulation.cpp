@@ -87,6 +87,96 @@ TEST(Simulation, AMouseSpringDragBuildsTheWorldOnceAndPullsTheBody) {
     EXPECT_EQ(f.ed.sim.worldBuilds(), buildsBefore + 2);  // released: rebuilt without it
 }
 
+// Moving bodies while paused goes to the live World in place, with no
+// rebuild, and the run goes on exactly as from a World rebuilt from the
+// edited scene (which carries the same warm start): the same bits after 20
+// more steps, for a body on top of the pile, one inside it and one at the
+// floor, each moved and given a velocity.
+TEST(Simulation, AMoveWhilePausedGoesToTheWorldInPlaceAndRunsAsARebuild) {
+    for (const char* name : {"c1999", "c1000", "c0"}) {
+        SCOPED_TRACE(name);
+        Fixture inPlace("pile.json"), rebuilt("pile.json");
+        Entity body;
+        for (Fixture* f : {&inPlace, &rebuilt}) {
+            f->ed.togglePlay();
+            for (int i = 0; i < 30; ++i) f->ed.update(1.0 / 60.0);
+            f->ed.togglePlay();
+            ASSERT_EQ(f->ed.sim.state(), SimState::Paused);
+            body = findByName(f->ed.doc.scene.registry, name);
+            ASSERT_TRUE(f->ed.doc.scene.registry.alive(body));
+        }
+        const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
+        for (Fixture* f : {&inPlace, &rebuilt}) {
+            ASSERT_TRUE(f->ed.applyEdit("move", [&](Scene& s) {
+                s.registry.tryGet<Position>(body)->value.y += 0.75;
+                s.registry.emplace<Velocity>(body, Velocity{{1.5, -0.5}});
+                return true;
+            }));
+        }
+        rebuilt.ed.sim.sceneChanged();  // the other path: rebuild from the edited scene
+        for (int i = 0; i < 20; ++i) {
+            inPlace.ed.stepForward();
+            rebuilt.ed.stepForward();
+        }
+        EXPECT_EQ(inPlace.ed.sim.worldBuilds(), builds) << "moved in place, never rebuilt";
+        EXPECT_GT(rebuilt.ed.sim.worldBuilds(), builds);
+        EXPECT_EQ(textOf(inPlace.ed.doc.scene), textOf(rebuilt.ed.doc.scene));
+    }
+}
+
+// A body of a sleeping pyramid moved in place wakes its island, as the
+// rebuild does, and the two runs agree bit for bit.
+TEST(Simulation, AMoveInPlaceWakesTheSleepingIslandAsARebuildDoes) {
+    Fixture inPlace("pyramid.json"), rebuilt("pyramid.json");
+    Entity top;
+    for (Fixture* f : {&inPlace, &rebuilt}) {
+        f->ed.togglePlay();
+        for (int i = 0; i < 900 && (!f->ed.sim.world() || f->ed.sim.world()->sleepingBodyCount() == 0); ++i)
+            f->ed.update(1.0 / 60.0);
+        f->ed.togglePlay();
+        ASSERT_GT(f->ed.sim.world()->sleepingBodyCount(), 0u) << "the pyramid falls asleep";
+        const Registry& reg = f->ed.doc.scene.registry;
+        double highest = -1e300;
+        for (Entity e : reg.entities())
+            if (reg.has<Box>(e) && reg.tryGet<Position>(e)->value.y > highest && !(reg.has<Static>(e) && reg.tryGet<Static>(e)->value)) {
+                highest = reg.tryGet<Position>(e)->value.y;
+                top = e;
+            }
+    }
+    const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
+    for (Fixture* f : {&inPlace, &rebuilt})
+        ASSERT_TRUE(f->ed.applyEdit("move", [&](Scene& s) {
+            s.registry.tryGet<Position>(top)->value.x += 0.3;
+            return true;
+        }));
+    rebuilt.ed.sim.sceneChanged();
+    for (int i = 0; i < 20; ++i) {
+        inPlace.ed.stepForward();
+        rebuilt.ed.stepForward();
+    }
+    EXPECT_EQ(inPlace.ed.sim.worldBuilds(), builds);
+    EXPECT_EQ(textOf(inPlace.ed.doc.scene), textOf(rebuilt.ed.doc.scene));
+    const World& w = *inPlace.ed.sim.world();
+    for (std::size_t b = 0; b < w.bodyCount(); ++b)
+        if (w.bodyEntity(b) == top) EXPECT_FALSE(w.asleep(b)) << "the moved box's island woke";
+}
+
+// Anything but a move (here a mass) rebuilds the World.
+TEST(Simulation, AnEditBeyondPositionAndVelocityRebuildsTheWorld) {
+    Fixture f("pile.json");
+    f.ed.togglePlay();
+    f.ed.update(1.0 / 60.0);
+    f.ed.togglePlay();
+    const std::uint64_t builds = f.ed.sim.worldBuilds();
+    const Entity body = findByName(f.ed.doc.scene.registry, "c10");
+    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
+        s.registry.emplace<Mass>(body, Mass{4.0});
+        return true;
+    }));
+    f.ed.stepForward();
+    EXPECT_EQ(f.ed.sim.worldBuilds(), builds + 1);
+}
+
 TEST(Simulation, DisabledSystemIsLeftOutOfTheWorld) {
     Fixture f("spring_chain.json");
     f.ed.sim.disabledSystems.insert("springs");

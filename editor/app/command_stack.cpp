@@ -41,43 +41,88 @@ void takeOptional(const std::string& in, std::size_t& at, void* field) {
     if (take<std::uint8_t>(in, at)) o = take<T>(in, at);
 }
 
+/// Appends component `c` of the table (at `component`) to `out`.
+void encodeComponent(std::string& out, std::size_t c, const void* component) {
+    const std::span<const ComponentInfo> table = componentTable();
+    put(out, std::uint8_t(c));
+    for (const FieldInfo& f : table[c].fields) {
+        const void* field = f.address(const_cast<void*>(component));
+        switch (f.kind) {
+        case FieldKind::Number: put(out, *static_cast<const double*>(field)); break;
+        case FieldKind::Integer: put(out, *static_cast<const int*>(field)); break;
+        case FieldKind::VectorList: {
+            const auto& list = *static_cast<const std::vector<Vec2>*>(field);
+            put(out, std::uint32_t(list.size()));
+            for (const Vec2 p : list) put(out, p);
+            break;
+        }
+        case FieldKind::OptionalNumber: putOptional<double>(out, field); break;
+        case FieldKind::Vector: put(out, *static_cast<const Vec2*>(field)); break;
+        case FieldKind::OptionalVector: putOptional<Vec2>(out, field); break;
+        case FieldKind::Color: put(out, *static_cast<const Rgb*>(field)); break;
+        case FieldKind::Bool: put(out, std::uint8_t(*static_cast<const bool*>(field))); break;
+        // A handle is stored as it is: undo and redo act on the same
+        // registry, where it stays valid (or is detected as stale).
+        case FieldKind::EntityRef: put(out, *static_cast<const Entity*>(field)); break;
+        case FieldKind::String: {
+            const auto& text = *static_cast<const std::string*>(field);
+            put(out, std::uint32_t(text.size()));
+            out += text;
+            break;
+        }
+        }
+    }
+}
+
 std::string encodeEntity(const Registry& reg, Entity e) {
     if (!reg.alive(e)) return {};
     std::string out(1, kAlive);
     const std::span<const ComponentInfo> table = componentTable();
-    for (std::size_t c = 0; c < table.size(); ++c) {
-        const void* component = table[c].getConst(reg, e);
-        if (!component) continue;
-        put(out, std::uint8_t(c));
-        for (const FieldInfo& f : table[c].fields) {
-            const void* field = f.address(const_cast<void*>(component));
-            switch (f.kind) {
-            case FieldKind::Number: put(out, *static_cast<const double*>(field)); break;
-            case FieldKind::Integer: put(out, *static_cast<const int*>(field)); break;
-            case FieldKind::VectorList: {
-                const auto& list = *static_cast<const std::vector<Vec2>*>(field);
-                put(out, std::uint32_t(list.size()));
-                for (const Vec2 p : list) put(out, p);
-                break;
-            }
-            case FieldKind::OptionalNumber: putOptional<double>(out, field); break;
-            case FieldKind::Vector: put(out, *static_cast<const Vec2*>(field)); break;
-            case FieldKind::OptionalVector: putOptional<Vec2>(out, field); break;
-            case FieldKind::Color: put(out, *static_cast<const Rgb*>(field)); break;
-            case FieldKind::Bool: put(out, std::uint8_t(*static_cast<const bool*>(field))); break;
-            // A handle is stored as it is: undo and redo act on the same
-            // registry, where it stays valid (or is detected as stale).
-            case FieldKind::EntityRef: put(out, *static_cast<const Entity*>(field)); break;
-            case FieldKind::String: {
-                const auto& text = *static_cast<const std::string*>(field);
-                put(out, std::uint32_t(text.size()));
-                out += text;
-                break;
-            }
-            }
-        }
-    }
+    for (std::size_t c = 0; c < table.size(); ++c)
+        if (const void* component = table[c].getConst(reg, e)) encodeComponent(out, c, component);
     return out;
+}
+
+/// The table indices of the components in which two encodings of one
+/// entity differ (present in one and not the other included), as bits.
+std::uint64_t changedComponents(const std::string& before, const std::string& after) {
+    // Each encoding is the marker, then per component its index and bytes
+    // in table order; a component's bytes end where the next index starts,
+    // which a walk over its fields finds.
+    const auto spans = [](const std::string& in) {
+        std::vector<std::pair<std::uint8_t, std::string_view>> out;
+        const std::span<const ComponentInfo> table = componentTable();
+        std::size_t at = in.empty() ? 0 : 1;
+        while (at < in.size()) {
+            const std::size_t start = at;
+            const std::uint8_t c = take<std::uint8_t>(in, at);
+            for (const FieldInfo& f : table[c].fields) {
+                switch (f.kind) {
+                case FieldKind::Number: at += sizeof(double); break;
+                case FieldKind::Integer: at += sizeof(int); break;
+                case FieldKind::VectorList: at += take<std::uint32_t>(in, at) * sizeof(Vec2); break;
+                case FieldKind::OptionalNumber: at += take<std::uint8_t>(in, at) ? sizeof(double) : 0; break;
+                case FieldKind::Vector: at += sizeof(Vec2); break;
+                case FieldKind::OptionalVector: at += take<std::uint8_t>(in, at) ? sizeof(Vec2) : 0; break;
+                case FieldKind::Color: at += sizeof(Rgb); break;
+                case FieldKind::Bool: at += 1; break;
+                case FieldKind::EntityRef: at += sizeof(Entity); break;
+                case FieldKind::String: at += take<std::uint32_t>(in, at); break;
+                }
+            }
+            out.emplace_back(c, std::string_view(in).substr(start, at - start));
+        }
+        return out;
+    };
+    const auto was = spans(before), now = spans(after);
+    std::uint64_t mask = 0;
+    for (const auto& [c, bytes] : was) {
+        const auto same = std::find_if(now.begin(), now.end(), [&](const auto& n) { return n.first == c; });
+        if (same == now.end() || same->second != bytes) mask |= std::uint64_t(1) << c;
+    }
+    for (const auto& [c, bytes] : now)
+        if (std::none_of(was.begin(), was.end(), [&](const auto& w) { return w.first == c; })) mask |= std::uint64_t(1) << c;
+    return mask;
 }
 
 /// Gives alive entity `e` (with no components) the encoded components.
@@ -239,6 +284,10 @@ bool CommandStack::apply(Scene& scene, std::string label, const std::function<bo
         apply(scene, change, false);  // an edit that gave up must leave no trace
         return false;
     }
+    lastEdit_.entities.clear();
+    for (const Delta::EntityChange& c : change.entities)
+        lastEdit_.entities.emplace_back(c.entity, changedComponents(c.before, c.after));
+    lastEdit_.beyondComponents = change.slots || change.world || change.solver || change.version;
     if (merging) {
         // The command keeps its original "before"; only "after" moves on.
         Command& top = commands_[cursor_ - 1];

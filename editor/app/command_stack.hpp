@@ -59,6 +59,18 @@ public:
     void truncate(std::size_t n);
     void clear();
 
+    /// What the last successful apply() changed, that edit alone (merged
+    /// into the command before it or not): each entity it changed, with the
+    /// component-table indices of its changed components as bits, and
+    /// whether anything else changed (entities created or destroyed, the
+    /// world settings, the solver state). The simulation applies an edit
+    /// that only moved bodies to its World in place.
+    struct EditSummary {
+        std::vector<std::pair<Entity, std::uint64_t>> entities;
+        bool beyondComponents = false;
+    };
+    const EditSummary& lastEdit() const { return lastEdit_; }
+
     /// Bumped by every apply/undo/redo: lets views know the scene changed.
     std::uint64_t revision() const { return revision_; }
     /// Position of the cursor counted from the first command ever applied
@@ -101,6 +113,7 @@ private:
     bool open_ = false;
     std::uint64_t revision_ = 0;
     std::uint64_t dropped_ = 0;
+    EditSummary lastEdit_;
 };
 
 } // namespace stepwise::editor

@@ -158,7 +158,7 @@ void Editor::resolvePending(Resolution r) {
 bool Editor::applyEdit(const std::string& label, const std::function<bool(Scene&)>& edit, std::uint64_t mergeKey) {
     if (commands.absoluteCursor() < savedCursor_) savedReachable_ = false;  // the saved state leaves the redo branch
     if (!commands.apply(doc.scene, label, edit, mergeKey)) return false;
-    sim.sceneChanged();
+    sim.sceneEdited(doc.scene, commands.lastEdit());
     pruneSelection();
     status = label;
     return true;

@@ -101,6 +101,22 @@ bool Simulation::reload(const Scene& scene) {
     return true;
 }
 
+void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary& edit) {
+    const auto bit = [](std::string_view component) {
+        return std::uint64_t(1) << std::size_t(findComponent(component) - componentTable().data());
+    };
+    static const std::uint64_t kPose = bit("position") | bit("velocity");
+    bool inPlace = world_ && !stale_ && !edit.beyondComponents;
+    for (const auto& [entity, changed] : edit.entities) {
+        if (!inPlace) break;
+        const Position* p = scene.registry.tryGet<Position>(entity);
+        const Velocity* v = scene.registry.tryGet<Velocity>(entity);
+        inPlace = (changed & ~kPose) == 0 && p && world_->moveBody(entity, p->value, v ? v->value : Vec2{});
+    }
+    // A partly applied edit is rebuilt whole, like any other.
+    if (!inPlace) stale_ = true;
+}
+
 bool Simulation::ensureWorld(const Scene& scene) {
     if (state_ == SimState::Editing) return false;
     if (!stale_ && world_) return true;

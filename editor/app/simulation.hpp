@@ -20,6 +20,8 @@
 ///   components of switched-off systems removed (gravity set to zero), so
 ///   the engine itself decides what each remaining system costs.
 
+#include "app/command_stack.hpp"
+
 #include "stepwise/scene.hpp"
 #include "stepwise/world.hpp"
 
@@ -69,6 +71,11 @@ public:
     /// The scene was changed from outside (edit, undo): rebuild before the
     /// next step.
     void sceneChanged() { stale_ = true; }
+    /// After an undoable edit: one that only moved bodies (their position
+    /// or velocity) goes to the live World in place (World::moveBody), so
+    /// the rest keeps its warm start and nothing is rebuilt; any other edit
+    /// makes the World stale.
+    void sceneEdited(const Scene& scene, const CommandStack::EditSummary& edit);
     /// Builds the World now if it is stale (for overlays while paused).
     bool ensureWorld(const Scene& scene);
 

@@ -271,6 +271,12 @@ public:
     /// cursor this way without rebuilding the world (which would also drop
     /// the contacts' warm start). Fails when `spring` is not such a spring.
     Result<void> setSpringAnchor(Entity spring, Vec2 anchor);
+    /// Puts dynamic body `body` at `position` with `velocity` (metres, m/s),
+    /// in place: its island wakes, every other body and every contact's warm
+    /// start stay as they are. The editor's move tool drags a body this way
+    /// without rebuilding the world. Fails when `body` is not a dynamic body
+    /// of this world, or a value is not finite.
+    Result<void> moveBody(Entity body, Vec2 position, Vec2 velocity);
     double time() const;
 
     /// Systems this scene needs, in pipeline order: "gravity", "drag",

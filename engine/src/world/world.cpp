@@ -636,6 +636,23 @@ Result<void> World::setSpringAnchor(Entity spring, Vec2 anchor) {
     return Error{"no anchored spring with that entity in this world"};
 }
 
+Result<void> World::moveBody(Entity body, Vec2 position, Vec2 velocity) {
+    if (!isFinite(position) || !isFinite(velocity)) return Error{"a position and velocity must be finite"};
+    const std::vector<Entity>& bodies = impl_->bodyEntity;
+    const auto it = std::find(bodies.begin(), bodies.end(), body);
+    if (it == bodies.end()) return Error{"not a dynamic body of this world"};
+    const std::size_t b = std::size_t(it - bodies.begin());
+    double* x = impl_->xs();
+    double* v = impl_->vs();
+    x[2 * b] = position.x;
+    x[2 * b + 1] = position.y;
+    v[2 * b] = velocity.x;
+    v[2 * b + 1] = velocity.y;
+    impl_->sleep.wake(std::uint32_t(b));
+    impl_->sleepChanged();
+    return {};
+}
+
 double World::time() const { return impl_->settings.time; }
 
 std::vector<std::string_view> World::activeSystems() const { return impl_->active; }
