@@ -21,52 +21,52 @@ bool Simulation::canDisable(std::string_view system) {
            system == "boids" || system == "collisions";
 }
 
-Scene Simulation::simulationScene(const Scene& scene, Entity* mouseSpringEntity) const {
+SystemSwitches Simulation::switches() const {
+    SystemSwitches out;
+    for (const std::string& name : disabledSystems) (void)out.disable(name);
+    return out;
+}
+
+std::optional<Scene> Simulation::withMouseSpring(const Scene& scene, SystemSwitches& switches,
+                                                 Entity* mouseSpringEntity) const {
+    if (!mouseSpring || !scene.registry.alive(mouseSpring->first) || !scene.registry.has<Position>(mouseSpring->first))
+        return std::nullopt;
     Scene sim = scene;  // deep copy; the same entity handles, so writeBack lands on `scene`
     Registry& reg = sim.registry;
-    auto off = [&](std::string_view s) { return disabledSystems.count(s) != 0; };
-    if (off("gravity")) sim.world.gravity = {0.0, 0.0};
-    for (Entity e : std::vector<Entity>(reg.entities())) {
-        if (off("drag")) reg.remove<Drag>(e);
-        if (off("springs") && reg.has<Spring>(e)) reg.remove<Spring>(e);
-        if (off("attractors")) reg.remove<Attractor>(e);
-        if (off("boids")) reg.remove<Boid>(e);
-        if (off("collisions")) {
-            reg.remove<Radius>(e);
-            reg.remove<Box>(e);
-            reg.remove<Plane>(e);
-            reg.remove<Restitution>(e);
-            reg.remove<Friction>(e);
-        }
+    // The mouse pulls with springs switched off too: then the level's own
+    // springs leave the copy instead.
+    if (!switches.springs) {
+        for (Entity e : reg.entities()) (void)reg.remove<Spring>(e);
+        switches.springs = true;
     }
-    if (mouseSpring && reg.alive(mouseSpring->first) && reg.has<Position>(mouseSpring->first)) {
-        // A critically damped zero-length spring to the cursor; stiffness
-        // scales with the body's mass so light and heavy bodies follow alike
-        // (omega = sqrt(k/m) = 12 rad/s, well inside every explicit
-        // integrator's limit at dt = 1/60).
-        const Entity body = mouseSpring->first;
-        const Mass* m = reg.tryGet<Mass>(body);
-        const double mass = m ? m->value : 1.0;
-        const double k = 144.0 * mass;
-        if (!reg.has<Name>(body) || reg.tryGet<Name>(body)->value.empty())
-            reg.emplace(body, Name{uniqueName(reg, "dragged")});
-        Spring s;
-        s.a = body;
-        s.anchor = mouseSpring->second;
-        s.k = k;
-        s.damping = 2.0 * std::sqrt(k * mass);
-        s.restLength = 0.0;
-        const Entity e = reg.create();
-        reg.emplace(e, Name{uniqueName(reg, "mouse_spring")});
-        reg.emplace(e, std::move(s));
-        if (mouseSpringEntity) *mouseSpringEntity = e;
-    }
+    // A critically damped zero-length spring to the cursor; stiffness
+    // scales with the body's mass so light and heavy bodies follow alike
+    // (omega = sqrt(k/m) = 12 rad/s, well inside every explicit
+    // integrator's limit at dt = 1/60).
+    const Entity body = mouseSpring->first;
+    const Mass* m = reg.tryGet<Mass>(body);
+    const double mass = m ? m->value : 1.0;
+    const double k = 144.0 * mass;
+    if (!reg.has<Name>(body) || reg.tryGet<Name>(body)->value.empty())
+        reg.emplace(body, Name{uniqueName(reg, "dragged")});
+    Spring spring;
+    spring.a = body;
+    spring.anchor = mouseSpring->second;
+    spring.k = k;
+    spring.damping = 2.0 * std::sqrt(k * mass);
+    spring.restLength = 0.0;
+    const Entity e = reg.create();
+    reg.emplace(e, Name{uniqueName(reg, "mouse_spring")});
+    reg.emplace(e, std::move(spring));
+    if (mouseSpringEntity) *mouseSpringEntity = e;
     return sim;
 }
 
 bool Simulation::rebuild(const Scene& scene) {
     builtMouseSpring_ = {};
-    Result<World> built = World::build(simulationScene(scene, &builtMouseSpring_));
+    SystemSwitches on = switches();
+    const std::optional<Scene> dragged = withMouseSpring(scene, on, &builtMouseSpring_);
+    Result<World> built = World::build(dragged ? *dragged : scene, on);
     ++worldBuilds_;
     builtMouseBody_ = builtMouseSpring_.isNull() ? Entity{} : mouseSpring->first;
     sceneAtBuild_.reset();
@@ -83,11 +83,13 @@ bool Simulation::rebuild(const Scene& scene) {
 bool Simulation::reload(const Scene& scene) {
     if (!world_) return rebuild(scene);
     Entity springEntity;
-    Scene sim = simulationScene(scene, &springEntity);
+    SystemSwitches on = switches();
+    std::optional<Scene> sim = withMouseSpring(scene, on, &springEntity);
     // The live World's own warm start carries over; a solver state the
     // scene was loaded with has been used once, at Play.
-    sim.solverState.reset();
-    Result<void> reloaded = world_->reload(sim);
+    if (scene.solverState && !sim) sim = scene;
+    if (sim) sim->solverState.reset();
+    Result<void> reloaded = world_->reload(sim ? *sim : scene, on);
     ++worldBuilds_;
     sceneAtBuild_.reset();
     if (!reloaded) {
@@ -359,11 +361,13 @@ bool Simulation::stepBack(Scene& scene) {
     const bool sameBuild = world_ && !stale_ && entry.scene == sceneAtBuild_;
     if (!sameBuild) {
         Entity springEntity;
-        Scene sim = simulationScene(scene, &springEntity);
+        SystemSwitches on = switches();
+        std::optional<Scene> dragged = withMouseSpring(scene, on, &springEntity);
+        Scene sim = dragged ? std::move(*dragged) : scene;
         sim.solverState = entry.state.solverState();
-        Result<void> r = world_ ? world_->reload(sim) : Result<void>(Error{"no world"});
+        Result<void> r = world_ ? world_->reload(sim, on) : Result<void>(Error{"no world"});
         if (!r) {
-            Result<World> built = World::build(sim);
+            Result<World> built = World::build(sim, on);
             if (!built) {
                 world_.reset();
                 message_ = "cannot simulate: " + built.error();

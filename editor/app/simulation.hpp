@@ -113,10 +113,14 @@ public:
     std::set<std::string, std::less<>> disabledSystems;
     /// Systems whose switch works: the names the editor knows how to remove.
     static bool canDisable(std::string_view system);
-    /// The scene the World is built from: switched-off systems removed,
-    /// the mouse spring added (its entity in that scene goes to
-    /// `mouseSpringEntity` when given).
-    Scene simulationScene(const Scene& scene, Entity* mouseSpringEntity = nullptr) const;
+    /// The systems switched off, as the World reads them.
+    SystemSwitches switches() const;
+    /// While the mouse drags a body during a run, the World is built from a
+    /// copy of the scene with a spring from the body to the cursor (its
+    /// entity goes to `mouseSpringEntity` when given); otherwise nullopt,
+    /// and the World is built from the scene itself.
+    std::optional<Scene> withMouseSpring(const Scene& scene, SystemSwitches& switches,
+                                         Entity* mouseSpringEntity = nullptr) const;
     /// Times the World was built since the program started (tests: a mouse
     /// drag must not rebuild it every step).
     std::uint64_t worldBuilds() const { return worldBuilds_; }

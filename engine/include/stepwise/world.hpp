@@ -177,7 +177,17 @@ struct ContactSettingsChoice {
     /// "pile 12 deep ...": what made the choice.
     std::string reason() const;
 };
-ContactSettingsChoice chooseContactSettings(const Scene& scene);
+/// Systems a World leaves out of its scene (the editor's switches). The
+/// scene keeps its components; the World compiles as if they were absent:
+/// no gravity, no drag, no springs, no attractors, no boids, or no contacts
+/// (joints still hold).
+struct SystemSwitches {
+    bool gravity = true, drag = true, springs = true, attractors = true, boids = true, collisions = true;
+    /// Switches off a system by name ("gravity", "drag", "springs",
+    /// "attractors", "boids", "collisions"); false for any other name.
+    bool disable(std::string_view system);
+};
+ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwitches& switches = {});
 /// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
 /// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
 /// compresses by load / (m_n omega^2), omega = 2 pi min(60 Hz, 1 / (4 h)),
@@ -212,7 +222,7 @@ public:
     /// Compiles `scene` into a world. Fails (with a message naming the entity
     /// and component) when the scene asks for something the engine cannot
     /// simulate.
-    static Result<World> build(const Scene& scene);
+    static Result<World> build(const Scene& scene, const SystemSwitches& switches = {});
 
     World(World&&) noexcept;
     World& operator=(World&&) noexcept;
@@ -248,7 +258,7 @@ public:
     /// from the scene; the warm start of every contact whose two entities
     /// still collide, and the step count, are kept. On failure the World is
     /// unchanged. The editor edits its one live World this way.
-    Result<void> reload(const Scene& scene);
+    Result<void> reload(const Scene& scene, const SystemSwitches& switches = {});
 
     const WorldSettings& settings() const;
     /// Where the running substeps and solver iterations came from.

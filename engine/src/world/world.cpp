@@ -580,8 +580,8 @@ Result<void> World::restoreState(const WorldState& s) {
     return {};
 }
 
-Result<void> World::reload(const Scene& scene) {
-    Result<World> next = build(scene);
+Result<void> World::reload(const Scene& scene, const SystemSwitches& switches) {
+    Result<World> next = build(scene, switches);
     if (!next) return Error{next.error()};
     if (!scene.solverState) {
         next->setSolverState(solverState());

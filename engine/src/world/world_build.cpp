@@ -224,9 +224,9 @@ std::optional<Error> checkPolygons(const Registry& reg) {
 /// that saved its state recorded what it ran (solver_state.chosen): that is
 /// kept, so a resume steps exactly as the long run (bodies that came or went
 /// since would not change it).
-std::optional<Error> chooseSolverCounts(const Scene& scene, WorldImpl& w) {
+std::optional<Error> chooseSolverCounts(const Scene& scene, const SystemSwitches& switches, WorldImpl& w) {
     const WorldSettings& ws = scene.world;
-    const ContactSettingsChoice choice = chooseContactSettings(scene);
+    const ContactSettingsChoice choice = chooseContactSettings(scene, switches);
     w.contactChoice = choice;
     const std::optional<ChosenSettings> recorded = scene.solverState ? scene.solverState->chosen : std::nullopt;
     if (recorded && (recorded->substeps < 1 || recorded->solverIterations < 1))
@@ -245,13 +245,15 @@ std::optional<Error> chooseSolverCounts(const Scene& scene, WorldImpl& w) {
 /// Shapes and joints: the collision stages, only when some entity has one;
 /// then the contact and joint solvers' settings (derivedRestitutionThreshold
 /// when the level gives none).
-std::optional<Error> compileCollisions(const Scene& scene, const BodyIndex& bodies, WorldImpl& w) {
+std::optional<Error> compileCollisions(const Scene& scene, const SystemSwitches& switches, const BodyIndex& bodies,
+                                       WorldImpl& w) {
     std::string jointProblem;
-    w.collision = detail::buildCollisions(scene, [&bodies](Entity e) { return bodies.of(e); }, kNoBody, &jointProblem);
+    w.collision = detail::buildCollisions(scene, [&bodies](Entity e) { return bodies.of(e); }, kNoBody,
+                                          switches.collisions, &jointProblem);
     if (!jointProblem.empty()) return Error{jointProblem};
-    if (std::optional<Error> refused = chooseSolverCounts(scene, w)) return refused;
+    if (std::optional<Error> refused = chooseSolverCounts(scene, switches, w)) return refused;
     if (!w.collision) return std::nullopt;
-    const WorldSettings& ws = scene.world;
+    const WorldSettings& ws = w.settings;
     const double substepLength = ws.dt / double(w.settings.substeps);
     w.collision->settings().iterations = w.settings.solverIterations;
     if (ws.jointHz) w.collision->jointSettings().hertz = *ws.jointHz;
@@ -361,7 +363,17 @@ std::shared_ptr<const WorldLayout> makeLayout(const WorldImpl& w) {
 
 } // namespace
 
-Result<World> World::build(const Scene& scene) {
+bool SystemSwitches::disable(std::string_view system) {
+    for (auto [name, on] : {std::pair<std::string_view, bool*>{"gravity", &gravity}, {"drag", &drag}, {"springs", &springs},
+                            {"attractors", &attractors}, {"boids", &boids}, {"collisions", &collisions}})
+        if (name == system) {
+            *on = false;
+            return true;
+        }
+    return false;
+}
+
+Result<World> World::build(const Scene& scene, const SystemSwitches& switches) {
     // A scene built in code or edited reaches here unchecked by the loader:
     // the settings table checks it, in the words a file would get.
     if (std::optional<Error> refused = worldSettingsProblem(scene.world)) return std::move(*refused);
@@ -373,19 +385,21 @@ Result<World> World::build(const Scene& scene) {
     auto impl = std::make_unique<WorldImpl>();
     WorldImpl& w = *impl;
     w.settings = scene.world;
+    if (!switches.gravity) w.settings.gravity = {0.0, 0.0};
     const Registry& reg = scene.registry;
     BodyIndex bodies;
     InitialState start;
     if (std::optional<Error> refused = compileBodies(reg, w, bodies, start)) return std::move(*refused);
-    compileGravity(scene.world, w.model);
-    compileDrag(reg, w);
-    if (std::optional<Error> refused = compileSprings(reg, bodies, w)) return std::move(*refused);
-    compileAttractors(reg, bodies, scene.world.G, w.model);
-    compileBoids(reg, w);
+    compileGravity(w.settings, w.model);
+    if (switches.drag) compileDrag(reg, w);
+    if (switches.springs)
+        if (std::optional<Error> refused = compileSprings(reg, bodies, w)) return std::move(*refused);
+    if (switches.attractors) compileAttractors(reg, bodies, scene.world.G, w.model);
+    if (switches.boids) compileBoids(reg, w);
     if (std::optional<Error> refused = checkPolygons(reg)) return std::move(*refused);
-    if (std::optional<Error> refused = compileCollisions(scene, bodies, w)) return std::move(*refused);
+    if (std::optional<Error> refused = compileCollisions(scene, switches, bodies, w)) return std::move(*refused);
     compileSpin(reg, w);
-    compileSleep(scene.world, w);
+    compileSleep(w.settings, w);
     listActiveSystems(w);
     allocateState(w, start, *kind);
     w.layout = makeLayout(w);

@@ -33,7 +33,7 @@ joints::JointKind jointKindOf(const std::string& type) {
 } // namespace
 
 std::unique_ptr<collision::CollisionSystem> buildCollisions(
-    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody,
+    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, bool shapes,
     std::string* problem) {
     const Registry& reg = scene.registry;
     std::unique_ptr<collision::CollisionSystem> system;
@@ -44,7 +44,8 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         system->settings().iterations = scene.world.solverIterations;
     };
     collision::ConvexPolygon polygon;  // copied by add()
-    for (const Entity e : reg.entities()) {
+    static const std::vector<Entity> kNoEntities;
+    for (const Entity e : shapes ? reg.entities() : kNoEntities) {
         collision::Collider c;
         if (const Radius* r = reg.tryGet<Radius>(e)) {
             c.shape.kind = collision::ShapeKind::Circle;
@@ -286,19 +287,21 @@ std::string ContactSettingsChoice::reason() const {
     return out;
 }
 
-ContactSettingsChoice chooseContactSettings(const Scene& scene) {
+ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwitches& switches) {
     ContactSettingsChoice choice;
     const Registry& reg = scene.registry;
     const auto& order = reg.entities();
-    choice.gravity = length(scene.world.gravity);
-    const Vec2 down = choice.gravity > 0.0 ? scene.world.gravity / choice.gravity : Vec2{0.0, -1.0};
+    const Vec2 gravity = switches.gravity ? scene.world.gravity : Vec2{};
+    choice.gravity = length(gravity);
+    const Vec2 down = choice.gravity > 0.0 ? gravity / choice.gravity : Vec2{0.0, -1.0};
     const Vec2 across{-down.y, down.x};
     const auto isStatic = [&](Entity e) {
         const Static* st = reg.tryGet<Static>(e);
         return st && st->value;
     };
+    // With contacts switched off no shape takes part.
     const auto hasShape = [&](Entity e) {
-        return reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e);
+        return switches.collisions && (reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e));
     };
     const auto dynamic = [&](Entity e) { return reg.alive(e) && reg.has<Position>(e) && !isStatic(e); };
     const auto massOf = [&](Entity e) { return reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0; };
@@ -357,7 +360,7 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene) {
         std::vector<std::pair<double, double>> flat;  // (position across gravity, size)
         for (std::uint32_t i = 0; i < bodies.size(); ++i) {
             const Entity e = bodies[i];
-            if (!(reg.has<Box>(e) || reg.has<Polygon>(e))) continue;
+            if (!switches.collisions || !(reg.has<Box>(e) || reg.has<Polygon>(e))) continue;
             if (jointed[i] && groupAnchored[findRoot(parent, i)]) continue;
             flat.emplace_back(dot(reg.tryGet<Position>(e)->value, across), sizeOf(e));
         }
@@ -383,7 +386,8 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene) {
     std::vector<Interval> walls;
     double left = -kInf, right = kInf;  // plane walls: the side bodies stay on
     double thinnest = kInf;
-    for (const Entity e : order) {
+    static const std::vector<Entity> kNoEntities;
+    for (const Entity e : switches.collisions ? order : kNoEntities) {
         if (const Plane* p = reg.tryGet<Plane>(e)) {
             const double len = length(p->normal);
             if (!(len > 0.0)) continue;

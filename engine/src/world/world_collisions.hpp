@@ -23,8 +23,9 @@ namespace stepwise::detail {
 /// shape joins the solver as a shapeless body (kShapelessRadius). A joint
 /// the engine cannot simulate (an end that no longer exists, two fixed
 /// ends) sets `problem` ("entity N (\"name\"): joint ...") and returns null.
+/// Without `shapes` (contacts switched off) only the joints are compiled.
 std::unique_ptr<collision::CollisionSystem> buildCollisions(
-    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody,
+    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, bool shapes = true,
     std::string* problem = nullptr);
 
 /// A dynamic body held by a joint but without a shape turns like a solid
