@@ -534,10 +534,10 @@ std::string writeGnuplot(const std::vector<Problem>& problems, const std::vector
 
 } // namespace
 
-std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log, std::vector<AccuracyRow>* rowsOut) {
+Result<void> runAccuracyReport(const AccuracyOptions& options, std::ostream& log, std::vector<AccuracyRow>* rowsOut) {
     std::error_code ec;
     std::filesystem::create_directories(options.out, ec);
-    if (ec) return "cannot create " + options.out.string() + ": " + ec.message();
+    if (ec) return Error{"cannot create " + options.out.string() + ": " + ec.message(), "", ErrorKind::Io};
     const bool quick = options.quick;
     const double minSeconds = quick ? 0.002 : 0.02;
     const int maxRepeats = quick ? 3 : 10;
@@ -747,9 +747,11 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
         md << "![work-precision](accuracy.png)\n";
     }
     std::string staging = (options.out / ".accuracy-XXXXXX").string();
-    if (!::mkdtemp(staging.data())) return "cannot write in " + options.out.string() + ": " + std::strerror(errno);
+    if (!::mkdtemp(staging.data()))
+        return Error{"cannot write in " + options.out.string() + ": " + std::strerror(errno), "", ErrorKind::Io};
     const std::filesystem::path stagingDir(staging);
     std::string problem = writeGnuplot(problems, rows, stagingDir, tree.exactSecondsPerEvaluation);
+    const ErrorKind kind = problem.empty() ? ErrorKind::Io : ErrorKind::Environment;  // gnuplot failed, or a write
     if (problem.empty()) {
         if (Result<void> w = writeFileAtomically(options.out / "accuracy.csv", csv.str()); !w) problem = w.error();
     }
@@ -762,7 +764,7 @@ std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
         if (ec) problem = (options.out / "accuracy.png").string() + ": error: cannot write: " + ec.message();
     }
     std::filesystem::remove_all(stagingDir, ec);
-    if (!problem.empty()) return problem;
+    if (!problem.empty()) return Error{problem, "", kind};
     if (rowsOut) *rowsOut = std::move(rows);
     return {};
 }

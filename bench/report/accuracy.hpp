@@ -7,6 +7,8 @@
 // problem, one line per method), plus a panel of the Barnes–Hut force error
 // against time for a range of theta, with exact summation as the peer.
 
+#include "stepwise/result.hpp"
+
 #include <filesystem>
 #include <iosfwd>
 #include <string>
@@ -33,9 +35,9 @@ struct AccuracyRow {
     double parameter = 0.0;
 };
 
-/// Runs the report. Progress goes to `log`. Returns "" or an error message
-/// (unwritable directory, gnuplot failure).
-std::string runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
+/// Runs the report. Progress goes to `log`. Fails when the directory cannot
+/// be written (kind Io) or gnuplot fails (kind Environment).
+Result<void> runAccuracyReport(const AccuracyOptions& options, std::ostream& log,
                               std::vector<AccuracyRow>* rowsOut = nullptr);
 
 } // namespace stepwise::report

@@ -103,10 +103,10 @@ std::optional<Error> checkField(const FieldInfo& field, const FieldValue& value)
     if (!valueFitsKind(field, value)) return Error{std::string(field.key) + ": a value of the wrong type for this field"};
     // The loader's own check (fieldValueProblem), so a value refused in a
     // file is refused here in the same words.
-    const std::optional<std::string> problem =
+    const std::optional<Error> problem =
         std::visit([&](const auto& v) { return fieldValueProblem(field, &v); }, value);
     if (!problem) return std::nullopt;
-    return Error{std::string(field.key) + ": " + *problem};
+    return Error{std::string(field.key) + ": " + problem->message};
 }
 
 std::optional<Error> setWorldField(Scene& scene, const WorldFieldInfo& info, const FieldValue& value) {

@@ -128,9 +128,8 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
             return;
         }
         try {
-            const std::string problem = report::runAccuracyReport(*options, std::cerr);
-            if (!problem.empty()) {
-                reportError(problem);
+            if (Result<void> ran = report::runAccuracyReport(*options, std::cerr); !ran) {
+                reportError(ran.error());
                 exitCode = kExitBadInput;
                 return;
             }

@@ -276,16 +276,16 @@ std::string formatNumber(double value) {
     return error == std::errc() ? std::string(buffer, end) : std::string("?");
 }
 
-std::optional<std::string> fieldValueProblem(const FieldInfo& field, const void* member) {
-    auto number = [&](double v, bool integer) -> std::optional<std::string> {
-        if (!std::isfinite(v)) return "expected a finite number, got " + formatNumber(v);
+std::optional<Error> fieldValueProblem(const FieldInfo& field, const void* member) {
+    auto number = [&](double v, bool integer) -> std::optional<Error> {
+        if (!std::isfinite(v)) return Error{"expected a finite number, got " + formatNumber(v)};
         if (!field.range.contains(v) || (integer && v != std::floor(v)))
-            return "expected " + field.range.describe(integer) + ", got " + formatNumber(v);
+            return Error{"expected " + field.range.describe(integer) + ", got " + formatNumber(v)};
         return std::nullopt;
     };
-    auto vector = [](Vec2 v) -> std::optional<std::string> {
+    auto vector = [](Vec2 v) -> std::optional<Error> {
         if (isFinite(v)) return std::nullopt;
-        return "expected finite numbers, got {\"x\": " + formatNumber(v.x) + ", \"y\": " + formatNumber(v.y) + "}";
+        return Error{"expected finite numbers, got {\"x\": " + formatNumber(v.x) + ", \"y\": " + formatNumber(v.y) + "}"};
     };
     switch (field.kind) {
     case FieldKind::Number: return number(*static_cast<const double*>(member), false);
@@ -306,7 +306,7 @@ std::optional<std::string> fieldValueProblem(const FieldInfo& field, const void*
     case FieldKind::Color: {
         const Rgb c = *static_cast<const Rgb*>(member);
         for (const double channel : {c.r, c.g, c.b})
-            if (auto problem = number(channel, false)) return "colour channels: " + *problem;
+            if (auto problem = number(channel, false)) return Error{"colour channels: " + problem->message};
         return std::nullopt;
     }
     case FieldKind::String: {
@@ -319,7 +319,7 @@ std::optional<std::string> fieldValueProblem(const FieldInfo& field, const void*
             message += (i ? ", " : "") + std::string(field.choices[i]);
         message += ", got \"" + value + "\"";
         if (auto guess = closestName(value, field.choices)) message += "; did you mean \"" + std::string(*guess) + "\"?";
-        return message;
+        return Error{message};
     }
     case FieldKind::Bool:
     case FieldKind::EntityRef: return std::nullopt;

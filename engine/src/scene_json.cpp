@@ -198,7 +198,7 @@ void readField(const FieldInfo& field, const Json& v, void* component, const std
         break;
     }
     }
-    if (auto problem = fieldValueProblem(field, member)) refuse(pointer, *problem);
+    if (auto problem = fieldValueProblem(field, member)) refuse(pointer, problem->message);
 }
 
 Json vectorJson(Vec2 v) {

@@ -108,8 +108,8 @@ std::optional<Error> worldSettingsProblem(const WorldSettings& settings) {
         FieldInfo field = info.field;
         if (info.maxGuardsInputOnly) field.range.max = std::numeric_limits<double>::infinity();
         const void* member = field.address(const_cast<WorldSettings*>(&settings));
-        if (std::optional<std::string> problem = fieldValueProblem(field, member))
-            return Error{"world." + std::string(field.key) + ": " + *problem};
+        if (std::optional<Error> problem = fieldValueProblem(field, member))
+            return problem->within("world." + std::string(field.key));
     }
     return std::nullopt;
 }

@@ -75,7 +75,7 @@ struct FieldInfo {
 /// field's name (callers say where): "expected an integer in [1, 1000], got
 /// 5000", "expected one of hinge, slider, ..., got \"hing\"; did you mean
 /// \"hinge\"?". Cross-field rules are the component's `finish`.
-std::optional<std::string> fieldValueProblem(const FieldInfo& field, const void* member);
+std::optional<Error> fieldValueProblem(const FieldInfo& field, const void* member);
 
 /// A number as messages show it: the shortest text that reads back to the
 /// same double ("0.1", "5000", "1e-07").
