@@ -181,6 +181,39 @@ TEST(LoaderRegressions, TheDepthLimitIsSixteenLevels) {
     EXPECT_EQ(refusal(nested(17)), "t.json: error: JSON nesting deeper than 16 levels; a level file needs 4");
 }
 
+// docs/format.md, "Limits": an object holds at most 256 keys, counted while
+// parsing, so the DOM's per-object key search (n^2 / 2 comparisons for n
+// keys) never sees more. 256 keys reach the ordinary checks; one more is
+// refused at that key, at every level of the file: the top, an entity, a
+// component and the world.
+TEST(LoaderRegressions, AnObjectHoldsAtMost256Keys) {
+    const auto keys = [](int n, const char* prefix) {
+        std::string out;
+        for (int i = 0; i < n; ++i) out += (i ? ", \"" : "\"") + std::string(prefix) + std::to_string(i) + "\": 1";
+        return out;
+    };
+    const std::string limit = "more than 256 keys in one object; the limit is 256 (a level's objects have about 20)";
+    // 256 keys: past the reader, refused for what they are.
+    EXPECT_EQ(refusal("{" + keys(255, "k") + R"(, "entities": []})"),
+              "t.json: error: /k0: unknown top-level key \"k0\" Known keys: version, world, view, entities, solver_state");
+    const std::string top = "{" + keys(257, "k") + "}";
+    EXPECT_EQ(refusal(top), "t.json:1:" + std::to_string(top.find("\"k256\"") + 1) + ": error: " + limit);
+    const std::string entity = R"({"entities": [{)" + keys(257, "c") + "}]}";
+    EXPECT_EQ(refusal(entity),
+              "t.json:1:" + std::to_string(entity.find("\"c256\"") + 1) + ": error: /entities/0: " + limit);
+    const std::string component = R"({"entities": [{"position": {)" + keys(257, "f") + "}}]}";
+    EXPECT_EQ(refusal(component), "t.json:1:" + std::to_string(component.find("\"f256\"") + 1) +
+                                      ": error: /entities/0/position: " + limit);
+    const std::string world = R"({"world": {)" + keys(257, "w") + R"(}, "entities": []})";
+    EXPECT_EQ(refusal(world), "t.json:1:" + std::to_string(world.find("\"w256\"") + 1) + ": error: /world: " + limit);
+    // The limit is a setting: raised, the same file is past the reader.
+    LoadLimits wide;
+    wide.maxKeysPerObject = 1000;
+    Result<Scene> r = parseScene(top, "t.json", wide);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().find(limit), std::string::npos) << r.error();
+}
+
 // Every kept input (findings and hand-written edge cases) satisfies the
 // fuzzer's property: refused with one line of UTF-8 naming the file, or
 // loads and round-trips to identical bytes.

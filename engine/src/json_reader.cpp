@@ -175,6 +175,11 @@ public:
     }
     bool key(Json::string_t& k) {
         Frame& frame = frames_[std::size_t(open_ - 1)];
+        if (++frame.keys > limits_.maxKeysPerObject)
+            throw Stop{(open_ > 1 ? pointerTo(open_ - 1) + ": " : std::string()) + "more than " +
+                           std::to_string(limits_.maxKeysPerObject) + " keys in one object; the limit is " +
+                           std::to_string(limits_.maxKeysPerObject) + " (a level's objects have about 20)",
+                       keyStart(offset())};
         checkDuplicate(frame, k);
         frame.key = k;
         return dom_.key(k);
@@ -215,6 +220,7 @@ private:
         /// keys), a hash map past 16.
         std::vector<std::pair<std::uint64_t, std::size_t>> smallKeys;
         std::unordered_map<std::uint64_t, std::size_t> bigKeys;
+        std::size_t keys = 0;  ///< keys read in this object
     };
 
     std::size_t offset() const { return std::size_t(*cursor_ - text_.data()); }
@@ -290,6 +296,7 @@ private:
         f.index = 0;
         f.smallKeys.clear();
         f.bigKeys.clear();
+        f.keys = 0;
     }
 
     /// Offset of the opening quote of the key whose closing quote is at

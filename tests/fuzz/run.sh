@@ -4,8 +4,10 @@
 # Seeds: every levels/*.json plus tests/fuzz/corpus/ (kept findings and inputs
 # worth keeping). New inputs the fuzzer finds go to build-fuzz/corpus/, so
 # the repository's corpus only grows by hand. A crash, leak, sanitizer
-# report, timeout (5 s) or out-of-memory (2 GiB) leaves build-fuzz/crash-*
-# (or timeout-*/oom-*) and makes this script exit non-zero; replay one with
+# report, timeout (2 s: a 64 KiB input loads in milliseconds, so a slower
+# one means a path that grows faster than its input) or out-of-memory
+# (2 GiB) leaves build-fuzz/crash-* (or timeout-*/oom-*) and makes this
+# script exit non-zero; replay one with
 #   build-fuzz/tests/fuzz/fuzz_scene_loader build-fuzz/crash-...
 # Set FUZZ_EXTRA for more libFuzzer flags (e.g. FUZZ_EXTRA=-jobs=2).
 set -euo pipefail
@@ -28,5 +30,5 @@ mkdir -p "$build/corpus" "$build/seeds"
 find levels -name '*.json' ! -name scene.schema.json -size -65537c -exec cp {} "$build/seeds/" \;
 # shellcheck disable=SC2086
 exec "$build/tests/fuzz/fuzz_scene_loader" "$build/corpus" "$build/seeds" tests/fuzz/corpus \
-  -dict=tests/fuzz/scene.dict -max_len=65536 -max_total_time="$seconds" -timeout=5 -rss_limit_mb=2048 \
+  -dict=tests/fuzz/scene.dict -max_len=65536 -max_total_time="$seconds" -timeout=2 -rss_limit_mb=2048 \
   -artifact_prefix="$build/" -print_final_stats=1 ${FUZZ_EXTRA:-}

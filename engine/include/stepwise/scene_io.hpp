@@ -29,6 +29,11 @@ struct LoadLimits {
     std::size_t maxValues = 20'000'000;
     /// Values inside one entity (its components and their fields).
     std::size_t maxValuesPerEntity = 100'000;
+    /// Keys in one JSON object. The DOM keeps an object's keys in file
+    /// order and finds one by searching them, so reading n keys costs n^2 / 2
+    /// comparisons; a level's largest object (an entity, the world) has
+    /// about 20 keys.
+    std::size_t maxKeysPerObject = 256;
 };
 
 /// Parses level text. `sourceName` prefixes every message ("levels/a.json").
