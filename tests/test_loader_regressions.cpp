@@ -214,6 +214,31 @@ TEST(LoaderRegressions, AnObjectHoldsAtMost256Keys) {
     EXPECT_EQ(r.error().find(limit), std::string::npos) << r.error();
 }
 
+// Saved contact impulses can only be what a run writes: a normal impulse
+// that pushes (>= 0), between two entities, one entry per pair and feature
+// (in either order). Anything else would change the physics on resume.
+TEST(LoaderRegressions, SavedContactsAreOnlyWhatARunWrites) {
+    const auto level = [](const std::string& contacts) {
+        return R"({"entities": [{"name": "a", "position": {"x": 0, "y": 0.5}, "radius": 0.5},
+                                {"name": "b", "position": {"x": 0, "y": 1.5}, "radius": 0.5}],
+                   "solver_state": {"contacts": [)" + contacts + "]}}";
+    };
+    const std::string good = R"({"a": "a", "b": "b", "feature": 0, "normal_impulse": 0.1, "tangent_impulse": 0})";
+    ASSERT_TRUE(parseScene(level(good), "t.json"));
+    EXPECT_EQ(refusal(level(R"({"a": "a", "b": "b", "feature": 0, "normal_impulse": -100, "tangent_impulse": 0})")),
+              "t.json: error: /solver_state/contacts/0/normal_impulse: expected a number >= 0, got -100");
+    EXPECT_EQ(refusal(level(R"({"a": "a", "b": "a", "feature": 0, "normal_impulse": 1, "tangent_impulse": 0})")),
+              "t.json: error: /solver_state/contacts/0/b: a contact joins an entity to itself");
+    const std::string duplicate =
+        "t.json: error: /solver_state/contacts/1: this pair and feature have an entry already (/solver_state/contacts/0)";
+    EXPECT_EQ(refusal(level(good + ", " + good)), duplicate);
+    EXPECT_EQ(refusal(level(good + R"(, {"a": "b", "b": "a", "feature": 0, "normal_impulse": 1, "tangent_impulse": 0})")),
+              duplicate);
+    // Another feature of the same pair is another contact point.
+    EXPECT_TRUE(parseScene(level(good + R"(, {"a": "a", "b": "b", "feature": 1, "normal_impulse": 1, "tangent_impulse": 0})"),
+                           "t.json"));
+}
+
 // Every kept input (findings and hand-written edge cases) satisfies the
 // fuzzer's property: refused with one line of UTF-8 naming the file, or
 // loads and round-trips to identical bytes.

@@ -423,6 +423,10 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
         if (!value.is_array()) refuse(at, "expected an array of " + key + ", got " + describeFound(value));
         if (key == "contacts") {
             state.contacts.reserve(value.size());
+            // What a run writes: one entry per (pair, feature), between two
+            // entities, with a normal impulse that only ever pushes.
+            std::map<std::tuple<std::uint64_t, std::uint64_t, std::uint32_t>, std::size_t> seenContacts;
+            const NumberRange pushes{0.0, std::numeric_limits<double>::infinity(), false};
             for (std::size_t i = 0; i < value.size(); ++i) {
                 ContactImpulse c;
                 readEntry(value[i], child(at, i), "a contact", kContactKeys, kContactKeys.size(),
@@ -430,9 +434,15 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
                               if (field == "a") c.a = shapeAt(fv, fa);
                               else if (field == "b") c.b = shapeAt(fv, fa);
                               else if (field == "feature") c.feature = std::uint32_t(readInteger(fv, fa, 0, 0xFFFF));
-                              else if (field == "normal_impulse") c.normalImpulse = readNumber(fv, fa, NumberRange{});
+                              else if (field == "normal_impulse") c.normalImpulse = readNumber(fv, fa, pushes, NumberRange{});
                               else c.tangentImpulse = readNumber(fv, fa, NumberRange{});
                           });
+                if (c.a == c.b) refuse(child(child(at, i), "b"), "a contact joins an entity to itself");
+                const std::uint64_t ka = (std::uint64_t(c.a.index) << 32) | c.a.generation;
+                const std::uint64_t kb = (std::uint64_t(c.b.index) << 32) | c.b.generation;
+                const auto [it, fresh] = seenContacts.emplace(std::make_tuple(std::min(ka, kb), std::max(ka, kb), c.feature), i);
+                if (!fresh)
+                    refuse(child(at, i), "this pair and feature have an entry already (" + child(at, it->second) + ")");
                 state.contacts.push_back(c);
             }
             continue;

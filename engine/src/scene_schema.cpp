@@ -138,7 +138,7 @@ std::string sceneJsonSchema() {
         {"properties", Json{{"a", entityRef},
                             {"b", entityRef},
                             {"feature", Json{{"type", "integer"}, {"minimum", 0}, {"maximum", 65535}}},
-                            {"normal_impulse", Json{{"type", "number"}, {"description", "N*s"}}},
+                            {"normal_impulse", Json{{"type", "number"}, {"minimum", 0}, {"description", "N*s; a contact only pushes"}}},
                             {"tangent_impulse", Json{{"type", "number"}, {"description", "N*s"}}}}}};
     const auto impulse = [](const char* description) {
         return Json{{"type", "number"}, {"description", description}};
