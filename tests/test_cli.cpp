@@ -855,6 +855,32 @@ TEST_F(Cli, ANonFiniteEnergyIsANonFiniteValue) {
     EXPECT_NE(o.err.find("the total energy became -nan J (kinetic -nan"), std::string::npos) << o.err;
 }
 
+// An energy that is not finite names the first entity and term that are not,
+// with the numbers behind it: a spin of 1e300 rad/s, a body of 1e308 kg on a
+// floor, a gravity of -1e308 m/s^2.
+TEST_F(Cli, ANonFiniteEnergyNamesTheEntityAndTheTerm) {
+    const struct {
+        const char* level;
+        const char* term;
+    } cases[] = {
+        {R"({"world": {"gravity": {"x": 0, "y": 0}}, "entities": [{"name": "spinner", "position": {"x": 0, "y": 10},
+             "radius": 1, "angular_velocity": 1e300}]})",
+         "; first entity 0 (\"spinner\"): rotational energy I*w^2/2 became inf J (inertia 0.5 kg m^2, spin 1e+300 rad/s)"},
+        {R"({"entities": [{"name": "heavy", "position": {"x": 0, "y": 0.5}, "radius": 0.5, "mass": 1e308},
+             {"name": "floor", "plane": {"normal": {"x": 0, "y": 1}, "offset": 0}}]})",
+         "; first entity 0 (\"heavy\"): gravity's potential energy -m*g.x became inf J (mass 1e+308 kg at {0, "},
+        {R"({"world": {"gravity": {"x": 0, "y": -1e308}}, "entities": [{"name": "b", "position": {"x": 0, "y": 10}}]})",
+         "; first entity 0 (\"b\"): kinetic energy m*v^2/2 became inf J (mass 1 kg, speed "},
+    };
+    for (const auto& c : cases) {
+        const fs::path level = write("e.json", c.level);
+        const Outcome o = stepwise("run " + level.string() + " --steps 3");
+        EXPECT_EQ(o.exitCode, 3) << o.err;
+        EXPECT_NE(o.err.find("simulation diverged at step 3: the total energy became "), std::string::npos) << o.err;
+        EXPECT_NE(o.err.find(c.term), std::string::npos) << o.err;
+    }
+}
+
 // ---- the scripted editor -------------------------------------------
 
 // `saveas missing/x.json`, `open missing.json` and `savestate missing/x.json`

@@ -120,13 +120,15 @@ std::string duration(double seconds) {
 }
 
 /// "" when every energy is finite, else what became non-finite: an energy
-/// of -inf or NaN in a report is a non-finite value like any other.
-std::string nonFiniteEnergy(const EnergyReport& e, long long step) {
+/// of -inf or NaN in a report is a non-finite value like any other. The
+/// totals, then the first entity whose term is not finite and which term.
+std::string nonFiniteEnergy(const World& world, const EnergyReport& e, long long step) {
     if (std::isfinite(e.total()) && std::isfinite(e.momentum.x) && std::isfinite(e.momentum.y)) return {};
+    const std::string term = world.nonFiniteEnergyTerm();
     return "step " + std::to_string(step) + ": the total energy became " + number(e.total()) + " J (kinetic " +
            number(e.kinetic) + ", gravity " + number(e.gravity) + ", springs " + number(e.springs) +
            ", attractors " + number(e.attractors) + " J; momentum " + number(e.momentum.x) + ", " +
-           number(e.momentum.y) + " kg m/s)";
+           number(e.momentum.y) + " kg m/s)" + (term.empty() ? "" : "; first " + term);
 }
 
 /// Smallest bytes a trace row and a contacts line can take, for the check
@@ -212,7 +214,7 @@ int run(const RunOptions& options) {
               "momentum_x,momentum_y,contacts\n";
         appendTraceRow(row, 0, world);
         emit(trace);
-        divergence = nonFiniteEnergy(world.energy(), 0);
+        divergence = nonFiniteEnergy(world, world.energy(), 0);
         if (divergence->empty()) divergence.reset();
     }
 
@@ -235,7 +237,7 @@ int run(const RunOptions& options) {
          .afterStep = [&](std::uint64_t step) {
              if (trace) {
                  const EnergyReport e = world.energy();
-                 if (std::string bad = nonFiniteEnergy(e, (long long)step); !bad.empty()) {
+                 if (std::string bad = nonFiniteEnergy(world, e, (long long)step); !bad.empty()) {
                      divergence = bad;
                      return false;
                  }
@@ -297,7 +299,7 @@ int run(const RunOptions& options) {
     }
     const EnergyReport energy = world.energy();
     if (!divergence) {
-        if (std::string bad = nonFiniteEnergy(energy, taken); !bad.empty()) divergence = bad;
+        if (std::string bad = nonFiniteEnergy(world, energy, taken); !bad.empty()) divergence = bad;
     }
     if (divergence) {
         reportError(options.level + ": simulation diverged at " + *divergence + " (integrator " +

@@ -294,6 +294,12 @@ public:
     std::vector<std::string_view> activeSystems() const;
     const StepStats& lastStats() const;
     EnergyReport energy() const;
+    /// When energy() is not finite: the first term that is not, named by
+    /// its entity and quantity ("entity 3 (\"ball\"): kinetic energy
+    /// m*v^2/2 became inf J (mass 1e+308 kg, speed 10 m/s)"); "" when every
+    /// body's and spring's term is finite (then only the attractors' sum is
+    /// not).
+    std::string nonFiniteEnergyTerm() const;
     /// Contacts of the last step (empty when the scene has no shapes).
     std::span<const ContactRecord> contacts() const;
     /// Joints of the last step, in scene order: anchors, separation and
