@@ -409,30 +409,22 @@ TEST(World, ASwitchedOffSystemRunsAsIfItsComponentsWereRemoved) {
             for (Entity e : s.registry.entities()) (void)s.registry.remove<T>(e);
         };
     };
+    const auto removeShapes = [](Scene& s) {
+        for (Entity e : s.registry.entities()) {
+            (void)s.registry.remove<Radius>(e);
+            (void)s.registry.remove<Box>(e);
+            (void)s.registry.remove<Polygon>(e);
+            (void)s.registry.remove<Plane>(e);
+        }
+    };
     const std::vector<Case> cases{
         {"gravity", "pile.json", [](Scene& s) { s.world.gravity = {0.0, 0.0}; }},
         {"drag", "pool_break.json", removeAll(std::type_identity<Drag>{})},
         {"springs", "spring_chain.json", removeAll(std::type_identity<Spring>{})},
         {"attractors", "orbit.json", removeAll(std::type_identity<Attractor>{})},
         {"boids", "flock.json", removeAll(std::type_identity<Boid>{})},
-        {"collisions", "polygons.json",
-         [](Scene& s) {
-             for (Entity e : s.registry.entities()) {
-                 (void)s.registry.remove<Radius>(e);
-                 (void)s.registry.remove<Box>(e);
-                 (void)s.registry.remove<Polygon>(e);
-                 (void)s.registry.remove<Plane>(e);
-             }
-         }},
-        {"collisions", "bridge.json",
-         [](Scene& s) {
-             for (Entity e : s.registry.entities()) {
-                 (void)s.registry.remove<Radius>(e);
-                 (void)s.registry.remove<Box>(e);
-                 (void)s.registry.remove<Polygon>(e);
-                 (void)s.registry.remove<Plane>(e);
-             }
-         }},
+        {"collisions", "polygons.json", removeShapes},
+        {"collisions", "bridge.json", removeShapes},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(std::string(c.system) + " in " + c.level);
