@@ -299,6 +299,38 @@ TEST_F(Cli, ValidateRefusesOneEntityPastTheDocumentedLimitAndAcceptsTheLimit) {
                                    "semi_implicit_euler\n");
 }
 
+// Outputs are written through symbolic links: a linked output stays a link
+// and its target gets the bytes, and a dangling link counts as the file it
+// points at, so it cannot be the --trace file as well.
+TEST_F(Cli, OutputsAreWrittenThroughSymbolicLinks) {
+    const fs::path real = write("real.json", "{\"entities\": []}\n");
+    const fs::path link = dir_ / "link.json";
+    fs::create_symlink("real.json", link);
+    Outcome o = stepwise("run " + level("orbit.json") + " --steps 2 --out " + link.string());
+    ASSERT_EQ(o.exitCode, 0) << o.err;
+    EXPECT_TRUE(fs::is_symlink(link));
+    EXPECT_EQ(fs::read_symlink(link), fs::path("real.json"));
+    stepwise::Result<stepwise::Scene> written = stepwise::loadSceneFile(real);
+    ASSERT_TRUE(written) << written.error();
+    EXPECT_GT(written->registry.size(), 0u) << "the target holds the run";
+
+    const fs::path dangling = dir_ / "dangling.json";
+    fs::create_symlink("t.csv", dangling);
+    o = stepwise("run " + level("orbit.json") + " --steps 2 --out " + dangling.string() + " --trace " +
+                 (dir_ / "t.csv").string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, "stepwise: error: --trace: " + (dir_ / "t.csv").string() + " is the same file as --out " +
+                         dangling.string() + "; give each output its own file\n");
+    EXPECT_FALSE(fs::exists(dir_ / "t.csv"));
+    // A dangling link to a new file in an existing folder creates that file.
+    const fs::path fresh = dir_ / "fresh.json";
+    fs::create_symlink("made.json", fresh);
+    o = stepwise("run " + level("orbit.json") + " --steps 1 --out " + fresh.string());
+    ASSERT_EQ(o.exitCode, 0) << o.err;
+    EXPECT_TRUE(fs::is_symlink(fresh));
+    EXPECT_TRUE(fs::is_regular_file(dir_ / "made.json"));
+}
+
 TEST_F(Cli, ValidateRefusesAFileOverTheSizeLimitBeforeReadingIt) {
     const fs::path huge = write("huge.json", "{}");
     fs::resize_file(huge, (256ull << 20) + 1);  // sparse: no disk, and never read
@@ -434,15 +466,19 @@ TEST_F(Cli, BenchBadArgumentsExitTwoNamingTheArgument) {
     o = stepwise("bench accuracy --quick --out " + (dir_ / "r").string() + " --repeat 3");
     EXPECT_EQ(o.exitCode, 2);
     EXPECT_EQ(o.err.rfind("The following arguments were not expected: 3 --repeat\n", 0), 0u) << o.err;
-    // Checked before any measuring: fails at once and creates nothing.
+    // Checked before any measuring: fails at once and creates nothing. The
+    // folder must exist, as for every other output.
     const fs::path notAFolder = write("file.txt", "");
     o = stepwise("bench accuracy --quick --out " + (notAFolder / "report").string());
     EXPECT_EQ(o.exitCode, 2);
-    EXPECT_EQ(o.err, "stepwise: error: --out: cannot create the folder " + (notAFolder / "report").string() +
-                         ": Not a directory\n");
+    EXPECT_EQ(o.err, "stepwise: error: --out: " + (notAFolder / "report").string() + " is not an existing folder\n");
     o = stepwise("bench accuracy --quick --out " + notAFolder.string());
     EXPECT_EQ(o.exitCode, 2);
-    EXPECT_EQ(o.err, "stepwise: error: --out: cannot create the folder " + notAFolder.string() + ": Not a directory\n");
+    EXPECT_EQ(o.err, "stepwise: error: --out: " + notAFolder.string() + " is not an existing folder\n");
+    o = stepwise("bench accuracy --quick --out " + (dir_ / "missing" / "report").string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, "stepwise: error: --out: " + (dir_ / "missing" / "report").string() + " is not an existing folder\n");
+    EXPECT_FALSE(fs::exists(dir_ / "missing"));
     EXPECT_FALSE(fs::exists(dir_ / "r"));
     // A report file the user may not replace (0444, as an unprivileged
     // user): refused before measuring, in the words of every other output,

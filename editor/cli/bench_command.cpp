@@ -104,16 +104,14 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
     CLI::App* accuracy = bench->add_subcommand(
         "accuracy", "Speed against error of every integrator (and Boost.Odeint's) on five problems");
     accuracy->add_flag("--quick", options->quick, "Fewer dt and repeats (finishes in under a minute)");
-    accuracy->add_option("--out", *out, "Directory for accuracy.csv, accuracy.md and accuracy.png")->required();
+    accuracy->add_option("--out", *out, "Existing folder for accuracy.csv, accuracy.md and accuracy.png")->required();
     accuracy->callback([options, out, &exitCode] {
         options->out = *out;
         // Checked before minutes of measuring, and named as the argument.
+        // Like every other output, the folder must exist.
         std::error_code ec;
-        std::filesystem::create_directories(options->out, ec);
-        if (ec || !std::filesystem::is_directory(options->out, ec)) {
-            // An existing file of that name is ENOTDIR ("Not a directory").
-            reportError("--out: cannot create the folder " + *out + ": " +
-                        (ec ? ec.message() : std::string("not a directory")));
+        if (!std::filesystem::is_directory(options->out, ec)) {
+            reportError("--out: " + *out + " is not an existing folder");
             exitCode = kExitBadInput;
             return;
         }

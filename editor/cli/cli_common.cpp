@@ -46,13 +46,14 @@ namespace {
 
 /// Device and inode of the file `path` names; for a file not there yet,
 /// those of its folder plus its name. False when the folder is missing too.
-bool fileIdentity(const std::string& path, std::tuple<dev_t, ino_t, std::string>& id) {
+bool fileIdentity(const std::string& given, std::tuple<dev_t, ino_t, std::string>& id) {
     struct stat info {};
-    if (::stat(path.c_str(), &info) == 0) {
+    if (::stat(given.c_str(), &info) == 0) {
         id = {info.st_dev, info.st_ino, std::string()};
         return true;
     }
-    const std::filesystem::path p(path);
+    // Not there yet: where a write would create it (through a dangling link).
+    const std::filesystem::path p = resolveOutputPath(given);
     const std::filesystem::path folder = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
     if (::stat(folder.c_str(), &info) != 0) return false;
     id = {info.st_dev, info.st_ino, p.filename().string()};

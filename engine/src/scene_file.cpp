@@ -39,30 +39,49 @@ Result<Scene> loadSceneFile(const fs::path& path, const LoadLimits& limits) {
     return parseScene(text, name, limits);
 }
 
-std::string checkWritableTarget(const fs::path& path) {
-    const std::string name = path.string();
+fs::path resolveOutputPath(const fs::path& path) {
+    fs::path p = path;
+    // Linux's own bound on a chain of links; past it (a loop) the path is
+    // returned as it is and stat() says "Too many levels of symbolic links".
+    for (int hops = 0; hops < 40; ++hops) {
+        std::error_code ec;
+        if (!fs::is_symlink(fs::symlink_status(p, ec)) || ec) return p;
+        const fs::path to = fs::read_symlink(p, ec);
+        if (ec) return p;
+        p = to.is_absolute() ? to : (p.has_parent_path() ? p.parent_path() : fs::path(".")) / to;
+    }
+    return path;
+}
+
+std::string checkWritableTarget(const fs::path& given) {
+    const std::string name = given.string();
     const auto cannot = [&](const std::string& why) { return name + ": error: cannot write: " + why; };
     if (name.empty()) return ": error: cannot write: no file name given";
+    const fs::path path = resolveOutputPath(given);
     const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
     struct stat info {};
     if (::stat(folder.c_str(), &info) != 0) return cannot(std::strerror(errno));
     if (!S_ISDIR(info.st_mode)) return cannot(std::strerror(ENOTDIR));
     // The temporary is created in the folder and renamed there.
     if (::access(folder.c_str(), W_OK | X_OK) != 0) return cannot(std::strerror(errno));
-    if (::stat(name.c_str(), &info) == 0) {
+    if (::stat(path.c_str(), &info) == 0) {
         if (S_ISDIR(info.st_mode)) return cannot(std::strerror(EISDIR));
         // A device or pipe (/dev/stdout) would be replaced by the rename,
         // not written through.
         if (!S_ISREG(info.st_mode)) return cannot("not a regular file (outputs are replaced by a rename)");
         // The rename would replace a read-only file too (it needs only the
         // folder's permission); the file's own mode says the user may not.
-        if (::access(name.c_str(), W_OK) != 0) return cannot(std::strerror(errno));
+        if (::access(path.c_str(), W_OK) != 0) return cannot(std::strerror(errno));
+    } else if (errno == ELOOP) {
+        return cannot(std::strerror(ELOOP));
     }
     return {};
 }
 
-Result<StreamedFileWriter> StreamedFileWriter::open(const fs::path& path) {
-    if (std::string problem = checkWritableTarget(path); !problem.empty()) return Error{problem};
+Result<StreamedFileWriter> StreamedFileWriter::open(const fs::path& given) {
+    if (std::string problem = checkWritableTarget(given); !problem.empty()) return Error{problem};
+    // Through a link: the temporary goes beside the target and replaces it.
+    const fs::path path = resolveOutputPath(given);
     StreamedFileWriter w;
     w.name_ = path.string();
     w.folder_ = path.has_parent_path() ? path.parent_path() : fs::path(".");
@@ -224,7 +243,7 @@ Result<void> saveSceneFile(const Scene& scene, const fs::path& path) {
         return Error{std::move(message)};
     }
     Result<void> written = writeFileAtomically(path, sceneToJsonText(scene));
-    if (written) removeStaleTemporaries(path);
+    if (written) removeStaleTemporaries(resolveOutputPath(path));
     return written;
 }
 

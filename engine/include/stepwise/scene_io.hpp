@@ -58,6 +58,12 @@ std::string sceneToJsonText(const Scene& scene);
 /// before any work.
 std::string checkWritableTarget(const std::filesystem::path& path);
 
+/// Where a write to `path` lands: `path` itself, or, for a symbolic link
+/// (a dangling one included), the file it finally points at. Outputs are
+/// written through links, so a linked file stays linked and its target gets
+/// the new bytes; the same-file checks compare the targets.
+std::filesystem::path resolveOutputPath(const std::filesystem::path& path);
+
 /// A file written in pieces and put in place atomically at the end (a long
 /// run's trace: memory stays flat however many steps). The bytes go to a
 /// hidden temporary in the target's folder; commit() does fsync, rename
