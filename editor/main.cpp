@@ -2,6 +2,7 @@
 // `godot --headless`. Each subcommand lives in editor/cli/.
 
 #include "cli/commands.hpp"
+#include "cli/interrupts.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -11,6 +12,7 @@
 
 int main(int argc, char** argv) {
     using namespace stepwise::cli;
+    installInterruptHandlers();
     CLI::App app{"Stepwise: a 2D physics level editor and sandbox", "stepwise"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "stepwise 0.1.0");

@@ -15,6 +15,7 @@
 
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -812,6 +813,78 @@ TEST_F(Cli, AnEndlessRunIsBoundedEstimatedAndInterruptible) {
     EXPECT_NE(o.err.find(" years; Ctrl-C stops the run and writes nothing\n"), std::string::npos) << o.err;
     EXPECT_NE(o.err.find(" of 1000000000000000000; --out not written\n"), std::string::npos) << o.err;
     EXPECT_FALSE(fs::exists(dir_ / "o.json"));
+}
+
+/// Starts `stepwise ARGS` with stderr to `errFile`; SIGINT ignored in the
+/// child when `ignoreInterrupt` (as a shell's background job has it).
+pid_t startStepwise(const std::vector<std::string>& args, const fs::path& errFile, bool ignoreInterrupt) {
+    const pid_t child = ::fork();
+    if (child == 0) {
+        if (ignoreInterrupt) ::signal(SIGINT, SIG_IGN);
+        const int err = ::open(errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        ::dup2(err, 2);
+        const int null = ::open("/dev/null", O_RDWR);
+        ::dup2(null, 0);
+        ::dup2(null, 1);
+        std::vector<char*> argv{const_cast<char*>(STEPWISE_BINARY)};
+        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        ::execv(STEPWISE_BINARY, argv.data());
+        _exit(127);
+    }
+    return child;
+}
+
+// An interrupt outside the step loop (here while `render --frames` has its
+// frames in hidden temporaries, put in place together at the end) exits 130
+// at once: no temporary is left, and any frame on disk is complete. SIGTERM
+// is taken the same way.
+TEST_F(Cli, AnInterruptWhileWritingFramesExits130AndLeavesNoTemporary) {
+    for (const int signal : {SIGINT, SIGTERM}) {
+        SCOPED_TRACE(signal == SIGINT ? "SIGINT" : "SIGTERM");
+        const fs::path frames = dir_ / ("frames" + std::to_string(signal));
+        fs::create_directory(frames);
+        const fs::path errFile = dir_ / "err.txt";
+        const pid_t child = startStepwise({"render", level("pile.json"), "--out", (frames / "f.png").string(), "--frames",
+                                           "2000", "--every", "1", "--width", "64", "--height", "48"},
+                                          errFile, false);
+        // Wait for a hundred frames' temporaries (OSMesa starts in well under
+        // 20 s): more than a fixed table of them would hold.
+        std::ptrdiff_t pending = 0;
+        for (int i = 0; i < 400 && pending < 100; ++i) {
+            ::usleep(50'000);
+            pending = std::distance(fs::directory_iterator(frames), fs::directory_iterator());
+        }
+        EXPECT_GE(pending, 100);
+        ::kill(child, signal);
+        int status = 0;
+        ::waitpid(child, &status, 0);
+        EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 130) << readFile(errFile);
+        EXPECT_EQ(readFile(errFile), "stepwise: error: interrupted; every output is as it was or complete\n");
+        std::size_t complete = 0;
+        for (const auto& entry : fs::directory_iterator(frames)) {
+            const std::string name = entry.path().filename().string();
+            EXPECT_EQ(name.find(".tmp-"), std::string::npos) << name << " left behind";
+            const std::string bytes = readFile(entry.path());
+            ASSERT_GE(bytes.size(), 12u) << name;
+            EXPECT_EQ(bytes.substr(bytes.size() - 8), std::string("IEND\xae\x42\x60\x82", 8)) << name << " is cut short";
+            ++complete;
+        }
+        EXPECT_EQ(complete, 0u) << "frames go in place only when all are drawn";
+    }
+}
+
+// A run started with SIGINT ignored (a shell's background job) keeps
+// ignoring it: it runs to the end and writes its output.
+TEST_F(Cli, AnInterruptIgnoredAtStartStaysIgnored) {
+    const fs::path errFile = dir_ / "err.txt", out = dir_ / "o.json";
+    const pid_t child = startStepwise({"run", level("pile.json"), "--steps", "400", "--out", out.string()}, errFile, true);
+    ::usleep(300'000);
+    ::kill(child, SIGINT);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 0) << readFile(errFile);
+    EXPECT_TRUE(fs::exists(out));
 }
 
 // On a terminal the run shows a progress line (through `script`, which

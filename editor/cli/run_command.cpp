@@ -3,6 +3,7 @@
 // the contacts of every step.
 
 #include "cli/cli_common.hpp"
+#include "cli/interrupts.hpp"
 #include "cli/option_checks.hpp"
 #include "cli/commands.hpp"
 
@@ -105,8 +106,6 @@ void appendContactLine(std::string& jsonl, std::uint64_t step, const World& worl
 
 /// Ctrl-C (SIGINT) or SIGTERM during the steps: the loop stops, the
 /// temporaries are removed and nothing is written.
-volatile std::sig_atomic_t gInterrupted = 0;
-extern "C" void onInterrupt(int) { gInterrupted = 1; }
 
 /// "45 s", "12 min", "3.2 h", "4.1 days", "2.3e+04 years".
 std::string duration(double seconds) {
@@ -218,12 +217,7 @@ int run(const RunOptions& options) {
         if (divergence->empty()) divergence.reset();
     }
 
-    gInterrupted = 0;
-    struct sigaction action {}, oldInt {}, oldTerm {};
-    action.sa_handler = onInterrupt;
-    sigemptyset(&action.sa_mask);
-    ::sigaction(SIGINT, &action, &oldInt);
-    ::sigaction(SIGTERM, &action, &oldTerm);
+    std::optional<CooperativeInterrupts> stepLoop(std::in_place);
     const bool terminal = ::isatty(2) != 0;
     bool progressShown = false, estimateShown = false;
     const auto start = std::chrono::steady_clock::now();
@@ -233,7 +227,7 @@ int run(const RunOptions& options) {
     std::uint64_t stepsWanted = divergence ? 0 : std::uint64_t(options.steps);
     const AdvanceResult advanced = advance(
         world, stepsWanted,
-        {.beforeStep = [&](std::uint64_t) { return !gInterrupted && !failure; },
+        {.beforeStep = [&](std::uint64_t) { return !interruptRequested() && !failure; },
          .afterStep = [&](std::uint64_t step) {
              if (trace) {
                  const EnergyReport e = world.energy();
@@ -280,8 +274,8 @@ int run(const RunOptions& options) {
          }});
     const long long taken = (long long)advanced.taken;
     if (advanced.divergence) divergence = advanced.divergence;
-    ::sigaction(SIGINT, &oldInt, nullptr);
-    ::sigaction(SIGTERM, &oldTerm, nullptr);
+    const bool interrupted = interruptRequested();
+    stepLoop.reset();  // from here an interrupt exits at once
     if (progressShown) std::fputc('\n', stderr);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -292,7 +286,7 @@ int run(const RunOptions& options) {
         std::cerr << *failure << "\n";
         return kExitBadInput;
     }
-    if (gInterrupted) {
+    if (interrupted) {
         reportError(options.level + ": interrupted at step " + std::to_string(taken) + " of " +
                     std::to_string(options.steps) + "; " + notWritten);
         return 128 + SIGINT;

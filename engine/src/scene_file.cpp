@@ -4,10 +4,13 @@
 
 #include "stepwise/scene_io.hpp"
 
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <fstream>
+#include <mutex>
+#include <vector>
 #include <sstream>
 #include <system_error>
 
@@ -78,6 +81,55 @@ std::string checkWritableTarget(const fs::path& given) {
     return {};
 }
 
+namespace {
+
+/// The temporaries of unfinished writers, for removeUnfinishedTemporaries.
+/// A signal handler walks the list without allocating or locking: nodes
+/// are only ever added at the head and never freed, and a node's path is
+/// read only while its state says live. Writers take and give back nodes
+/// under a mutex, through a free list, so listing costs O(1) however many
+/// temporaries are pending (render --frames keeps one per frame).
+struct TemporaryNode {
+    std::atomic<int> live{0};
+    std::string path;
+    TemporaryNode* next = nullptr;
+};
+std::atomic<TemporaryNode*> gTemporaries{nullptr};
+std::mutex gTemporariesMutex;
+std::vector<TemporaryNode*> gFreeTemporaries;
+
+TemporaryNode* listTemporary(const std::string& path) {
+    std::lock_guard<std::mutex> lock(gTemporariesMutex);
+    TemporaryNode* node = nullptr;
+    if (!gFreeTemporaries.empty()) {
+        node = gFreeTemporaries.back();
+        gFreeTemporaries.pop_back();
+    } else {
+        node = new TemporaryNode;  // kept for the life of the process
+        node->next = gTemporaries.load();
+        gTemporaries.store(node);
+    }
+    node->path = path;
+    node->live.store(1);
+    return node;
+}
+
+void unlistTemporary(void*& slot) {
+    if (!slot) return;
+    auto* node = static_cast<TemporaryNode*>(slot);
+    std::lock_guard<std::mutex> lock(gTemporariesMutex);
+    node->live.store(0);
+    gFreeTemporaries.push_back(node);
+    slot = nullptr;
+}
+
+} // namespace
+
+void removeUnfinishedTemporaries() noexcept {
+    for (TemporaryNode* node = gTemporaries.load(); node; node = node->next)
+        if (node->live.load()) ::unlink(node->path.c_str());
+}
+
 Result<StreamedFileWriter> StreamedFileWriter::open(const fs::path& given) {
     if (std::string problem = checkWritableTarget(given); !problem.empty()) return Error{problem};
     // Through a link: the temporary goes beside the target and replaces it.
@@ -93,6 +145,7 @@ Result<StreamedFileWriter> StreamedFileWriter::open(const fs::path& given) {
     w.fd_ = ::mkstemp(tmpl.data());
     if (w.fd_ < 0) return Error{w.name_ + ": error: cannot write: " + std::strerror(errno)};
     w.tmpPath_ = tmpl;
+    w.slot_ = listTemporary(w.tmpPath_);
     // Keep an existing file's permissions; a new file gets 0666 less umask
     // (mkstemp makes 0600).
     struct stat existing {};
@@ -110,8 +163,9 @@ Result<StreamedFileWriter> StreamedFileWriter::open(const fs::path& given) {
 
 StreamedFileWriter::StreamedFileWriter(StreamedFileWriter&& o) noexcept
     : name_(std::move(o.name_)), tmpPath_(std::move(o.tmpPath_)), folder_(std::move(o.folder_)),
-      buffer_(std::move(o.buffer_)), fd_(o.fd_), finished_(o.finished_) {
+      buffer_(std::move(o.buffer_)), fd_(o.fd_), finished_(o.finished_), slot_(o.slot_) {
     o.fd_ = -1;
+    o.slot_ = nullptr;
     o.tmpPath_.clear();
 }
 
@@ -124,7 +178,9 @@ StreamedFileWriter& StreamedFileWriter::operator=(StreamedFileWriter&& o) noexce
         buffer_ = std::move(o.buffer_);
         fd_ = o.fd_;
         finished_ = o.finished_;
+        slot_ = o.slot_;
         o.fd_ = -1;
+        o.slot_ = nullptr;
         o.tmpPath_.clear();
     }
     return *this;
@@ -136,6 +192,7 @@ void StreamedFileWriter::discard() {
     if (fd_ >= 0) ::close(fd_);
     fd_ = -1;
     if (!tmpPath_.empty()) ::unlink(tmpPath_.c_str());
+    unlistTemporary(slot_);
     tmpPath_.clear();
     buffer_.clear();
 }
@@ -188,6 +245,7 @@ Result<void> StreamedFileWriter::finish() {
 Result<void> StreamedFileWriter::commit() {
     if (Result<void> done = finish(); !done) return done;
     if (::rename(tmpPath_.c_str(), name_.c_str()) != 0) return fail("cannot replace the file", errno);
+    unlistTemporary(slot_);
     tmpPath_.clear();
     // Make the rename itself durable.
     const int dirFd = ::open(folder_.c_str(), O_RDONLY | O_DIRECTORY);

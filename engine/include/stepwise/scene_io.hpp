@@ -96,7 +96,14 @@ private:
     std::string buffer_;
     int fd_ = -1;
     bool finished_ = false;
+    void* slot_ = nullptr;  ///< where removeUnfinishedTemporaries() finds tmpPath_
 };
+
+/// Removes the hidden temporary of every StreamedFileWriter that is neither
+/// committed nor discarded. Async-signal-safe (unlink only, over a fixed
+/// table): an interrupt handler calls it before _exit, so that every output
+/// is either as it was or complete and no temporary is left.
+void removeUnfinishedTemporaries() noexcept;
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same folder,
 /// fsync, rename over the target, fsync of the folder. On any failure the old
