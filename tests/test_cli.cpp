@@ -874,6 +874,20 @@ TEST_F(Cli, AnInterruptWhileWritingFramesExits130AndLeavesNoTemporary) {
     }
 }
 
+// The most frames render takes (100,000) are checked as outputs, each
+// against the others, before any work: by identity in a map, which takes
+// well under a second, where comparing each with every one before took
+// minutes. The run then stops at a later refusal, having written nothing.
+TEST_F(Cli, A100000FrameRenderChecksItsOutputsBeforeAnyWork) {
+    const fs::path frames = dir_ / "many";
+    fs::create_directory(frames);
+    const Outcome o = stepwise("render " + level("orbit.json") + " --out " + (frames / "f.png").string() +
+                               " --frames 100000 --select nobody");
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, "stepwise: error: --select: " + level("orbit.json") + " has no entity named \"nobody\"\n");
+    EXPECT_TRUE(fs::is_empty(frames));
+}
+
 // A run started with SIGINT ignored (a shell's background job) keeps
 // ignoring it: it runs to the end and writes its output.
 TEST_F(Cli, AnInterruptIgnoredAtStartStaysIgnored) {

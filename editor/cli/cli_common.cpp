@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <tuple>
 
 #include <sys/stat.h>
@@ -69,7 +70,9 @@ Result<void> checkOutputs(const std::vector<std::string>& inputs, const std::vec
         Identity id;
         if (fileIdentity(in, id)) inputIds.emplace_back(id, in);
     }
-    std::vector<std::pair<Identity, const OutputFile*>> seen;
+    // By identity, so that render's up to 100,000 frames are checked in
+    // n log n, not n^2.
+    std::map<Identity, const OutputFile*> seen;
     for (const OutputFile& out : outputs) {
         // The saver's own message, as a failed save prints it.
         if (std::string problem = checkWritableTarget(out.path); !problem.empty())
@@ -80,12 +83,11 @@ Result<void> checkOutputs(const std::vector<std::string>& inputs, const std::vec
             if (inputId == id)
                 return Error{out.path + " is the input " + name + "; refusing to replace it (give the output another name)",
                              out.option};
-        for (const auto& [otherId, other] : seen)
-            if (otherId == id)
-                return Error{out.path + " is the same file as " + other->option + " " + other->path +
-                                 "; give each output its own file",
-                             out.option};
-        seen.emplace_back(id, &out);
+        if (const auto other = seen.find(id); other != seen.end())
+            return Error{out.path + " is the same file as " + other->second->option + " " + other->second->path +
+                             "; give each output its own file",
+                         out.option};
+        seen.emplace(id, &out);
     }
     return {};
 }

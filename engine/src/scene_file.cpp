@@ -86,7 +86,7 @@ namespace {
 /// The temporaries of unfinished writers, for removeUnfinishedTemporaries.
 /// A signal handler walks the list without allocating or locking: nodes
 /// are only ever added at the head and never freed, and a node's path is
-/// read only while its state says live. Writers take and give back nodes
+/// read only while the node is live. Writers take and give back nodes
 /// under a mutex, through a free list, so listing costs O(1) however many
 /// temporaries are pending (render --frames keeps one per frame).
 struct TemporaryNode {
