@@ -74,56 +74,47 @@ void encodeComponent(std::string& out, std::size_t c, const void* component) {
     }
 }
 
-std::string encodeEntity(const Registry& reg, Entity e) {
+/// Where each component starts in an encoding: (table index, offset).
+using ComponentStarts = std::vector<std::pair<std::uint8_t, std::uint32_t>>;
+
+std::string encodeEntity(const Registry& reg, Entity e, ComponentStarts* starts = nullptr) {
+    if (starts) starts->clear();
     if (!reg.alive(e)) return {};
     std::string out(1, kAlive);
     const std::span<const ComponentInfo> table = componentTable();
     for (std::size_t c = 0; c < table.size(); ++c)
-        if (const void* component = table[c].getConst(reg, e)) encodeComponent(out, c, component);
+        if (const void* component = table[c].getConst(reg, e)) {
+            if (starts) starts->emplace_back(std::uint8_t(c), std::uint32_t(out.size()));
+            encodeComponent(out, c, component);
+        }
     return out;
 }
 
 /// The table indices of the components in which two encodings of one
-/// entity differ (present in one and not the other included), as bits.
-std::uint64_t changedComponents(const std::string& before, const std::string& after) {
-    // Each encoding is the marker, then per component its index and bytes
-    // in table order; a component's bytes end where the next index starts,
-    // which a walk over its fields finds.
-    const auto spans = [](const std::string& in) {
-        std::vector<std::pair<std::uint8_t, std::string_view>> out;
-        const std::span<const ComponentInfo> table = componentTable();
-        std::size_t at = in.empty() ? 0 : 1;
-        while (at < in.size()) {
-            const std::size_t start = at;
-            const std::uint8_t c = take<std::uint8_t>(in, at);
-            for (const FieldInfo& f : table[c].fields) {
-                switch (f.kind) {
-                case FieldKind::Number: at += sizeof(double); break;
-                case FieldKind::Integer: at += sizeof(int); break;
-                case FieldKind::VectorList: at += take<std::uint32_t>(in, at) * sizeof(Vec2); break;
-                case FieldKind::OptionalNumber: at += take<std::uint8_t>(in, at) ? sizeof(double) : 0; break;
-                case FieldKind::Vector: at += sizeof(Vec2); break;
-                case FieldKind::OptionalVector: at += take<std::uint8_t>(in, at) ? sizeof(Vec2) : 0; break;
-                case FieldKind::Color: at += sizeof(Rgb); break;
-                case FieldKind::Bool: at += 1; break;
-                case FieldKind::EntityRef: at += sizeof(Entity); break;
-                case FieldKind::String: at += take<std::uint32_t>(in, at); break;
-                }
-            }
-            out.emplace_back(c, std::string_view(in).substr(start, at - start));
-        }
-        return out;
+/// entity differ (present on one side only included), as bits.
+std::uint64_t changedComponents(const std::string& before, const ComponentStarts& was, const std::string& after,
+                                const ComponentStarts& now) {
+    // A component's bytes run from its start to the next one's, or the end.
+    const auto bytesOf = [](const std::string& in, const ComponentStarts& starts, std::size_t k) {
+        const std::size_t end = k + 1 < starts.size() ? starts[k + 1].second : in.size();
+        return std::string_view(in).substr(starts[k].second, end - starts[k].second);
     };
-    const auto was = spans(before), now = spans(after);
     std::uint64_t mask = 0;
-    for (const auto& [c, bytes] : was) {
-        const auto same = std::find_if(now.begin(), now.end(), [&](const auto& n) { return n.first == c; });
-        if (same == now.end() || same->second != bytes) mask |= std::uint64_t(1) << c;
+    std::size_t a = 0, b = 0;  // both lists are in table order
+    while (a < was.size() || b < now.size()) {
+        if (b == now.size() || (a < was.size() && was[a].first < now[b].first)) {
+            mask |= std::uint64_t(1) << was[a++].first;
+        } else if (a == was.size() || now[b].first < was[a].first) {
+            mask |= std::uint64_t(1) << now[b++].first;
+        } else {
+            if (bytesOf(before, was, a) != bytesOf(after, now, b)) mask |= std::uint64_t(1) << was[a].first;
+            ++a;
+            ++b;
+        }
     }
-    for (const auto& [c, bytes] : now)
-        if (std::none_of(was.begin(), was.end(), [&](const auto& w) { return w.first == c; })) mask |= std::uint64_t(1) << c;
     return mask;
 }
+
 
 /// Gives alive entity `e` (with no components) the encoded components.
 void decodeEntity(const std::string& in, Registry& reg, Entity e) {
@@ -199,26 +190,38 @@ public:
         if (!seen_.insert(key(e)).second) return;
         // Created during this edit: it was not there before.
         const bool existed = !slots_ || aliveIn(*slots_, e);
-        changes_.push_back({e, existed ? encodeEntity(registry, e) : std::string(), {}});
+        Touched& t = touched_.emplace_back();
+        t.change.entity = e;
+        if (existed) t.change.before = encodeEntity(registry, e, &t.before);
     }
     void beforeSlotsChange(const Registry& registry) override {
         if (!slots_) slots_ = registry.slots();
     }
 
     /// What the edit changed: the entities whose components differ now, and
-    /// the slot table if it does. Ends the journal's watch.
-    CommandStack::Delta finish() {
+    /// the slot table if it does; `summary` gets each changed entity's
+    /// changed components. Ends the journal's watch.
+    CommandStack::Delta finish(CommandStack::EditSummary& summary) {
         registry_.setObserver(nullptr);
         CommandStack::Delta d;
-        for (CommandStack::Delta::EntityChange& c : changes_) {
-            c.after = encodeEntity(registry_, c.entity);
-            if (c.before != c.after) d.entities.push_back(std::move(c));
+        summary.entities.clear();
+        ComponentStarts after;
+        const auto keep = [&](CommandStack::Delta::EntityChange&& c, const ComponentStarts& before) {
+            summary.entities.emplace_back(c.entity, changedComponents(c.before, before, c.after, after));
+            d.entities.push_back(std::move(c));
+        };
+        for (Touched& t : touched_) {
+            t.change.after = encodeEntity(registry_, t.change.entity, &after);
+            if (t.change.before != t.change.after) keep(std::move(t.change), t.before);
         }
         if (slots_) {
             Registry::Slots now = registry_.slots();
             // Created and never touched (no components): still a change.
             for (const Entity e : now.order)
-                if (!aliveIn(*slots_, e) && !seen_.count(key(e))) d.entities.push_back({e, std::string(), encodeEntity(registry_, e)});
+                if (!aliveIn(*slots_, e) && !seen_.count(key(e))) {
+                    std::string encoded = encodeEntity(registry_, e, &after);
+                    keep({e, std::string(), std::move(encoded)}, {});
+                }
             if (!(now == *slots_)) d.slots.emplace(std::move(*slots_), std::move(now));
         }
         d.entities.shrink_to_fit();
@@ -228,8 +231,12 @@ public:
 private:
     static std::uint64_t key(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
     Registry& registry_;
+    struct Touched {
+        CommandStack::Delta::EntityChange change;  ///< `before` filled now, `after` by finish()
+        ComponentStarts before;
+    };
     std::unordered_set<std::uint64_t> seen_;
-    std::vector<CommandStack::Delta::EntityChange> changes_;
+    std::vector<Touched> touched_;
     std::optional<Registry::Slots> slots_;
 };
 
@@ -275,7 +282,8 @@ bool CommandStack::apply(Scene& scene, std::string label, const std::function<bo
     const int versionBefore = scene.version;
     EditJournal journal(scene.registry);
     const bool kept = edit(scene);
-    Delta change = journal.finish();
+    EditSummary summary;
+    Delta change = journal.finish(summary);
     setIfChanged(change.world, worldBefore, scene.world);
     setIfChanged(change.view, viewBefore, scene.view);
     setIfChanged(change.solver, solverBefore, scene.solverState);
@@ -284,10 +292,8 @@ bool CommandStack::apply(Scene& scene, std::string label, const std::function<bo
         apply(scene, change, false);  // an edit that gave up must leave no trace
         return false;
     }
-    lastEdit_.entities.clear();
-    for (const Delta::EntityChange& c : change.entities)
-        lastEdit_.entities.emplace_back(c.entity, changedComponents(c.before, c.after));
-    lastEdit_.beyondComponents = change.slots || change.world || change.solver || change.version;
+    summary.beyondComponents = change.slots || change.world || change.solver || change.version;
+    lastEdit_ = std::move(summary);
     if (merging) {
         // The command keeps its original "before"; only "after" moves on.
         Command& top = commands_[cursor_ - 1];

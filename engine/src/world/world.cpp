@@ -38,11 +38,11 @@
 #include "world/world_impl.hpp"
 #include "world/world_collisions.hpp"
 
+#include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -695,12 +695,6 @@ EnergyReport World::energy() const {
 
 std::string World::nonFiniteEnergyTerm() const {
     const WorldImpl& w = *impl_;
-    // Any double, finite or not, in its shortest round-trip form.
-    const auto describeValue = [](double v) {
-        char buffer[32];
-        const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, v);
-        return error == std::errc() ? std::string(buffer, end) : std::string("?");
-    };
     const detail::ForceModel& f = w.model;
     const double* x = w.xs();
     const double* v = w.vs();
@@ -711,13 +705,13 @@ std::string World::nonFiniteEnergyTerm() const {
         const double speed = std::hypot(v[2 * b], v[2 * b + 1]);
         const double kinetic = 0.5 * m * (v[2 * b] * v[2 * b] + v[2 * b + 1] * v[2 * b + 1]);
         if (!std::isfinite(kinetic))
-            return bodyLabel(b) + ": kinetic energy m*v^2/2 became " + describeValue(kinetic) + " J (mass " +
-                   describeValue(m) + " kg, speed " + describeValue(speed) + " m/s)";
+            return bodyLabel(b) + ": kinetic energy m*v^2/2 became " + formatNumber(kinetic) + " J (mass " +
+                   formatNumber(m) + " kg, speed " + formatNumber(speed) + " m/s)";
         const double potential = -m * (g.x * x[2 * b] + g.y * x[2 * b + 1]);
         if (!std::isfinite(potential))
-            return bodyLabel(b) + ": gravity's potential energy -m*g.x became " + describeValue(potential) +
-                   " J (mass " + describeValue(m) + " kg at {" + describeValue(x[2 * b]) + ", " +
-                   describeValue(x[2 * b + 1]) + "} m)";
+            return bodyLabel(b) + ": gravity's potential energy -m*g.x became " + formatNumber(potential) +
+                   " J (mass " + formatNumber(m) + " kg at {" + formatNumber(x[2 * b]) + ", " +
+                   formatNumber(x[2 * b + 1]) + "} m)";
     }
     if (const collision::CollisionSystem* contacts = w.collision.get())
         for (std::size_t c = 0; c < contacts->colliderCount(); ++c) {
@@ -726,8 +720,8 @@ std::string World::nonFiniteEnergyTerm() const {
             const double spin = contacts->angularVelocity(c);
             const double turning = 0.5 * col.inertia * spin * spin;
             if (!std::isfinite(turning))
-                return bodyLabel(std::size_t(col.body)) + ": rotational energy I*w^2/2 became " + describeValue(turning) +
-                       " J (inertia " + describeValue(col.inertia) + " kg m^2, spin " + describeValue(spin) + " rad/s)";
+                return bodyLabel(std::size_t(col.body)) + ": rotational energy I*w^2/2 became " + formatNumber(turning) +
+                       " J (inertia " + formatNumber(col.inertia) + " kg m^2, spin " + formatNumber(spin) + " rad/s)";
         }
     for (std::size_t k = 0; k < f.springs.size(); ++k) {
         const detail::SpringData& s = f.springs[k];
@@ -736,8 +730,8 @@ std::string World::nonFiniteEnergyTerm() const {
         const double stretch = std::hypot(bx - ax, by - ay) - s.rest;
         const double elastic = 0.5 * s.k * stretch * stretch;
         if (!std::isfinite(elastic))
-            return "spring " + w.springName[k] + ": energy k*stretch^2/2 became " + describeValue(elastic) +
-                   " J (k " + describeValue(s.k) + " N/m, stretch " + describeValue(stretch) + " m)";
+            return "spring " + w.springName[k] + ": energy k*stretch^2/2 became " + formatNumber(elastic) +
+                   " J (k " + formatNumber(s.k) + " N/m, stretch " + formatNumber(stretch) + " m)";
     }
     return {};
 }
