@@ -21,10 +21,19 @@ struct OffscreenRenderer::Context {
     }
 };
 
+std::optional<Error> OffscreenRenderer::sizeProblem(int widthPx, int heightPx) {
+    const std::string size = std::to_string(widthPx) + "x" + std::to_string(heightPx);
+    if (widthPx <= 0 || heightPx <= 0 || widthPx > kMaxSidePx || heightPx > kMaxSidePx)
+        return Error{"image size " + size + " is outside 1.." + std::to_string(kMaxSidePx) + " pixels a side"};
+    const long long pixels = (long long)widthPx * heightPx;
+    if (pixels > kMaxPixels)
+        return Error{"image size " + size + " is " + std::to_string(pixels) + " pixels; the limit is " +
+                     std::to_string(kMaxPixels) + " (7680x4320)"};
+    return std::nullopt;
+}
+
 Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int widthPx, int heightPx) {
-    if (widthPx <= 0 || heightPx <= 0 || widthPx > 16384 || heightPx > 16384)
-        return Error{"image size " + std::to_string(widthPx) + "x" + std::to_string(heightPx) +
-                     " is outside 1..16384 pixels"};
+    if (std::optional<Error> problem = sizeProblem(widthPx, heightPx)) return *problem;
     std::unique_ptr<OffscreenRenderer> r(new OffscreenRenderer());
     r->context_ = std::make_unique<Context>();
     // No depth or stencil: 2D drawing in painter's order needs neither.

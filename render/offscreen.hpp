@@ -7,11 +7,20 @@
 #include "renderer.hpp"
 
 #include <memory>
+#include <optional>
 
 namespace stepwise::render {
 
 class OffscreenRenderer {
 public:
+    /// Largest image: 8K UHD (7680 x 4320). Each side may reach 16384 on its
+    /// own, but llvmpipe keeps several buffers of this size, so the product
+    /// is what bounds memory (about 0.5 GB here) and time.
+    static constexpr long long kMaxSidePx = 16384;
+    static constexpr long long kMaxPixels = 7680LL * 4320LL;
+    /// Why widthPx x heightPx cannot be rendered, or nothing when it can.
+    static std::optional<Error> sizeProblem(int widthPx, int heightPx);
+
     /// Creates a 3.3 core context drawing into a widthPx x heightPx buffer.
     static Result<std::unique_ptr<OffscreenRenderer>> create(int widthPx, int heightPx);
     ~OffscreenRenderer();

@@ -25,7 +25,7 @@ void setDistinct(const FieldInfo& field, void* component, int salt, Entity targe
     case FieldKind::Integer: *static_cast<int*>(m) = int(field.range.min) + salt; break;
     case FieldKind::OptionalNumber: *static_cast<std::optional<double>*>(m) = v * 3.1; break;
     case FieldKind::Vector: *static_cast<Vec2*>(m) = {0.1 * salt + 1.0 / 3.0, -2.0 / 7.0}; break;
-    case FieldKind::OptionalVector: *static_cast<std::optional<Vec2>*>(m) = Vec2{1e-300, -1e300}; break;
+    case FieldKind::OptionalVector: *static_cast<std::optional<Vec2>*>(m) = Vec2{1e-300, -9.87654321e29}; break;
     case FieldKind::Color: *static_cast<Rgb*>(m) = {0.453125, 1.0 / 3.0, 0.0}; break;
     case FieldKind::Bool: *static_cast<bool*>(m) = salt % 2 == 0; break;
     case FieldKind::VectorList:  // a convex, counter-clockwise quadrilateral off its origin

@@ -365,8 +365,10 @@ TEST(FusedKernels, EveryInstructionSetMatchesTheUnfusedFormulasBitForBit) {
 }
 
 TEST(FusedKernels, DivergenceIsCaughtInTheVectorBlockAndInTheTail) {
-    // x grows by 0.5e308 per step: step 4 pushes it past DBL_MAX. Body 1 is
-    // in the first block of four, body 5 in the scalar tail (6 bodies).
+    // A velocity far past the fastest a level holds (built in code, so no
+    // loader refused it): the kernel's quick range test flags it in its
+    // writing pass at step 1, and the state stays as it was. Body 1 is in
+    // the first block of four, body 5 in the scalar tail (6 bodies).
     for (SimdLevel level : availableSimdLevels()) {
         detail::setSimdLevel(level);
         for (const char* integrator : {"semi_implicit_euler", "rk4"})
@@ -377,15 +379,14 @@ TEST(FusedKernels, DivergenceIsCaughtInTheVectorBlockAndInTheTail) {
                     s.registry.emplace<Drag>(e, {i == bad ? 0.0 : 0.2});
                 }
                 World w = buildOrDie(s);
-                for (int i = 0; i < 3; ++i) ASSERT_TRUE(w.step().ok()) << simdName(level) << " " << integrator;
                 const Vec2 before = w.bodyPosition(std::size_t(bad));
                 Result<void> r = w.step();
                 ASSERT_FALSE(r.ok()) << simdName(level) << " " << integrator << " body " << bad;
-                EXPECT_EQ(r.error(), "step 4: entity " + std::to_string(bad) + " (\"b" + std::to_string(bad) +
-                                         "\"): position.x became inf")
+                EXPECT_EQ(r.error(), "step 1: entity " + std::to_string(bad) + " (\"b" + std::to_string(bad) +
+                                         "\"): velocity.x became 1e+308, beyond the +-1e+09 a level can hold")
                     << simdName(level) << " " << integrator;
                 EXPECT_EQ(w.bodyPosition(std::size_t(bad)), before);
-                EXPECT_EQ(w.lastStats().step, 3u);
+                EXPECT_EQ(w.lastStats().step, 0u);
             }
     }
     detail::setSimdLevel(SimdLevel::Avx512);

@@ -204,7 +204,7 @@ TEST(PolygonFormat, BadOutlinesAreRefusedWithTheEntityAndThePointer) {
               "t.json: error: /entities/0/polygon/vertices: expected an array of vectors, got 3");
     EXPECT_EQ(loadError(level("{\"position\": {\"x\": 0, \"y\": 0}, \"polygon\": {\"vertices\": [{\"x\": 0, \"y\": "
                               "0}, {\"x\": 1, \"y\": \"a\"}, {\"x\": 0, \"y\": 1}]}}")),
-              "t.json: error: /entities/0/polygon/vertices/1/y: expected a finite number, got \"a\"");
+              "t.json: error: /entities/0/polygon/vertices/1/y: expected a number in [-1e+30, 1e+30], got \"a\"");
     EXPECT_EQ(loadError(level("{\"position\": {\"x\": 0, \"y\": 0}, \"radius\": 1, \"polygon\": {}}")),
               "t.json: error: /entities/0: an entity has at most one shape (radius, box, polygon or plane), got 2");
     EXPECT_EQ(loadError(level("{\"polygon\": {}}")),

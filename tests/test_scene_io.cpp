@@ -123,7 +123,7 @@ TEST(SceneSave, LoadSaveLoadSaveIsByteIdenticalForEveryShippedLevel) {
 TEST(SceneSave, NumbersReadBackToTheIdenticalDouble) {
     Scene scene;
     const Entity e = scene.registry.create();
-    const double awkward[] = {0.1, 1.0 / 3.0, 2.2221813, 0.93000000000000006, 5e-324, 1.7976931348623157e308,
+    const double awkward[] = {0.1, 1.0 / 3.0, 2.2221813, 0.93000000000000006, 5e-324, 9.999999999999999e29, -1e30,
                               -0.0, 123456789.123456789, 1e-7};
     for (double v : awkward) {
         scene.registry.emplace<Position>(e, Position{{v, -v}});
@@ -207,7 +207,7 @@ TEST(SceneErrors, TrailingCommaGetsItsOwnHint) {
 
 TEST(SceneErrors, WrongTypeNamesThePointerExpectedAndFound) {
     EXPECT_EQ(refusal(R"({"entities": [{}, {}, {}, {"position": {"x": 0, "y": 0}, "velocity": {"x": "fast", "y": 0}}]})"),
-              "t.json: error: /entities/3/velocity/x: expected a finite number, got \"fast\"");
+              "t.json: error: /entities/3/velocity/x: expected a number in [-1e+09, 1e+09], got \"fast\"");
     EXPECT_EQ(refusal(R"({"entities": [{"name": 7}]})"), "t.json: error: /entities/0/name: expected a string, got 7");
     EXPECT_EQ(refusal(R"({"entities": {}})"), "t.json: error: /entities: expected an array of entities, got an empty object");
     EXPECT_EQ(refusal(R"([])"), "t.json: error: expected a level object {\"entities\": [...]}, got an empty array");
@@ -261,11 +261,11 @@ TEST(SceneErrors, DuplicateNames) {
 
 TEST(SceneErrors, MassRadiusAndNonFiniteNumbers) {
     EXPECT_EQ(refusal(R"({"entities": [{"position": {"x": 0, "y": 0}, "mass": 0}]})"),
-              "t.json: error: /entities/0/mass: expected a number > 0, got 0");
+              "t.json: error: /entities/0/mass: expected a number in [1e-30, 1e+30], got 0");
     EXPECT_EQ(refusal(R"({"entities": [{"position": {"x": 0, "y": 0}, "mass": -2.5}]})"),
-              "t.json: error: /entities/0/mass: expected a number > 0, got -2.5");
+              "t.json: error: /entities/0/mass: expected a number in [1e-30, 1e+30], got -2.5");
     EXPECT_EQ(refusal(R"({"entities": [{"position": {"x": 0, "y": 0}, "radius": -1}]})"),
-              "t.json: error: /entities/0/radius: expected a number > 0, got -1");
+              "t.json: error: /entities/0/radius: expected a number in [1e-30, 1e+30], got -1");
     EXPECT_EQ(refusal(R"({"entities": [{"position": {"x": 1e999, "y": 0}}]})"),
               "t.json:1:34: error: number 1e999 is out of double range; expected a finite number");
     // NaN is not JSON at all: the parser refuses it with a position.
@@ -421,12 +421,18 @@ TEST(WorldFields, EveryOutOfRangeSettingIsRefusedAtItsPointer) {
         const NumberRange& r = info.field.range;
         if (!std::isfinite(r.max)) continue;
         const std::string key(info.field.key);
-        const std::string text = R"({"world": {")" + key + R"(": )" + formatNumber(r.max + 1) + R"(}, "entities": []})";
+        // One past an integer bound; past 1e30, one part in a million (1e30
+        // + 1 is 1e30 again).
+        const double outside = r.max + std::max(1.0, r.max * 1e-6);
+        // A vector's bound is each axis's.
+        const bool vector = info.field.kind == FieldKind::Vector;
+        const std::string value = vector ? R"({"x": )" + formatNumber(outside) + "}" : formatNumber(outside);
+        const std::string text = R"({"world": {")" + key + R"(": )" + value + R"(}, "entities": []})";
         Result<Scene> scene = parseScene(text, "t.json");
         ASSERT_FALSE(scene) << key;
-        EXPECT_EQ(scene.error(), "t.json: error: /world/" + key + ": expected " +
+        EXPECT_EQ(scene.error(), "t.json: error: /world/" + key + (vector ? "/x" : "") + ": expected " +
                                      r.describe(info.field.kind == FieldKind::Integer) + ", got " +
-                                     formatNumber(r.max + 1));
+                                     formatNumber(outside));
     }
 }
 

@@ -115,6 +115,11 @@ int render(const RenderOptions& o) {
             return kExitBadInput;
         }
     }
+    // Before the level loads: a size past the limit costs nothing to refuse.
+    if (std::optional<Error> size = render::OffscreenRenderer::sizeProblem(o.width, o.height)) {
+        reportError("--width/--height: " + size->message);
+        return kExitBadInput;
+    }
     // The last frame's step count must fit in a long long.
     if (o.frames > 1 && o.steps > std::numeric_limits<long long>::max() - (long long)(o.frames - 1) * o.every) {
         reportError("--steps: " + std::to_string(o.steps) + " plus " + std::to_string(o.frames - 1) + " x --every " +

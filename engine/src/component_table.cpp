@@ -18,10 +18,12 @@ namespace stepwise {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr NumberRange kAny{};
-constexpr NumberRange kPositive{0.0, kInf, true};
-constexpr NumberRange kNonNegative{0.0, kInf, false};
+constexpr NumberRange kAny = kAnyMagnitude;
+constexpr NumberRange kPositive{0.0, kMaxMagnitude, true};
+constexpr NumberRange kNonNegative{0.0, kMaxMagnitude, false};
+/// Masses and shape sizes: their squares and products (inertia m r^2, and
+/// its inverse) stay normal doubles.
+constexpr NumberRange kSize{kMinSize, kMaxMagnitude, false};
 constexpr NumberRange kUnit{0.0, 1.0, false};
 
 template <auto Member>
@@ -70,24 +72,13 @@ std::optional<Error> finishPlane(void* component) {
     // The offset is measured along the normal as written (n.p >= d); keep the
     // same half-plane after normalising n by scaling d with it.
     const double offset = plane.offset / len;
-    if (!std::isfinite(offset))
-        return Error{"expected an offset that stays finite once the normal is normalised (offset / |normal|), got " +
+    if (!(std::abs(offset) <= kMaxMagnitude))
+        return Error{"expected an offset that stays within " + formatNumber(kMaxMagnitude) +
+                         " once the normal is normalised (offset / |normal|), got " +
                          describeNumber(plane.offset) + " with |normal| = " + describeNumber(len),
                      "offset"};
     plane.normal = plane.normal / len;
     plane.offset = offset;
-    return {};
-}
-
-/// Fastest speed a file (or the inspector) accepts, m/s. Faster, v*v and so
-/// the kinetic energy m*v^2/2 overflow a double; the first step diverges.
-constexpr double kMaxSpeed = 1e150;
-
-std::optional<Error> finishVelocity(void* component) {
-    const Vec2 v = static_cast<Velocity*>(component)->value;
-    if (std::abs(v.x) > kMaxSpeed || std::abs(v.y) > kMaxSpeed)
-        return Error{"expected a speed up to 1e150 m/s in each axis (beyond it the kinetic energy m*v^2/2 overflows), "
-               "got {\"x\": " + describeNumber(v.x) + ", \"y\": " + describeNumber(v.y) + "}"};
     return {};
 }
 
@@ -145,16 +136,16 @@ std::vector<ComponentInfo> buildTable() {
     t.push_back(row<Position>("position", "centre of the body", true, {},
                               {field<&Position::value>("", kAny, "m", "centre of the body")}));
     t.push_back(row<Velocity>("velocity", "linear velocity", true, needsPosition,
-                              {field<&Velocity::value>("", kAny, "m/s", "linear velocity")}, &finishVelocity));
+                              {field<&Velocity::value>("", kAnySpeed, "m/s", "linear velocity")}));
     t.push_back(row<Mass>("mass", "mass of a dynamic body", true, needsPosition,
-                          {field<&Mass::value>("", kPositive, "kg", "mass of a dynamic body")}));
+                          {field<&Mass::value>("", kSize, "kg", "mass of a dynamic body")}));
     t.push_back(row<Static>("static", "immovable: infinite mass, never integrated", true, needsPosition,
                             {field<&Static::value>("", kAny, "", "immovable when true")}));
     t.push_back(row<Radius>("radius", "circle shape; the body collides", true, needsPosition,
-                            {field<&Radius::value>("", kPositive, "m", "circle radius")}));
+                            {field<&Radius::value>("", kSize, "m", "circle radius")}));
     t.push_back(row<Box>("box", "box shape, rotated by angle; the body collides", false, needsPosition,
-                         {field<&Box::width>("width", kPositive, "m", "full width"),
-                          field<&Box::height>("height", kPositive, "m", "full height")}));
+                         {field<&Box::width>("width", kSize, "m", "full width"),
+                          field<&Box::height>("height", kSize, "m", "full height")}));
     {
         ComponentInfo polygon = row<Polygon>(
             "polygon", "convex polygon shape, rotated by angle about position; the body collides", false,
@@ -168,7 +159,7 @@ std::vector<ComponentInfo> buildTable() {
     t.push_back(row<Angle>("angle", "orientation, counter-clockwise", true, needsPosition,
                            {field<&Angle::value>("", kAny, "rad", "orientation")}));
     t.push_back(row<AngularVelocity>("angular_velocity", "spin, counter-clockwise", true, needsPosition,
-                                     {field<&AngularVelocity::value>("", kAny, "rad/s", "spin")}));
+                                     {field<&AngularVelocity::value>("", kAnySpeed, "rad/s", "spin")}));
     t.push_back(row<Color>("color", "display colour", true, {},
                            {field<&Color::value>("", kUnit, "", "display colour, channels in 0..1")}));
     // Material properties: planes have them too, so they need no position.
@@ -205,7 +196,7 @@ std::vector<ComponentInfo> buildTable() {
          field<&Boid::cohesion>("cohesion", kNonNegative, "m/s^2", "weight of cohesion"),
          field<&Boid::goal>("goal", kAny, "m", "point to seek"),
          field<&Boid::goalWeight>("goal_weight", kNonNegative, "m/s^2", "weight of seeking the goal"),
-         field<&Boid::maxSpeed>("max_speed", kPositive, "m/s", "speed limit of steering")},
+         field<&Boid::maxSpeed>("max_speed", NumberRange{0.0, kMaxSpeed, true}, "m/s", "speed limit of steering")},
         &finishBoid));
     {
         FieldInfo type = field<&Joint::type>("type", kAny, "", "hinge, slider, weld, distance or rope");
@@ -223,7 +214,7 @@ std::vector<ComponentInfo> buildTable() {
                                            "angle of b relative to a that counts as zero; absent: as loaded"),
              field<&Joint::lower>("lower", kAny, "rad or m", "hinge: lowest angle; slider: lowest travel"),
              field<&Joint::upper>("upper", kAny, "rad or m", "hinge: highest angle; slider: highest travel"),
-             field<&Joint::motorSpeed>("motor_speed", kAny, "rad/s or m/s", "motor target speed; absent 0"),
+             field<&Joint::motorSpeed>("motor_speed", kAnySpeed, "rad/s or m/s", "motor target speed; absent 0"),
              field<&Joint::maxMotorTorque>("max_motor_torque", kNonNegative, "N*m", "hinge motor: largest torque"),
              field<&Joint::maxMotorForce>("max_motor_force", kNonNegative, "N", "slider motor: largest force"),
              field<&Joint::length>("length", kNonNegative, "m", "distance, rope: length; absent: as loaded"),
@@ -283,9 +274,12 @@ std::optional<Error> fieldValueProblem(const FieldInfo& field, const void* membe
             return Error{"expected " + field.range.describe(integer) + ", got " + formatNumber(v)};
         return std::nullopt;
     };
-    auto vector = [](Vec2 v) -> std::optional<Error> {
-        if (isFinite(v)) return std::nullopt;
-        return Error{"expected finite numbers, got {\"x\": " + formatNumber(v.x) + ", \"y\": " + formatNumber(v.y) + "}"};
+    auto vector = [](Vec2 v, const NumberRange& axis) -> std::optional<Error> {
+        if (axis.contains(v.x) && axis.contains(v.y)) return std::nullopt;
+        return Error{std::string(isFinite(v) ? "expected each axis in [" + formatNumber(axis.min) + ", " +
+                                                   formatNumber(axis.max) + "]"
+                                             : "expected finite numbers") +
+                     ", got {\"x\": " + formatNumber(v.x) + ", \"y\": " + formatNumber(v.y) + "}"};
     };
     switch (field.kind) {
     case FieldKind::Number: return number(*static_cast<const double*>(member), false);
@@ -294,14 +288,14 @@ std::optional<Error> fieldValueProblem(const FieldInfo& field, const void* membe
         const auto& v = *static_cast<const std::optional<double>*>(member);
         return v ? number(*v, false) : std::nullopt;
     }
-    case FieldKind::Vector: return vector(*static_cast<const Vec2*>(member));
+    case FieldKind::Vector: return vector(*static_cast<const Vec2*>(member), field.range);
     case FieldKind::OptionalVector: {
         const auto& v = *static_cast<const std::optional<Vec2>*>(member);
-        return v ? vector(*v) : std::nullopt;
+        return v ? vector(*v, field.range) : std::nullopt;
     }
     case FieldKind::VectorList:
         for (const Vec2 p : *static_cast<const std::vector<Vec2>*>(member))
-            if (auto problem = vector(p)) return problem;
+            if (auto problem = vector(p, kAnyMagnitude)) return problem;
         return std::nullopt;
     case FieldKind::Color: {
         const Rgb c = *static_cast<const Rgb*>(member);

@@ -1,6 +1,7 @@
 // Polygon shapes: the one validity check (loader, world, editor) and the
 // mass properties the engine derives from the outline.
 
+#include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
 
 #include <algorithm>
@@ -22,8 +23,11 @@ std::string pointText(Vec2 p) {
 std::optional<Error> polygonProblem(const std::vector<Vec2>& v) {
     const std::size_t n = v.size();
     if (n < 3 || n > 8) return Error{"expected 3 to 8 vertices, got " + std::to_string(n)};
-    for (const Vec2& p : v)
-        if (!isFinite(p)) return Error{"expected finite vertices"};
+    for (std::size_t i = 0; i < n; ++i)
+        if (!(std::abs(v[i].x) <= kMaxMagnitude && std::abs(v[i].y) <= kMaxMagnitude))
+            return Error{"vertex " + std::to_string(i) + " " + pointText(v[i]) + " is not within " +
+                             formatNumber(kMaxMagnitude) + " m of the body's position on each axis",
+                         std::to_string(i)};
     // Tolerances are relative to the polygon's size, so a 1 mm triangle and a
     // 1 km one are judged alike. extent: the largest coordinate span, metres.
     Vec2 lo = v[0], hi = v[0];
@@ -32,7 +36,11 @@ std::optional<Error> polygonProblem(const std::vector<Vec2>& v) {
         hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
     }
     const double extent = std::max(hi.x - lo.x, hi.y - lo.y);
-    // Closer than a billionth of the size: the edge between them has no
+    // Below it the area (extent^2) and second moment (extent^4) leave the
+    // normal doubles, and the checks below would misjudge rounding as shape.
+    if (!(extent >= kMinSize))
+        return Error{"the polygon is " + formatNumber(extent) + " m across; the smallest shape is " +
+                     formatNumber(kMinSize) + " m"};    // Closer than a billionth of the size: the edge between them has no
     // usable direction (its normal would be rounding noise).
     const double samePoint = 1e-9 * extent;
     for (std::size_t j = 1; j < n; ++j)

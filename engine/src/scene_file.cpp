@@ -28,6 +28,10 @@ Result<Scene> loadSceneFile(const fs::path& path, const LoadLimits& limits) {
     const fs::file_status status = fs::status(path, ec);
     if (ec || !fs::exists(status)) return Error{name + ": error: no such file"};
     if (fs::is_directory(status)) return Error{name + ": error: is a directory, expected a level file"};
+    // A device or pipe has no size to check against the limit, and reading
+    // one may never end.
+    if (!fs::is_regular_file(status))
+        return Error{name + ": error: is not a regular file (a device, pipe or socket); expected a level file"};
     const std::uintmax_t size = fs::file_size(path, ec);
     if (ec) return Error{name + ": error: cannot read: " + ec.message()};
     // Checked before reading so a huge file costs nothing.

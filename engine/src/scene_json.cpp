@@ -74,6 +74,15 @@ std::string joinNames(std::span<const std::string_view> names) {
     return out;
 }
 
+// "unknown X "key"; did you mean "Y"? Known Xs: ..." (or "unknown X "key".
+// Known Xs: ..." when nothing is close), one sentence shape for every name.
+std::string unknownNameMessage(std::string message, std::string_view key,
+                               std::span<const std::string_view> known, std::string_view knownLabel) {
+    if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
+    else message += ".";
+    return message + " Known " + std::string(knownLabel) + ": " + joinNames(known);
+}
+
 [[noreturn]] void refuse(std::string pointer, std::string message) {
     throw Refusal{std::move(pointer), std::move(message)};
 }
@@ -128,8 +137,11 @@ std::array<double, N> readAxes(const Json& v, const std::string& pointer, const 
     return out;
 }
 
-Vec2 readVector(const Json& v, const std::string& pointer) {
-    const auto a = readAxes<2>(v, pointer, NumberRange{}, "a vector {\"x\": number, \"y\": number}");
+/// Coordinates and the like are bounded by the level's largest magnitude,
+/// velocities by its largest speed; impulses pass NumberRange{} (any finite
+/// number).
+Vec2 readVector(const Json& v, const std::string& pointer, const NumberRange& range = kAnyMagnitude) {
+    const auto a = readAxes<2>(v, pointer, range, "a vector {\"x\": number, \"y\": number}");
     return {a[0], a[1]};
 }
 
@@ -166,9 +178,9 @@ void readField(const FieldInfo& field, const Json& v, void* component, const std
     case FieldKind::OptionalNumber:
         *static_cast<std::optional<double>*>(member) = readNumber(v, pointer, NumberRange{}, field.range);
         break;
-    case FieldKind::Vector: *static_cast<Vec2*>(member) = readVector(v, pointer); break;
+    case FieldKind::Vector: *static_cast<Vec2*>(member) = readVector(v, pointer, field.range); break;
     case FieldKind::OptionalVector:
-        *static_cast<std::optional<Vec2>*>(member) = readVector(v, pointer);
+        *static_cast<std::optional<Vec2>*>(member) = readVector(v, pointer, field.range);
         break;
     case FieldKind::Color: *static_cast<Rgb*>(member) = readColor(v, pointer, field.range); break;
     case FieldKind::Bool: *static_cast<bool*>(member) = readBool(v, pointer); break;
@@ -277,9 +289,9 @@ void readComponent(const ComponentInfo& info, const Json& value, Registry& regis
             if (it == info.fields.end()) {
                 std::vector<std::string_view> known;
                 for (const FieldInfo& f : info.fields) known.push_back(f.key);
-                std::string message = "unknown field \"" + key + "\" in \"" + std::string(info.name) + "\"";
-                if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
-                refuse(child(pointer, key), message + " Known fields: " + joinNames(known));
+                refuse(child(pointer, key),
+                       unknownNameMessage("unknown field \"" + key + "\" in \"" + std::string(info.name) + "\"", key,
+                                          known, "fields"));
             }
             const std::size_t unresolvedBefore = names.unresolved.size();
             readField(*it, fieldValue, component, child(pointer, key), names);
@@ -310,9 +322,9 @@ void readEntity(const Json& entityJson, std::size_t index, Registry& registry, E
         const ComponentInfo* info = findComponent(key);
         if (!info) {
             const auto known = componentNames();
-            std::string message = "unknown component \"" + key + "\" on " + entityLabel(index, entityJson);
-            if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
-            refuse(child(pointer, key), message + " Known components: " + joinNames(known));
+            refuse(child(pointer, key),
+                   unknownNameMessage("unknown component \"" + key + "\" on " + entityLabel(index, entityJson), key,
+                                      known, "components"));
         }
         readComponent(*info, value, registry, e, child(pointer, key), names, entityLabel(index, entityJson));
     }
@@ -336,12 +348,11 @@ void readWorld(const Json& v, WorldSettings& world) {
         const WorldFieldInfo* info = findWorldField(key);
         if (!info) {
             const std::vector<std::string_view> known = worldFieldNames();
-            std::string message = "unknown world setting \"" + key + "\"";
-            if (auto guess = closestName(key, known)) message += "; did you mean \"" + std::string(*guess) + "\"?";
-            refuse(at, message + " Known settings: " + joinNames(known));
+            refuse(at, unknownNameMessage("unknown world setting \"" + key + "\"", key, known, "settings"));
         }
         readField(info->field, value, &world, at, kNoNames);
     }
+    if (std::optional<Error> problem = adaptiveStepProblem(world)) refuse(child(pointer, "adaptive_step"), problem->message);
 }
 
 /// Whether the entity has a shape, so contacts (and their warm start) can
@@ -472,9 +483,9 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
                               } else if (field == "still_at") {
                                   b.stillAt = readVector(fv, fa);
                               } else if (field == "still_angle") {
-                                  b.stillAngle = readNumber(fv, fa, NumberRange{});
+                                  b.stillAngle = readNumber(fv, fa, kAnyMagnitude);
                               } else if (field == "still_velocity") {
-                                  b.stillVelocity = readVector(fv, fa);
+                                  b.stillVelocity = readVector(fv, fa, kAnySpeed);
                               } else {
                                   b.island = dynamicAt(fv, fa);
                               }
@@ -496,7 +507,7 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
                               if (!registry.has<Joint>(j.joint)) refuse(fa, "entity " + fv.dump() + " is not a joint");
                               if (!seenJoints.insert(j.joint).second)
                                   refuse(fa, "joint " + fv.dump() + " has an entry already");
-                          } else if (field == "linear_impulse") j.linear = readVector(fv, fa);
+                          } else if (field == "linear_impulse") j.linear = readVector(fv, fa, NumberRange{});
                           else if (field == "angular_impulse") j.angular = readNumber(fv, fa, NumberRange{});
                           else if (field == "axial_impulse") j.axial = readNumber(fv, fa, NumberRange{});
                           else if (field == "motor_impulse") j.motor = readNumber(fv, fa, NumberRange{});
@@ -773,9 +784,7 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
                                                                   "solver_state"};
         for (const auto& [key, value] : root.items()) {
             if (std::find(kTopKeys.begin(), kTopKeys.end(), key) == kTopKeys.end()) {
-                std::string message = "unknown top-level key \"" + key + "\"";
-                if (auto guess = closestName(key, kTopKeys)) message += "; did you mean \"" + std::string(*guess) + "\"?";
-                refuse(child("", key), message + " Known keys: " + joinNames(kTopKeys));
+                refuse(child("", key), unknownNameMessage("unknown top-level key \"" + key + "\"", key, kTopKeys, "keys"));
             }
         }
         if (auto it = root.find("version"); it != root.end()) {
@@ -829,13 +838,12 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
         const Vec2 a = scene.registry.tryGet<Position>(s->a)->value;
         const Vec2 b = s->anchor ? *s->anchor : scene.registry.tryGet<Position>(s->b)->value;
         const double rest = length(b - a);
-        // Ends more than about 1e154 m apart: the squared length overflows,
-        // and an infinite rest_length would be saved as null, which does not
-        // load. The force code computes the length the same way.
-        if (!std::isfinite(rest))
-            return Error{prefix + child("/entities", i) +
-                         "/spring: the ends are too far apart to compute the length (over 1e154 m); give "
-                         "\"rest_length\""};
+        // Ends up to 2.8e30 m apart may be given, but the saved rest_length
+        // must load again.
+        if (!(rest <= kMaxMagnitude))
+            return Error{prefix + child("/entities", i) + "/spring: the ends are " + formatNumber(rest) +
+                         " m apart, past the " + formatNumber(kMaxMagnitude) +
+                         " m a rest_length may be; give \"rest_length\""};
         s->restLength = rest;
     }
     for (std::size_t i = 0; i < entities.size(); ++i) {
@@ -878,10 +886,11 @@ std::string completeJoint(const Registry& registry, Joint& joint) {
     const Pose a = poseOf(joint.a), b = poseOf(joint.b);
     if (joint.anchor) {
         const Vec2 localA = toLocal(a, *joint.anchor), localB = toLocal(b, *joint.anchor);
-        // Past about 1e308 m apart the difference overflows; an infinite
-        // local would be saved as null, which does not load.
-        if (!isFinite(localA) || !isFinite(localB))
-            return "anchor: too far from the bodies to express in their frames (over 1e308 m)";
+        // Derived values are saved, so they must be what a level may hold.
+        const auto inRange = [](Vec2 v) { return std::abs(v.x) <= kMaxMagnitude && std::abs(v.y) <= kMaxMagnitude; };
+        if (!inRange(localA) || !inRange(localB))
+            return "anchor: too far from the bodies to express in their frames (past " + formatNumber(kMaxMagnitude) +
+                   " m on an axis)";
         joint.localA = localA;
         joint.localB = localB;
         joint.anchor.reset();
@@ -889,16 +898,18 @@ std::string completeJoint(const Registry& registry, Joint& joint) {
     const bool angular = joint.type == "hinge" || joint.type == "slider" || joint.type == "weld";
     if (angular && !joint.referenceAngle) {
         const double reference = b.angle - a.angle;
-        if (!std::isfinite(reference))
-            return "reference_angle: the bodies' angles are too far apart to subtract; give \"reference_angle\"";
+        if (!(std::abs(reference) <= kMaxMagnitude))
+            return "reference_angle: the bodies' angles differ by more than " + formatNumber(kMaxMagnitude) +
+                   " rad; give \"reference_angle\"";
         joint.referenceAngle = reference;
     }
     const bool hasLength = joint.type == "distance" || joint.type == "rope";
     if (hasLength && !joint.length) {
         const double d = length(toWorld(b, joint.localB) - toWorld(a, joint.localA));
-        // Same overflow as a spring's rest length: an infinite length would
-        // be saved as null, which does not load.
-        if (!std::isfinite(d)) return "length: the anchors are too far apart to compute it (over 1e154 m); give \"length\"";
+        // As a spring's rest length: the saved length must load again.
+        if (!(d <= kMaxMagnitude))
+            return "length: the anchors are " + formatNumber(d) + " m apart, past the " + formatNumber(kMaxMagnitude) +
+                   " m a length may be; give \"length\"";
         joint.length = d;
     }
     return {};

@@ -37,7 +37,10 @@ Json fieldSchema(const FieldInfo& f) {
         if (std::isfinite(f.range.max)) j["maximum"] = long(f.range.max);
         break;
     case FieldKind::Vector:
-    case FieldKind::OptionalVector: j = ref("vector"); break;
+    case FieldKind::OptionalVector:
+        // Speeds have a tighter bound than the shared vector's.
+        j = f.range.min == kAnyMagnitude.min && f.range.max == kAnyMagnitude.max ? ref("vector") : ref("speed");
+        break;
     case FieldKind::Color: j = ref("color"); break;
     case FieldKind::Bool: j = Json{{"type", "boolean"}}; break;
     case FieldKind::String:
@@ -72,7 +75,11 @@ Json axesSchema(std::initializer_list<const char*> axes, Json axis, const char* 
 
 std::string sceneJsonSchema() {
     Json defs = Json::object();
-    defs["vector"] = axesSchema({"x", "y"}, Json{{"type", "number"}}, "2D vector; a missing axis is 0");
+    const auto axis = [](const NumberRange& r) {
+        return Json{{"type", "number"}, {"minimum", r.min}, {"maximum", r.max}};
+    };
+    defs["vector"] = axesSchema({"x", "y"}, axis(kAnyMagnitude), "2D vector; a missing axis is 0");
+    defs["speed"] = axesSchema({"x", "y"}, axis(kAnySpeed), "2D velocity, m/s; a missing axis is 0");
     defs["color"] = axesSchema({"x", "y", "z"}, Json{{"type", "number"}, {"minimum", 0}, {"maximum", 1}},
                                "RGB colour, channels in 0..1");
 

@@ -26,8 +26,8 @@ std::vector<WorldFieldInfo> buildTable() {
     // dopri5 proposes up to five times its step, which a World takes back
     // when it is reloaded.
     return {
-        {makeField<&WorldSettings::gravity>("gravity", {}, "m/s^2", "applied to every dynamic body")},
-        {makeField<&WorldSettings::G>("G", {}, "N*m^2/kg^2", "gravitational constant for attractors")},
+        {makeField<&WorldSettings::gravity>("gravity", kAnyMagnitude, "m/s^2", "applied to every dynamic body")},
+        {makeField<&WorldSettings::G>("G", kAnyMagnitude, "N*m^2/kg^2", "gravitational constant for attractors")},
         {integrator},
         {.field = makeField<&WorldSettings::dt>("dt", {0.0, 10.0, true}, "s", "seconds per step"),
          .maxGuardsInputOnly = true},
@@ -36,7 +36,7 @@ std::vector<WorldFieldInfo> buildTable() {
                                              "the scene's structure (its pile, load and joints) and recorded "
                                              "in a saved run's solver_state.chosen"),
          true},
-        {makeField<&WorldSettings::time>("time", {}, "s", "simulated seconds so far")},
+        {makeField<&WorldSettings::time>("time", kAnyMagnitude, "s", "simulated seconds so far")},
         {makeField<&WorldSettings::solverIterations>("solver_iterations", {1.0, 1000.0}, "",
                                                      "contact solver velocity iterations per substep; absent: 8, "
                                                      "or chosen with substeps when that is absent too"),
@@ -102,6 +102,13 @@ std::vector<std::string_view> worldFieldNames() {
     return names;
 }
 
+std::optional<Error> adaptiveStepProblem(const WorldSettings& settings) {
+    const double smallest = kSmallestAdaptiveStep * settings.dt;
+    if (settings.adaptiveStep == 0.0 || settings.adaptiveStep > smallest) return std::nullopt;
+    return Error{"expected 0 (none yet) or more than " + formatNumber(kSmallestAdaptiveStep) + " dt (" +
+                 formatNumber(smallest) + " s), dopri5's smallest step, got " + formatNumber(settings.adaptiveStep)};
+}
+
 std::optional<Error> worldSettingsProblem(const WorldSettings& settings) {
     for (const WorldFieldInfo& info : worldFieldTable()) {
         if (info.isUnset(settings)) continue;
@@ -111,6 +118,7 @@ std::optional<Error> worldSettingsProblem(const WorldSettings& settings) {
         if (std::optional<Error> problem = fieldValueProblem(field, member))
             return problem->within("world." + std::string(field.key));
     }
+    if (std::optional<Error> problem = adaptiveStepProblem(settings)) return problem->within("world.adaptive_step");
     return std::nullopt;
 }
 

@@ -55,10 +55,30 @@ struct NumberRange {
     std::string describe(bool integer = false) const;
 };
 
+/// The largest magnitude any quantity in a level may have, in its SI unit
+/// (coordinates, speeds, spins, masses, stiffnesses, G, gravity...), and the
+/// smallest size (radius, box side, polygon extent) or mass. Within them
+/// every product a step forms (m v^2 and I w^2 up to 1e150, m g y, k x^2,
+/// G m m / r) stays far from a double's 1.8e308, so any level the loader
+/// accepts can be stepped; a run that carries a body past them stops as
+/// diverged, so everything a run saves loads again.
+inline constexpr double kMaxMagnitude = 1e30;
+inline constexpr double kMinSize = 1e-30;
+inline constexpr NumberRange kAnyMagnitude{-kMaxMagnitude, kMaxMagnitude};
+/// The fastest linear (m/s) or angular (rad/s) speed. Tighter than
+/// kMaxMagnitude because a contact's answer is a difference of speeds: at
+/// 1e20 m/s the 120 m/s that closes a 2 m gap in a 60 Hz step is below the
+/// speed's rounding (16,384 m/s), and a ball fired at a wall stops where it
+/// starts. At 1e9 the rounding is 1.2e-7 m/s, a 2e-9 m error per step.
+inline constexpr double kMaxSpeed = 1e9;
+inline constexpr NumberRange kAnySpeed{-kMaxSpeed, kMaxSpeed};
+
 struct FieldInfo {
     std::string_view key;          ///< JSON key; empty for an inline component
     FieldKind kind;
-    NumberRange range;             ///< Number and OptionalNumber only
+    /// Number and OptionalNumber: the value; Vector and OptionalVector: each
+    /// axis; VectorList: the count.
+    NumberRange range;
     std::string_view unit;         ///< "m", "kg", "m/s", "" ...
     std::string_view description;  ///< one line, for tooltips and the schema
     void* (*address)(void* component); ///< points at the member inside the struct

@@ -174,6 +174,11 @@ struct ContactSettingsChoice {
     double columnWidth = 0.0;  ///< m, the median flat-faced body's size
     int pileSubsteps = 1;      ///< what each rule alone needs (the pile's and the column's)
     int loadSubsteps = 1;
+    /// rad/s: a bound on the fastest spring mode, max(omega, damping rate),
+    /// by Gershgorin's theorem on M^-1/2 K M^-1/2 (0: no springs, or an
+    /// implicit or adaptive integrator, which need no rule).
+    double springRate = 0.0;
+    int springSubsteps = 1;    ///< the fewest with h * springRate <= 1
     /// "pile 12 deep ...": what made the choice.
     std::string reason() const;
 };

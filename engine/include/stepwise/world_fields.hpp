@@ -19,6 +19,10 @@
 
 namespace stepwise {
 
+/// dopri5's smallest internal step, as a fraction of the frame (dt): below
+/// it the step is refused as one that cannot meet the tolerance.
+inline constexpr double kSmallestAdaptiveStep = 1e-12;
+
 struct WorldFieldInfo {
     /// key, kind, range, unit, description; `address` points into a
     /// WorldSettings.
@@ -55,5 +59,9 @@ std::vector<std::string_view> worldFieldNames();
 /// row that guards input only. World::build checks with it, so a scene made
 /// in code is held to the file's ranges but for those caps.
 std::optional<Error> worldSettingsProblem(const WorldSettings& settings);
+/// adaptive_step against dt: 0 (none yet) or above kSmallestAdaptiveStep
+/// dt, or dopri5 refuses its first step. The loader checks it once the
+/// world is read; worldSettingsProblem includes it.
+std::optional<Error> adaptiveStepProblem(const WorldSettings& settings);
 
 } // namespace stepwise

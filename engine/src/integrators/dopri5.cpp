@@ -21,6 +21,7 @@
 // solve may have changed the velocities since the last one.
 
 #include "integrators/integrator.hpp"
+#include "stepwise/world_fields.hpp"
 
 #include <algorithm>
 #include <array>
@@ -90,7 +91,7 @@ public:
             // a sliver of less than 1e-10 of the frame for a last step).
             const bool clipped = h >= remaining - 1e-10 * H;
             const double hs = clipped ? remaining : h;
-            if (!(hs > 1e-12 * H) || ++steps > kMaxStepsPerFrame) {
+            if (!(hs > kSmallestAdaptiveStep * H) || ++steps > kMaxStepsPerFrame) {
                 char text[200];
                 std::snprintf(text, sizeof text,
                               "dopri5: cannot meet tolerance %.3g: step size %.3g s after %ld internal steps "
@@ -125,7 +126,11 @@ public:
                 rejectedLast = true;
             }
         }
-        proposal_ = h;
+        // Capped at the frame: a longer proposal is clipped to the frame's
+        // end anyway, and while h >= H every attempt is H whatever h is, so
+        // the cap changes no step. It keeps the saved adaptive_step within
+        // dt, which the loader accepts.
+        proposal_ = std::min(h, H);
     }
 
 private:

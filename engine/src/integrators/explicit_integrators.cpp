@@ -50,7 +50,13 @@ struct LocalArgs {
     std::size_t n;       ///< bodies
 };
 
-inline std::uint64_t nonFiniteBits(double v) { return std::bit_cast<std::uint64_t>(v - v); }
+// Non-zero when value * scale overflows (|value| at or past the quick bound
+// the scale stands for, see integrator.hpp) or value is not finite: inf - inf
+// and NaN - NaN are NaN.
+inline std::uint64_t outOfQuickRangeBits(double value, double scale) {
+    const double scaled = value * scale;
+    return std::bit_cast<std::uint64_t>(scaled - scaled);
+}
 
 // The per-body updates, for T = V8 (four bodies of the interleaved state)
 // or double (one coordinate of the tail): the same code, so the same
@@ -124,7 +130,8 @@ template <bool Rk, bool Drag>
             eulerBody<Drag>(x, v, r, g, h, xn, vn);
         std::memcpy(v1 + 2 * b, &vn, sizeof vn);
         std::memcpy(x1 + 2 * b, &xn, sizeof xn);
-        bad8 |= (U8)(vn - vn) | (U8)(xn - xn);
+        const V8 vs = vn * kQuickSpeedScale, xs = xn * kQuickRangeScale;
+        bad8 |= (U8)(vs - vs) | (U8)(xs - xs);
     }
     std::uint64_t bad = 0;
     for (int lane = 0; lane < 8; ++lane) bad |= bad8[lane];
@@ -138,7 +145,7 @@ template <bool Rk, bool Drag>
             eulerBody<Drag>(x0[i], v0[i], r, gi, h, xn, vn);
         v1[i] = vn;
         x1[i] = xn;
-        bad |= nonFiniteBits(vn) | nonFiniteBits(xn);
+        bad |= outOfQuickRangeBits(vn, kQuickSpeedScale) | outOfQuickRangeBits(xn, kQuickRangeScale);
     }
     return bad == 0;
 }
@@ -239,7 +246,7 @@ public:
         }
     }
     int lastEvaluations() const override { return 1; }
-    bool lastStepVerifiedFinite() const override { return verified_; }
+    bool lastStepVerifiedInRange() const override { return verified_; }
 
 private:
     Vec a_;
@@ -345,7 +352,7 @@ public:
         }
     }
     int lastEvaluations() const override { return 4; }
-    bool lastStepVerifiedFinite() const override { return verified_; }
+    bool lastStepVerifiedInRange() const override { return verified_; }
 
 private:
     Vec a_, xs_, vs_;

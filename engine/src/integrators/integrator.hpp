@@ -16,6 +16,15 @@
 
 namespace stepwise::detail {
 
+/// The state check's quick bounds: x * kQuickRangeScale overflows exactly
+/// when |x| >= 2^99 (6.3e29, under kMaxMagnitude), and v * kQuickSpeedScale
+/// when |v| >= 2^29 (5.4e8, under kMaxSpeed); a power of two scales without
+/// rounding. So one multiply turns a finiteness test into a range test. A
+/// value the quick test flags is then held against the limits themselves
+/// (WorldImpl::findOutOfRange).
+inline constexpr double kQuickRangeScale = 0x1p925;
+inline constexpr double kQuickSpeedScale = 0x1p995;
+
 enum class IntegratorKind {
     ExplicitEuler,      ///< x1 = x0 + h v0, v1 = v0 + h a(x0, v0)            order 1
     SemiImplicitEuler,  ///< v1 = v0 + h a(x0, v0), x1 = x0 + h v1 (symplectic) order 1
@@ -51,10 +60,11 @@ public:
     /// Force evaluations in the last step (implicit: Newton iterations + 1).
     virtual int lastEvaluations() const = 0;
     /// True when the last step() itself checked, in its writing pass, that
-    /// every value of (x1, v1) is finite. The world then skips its own pass
-    /// over the state (at 1e4 bodies that pass cost a third of the step).
-    /// False means "not checked", never "not finite": the world checks.
-    virtual bool lastStepVerifiedFinite() const { return false; }
+    /// every value of (x1, v1) is within the quick bounds (so finite and
+    /// within a level's ranges). The world then skips its own pass over
+    /// the state (at 1e4 bodies that pass cost a third of the step). False
+    /// means "not checked", never "out of range": the world checks.
+    virtual bool lastStepVerifiedInRange() const { return false; }
     /// Set when the last step's linear solve failed or lost its accuracy
     /// (implicit methods): the world refuses the step as it refuses a
     /// non-finite value, instead of keeping a frozen or wrong state.

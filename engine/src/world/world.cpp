@@ -69,21 +69,22 @@ std::string describeValue(double v) {
     return v > 0 ? "inf" : "-inf";
 }
 
-// True when every value is finite. x * 0 is 0 for a finite x and NaN for
-// inf or NaN, and NaN survives addition, so one sum answers for the whole
-// array. Four partial sums break the dependency chain (0.14 ns per value
-// against 0.43 for an exponent-bit test, which GCC 12 does not vectorise).
-// Relies on IEEE semantics: no -ffast-math (CMakeLists).
-bool allFinite(const double* p, std::size_t m) {
+// True when every value times `scale` (kQuickRangeScale or
+// kQuickSpeedScale) stays finite: x * scale * 0 is 0 then and NaN otherwise,
+// and NaN survives addition, so one sum answers for the whole array. Four
+// partial sums break the dependency chain (0.14 ns per value against 0.43 for
+// an exponent-bit test, which GCC 12 does not vectorise). Relies on IEEE
+// semantics: no -ffast-math (CMakeLists).
+bool allInQuickRange(const double* p, std::size_t m, double scale) {
     double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
     std::size_t i = 0;
     for (; i + 4 <= m; i += 4) {
-        a0 += p[i] * 0.0;
-        a1 += p[i + 1] * 0.0;
-        a2 += p[i + 2] * 0.0;
-        a3 += p[i + 3] * 0.0;
+        a0 += p[i] * scale * 0.0;
+        a1 += p[i + 1] * scale * 0.0;
+        a2 += p[i + 2] * scale * 0.0;
+        a3 += p[i + 3] * scale * 0.0;
     }
-    for (; i < m; ++i) a0 += p[i] * 0.0;
+    for (; i < m; ++i) a0 += p[i] * scale * 0.0;
     const double sum = (a0 + a1) + (a2 + a3);
     return sum == sum;
 }
@@ -96,26 +97,47 @@ std::string format(double v) {
 
 } // namespace
 
-std::string WorldImpl::findNonFinite(std::uint64_t stepNumber) const {
+std::string WorldImpl::findOutOfRange(std::uint64_t stepNumber) const {
+    // One entry per quantity: its name, its value and the bound a level
+    // file holds it to.
+    struct Quantity {
+        const char* what;
+        double value, limit;
+    };
+    const auto problem = [&](std::size_t body, std::initializer_list<Quantity> quantities) -> std::string {
+        for (const Quantity& q : quantities) {
+            if (std::abs(q.value) <= q.limit) continue;
+            std::string text = "step " + std::to_string(stepNumber) + ": " +
+                               entityLabel(bodySceneIndex[body], &bodyName[body]) + ": " + q.what + " became ";
+            if (!std::isfinite(q.value)) return text + describeValue(q.value);
+            return text + formatNumber(q.value) + ", beyond the +-" + formatNumber(q.limit) + " a level can hold";
+        }
+        return {};
+    };
     const double* px = xs();
     const double* pv = vs();
-    const std::size_t n = bodyEntity.size();
-    for (std::size_t b = 0; b < n; ++b) {
+    for (std::size_t b = 0; b < bodyEntity.size(); ++b) {
         // Velocity before position: in a blow-up the velocity overflows
         // first and the position follows from it.
-        const std::pair<const char*, double> quantities[] = {
-            {"velocity.x", pv[2 * b]}, {"velocity.y", pv[2 * b + 1]},
-            {"position.x", px[2 * b]}, {"position.y", px[2 * b + 1]}};
-        for (const auto& [what, value] : quantities)
-            if (!std::isfinite(value))
-                return "step " + std::to_string(stepNumber) + ": " + entityLabel(bodySceneIndex[b], &bodyName[b]) +
-                       ": " + what + " became " + describeValue(value);
+        std::string found = problem(b, {{"velocity.x", pv[2 * b], kMaxSpeed},
+                                        {"velocity.y", pv[2 * b + 1], kMaxSpeed},
+                                        {"position.x", px[2 * b], kMaxMagnitude},
+                                        {"position.y", px[2 * b + 1], kMaxMagnitude}});
+        if (!found.empty()) return found;
     }
-    for (std::size_t s = 0; s < spinBody.size(); ++s)
-        if (!std::isfinite(angle[s]))
-            return "step " + std::to_string(stepNumber) + ": " +
-                   entityLabel(bodySceneIndex[spinBody[s]], &bodyName[spinBody[s]]) + ": angle became " +
-                   describeValue(angle[s]);
+    for (std::size_t s = 0; s < spinBody.size(); ++s) {
+        std::string found = problem(spinBody[s], {{"angular_velocity", angularVelocity[s], kMaxSpeed},
+                                                  {"angle", angle[s], kMaxMagnitude}});
+        if (!found.empty()) return found;
+    }
+    if (collision)
+        for (std::size_t c = 0; c < collision->colliderCount(); ++c) {
+            const std::int32_t b = collision->collider(c).body;
+            if (b < 0) continue;
+            std::string found = problem(std::size_t(b), {{"angular_velocity", collision->angularVelocity(c), kMaxSpeed},
+                                                         {"angle", collision->angle(c), kMaxMagnitude}});
+            if (!found.empty()) return found;
+        }
     return {};
 }
 
@@ -184,7 +206,7 @@ Result<void> World::step() {
     std::copy(w.angle.begin(), w.angle.end(), w.angleBackup.begin());
     int evaluations = 0, internalSteps = 0, rejectedSteps = 0;
     const std::string* failure = nullptr;  // the integrator could not meet its tolerance
-    bool verifiedFinite = false;  // the last substep's integrator pass checked x, v
+    bool verifiedInRange = false;  // the last substep's integrator pass checked x, v
     double rotationSeconds = 0.0, contactSeconds = 0.0;
     collision::CollisionSystem* contacts = w.collision.get();
     if (contacts) {
@@ -201,7 +223,7 @@ Result<void> World::step() {
         evaluations += w.integrator->lastEvaluations();
         internalSteps += w.integrator->lastAcceptedSteps();
         rejectedSteps += w.integrator->lastRejectedSteps();
-        verifiedFinite = w.integrator->lastStepVerifiedFinite();
+        verifiedInRange = w.integrator->lastStepVerifiedInRange();
         if (const detail::SolveFailure* failed = w.integrator->lastFailure()) {
             // Refused like a non-finite value: the state stays at the start
             // of the step (no buffer was flipped; with substeps, the backup).
@@ -240,16 +262,23 @@ Result<void> World::step() {
     // --- check. The integrator may have checked x and v in its writing
     // pass (fused kernels): then only if nothing changed them since (no
     // contact solve) is a second pass over the state skipped.
-    const bool stateChecked = verifiedFinite && !contacts;
-    const bool finite = !failure && (stateChecked || (allFinite(w.xs(), m) && allFinite(w.vs(), m))) &&
-                        allFinite(w.angle.data(), w.angle.size()) &&
-                        (!contacts || (allFinite(contacts->angles().data(), contacts->angles().size()) &&
-                                       allFinite(contacts->angularVelocities().data(),
-                                                 contacts->angularVelocities().size())));
+    const bool stateChecked = verifiedInRange && !contacts;
+    constexpr double lengths = detail::kQuickRangeScale, speeds = detail::kQuickSpeedScale;
+    const bool inQuickRange =
+        (stateChecked || (allInQuickRange(w.xs(), m, lengths) && allInQuickRange(w.vs(), m, speeds))) &&
+        allInQuickRange(w.angle.data(), w.angle.size(), lengths) &&
+        allInQuickRange(w.angularVelocity.data(), w.angularVelocity.size(), speeds) &&
+        (!contacts ||
+         (allInQuickRange(contacts->angles().data(), contacts->angles().size(), lengths) &&
+          allInQuickRange(contacts->angularVelocities().data(), contacts->angularVelocities().size(), speeds)));
     const Clock::time_point t2 = timed ? Clock::now() : Clock::time_point{};
-    if (!finite) {
-        std::string message =
-            failure ? "step " + std::to_string(w.stats.step + 1) + ": " + *failure : w.findNonFinite(w.stats.step + 1);
+    // The quick test flags from 2^99 on; only what is non-finite or past
+    // kMaxMagnitude stops the run, so a state that saves also loads.
+    const std::string outOfRange =
+        failure ? "step " + std::to_string(w.stats.step + 1) + ": " + *failure
+                : inQuickRange ? std::string() : w.findOutOfRange(w.stats.step + 1);
+    if (!outOfRange.empty()) {
+        std::string message = outOfRange;
         // Undo: the step's input is still in the other buffer (one
         // substep) or in the backup (several).
         if (substeps == 1) {
@@ -487,6 +516,19 @@ void World::setSolverState(const SolverState& state) {
                                                 w.sleep.extent[b] * std::abs(angle - a[2]))
                                      : std::numeric_limits<double>::infinity();
             if (!(speed <= w.sleep.velocity) || !(drift <= w.sleep.driftLimit())) w.sleep.wake(b);
+        }
+        // Nor half of a connected group: a joint, spring or touching contact
+        // between a sleeping body and one outside its island (awake, or in
+        // another island the file names) wakes both islands, as the run that
+        // saved it would have kept them one.
+        if (!w.sleep.sleeping.empty()) {
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+            w.islandEdges(edges);
+            for (const auto& [a, b] : edges)
+                if (w.sleep.island[a] != w.sleep.island[b]) {
+                    w.sleep.wake(a);
+                    w.sleep.wake(b);
+                }
         }
         w.sleepChanged();
         w.sleptUnder = w.settings;  // a resume steps on under the settings it is given

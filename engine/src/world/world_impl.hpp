@@ -85,9 +85,10 @@ public:
     double* xs() { return x[current].data(); }
     double* vs() { return v[current].data(); }
 
-    /// "step 42: entity 3 (\"ball\"): velocity.x became inf", or "" if the
-    /// state is finite.
-    std::string findNonFinite(std::uint64_t stepNumber) const;
+    /// "step 42: entity 3 (\"ball\"): velocity.x became inf" (or a value
+    /// past kMaxMagnitude, which a level could not hold), or "" if every
+    /// position, velocity, angle and spin is within it.
+    std::string findOutOfRange(std::uint64_t stepNumber) const;
     /// "step 42: implicit_euler: the linear ...; bodies of the failing
     /// system: entity 0 (\"a\"), entity 1 (\"b\")".
     std::string describeSolveFailure(const detail::SolveFailure& failure, std::uint64_t stepNumber) const;
@@ -98,6 +99,9 @@ public:
     /// state (`startX`, `startV`: the step's start), the awake bodies'
     /// timers advance, and still islands fall asleep.
     void updateSleep(const double* startX, const double* startV);
+    /// Pairs of dynamic bodies that share an island: springs, joints and
+    /// touching contacts.
+    void islandEdges(std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges) const;
     /// After reload(): wakes the islands whose bodies, springs or joints
     /// differ from `before` (the World this one replaces), all of them when
     /// the world settings differ, and those that touched a removed body.

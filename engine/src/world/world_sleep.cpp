@@ -17,6 +17,12 @@ void WorldImpl::sleepChanged() {
     if (collision) collision->refreshSleeping(detail::asVec2(xs(), bodyEntity.size()));
 }
 
+void WorldImpl::islandEdges(std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges) const {
+    for (const detail::SpringData& s : model.springs)
+        if (s.b != detail::kNoBody) edges.emplace_back(s.a, s.b);
+    if (collision) collision->bodyEdges(edges);
+}
+
 void WorldImpl::updateSleep(const double* startX, const double* startV) {
     if (!sleep.enabled) return;
     double* px = xs();
@@ -48,9 +54,7 @@ void WorldImpl::updateSleep(const double* startX, const double* startV) {
     };
     if (!sleep.advanceTimers(speed, px, pv, angle, settings.dt, fieldAccel)) return;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-    for (const detail::SpringData& s : model.springs)
-        if (s.b != detail::kNoBody) edges.emplace_back(s.a, s.b);
-    if (collision) collision->bodyEdges(edges);
+    islandEdges(edges);
     // An island falls asleep as it is: velocities and spins (all under
     // sleep_velocity) are kept, frozen, so a wake resumes it exactly where
     // it paused, and a saved file shows the state it paused in.
