@@ -8,8 +8,9 @@
 #            UndefinedBehaviorSanitizer, LeakSanitizer included, and assert()
 #            on): every test again; any report or failed assert fails the
 #            test that caused it
-#   fuzz     build-fuzz/ (clang, libFuzzer): 60 s on the level loader
-#            (tests/fuzz/run.sh), seeded from levels/ and tests/fuzz/corpus/
+#   fuzz     build-fuzz/ (clang, libFuzzer): 60 s on the level loader and
+#            45 s on the whole pipeline (tests/fuzz/run.sh), seeded from
+#            levels/ and tests/fuzz/corpus/
 # STEPWISE_STAGES="release" (or any subset, space-separated) runs fewer.
 # Extra arguments go to both ctest runs, e.g. `-L unit` or `-R Scene`.
 set -euo pipefail
@@ -73,4 +74,5 @@ fi
 
 if has fuzz; then
   timed fuzz-60s bash tests/fuzz/run.sh 60
+  timed fuzz-pipeline-45s bash tests/fuzz/run.sh 45 fuzz_pipeline
 fi

@@ -998,6 +998,56 @@ TEST_F(Cli, InputsTheEngineCannotStepAreRefusedAtLoad) {
     }
 }
 
+// A device or a pipe is not a level: it has no size to check against the
+// limit, and reading one may never end. Refused before reading, saying what
+// was expected.
+TEST_F(Cli, ADeviceOrAPipeAsTheLevelIsRefusedAsNotARegularFile) {
+    const fs::path fifo = dir_ / "pipe.json";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    for (const std::string path : {std::string("/dev/null"), std::string("/dev/zero"), fifo.string()}) {
+        const Outcome o = stepwise("validate " + path);
+        EXPECT_EQ(o.exitCode, 2) << path;
+        EXPECT_EQ(o.err, path + ": error: is not a regular file (a device, pipe or socket); expected a level file\n");
+    }
+}
+
+// render refuses an image past 7680 x 4320 pixels before reading the level
+// (16384 x 16384 took 3.8 GB and 65 s); the largest allowed renders.
+TEST_F(Cli, RenderRefusesImagesPastTheDocumentedPixelCount) {
+    const fs::path out = dir_ / "big.png";
+    Outcome o = stepwise("render " + level("orbit.json") + " --width 16384 --height 16384 --out " +
+                         out.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_EQ(o.err, "stepwise: error: --width/--height: image size 16384x16384 is 268435456 pixels; the limit is "
+                     "33177600 (7680x4320)\n");
+    o = stepwise("render " + level("orbit.json") + " --width 7681 --height 4320 --out " + out.string());
+    EXPECT_EQ(o.exitCode, 2);
+    EXPECT_FALSE(fs::exists(out));
+    o = stepwise("render " + level("orbit.json") + " --width 16384 --height 2025 --no-hud --out " +
+                 out.string());
+    EXPECT_EQ(o.exitCode, 0) << o.err;
+    EXPECT_TRUE(fs::exists(out));
+}
+
+// dopri5's proposed step is saved for an exact resume. At dt > 2 s it was
+// saved above 10 s, which the loader refuses; it is now capped at the frame
+// (no step changes), so every dt a level may give saves a file that loads
+// and resumes bit for bit.
+TEST_F(Cli, Dopri5AtLongStepsSavesAnAdaptiveStepThatLoads) {
+    for (const char* dt : {"0.5", "2.5", "10"}) {
+        const fs::path file = write("slow.json", std::string(R"({"world": {"integrator": "dopri5", "dt": )") + dt +
+                                                     R"(, "gravity": {"x": 0, "y": 0}},
+            "entities": [{"name": "a", "position": {"x": 0, "y": 0}, "mass": 1, "velocity": {"x": 0.1, "y": 0}},
+                         {"name": "s", "spring": {"a": "a", "anchor": {"x": 0, "y": 0}, "k": 0.01, "rest_length": 0}}]})");
+        const fs::path half = dir_ / "half.json", whole = dir_ / "whole.json", resumed = dir_ / "resumed.json";
+        ASSERT_EQ(stepwise("run " + file.string() + " --steps 4 --out " + half.string()).exitCode, 0) << dt;
+        const Outcome loaded = stepwise("run " + half.string() + " --steps 4 --out " + resumed.string());
+        ASSERT_EQ(loaded.exitCode, 0) << dt << ": " << loaded.err;
+        ASSERT_EQ(stepwise("run " + file.string() + " --steps 8 --out " + whole.string()).exitCode, 0) << dt;
+        EXPECT_EQ(readFile(resumed), readFile(whole)) << dt;
+    }
+}
+
 // ---- the scripted editor -------------------------------------------
 
 // `saveas missing/x.json`, `open missing.json` and `savestate missing/x.json`

@@ -3,8 +3,10 @@
 // every file in tests/fuzz/corpus/ through the fuzzer's own property, so the
 // ordinary gcc build checks them too.
 
+#include "fuzz/pipeline_property.hpp"
 #include "fuzz/scene_loader_property.hpp"
 
+#include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
@@ -244,13 +246,15 @@ TEST(LoaderRegressions, SavedContactsAreOnlyWhatARunWrites) {
 }
 
 // Every kept input (findings and hand-written edge cases) satisfies the
-// fuzzer's property: refused with one line of UTF-8 naming the file, or
-// loads and round-trips to identical bytes.
+// fuzzers' properties: refused with one line of UTF-8 naming the file, or
+// loads and round-trips to identical bytes; and steps, or stops with a
+// message, and saves what loads.
 TEST(LoaderRegressions, EveryFileInTheFuzzCorpusSatisfiesTheFuzzersProperty) {
     int files = 0;
     for (const auto& entry : fs::directory_iterator(fs::path(STEPWISE_SOURCE_DIR) / "tests" / "fuzz" / "corpus")) {
         ++files;
         EXPECT_EQ(fuzz::checkLoaderProperty(readFile(entry.path())), "") << entry.path();
+        EXPECT_EQ(fuzz::checkPipelineProperty(readFile(entry.path())), "") << entry.path();
     }
     EXPECT_GE(files, 6);
 }
@@ -414,4 +418,107 @@ TEST(LoaderRegressions, EscapingControlCharactersDoesNotPushAMessagePastTheBound
         readFile(fs::path(STEPWISE_SOURCE_DIR) / "tests/fuzz/corpus/long-key-of-control-characters.json");
     const std::string message = refusal(kept);
     EXPECT_LE(message.size(), 4096u + 64u) << message.size();
+}
+
+// ---- ranges the engine can step (docs/format.md, "Ranges") ------------
+
+namespace {
+
+/// `stepwise run --out`'s file: state and solver state.
+std::string savedRun(const World& world, Scene scene) {
+    world.writeBack(scene);
+    scene.solverState.reset();
+    SolverState solver = world.solverState();
+    if (!solver.empty()) scene.solverState = std::move(solver);
+    return sceneToJsonText(scene);
+}
+
+std::string number(double v) { return formatNumber(v); }
+
+} // namespace
+
+// Every bound at once: the lightest, heaviest, smallest and largest body of
+// each shape, still or at the fastest speed and spin, under no gravity or
+// the strongest, on a floor beside a wall, under every integrator. Each
+// loads, builds and takes 3 steps, or stops saying which body left which
+// range; nothing becomes inf or NaN; and what a run that did not stop saves
+// loads again.
+TEST(LoaderRegressions, ExtremeLevelsStepWithFiniteNumbersAndSaveWhatLoads) {
+    int ran = 0, stopped = 0;
+    for (const char* integrator : {"explicit_euler", "semi_implicit_euler", "midpoint", "rk4", "velocity_verlet",
+                                   "implicit_euler", "implicit_midpoint", "dopri5"})
+        for (const double mass : {1e-30, 1.0, 1e30})
+            for (const double size : {1e-30, 1.0, 1e30})
+                for (const double speed : {0.0, 1e9})
+                    for (const double spin : {0.0, -1e9})
+                        for (const double gravity : {0.0, 1e30})
+                            for (const char* shape : {"radius", "box", "polygon"}) {
+                                const std::string s = number(size), m = number(-size);
+                                const std::string geometry =
+                                    std::string(shape) == "radius" ? R"("radius": )" + s
+                                    : std::string(shape) == "box"
+                                        ? R"("box": {"width": )" + s + R"(, "height": )" + s + "}"
+                                        : R"("polygon": {"vertices": [{"x": )" + m + R"(, "y": )" + m +
+                                              R"(}, {"x": )" + s + R"(, "y": )" + m + R"(}, {"x": 0, "y": )" + s +
+                                              "}]}";
+                                const std::string text =
+                                    R"({"world": {"integrator": ")" + std::string(integrator) +
+                                    R"(", "gravity": {"x": 0, "y": )" + number(-gravity) + R"(}}, "entities": [
+                                    {"name": "floor", "position": {"x": 0, "y": -0.5}, "static": true,
+                                     "box": {"width": 40, "height": 1}},
+                                    {"name": "wall", "plane": {"normal": {"x": -1, "y": 0}, "offset": -3}},
+                                    {"name": "b", "position": {"x": 0, "y": )" + s + R"(}, "mass": )" +
+                                    number(mass) + R"(, "velocity": {"x": )" + number(speed) + R"(, "y": )" +
+                                    number(-speed) + R"(}, "angular_velocity": )" + number(spin) + ", " + geometry +
+                                    "}]}";
+                                const std::string what = text;
+                                Result<Scene> scene = parseScene(text, "extreme.json");
+                                ASSERT_TRUE(scene) << scene.error() << "\n" << what;
+                                Result<World> world = World::build(*scene);
+                                ASSERT_TRUE(world) << world.error() << "\n" << what;
+                                bool ok = true;
+                                for (int step = 0; step < 3 && ok; ++step) {
+                                    const Result<void> r = world->step();
+                                    if (r) continue;
+                                    ok = false;
+                                    ++stopped;
+                                    EXPECT_NE(r.error().find(", beyond the +-"), std::string::npos)
+                                        << r.error() << "\n" << what;
+                                }
+                                if (!ok) continue;
+                                ++ran;
+                                const std::string saved = savedRun(*world, *scene);
+                                Result<Scene> again = parseScene(saved, "saved.json");
+                                EXPECT_TRUE(again) << again.error() << "\n" << saved;
+                            }
+    // Both outcomes are exercised: tiny bodies hit at 1e9 m/s spin past
+    // 1e9 rad/s, and the rest run on.
+    EXPECT_GT(ran, 500);
+    EXPECT_GT(stopped, 500);
+}
+
+// A ball fired at a wall stops at the wall, at every speed a level holds:
+// a contact's answer is a difference of speeds, and past 1e9 m/s it drowned
+// in the speed's rounding (at 1e20 the ball stopped where it started).
+TEST(LoaderRegressions, ABallFiredAtAWallStopsAtTheWallAtEverySpeed) {
+    for (const char* wall : {R"({"name": "wall", "plane": {"normal": {"x": -1, "y": 0}, "offset": -3}})",
+                             R"({"name": "wall", "position": {"x": 3.5, "y": 0}, "static": true,
+                                 "box": {"width": 1, "height": 10}})"})
+        for (const double dt : {1.0 / 60.0, 1.0 / 240.0})
+            for (double speed = 1e2; speed <= 1e9; speed *= 10.0) {
+                const std::string text = R"({"world": {"gravity": {"x": 0, "y": 0}, "dt": )" + number(dt) +
+                                         R"(}, "entities": [{"name": "ball", "position": {"x": 0, "y": 0},
+                                         "radius": 0.5, "velocity": {"x": )" + number(speed) + R"(, "y": 0}}, )" +
+                                         wall + "]}";
+                Result<Scene> scene = parseScene(text, "wall.json");
+                ASSERT_TRUE(scene) << scene.error();
+                Result<World> built = World::build(*scene);
+                ASSERT_TRUE(built) << built.error();
+                World& world = *built;
+                // Enough steps to cover the 2 m gap, and two more at rest.
+                const int steps = 2 + int(std::ceil(2.0 / (speed * dt)));
+                for (int step = 0; step < steps; ++step) ASSERT_TRUE(world.step().ok()) << speed;
+                EXPECT_NEAR(world.bodyPosition(0).x, 2.5, 1e-6) << speed << " m/s, dt " << dt << ", " << wall;
+                EXPECT_NEAR(world.bodyVelocity(0).x, 0.0, 1e-6) << speed << " m/s, dt " << dt;
+            }
 }

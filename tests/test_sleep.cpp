@@ -534,3 +534,33 @@ TEST(Sleep, TheFileCarriesTheSettingsAndTheSleepState) {
     World awake = build(*off);
     EXPECT_EQ(awake.sleepingBodyCount(), 0u);
 }
+
+// A run keeps bodies joined by a joint, a spring or a touching contact in
+// one island, so a file that splits such a group (one end asleep, the other
+// awake or in another island) is not what a run writes: both islands wake
+// when the World is built. Without the joint the same file keeps its crate
+// asleep, so it is the joint that wakes it.
+TEST(Sleep, AFileThatSplitsAJoinedGroupWakesBothIslands) {
+    const auto level = [](const std::string& joint, const std::string& bobEntry) {
+        return R"({"entities": [
+            {"name": "floor", "position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 10, "height": 1}},
+            {"name": "crate", "position": {"x": 0, "y": 0.5}, "box": {"width": 1, "height": 1}},
+            {"name": "bob", "position": {"x": 3, "y": 0.5}, "radius": 0.2})" +
+               joint + R"(],
+            "solver_state": {"bodies": [
+              {"body": "crate", "sleep_time": 1, "still_at": {"x": 0, "y": 0.5}, "still_angle": 0, "island": "crate"})" +
+               bobEntry + "]}}";
+    };
+    const std::string hinge = R"(, {"name": "arm", "joint": {"type": "distance", "a": "crate", "b": "bob"}})";
+    const std::string bobAsleepAlone =
+        R"(, {"body": "bob", "sleep_time": 1, "still_at": {"x": 3, "y": 0.5}, "still_angle": 0, "island": "bob"})";
+    const auto sleepingAfterLoad = [](const std::string& text) {
+        Result<Scene> scene = parseScene(text, "split.json");
+        EXPECT_TRUE(scene) << scene.error();
+        return scene ? build(*scene).sleepingBodyCount() : std::size_t(99);
+    };
+    EXPECT_EQ(sleepingAfterLoad(level("", "")), 1u) << "the crate alone may sleep";
+    EXPECT_EQ(sleepingAfterLoad(level("", bobAsleepAlone)), 2u) << "two islands that nothing joins";
+    EXPECT_EQ(sleepingAfterLoad(level(hinge, "")), 0u) << "the awake bob is joined to the sleeping crate";
+    EXPECT_EQ(sleepingAfterLoad(level(hinge, bobAsleepAlone)), 0u) << "two islands the joint makes one";
+}
