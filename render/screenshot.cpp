@@ -29,7 +29,7 @@ Result<Screenshot> renderSceneScreenshot(OffscreenRenderer& renderer, Scene scen
                                               return true;
                                           }});
         shot.stepsTaken = (long long)run.taken;
-        if (run.divergence) return Error{"diverged: " + *run.divergence};
+        if (run.divergence) return run.divergence->within("diverged");
         world->writeBack(scene);
     } else {
         shot.note = built.error();

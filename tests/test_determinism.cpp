@@ -135,7 +135,7 @@ Outcome simulate(const std::string& integrator, std::string_view sceneText = kSc
     if (!world) return {};
     world->setProfiling(false);  // no clock reads: nothing outside the state enters a step
     const AdvanceResult run = advance(*world, kSteps);
-    EXPECT_TRUE(run.ok()) << integrator << ": " << run.divergence.value_or("");
+    EXPECT_TRUE(run.ok()) << integrator << ": " << (run.divergence ? run.divergence->message : "");
     if (!run.ok()) return {};
     world->writeBack(*scene);
     return {sceneToJsonText(*scene), world->contacts().size(), world->activeSystems()};

@@ -56,7 +56,7 @@ std::string straight(const fs::path& level, std::uint64_t steps) {
     const Scene scene = load(level);
     World w = build(scene);
     const AdvanceResult r = advance(w, steps);
-    EXPECT_TRUE(r.ok()) << level << ": " << r.divergence.value_or("");
+    EXPECT_TRUE(r.ok()) << level << ": " << (r.divergence ? r.divergence->message : "");
     return savedText(w, scene);
 }
 

@@ -170,6 +170,12 @@ TEST(World, DivergenceNamesStepEntityAndQuantityAndKeepsState) {
     ASSERT_FALSE(r.ok());
     EXPECT_EQ(r.error(), "step 3: entity 1 (\"ball\"): velocity.y became -1.5e+09, beyond the +-1e+09 a level can "
                          "hold");
+    EXPECT_EQ(r.failure().kind, ErrorKind::Diverged);
+    const AdvanceResult advanced = advance(w, 5);
+    ASSERT_TRUE(advanced.divergence);
+    EXPECT_EQ(advanced.taken, 0u);
+    EXPECT_EQ(advanced.divergence->kind, ErrorKind::Diverged);
+    EXPECT_EQ(advanced.divergence->message, r.error());
     EXPECT_EQ(w.bodyPosition(0), before);
     EXPECT_EQ(w.time(), timeBefore);
     EXPECT_EQ(w.lastStats().step, 2u);

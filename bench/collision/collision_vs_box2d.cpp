@@ -162,7 +162,7 @@ Outcome runStepwise(const Scene& initial, int steps, std::size_t topIndex) {
                                                                     : collision::BroadPhaseKind::UniformGrid);
     const auto start = std::chrono::steady_clock::now();
     if (const AdvanceResult r = advance(world, std::uint64_t(steps)); !r.ok()) {
-        std::cerr << "stepwise diverged: " << *r.divergence << "\n";
+        std::cerr << "stepwise diverged: " << r.divergence->message << "\n";
         std::exit(1);
     }
     Outcome out;

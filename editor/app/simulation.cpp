@@ -313,7 +313,7 @@ AdvanceResult Simulation::runSteps(Scene& scene, int count, const std::function<
         popHistory();  // the world is left as before the step
         state_ = SimState::Paused;
         diverged_ = true;
-        message_ = "diverged: " + *r.divergence;
+        message_ = "diverged: " + r.divergence->message;
     }
     return r;
 }

@@ -218,7 +218,7 @@ int render(const RenderOptions& o) {
             stepsTaken += (long long)run.taken;
             if (run.divergence) {
                 if (tty) std::fputc('\n', stderr);
-                reportError(o.level + ": simulation diverged at " + *run.divergence + " (integrator " +
+                reportError(o.level + ": simulation diverged at " + run.divergence->message + " (integrator " +
                             world->settings().integrator + ") before frame " + std::to_string(frame) +
                             "; no frame written");
                 return kExitDiverged;

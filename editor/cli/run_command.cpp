@@ -118,16 +118,18 @@ std::string duration(double seconds) {
     return buffer;
 }
 
-/// "" when every energy is finite, else what became non-finite: an energy
-/// of -inf or NaN in a report is a non-finite value like any other. The
-/// totals, then the first entity whose term is not finite and which term.
-std::string nonFiniteEnergy(const World& world, const EnergyReport& e, long long step) {
-    if (std::isfinite(e.total()) && std::isfinite(e.momentum.x) && std::isfinite(e.momentum.y)) return {};
+/// Nothing when every energy is finite, else what became non-finite (a
+/// divergence): an energy of -inf or NaN in a report is a non-finite value
+/// like any other. The totals, then the first entity whose term is not
+/// finite and which term.
+std::optional<Error> nonFiniteEnergy(const World& world, const EnergyReport& e, long long step) {
+    if (std::isfinite(e.total()) && std::isfinite(e.momentum.x) && std::isfinite(e.momentum.y)) return std::nullopt;
     const std::string term = world.nonFiniteEnergyTerm();
-    return "step " + std::to_string(step) + ": the total energy became " + number(e.total()) + " J (kinetic " +
-           number(e.kinetic) + ", gravity " + number(e.gravity) + ", springs " + number(e.springs) +
-           ", attractors " + number(e.attractors) + " J; momentum " + number(e.momentum.x) + ", " +
-           number(e.momentum.y) + " kg m/s)" + (term.empty() ? "" : "; first " + term);
+    return Error{"step " + std::to_string(step) + ": the total energy became " + number(e.total()) + " J (kinetic " +
+                     number(e.kinetic) + ", gravity " + number(e.gravity) + ", springs " + number(e.springs) +
+                     ", attractors " + number(e.attractors) + " J; momentum " + number(e.momentum.x) + ", " +
+                     number(e.momentum.y) + " kg m/s)" + (term.empty() ? "" : "; first " + term),
+                 "", ErrorKind::Diverged};
 }
 
 /// Smallest bytes a trace row and a contacts line can take, for the check
@@ -207,14 +209,13 @@ int run(const RunOptions& options) {
         if (Result<void> written = writer->write(row); !written && !failure) failure = written.error();
         row.clear();
     };
-    std::optional<std::string> divergence;
+    std::optional<Error> divergence;
     if (trace) {
         row = "step,time,kinetic,potential_gravity,potential_springs,potential_attractors,potential,total,"
               "momentum_x,momentum_y,contacts\n";
         appendTraceRow(row, 0, world);
         emit(trace);
         divergence = nonFiniteEnergy(world, world.energy(), 0);
-        if (divergence->empty()) divergence.reset();
     }
 
     std::optional<CooperativeInterrupts> stepLoop(std::in_place);
@@ -231,8 +232,8 @@ int run(const RunOptions& options) {
          .afterStep = [&](std::uint64_t step) {
              if (trace) {
                  const EnergyReport e = world.energy();
-                 if (std::string bad = nonFiniteEnergy(world, e, (long long)step); !bad.empty()) {
-                     divergence = bad;
+                 if (std::optional<Error> bad = nonFiniteEnergy(world, e, (long long)step)) {
+                     divergence = std::move(bad);
                      return false;
                  }
                  appendTraceRow(row, step, world);
@@ -293,10 +294,10 @@ int run(const RunOptions& options) {
     }
     const EnergyReport energy = world.energy();
     if (!divergence) {
-        if (std::string bad = nonFiniteEnergy(world, energy, taken); !bad.empty()) divergence = bad;
+        divergence = nonFiniteEnergy(world, energy, taken);
     }
     if (divergence) {
-        reportError(options.level + ": simulation diverged at " + *divergence + " (integrator " +
+        reportError(options.level + ": simulation diverged at " + divergence->message + " (integrator " +
                     world.settings().integrator + ", dt " + number(world.settings().dt) + "); " + notWritten);
         return kExitDiverged;
     }

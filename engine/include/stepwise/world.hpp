@@ -374,7 +374,7 @@ private:
 /// What advance() did.
 struct AdvanceResult {
     std::uint64_t taken = 0;        ///< steps completed
-    std::optional<std::string> divergence;  ///< World::step's message when a step failed
+    std::optional<Error> divergence;  ///< World::step's error (ErrorKind::Diverged) when a step failed
     bool stopped = false;           ///< afterStep asked to stop
     bool ok() const { return !divergence; }
 };

@@ -237,7 +237,7 @@ Result<void> World::step() {
                 contacts->restoreRotation(w.collisionAngleBackup, w.collisionSpinBackup);
                 contacts->undoSolverState();
             }
-            return Error{w.describeSolveFailure(*failed, w.stats.step + 1)};
+            return Error{w.describeSolveFailure(*failed, w.stats.step + 1), "", ErrorKind::Diverged};
         }
         if (!w.integrator->lastToleranceFailure().empty()) {
             failure = &w.integrator->lastToleranceFailure();
@@ -293,7 +293,7 @@ Result<void> World::step() {
             contacts->undoSolverState();
         }
         w.integrator->setProposedStep(w.settings.adaptiveStep);
-        return Error{message};
+        return Error{message, "", ErrorKind::Diverged};
     }
     w.settings.time += w.settings.dt;
     w.stepStartKnown = true;
@@ -644,7 +644,7 @@ AdvanceResult advance(World& world, std::uint64_t steps, const AdvanceHooks& hoo
             break;
         }
         if (Result<void> stepped = world.step(); !stepped) {
-            result.divergence = stepped.error();
+            result.divergence = stepped.failure();
             break;
         }
         ++result.taken;
