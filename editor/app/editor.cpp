@@ -34,8 +34,13 @@ void Editor::note(std::string text) {
 bool Editor::open(const std::filesystem::path& file) {
     Document next;
     if (Result<void> r = next.open(file); !r) {
+        // The loader's message names the file and the place in it (line and
+        // column, or why it cannot be read): the modal shows it whole and the
+        // status line carries it too, whichever way the open was asked for.
         errorModal = r.error();
-        note("open failed: " + file.string());
+        std::string line = "open failed: " + r.error();
+        std::replace(line.begin(), line.end(), '\n', ' ');
+        note(std::move(line));
         return false;
     }
     replaceDocument(std::move(next));

@@ -204,6 +204,11 @@ void endLayout(UiState& ui, ImVec2 display) {
 
 } // namespace
 
+void recordWidgetRect(UiState& ui, const std::string& key) {
+    const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+    ui.widgetRects[key] = ImVec4(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y);
+}
+
 std::string displayableText(const std::string& text) {
     // Typographic quotes and dashes (UTF-8 E2 80 xx) that the font has no
     // glyph for are shown as their ASCII look-alikes instead of '?'.

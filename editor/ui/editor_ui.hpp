@@ -64,6 +64,8 @@ struct UiState {
     /// --debug-state reports them, so a test clicks a field wherever the
     /// layout and the window size put it.
     std::map<std::string, ImVec4, std::less<>> widgetRects;
+    /// The Error modal's Enter: set once Enter is up while the modal shows.
+    bool errorEnterArmed = false;
 
     // Dialog buffers
     std::string openPath, saveAsPath, entityFilter, contactFilter;
@@ -127,6 +129,9 @@ void drawInspector(UiState& ui, editor::Editor& ed);
 /// by the world-settings table: range, unit and description from the table,
 /// the edit checked as the loader checks it (editor::setWorldField).
 bool worldFieldWidget(UiState& ui, editor::Editor& ed, std::string_view key);
+
+/// Records the last item's rectangle in `ui.widgetRects` under `key`.
+void recordWidgetRect(UiState& ui, const std::string& key);
 
 /// `text` with the typographic quotes and dashes the current font has no
 /// glyph for replaced by ASCII (else ImGui draws '?').
