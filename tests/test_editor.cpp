@@ -474,3 +474,93 @@ TEST(ContactTable, FiltersByEitherNameAndSortsStablyByTheChosenColumn) {
     EXPECT_EQ(rows("", {true, ContactColumn::A, false}), (V{1, 0, 2, 4, 5, 3}));
     EXPECT_EQ(rows("", {true, ContactColumn::A, true}), (V{3, 0, 2, 4, 5, 1}));
 }
+
+// ---- recovery copies live only as long as the changes they hold ------------
+
+namespace {
+
+/// A copy of levels/`level` in the fixture's folder, opened, edited (G) and
+/// autosaved: its recovery copy exists.
+std::filesystem::path editAndAutosave(Fixture& f, const std::string& level, const std::string& as) {
+    const std::filesystem::path file = f.tmp.path / as;
+    std::filesystem::copy_file(kLevels / level, file);
+    EXPECT_TRUE(f.ed.open(file)) << f.ed.errorModal;
+    EXPECT_FALSE(f.ed.tickAutosave(0.0));
+    EXPECT_TRUE(f.ed.applyEdit("G", [](Scene& s) {
+        s.world.G = 7.0;
+        return true;
+    }));
+    EXPECT_TRUE(f.ed.tickAutosave(31.0));
+    EXPECT_TRUE(std::filesystem::exists(f.ed.doc.recoveryPath(f.ed.configDir)));
+    return file;
+}
+
+/// Whether a fresh editor opening `file` would be offered a recovery copy.
+bool offeredOnReopen(const Fixture& f, const std::filesystem::path& file) {
+    Editor again;
+    again.configDir = f.ed.configDir;
+    EXPECT_TRUE(again.open(file)) << again.errorModal;
+    return again.recoveryAvailable().has_value();
+}
+
+} // namespace
+
+// Recover, then open another level and choose Discard: reopening the first
+// level offered the discarded changes again.
+TEST(Recovery, RecoveredChangesDiscardedForAnotherLevelAreNotOfferedAgain) {
+    Fixture f("orbit.json");
+    const std::filesystem::path bridge = editAndAutosave(f, "default.json", "bridge.json");
+    Editor crashed;  // the editor that autosaved is gone; a new one recovers
+    crashed.configDir = f.ed.configDir;
+    ASSERT_TRUE(crashed.open(bridge));
+    const auto copy = crashed.recoveryAvailable();
+    ASSERT_TRUE(copy);
+    ASSERT_TRUE(crashed.recover(*copy));
+    ASSERT_TRUE(crashed.dirty());
+    crashed.request(PendingAction::Open, kLevels / "orbit.json");
+    ASSERT_EQ(crashed.uiRequest, UiRequest::ConfirmDiscard);
+    crashed.resolvePending(Editor::Resolution::Discard);
+    EXPECT_EQ(crashed.doc.title(), "orbit.json");
+    EXPECT_FALSE(std::filesystem::exists(*copy));
+    EXPECT_FALSE(offeredOnReopen(f, bridge));
+}
+
+// Opening another level or a new one and discarding the changes deletes
+// their copy; choosing Save writes them and deletes it too.
+TEST(Recovery, ChangesReplacedByAnotherLevelTakeTheirCopyWithThem) {
+    for (const PendingAction action : {PendingAction::Open, PendingAction::New}) {
+        for (const Editor::Resolution answer : {Editor::Resolution::Discard, Editor::Resolution::Save}) {
+            Fixture f("orbit.json");
+            const std::filesystem::path file = editAndAutosave(f, "default.json", "level.json");
+            const std::filesystem::path copy = f.ed.doc.recoveryPath(f.ed.configDir);
+            f.ed.request(action, kLevels / "orbit.json");
+            ASSERT_EQ(f.ed.uiRequest, UiRequest::ConfirmDiscard);
+            f.ed.resolvePending(answer);
+            EXPECT_EQ(f.ed.doc.title(), action == PendingAction::Open ? "orbit.json" : "untitled");
+            EXPECT_FALSE(std::filesystem::exists(copy)) << int(action) << " " << int(answer);
+            EXPECT_FALSE(offeredOnReopen(f, file)) << int(action) << " " << int(answer);
+        }
+    }
+}
+
+// A rename, autosaved, then undone back to the file's state: the copy went
+// on to be offered later.
+TEST(Recovery, UndoingBackToTheFilesStateDeletesTheCopy) {
+    Fixture f("orbit.json");
+    const std::filesystem::path file = f.tmp.path / "level.json";
+    std::filesystem::copy_file(kLevels / "default.json", file);
+    ASSERT_TRUE(f.ed.open(file));
+    EXPECT_FALSE(f.ed.tickAutosave(0.0));
+    ASSERT_TRUE(rename(f, f.named("bob"), "robert"));
+    ASSERT_TRUE(f.ed.tickAutosave(31.0));
+    const std::filesystem::path copy = f.ed.doc.recoveryPath(f.ed.configDir);
+    ASSERT_TRUE(std::filesystem::exists(copy));
+    ASSERT_TRUE(f.ed.undo());
+    EXPECT_FALSE(f.ed.dirty());
+    EXPECT_FALSE(std::filesystem::exists(copy));
+    EXPECT_FALSE(offeredOnReopen(f, file));
+    // Redo makes the changes unsaved again; the next autosave writes a copy.
+    ASSERT_TRUE(f.ed.redo());
+    EXPECT_TRUE(f.ed.tickAutosave(62.0));
+    EXPECT_TRUE(offeredOnReopen(f, file));
+}

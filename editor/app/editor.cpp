@@ -56,6 +56,11 @@ void Editor::newDocument() {
 }
 
 void Editor::replaceDocument(Document next) {
+    // The level being replaced had its changes saved, discarded (the
+    // unsaved-changes question) or had none: its recovery copy recovers
+    // nothing any more, and left behind it would offer the discarded
+    // changes the next time that level opens.
+    discardRecovery();
     if (sim.running()) sim.reset(doc.scene);
     doc = std::move(next);
     ++documentSerial_;
@@ -177,6 +182,7 @@ bool Editor::undo() {
     const std::string label = commands.undo(doc.scene);
     if (label.empty()) return false;
     afterSceneReplaced();
+    forgetRecoveryWhenClean();
     note("undo: " + label);
     return true;
 }
@@ -185,8 +191,15 @@ bool Editor::redo() {
     const std::string label = commands.redo(doc.scene);
     if (label.empty()) return false;
     afterSceneReplaced();
+    forgetRecoveryWhenClean();
     note("redo: " + label);
     return true;
+}
+
+void Editor::forgetRecoveryWhenClean() {
+    // Back at the file's own state (undo, redo or Reset got there): the
+    // recovery copy holds changes that are no longer wanted.
+    if (!dirty()) discardRecovery();
 }
 
 void Editor::pruneSelection() {
@@ -355,6 +368,7 @@ void Editor::resetSimulation() {
     commands.truncate(playMark_);
     trails = render::TrailRecorder(trails.capacity());
     afterSceneReplaced();
+    forgetRecoveryWhenClean();
     note("reset to the edited level");
 }
 

@@ -163,6 +163,9 @@ public:
     /// A recovery file for the current document that is newer than it.
     std::optional<std::filesystem::path> recoveryAvailable() const;
     bool recover(const std::filesystem::path& recoveryFile);
+    /// Deletes the document's recovery copy. Also done when the changes it
+    /// holds are saved, discarded, undone back to the file's state, or
+    /// replaced by another level (Open, New): a copy outlives only a crash.
     void discardRecovery();
 
     /// Frame input for the renderer: scene, world, overlays, camera, selection.
@@ -174,6 +177,7 @@ public:
 
 private:
     void afterSceneReplaced();
+    void forgetRecoveryWhenClean();
     /// Open and New: the new document replaces the old one with a fresh
     /// undo history, selection, trails and view.
     void replaceDocument(Document next);
