@@ -564,3 +564,58 @@ TEST(Recovery, UndoingBackToTheFilesStateDeletesTheCopy) {
     EXPECT_TRUE(f.ed.tickAutosave(62.0));
     EXPECT_TRUE(offeredOnReopen(f, file));
 }
+
+// ---- break on contact ------------------------------------------------------
+
+namespace {
+
+/// Steps until the simulation's message changes (at most `limit` steps).
+std::string nextBreak(Fixture& f, int limit = 400) {
+    const std::string before = f.ed.sim.message();
+    for (int i = 0; i < limit && f.ed.sim.message() == before; ++i) f.ed.stepForward();
+    return f.ed.sim.message();
+}
+
+} // namespace
+
+// The ball rolling down default.json's ramp first met it as a speculative
+// contact (a gap of 2.35 cm), and the message said "touches".
+TEST(BreakOnContact, TheMessageSaysWhetherThePairTouchesOrIsAboutTo) {
+    Fixture f("default.json");
+    f.ed.setBreakOnContact(f.named("ball 1"));
+    EXPECT_EQ(nextBreak(f), "break on contact: ball 1 is about to touch ramp at t = 0.4000 s (speculative contact, gap 0.0235 m)");
+    EXPECT_EQ(f.ed.status, f.ed.sim.message());
+    // A pair seen about to touch pauses again when it touches.
+    std::string touching;
+    for (int i = 0; i < 20 && touching.empty(); ++i)
+        if (const std::string m = nextBreak(f); m.find(" touches ") != std::string::npos) touching = m;
+    EXPECT_EQ(touching, "break on contact: ball 1 touches ramp at t = 1.4833 s (depth 2.78e-17 m)");
+    // Crates resting on the floor meet it at a depth of zero within round-off.
+    Fixture g("default.json");
+    g.ed.setBreakOnContact(g.named("crate 1"));
+    EXPECT_EQ(nextBreak(g), "break on contact: crate 1 touches floor at t = 0.0167 s (depth 0 m)");
+}
+
+// The watched body stayed whatever was selected later, nothing named it, and
+// it stayed watched in the next level opened.
+TEST(BreakOnContact, TheWatchedBodyIsNamedKeptAndClearedWithTheLevel) {
+    Fixture f("orbit.json");
+    RecordingHost host;
+    EXPECT_EQ(f.ed.breakOnLabel(), "off");
+    ASSERT_TRUE(runLine(f.ed, host, "breakon comet"));
+    EXPECT_EQ(f.ed.sim.breakOnContact, f.named("comet"));
+    EXPECT_EQ(f.ed.breakOnLabel(), "comet");
+    EXPECT_EQ(f.ed.status, "break on contact: watching comet");
+    f.ed.select({f.named("planet")});
+    EXPECT_EQ(f.ed.breakOnLabel(), "comet") << "a choice, not the selection";
+    ASSERT_TRUE(runLine(f.ed, host, "open " + (kLevels / "spring_chain.json").string()));
+    EXPECT_TRUE(f.ed.sim.breakOnContact.isNull());
+    EXPECT_EQ(f.ed.breakOnLabel(), "off");
+    // Deleting the watched body stops the watch.
+    ASSERT_TRUE(runLine(f.ed, host, "breakon link5"));
+    f.ed.select({f.named("link5")});
+    ASSERT_TRUE(f.ed.deleteSelection());
+    EXPECT_TRUE(f.ed.sim.breakOnContact.isNull());
+    EXPECT_EQ(f.ed.breakOnLabel(), "off");
+    EXPECT_TRUE(host.errors.empty());
+}

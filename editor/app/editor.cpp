@@ -62,6 +62,8 @@ void Editor::replaceDocument(Document next) {
     // changes the next time that level opens.
     discardRecovery();
     if (sim.running()) sim.reset(doc.scene);
+    // A handle into the old level means nothing in the new one.
+    sim.breakOnContact = {};
     doc = std::move(next);
     ++documentSerial_;
     commands.clear();
@@ -205,6 +207,7 @@ void Editor::forgetRecoveryWhenClean() {
 void Editor::pruneSelection() {
     std::erase_if(selection, [&](Entity e) { return !doc.scene.registry.alive(e); });
     if (!doc.scene.registry.alive(springStart_)) springStart_ = {};
+    if (!sim.breakOnContact.isNull() && !doc.scene.registry.alive(sim.breakOnContact)) sim.breakOnContact = {};
 }
 
 void Editor::startReferencePick(const ComponentInfo& component, const FieldInfo& field, std::vector<Entity> entities) {
@@ -324,6 +327,16 @@ bool Editor::paste() {
 }
 
 // ---- simulation ------------------------------------------------------------------
+
+void Editor::setBreakOnContact(Entity body) {
+    sim.breakOnContact = doc.scene.registry.alive(body) ? body : Entity{};
+    note(sim.breakOnContact.isNull() ? std::string("break on contact: off")
+                                     : "break on contact: watching " + breakOnLabel());
+}
+
+std::string Editor::breakOnLabel() const {
+    return sim.breakOnContact.isNull() ? std::string("off") : displayName(doc.scene.registry, sim.breakOnContact);
+}
 
 void Editor::togglePlay() {
     if (sim.state() == SimState::Playing) {

@@ -107,6 +107,14 @@ public:
     bool hasClipboard() const { return !clipboardEntities_.empty(); }
 
     // ---- simulation -----------------------------------------------------
+    /// Break on contact: the run pauses at the step where `body` starts
+    /// touching something (null: off). A body chosen here stays watched
+    /// whatever is selected later; it is cleared with the level (Open, New)
+    /// and when the body is deleted. Says what is watched in the status line.
+    void setBreakOnContact(Entity body);
+    /// What the Viewport's toolbar shows beside "Break on contact": the
+    /// watched body's name, or "off".
+    std::string breakOnLabel() const;
     void togglePlay();
     void stepForward();
     void stepBack();

@@ -49,6 +49,13 @@ struct SimSample {
     double contacts = 0.0;
 };
 
+/// A contact whose bodies touch (depth >= 0 within round-off), not a
+/// speculative one with a gap still open.
+bool touches(const ContactRecord& c);
+/// What a break on contact says: whether the pair touches (depth >= 0)
+/// or is a speculative contact about to touch (its gap), and when.
+std::string breakMessage(const Registry& reg, const ContactRecord& c, double time);
+
 class Simulation {
 public:
     SimState state() const { return state_; }
@@ -204,7 +211,7 @@ private:
     double frameStepMs_ = 0.0;
     std::string message_;
     bool diverged_ = false;
-    bool touchingBefore_ = false;
+    int contactStageBefore_ = 0;  ///< break on contact: 0 none, 1 speculative, 2 touching, last step
     bool behind_ = false;
     std::uint64_t worldBuilds_ = 0;
     /// The mouse spring the current World was built with: its body and its

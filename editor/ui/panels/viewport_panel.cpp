@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 namespace stepwise::ui {
 
@@ -41,17 +42,49 @@ void simToolbar(UiState& ui, Editor& ed) {
     ImGui::SameLine(0, 4 * ui.scale);
     ImGui::Text("time x%.2f", ed.sim.timeScale);
     ImGui::SameLine();
+    // The watched body is named beside the box and chosen there; it does
+    // not follow the selection (a break selects the pair it stopped at,
+    // which would then change what is watched).
     bool breakOn = !ed.sim.breakOnContact.isNull();
-    const bool canBreak = ed.selection.size() == 1;
+    const Registry& reg = ed.doc.scene.registry;
+    const bool canBreak = ed.selection.size() == 1 && editor::isBody(reg, ed.selection[0]);
     ImGui::BeginDisabled(!canBreak && !breakOn);
-    if (ImGui::Checkbox("Break on contact", &breakOn))
-        ed.sim.breakOnContact = breakOn && canBreak ? ed.selection[0] : Entity{};
+    if (ImGui::Checkbox("Break on contact", &breakOn)) ed.setBreakOnContact(breakOn && canBreak ? ed.selection[0] : Entity{});
     ImGui::EndDisabled();
-    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
-        ImGui::SetTooltip("Pause at the step where the selected body first touches something");
-    ImGui::SameLine();
-    ImGui::TextColored(kDim, "t = %.3f s  step %llu  history %zu", ed.doc.scene.world.time,
-                       static_cast<unsigned long long>(ed.sim.steps()), ed.sim.historySize());
+    const char* breakHelp = "Pause at the step where the watched body first touches something, or is about to "
+                            "(a speculative contact). Ticking the box watches the selected body; the list "
+                            "picks any body. Selecting another body later does not change it.";
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", breakHelp);
+    ImGui::SameLine(0, 4 * ui.scale);
+    ImGui::SetNextItemWidth(96 * ui.scale);
+    if (ImGui::BeginCombo("##breakon", ed.breakOnLabel().c_str(), ImGuiComboFlags_HeightLarge)) {
+        if (ImGui::Selectable("off", !breakOn)) ed.setBreakOnContact({});
+        std::vector<Entity> bodies;
+        for (Entity e : reg.entities())
+            if (editor::isBody(reg, e)) bodies.push_back(e);
+        ImGuiListClipper clipper;
+        clipper.Begin(int(bodies.size()));
+        while (clipper.Step())
+            for (int i = clipper.DisplayStart; i < clipper.DisplayEnd; ++i) {
+                const Entity e = bodies[std::size_t(i)];
+                ImGui::PushID(int(e.index));
+                if (ImGui::Selectable(editor::displayName(reg, e).c_str(), e == ed.sim.breakOnContact))
+                    ed.setBreakOnContact(e);
+                ImGui::PopID();
+            }
+        ImGui::EndCombo();
+    }
+    recordWidgetRect(ui, "viewport/breakon");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", breakHelp);
+    char clock[96];
+    std::snprintf(clock, sizeof clock, "t = %.3f s  step %llu  history %zu", ed.doc.scene.world.time,
+                  static_cast<unsigned long long>(ed.sim.steps()), ed.sim.historySize());
+    // On the same row when it fits, else on a row of its own: cut off at
+    // the panel's edge it would hide the step count.
+    const float right = ImGui::GetItemRectMax().x + ImGui::GetStyle().ItemSpacing.x + ImGui::CalcTextSize(clock).x;
+    if (right <= ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x) ImGui::SameLine();
+    else ImGui::SetCursorPosX(ImGui::GetCursorPosX() + 6 * ui.scale);
+    ImGui::TextColored(kDim, "%s", clock);
 }
 
 } // namespace
