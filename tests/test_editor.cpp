@@ -619,3 +619,31 @@ TEST(BreakOnContact, TheWatchedBodyIsNamedKeptAndClearedWithTheLevel) {
     EXPECT_EQ(f.ed.breakOnLabel(), "off");
     EXPECT_TRUE(host.errors.empty());
 }
+
+// ---- number fields name the field edited -----------------------------------
+
+// Setting a hinge's upper below its lower was refused with a message that
+// named lower, the field not touched.
+TEST(NumberFields, ARefusalOfUpperBelowLowerNamesUpper) {
+    TempDir tmp;
+    Editor ed;
+    ed.configDir = tmp.path / "config";
+    ASSERT_TRUE(ed.open(std::filesystem::path(STEPWISE_SOURCE_DIR) / "tests" / "data" / "joints_every_type.json"));
+    const Entity hinge = findByName(ed.doc.scene.registry, "hinge");
+    const ComponentInfo* joint = findComponent("joint");
+    ASSERT_NE(joint, nullptr);
+    const auto fieldNamed = [&](std::string_view key) {
+        for (const FieldInfo& f : joint->fields)
+            if (f.key == key) return &f;
+        return static_cast<const FieldInfo*>(nullptr);
+    };
+    const std::string before = textOf(ed.doc.scene);
+    std::string problem;
+    EXPECT_EQ(setFieldOnAll(ed.doc.scene, *joint, *fieldNamed("upper"), std::optional<double>(-1.0), {hinge}, &problem), 0u);
+    EXPECT_EQ(problem, "\"hinge\" joint.upper: conflicts with joint.lower: expected at most upper (-1), got -0.5");
+    EXPECT_EQ(textOf(ed.doc.scene), before);
+    // Editing lower above upper names lower, as before.
+    EXPECT_EQ(setFieldOnAll(ed.doc.scene, *joint, *fieldNamed("lower"), std::optional<double>(1.0), {hinge}, &problem), 0u);
+    EXPECT_EQ(problem, "\"hinge\" joint.lower: expected at most upper (0.5), got 1");
+    EXPECT_EQ(textOf(ed.doc.scene), before);
+}

@@ -4,6 +4,7 @@
 // what the window showed after the last frame (modal, status line, error
 // text, tool, the rectangles of the fields a test clicks).
 
+#include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
 #include "test_support.hpp"
@@ -110,4 +111,80 @@ TEST_F(EditorSession, TypingAfterCtrlOReplacesThePathInTheField) {
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(r.state.at("modal"), "");
     EXPECT_EQ(r.state.at("status"), "opened " + b.string());
+}
+
+// ---- typing into number fields -------------------------------------------------
+
+namespace {
+
+/// The level a script saved with `saveas`.
+stepwise::Scene savedLevel(const fs::path& file) {
+    stepwise::Result<stepwise::Scene> s = stepwise::loadSceneFile(file);
+    EXPECT_TRUE(s) << s.error();
+    return s ? std::move(*s) : stepwise::Scene{};
+}
+
+/// The entity named `name` in `scene` (null when none).
+stepwise::Entity findNamed(const stepwise::Scene& scene, const std::string& name) {
+    for (stepwise::Entity e : scene.registry.entities())
+        if (const stepwise::Name* n = scene.registry.tryGet<stepwise::Name>(e); n && n->value == name) return e;
+    return {};
+}
+
+/// "X Y" of a point `dx` pixels into a widget, at its middle height.
+std::string into(const nlohmann::json& state, const std::string& widget, int dx) {
+    const nlohmann::json& r = state.at("widgets").at(widget);
+    return std::to_string(int(r[0].get<double>()) + dx) + " " +
+           std::to_string(int(r[1].get<double>() + r[3].get<double>() / 2));
+}
+
+} // namespace
+
+// World fields needed a double click: after a single click, typing "0.01"
+// switched tools (0 is Polygon) and Ctrl+A selected every entity.
+TEST_F(EditorSession, ASingleClickTypesIntoAWorldFieldAndNoShortcutFires) {
+    const Run layout = run(level("default.json"), "wait 1\n");
+    ASSERT_EQ(layout.exitCode, 0) << layout.err;
+    const fs::path out = tmp.path / "out.json";
+    const Run r = run(level("default.json"), "click " + centre(layout.state, "world/dt") +
+                                                 "\nkey 0\nkey Ctrl+A\ntext \"0.01\"\nkey Enter\nwait 2\nsaveas " +
+                                                 out.string() + "\n");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.state.at("tool"), "Select") << "the 0 went to the tool keys";
+    EXPECT_EQ(r.state.at("selection"), 0) << "Ctrl+A went to Select all";
+    EXPECT_EQ(savedLevel(out).world.dt, 0.01);
+}
+
+// A colour channel took typing only after a double click too.
+TEST_F(EditorSession, ASingleClickTypesIntoAColourChannel) {
+    const Run layout = run(level("default.json"), "select bob\nwait 1\n");
+    ASSERT_EQ(layout.exitCode, 0) << layout.err;
+    const fs::path out = tmp.path / "out.json";
+    const Run r = run(level("default.json"), "select bob\nclick " + into(layout.state, "inspector/color", 15) +
+                                                 "\ntext \"0.5\"\nkey Enter\nwait 2\nsaveas " + out.string() + "\n");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.state.at("tool"), "Select");
+    const stepwise::Scene saved = savedLevel(out);
+    const stepwise::Entity bob = findNamed(saved, "bob");
+    ASSERT_FALSE(bob.isNull());
+    EXPECT_EQ(saved.registry.tryGet<stepwise::Color>(bob)->value.r, 0.5);
+}
+
+// "nan" typed into a number field was dropped without a word.
+TEST_F(EditorSession, NanTypedIntoANumberFieldIsRefusedWithAMessageNamingTheField) {
+    const Run layout = run(level("default.json"), "select bob\nwait 1\n");
+    ASSERT_EQ(layout.exitCode, 0) << layout.err;
+    const std::string why = ": \"nan\" is not a number (digits, '.', 'e', '+', '-', '*' and '/' can be typed)";
+    const fs::path out = tmp.path / "out.json";
+    Run r = run(level("default.json"), "click " + centre(layout.state, "world/dt") + "\ntext \"nan\"\nwait 1\n");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.state.at("status"), "refused: world.dt" + why);
+    r = run(level("default.json"), "select bob\nclick " + centre(layout.state, "inspector/mass") +
+                                       "\ntext \"nan\"\nwait 1\nkey Enter\nwait 1\nsaveas " + out.string() + "\n");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.state.at("tool"), "Select");
+    const stepwise::Scene saved = savedLevel(out);
+    EXPECT_EQ(saved.registry.tryGet<stepwise::Mass>(findNamed(saved, "bob"))->value, 1.5);
+    r = run(level("default.json"), "select bob\nclick " + centre(layout.state, "inspector/mass") + "\ntext \"nan\"\nwait 1\n");
+    EXPECT_EQ(r.state.at("status"), "refused: \"bob\" mass" + why);
 }

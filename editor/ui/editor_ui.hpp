@@ -77,9 +77,10 @@ struct UiState {
     // Inspector edit coalescing: the widget being dragged and its merge key.
     ImGuiID activeWidget = 0;
     std::uint64_t activeKey = 0;
-    /// A number field clicked once without a drag: it takes typed text
-    /// from the next frame on.
-    ImGuiID typeInto = 0;
+    /// Characters typed into the number field `refusedTypingFor` that
+    /// cannot be part of a number (ImGui drops them): its panel says so.
+    std::string refusedTyping;
+    ImGuiID refusedTypingFor = 0;
 
     // Timing (ms), averaged, for the status bar and the profile
     double frameMs = 0.0, uiMs = 0.0, sceneMs = 0.0, stepMs = 0.0;

@@ -12,6 +12,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/world_fields.hpp"
 
+#include <imgui_internal.h>
 #include <imgui_stdlib.h>
 
 #include <algorithm>
@@ -30,15 +31,12 @@ float speedFor(double v) { return float(std::max(1e-3, std::abs(v) * 0.005)); }
 
 /// Shows the widget for one field; returns true with `value` updated when
 /// the user changed it.
-/// `typeNow`: focus the number field so typing goes into it (a single click
-/// on it, last frame, without a drag).
-bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const Registry& reg, bool typeNow) {
+bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const Registry& reg) {
     const double* lo = std::isfinite(f.range.min) ? &f.range.min : nullptr;
     const double* hi = std::isfinite(f.range.max) ? &f.range.max : nullptr;
     switch (f.kind) {
     case FieldKind::Number: {
         double& v = std::get<double>(value);
-        if (typeNow) ImGui::SetKeyboardFocusHere();
         // A range (0, max] (dt, a tolerance) is dragged on a log scale: its
         // useful values span decades.
         if (f.range.minExclusive && f.range.min == 0.0 && hi)
@@ -50,7 +48,6 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
         // Only world settings are integers; 0 there is "not given"
         // (the engine chooses), shown as "auto" until dragged.
         int& v = std::get<int>(value);
-        if (typeNow) ImGui::SetKeyboardFocusHere();
         const int intLo = lo ? int(*lo) : 0, intHi = hi ? int(*hi) : 0;
         if (!ImGui::DragInt(label, &v, 0.1f, intLo, intHi, v == 0 ? "auto" : "%d")) return false;
         if (lo && hi) v = std::clamp(v, intLo, intHi);
@@ -68,7 +65,6 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
             return changed;
         }
         double d = *v;
-        if (typeNow) ImGui::SetKeyboardFocusHere();
         if (ImGui::DragScalar(label, ImGuiDataType_Double, &d, speedFor(d), lo, hi, "%.6g")) {
             v = d;
             changed = true;
@@ -78,7 +74,6 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
     case FieldKind::Vector: {
         Vec2& v = std::get<Vec2>(value);
         double xy[2] = {v.x, v.y};
-        if (typeNow) ImGui::SetKeyboardFocusHere();
         if (!ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, speedFor(std::max(std::abs(v.x), std::abs(v.y))),
                                 nullptr, nullptr, "%.5g"))
             return false;
@@ -96,7 +91,6 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
             return changed;
         }
         double xy[2] = {v->x, v->y};
-        if (typeNow) ImGui::SetKeyboardFocusHere();
         if (ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, 0.01f, nullptr, nullptr, "%.5g")) {
             v = Vec2{xy[0], xy[1]};
             changed = true;
@@ -175,6 +169,16 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
     return false;
 }
 
+/// While the number field just drawn is typed into, characters that cannot
+/// be part of a number are dropped by ImGui; the status line says so, naming
+/// the field (`who` is "world." or "\"bob\" ", `field` "dt" or "mass").
+void reportRefusedTyping(UiState& ui, Editor& ed, const std::string& who, std::string_view field) {
+    if (ui.refusedTypingFor == 0 || !ImGui::IsItemActive() || GImGui->LastItemData.ID != ui.refusedTypingFor) return;
+    const std::string text = "refused: " + who + std::string(field) + ": \"" + ui.refusedTyping +
+                             "\" is not a number (digits, '.', 'e', '+', '-', '*' and '/' can be typed)";
+    if (ed.status != text) ed.note(text);
+}
+
 /// "key [unit]", the label of a field's widget.
 std::string fieldLabel(std::string_view key, std::string_view unit) {
     std::string label(key);
@@ -190,7 +194,9 @@ bool worldFieldWidget(UiState& ui, Editor& ed, std::string_view key) {
     const FieldInfo& f = info->field;
     FieldValue value = editor::readField(f, &ed.doc.scene.world);
     const std::string label = fieldLabel(f.key, f.unit);
-    const bool changed = fieldWidget(f, value, label.c_str(), ed.doc.scene.registry, false);
+    const bool changed = fieldWidget(f, value, label.c_str(), ed.doc.scene.registry);
+    recordWidgetRect(ui, "world/" + std::string(key));
+    reportRefusedTyping(ui, ed, "world.", f.key);
     if (ImGui::IsItemHovered() && !f.description.empty())
         ImGui::SetTooltip("%.*s%s%s", int(f.description.size()), f.description.data(),
                           f.kind == FieldKind::Number || f.kind == FieldKind::Integer ? "\nrange: " : "",
@@ -271,9 +277,9 @@ void drawInspector(UiState& ui, Editor& ed) {
                 if (mixed) label += " (mixed)";
                 ImGui::PushID(f.key.empty() ? "value" : f.key.data());
                 const ImGuiID id = ImGui::GetID(label.c_str());
-                const bool typeNow = ui.typeInto == id;
-                if (typeNow) ui.typeInto = 0;
-                const bool changed = fieldWidget(f, value, label.c_str(), reg, typeNow);
+                const bool changed = fieldWidget(f, value, label.c_str(), reg);
+                reportRefusedTyping(ui, ed, "\"" + editor::displayName(reg, primary) + "\" ",
+                                    editor::fieldPathName(info, f.key));
                 {  // where the field is this frame, for --debug-state (tests click it wherever the layout puts it)
                     const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
                     std::string key = "inspector/";
@@ -284,16 +290,6 @@ void drawInspector(UiState& ui, Editor& ed) {
                     }
                     ui.widgetRects[key] = ImVec4(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y);
                 }
-                // ImGui's drag fields take typed text only after a double
-                // click; a designer clicks once and types, and the digits
-                // would go to the tool shortcuts. A click released without
-                // a drag opens the text field on the next frame.
-                const bool numeric = f.kind == FieldKind::Number || f.kind == FieldKind::OptionalNumber ||
-                                     f.kind == FieldKind::Vector || f.kind == FieldKind::OptionalVector;
-                const ImGuiIO& io = ImGui::GetIO();
-                if (numeric && ImGui::IsItemDeactivated() && ImGui::IsMouseReleased(ImGuiMouseButton_Left) &&
-                    io.MouseDragMaxDistanceSqr[0] < io.MouseDragThreshold * io.MouseDragThreshold)
-                    ui.typeInto = id;
                 if (f.kind == FieldKind::EntityRef) {
                     ImGui::SameLine();
                     if (ImGui::SmallButton("pick")) ed.startReferencePick(info, f, selection);
