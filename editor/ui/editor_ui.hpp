@@ -131,6 +131,11 @@ void drawInspector(UiState& ui, editor::Editor& ed);
 /// the edit checked as the loader checks it (editor::setWorldField).
 bool worldFieldWidget(UiState& ui, editor::Editor& ed, std::string_view key);
 
+/// While the number field just drawn is typed into, ImGui drops the
+/// characters that cannot be part of a number; this puts them in the status
+/// line, naming the field (`who` "world." or "\"bob\" ", `field` "dt").
+void reportRefusedTyping(UiState& ui, editor::Editor& ed, const std::string& who, std::string_view field);
+
 /// Records the last item's rectangle in `ui.widgetRects` under `key`.
 void recordWidgetRect(UiState& ui, const std::string& key);
 

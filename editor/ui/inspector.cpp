@@ -169,16 +169,6 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
     return false;
 }
 
-/// While the number field just drawn is typed into, characters that cannot
-/// be part of a number are dropped by ImGui; the status line says so, naming
-/// the field (`who` is "world." or "\"bob\" ", `field` "dt" or "mass").
-void reportRefusedTyping(UiState& ui, Editor& ed, const std::string& who, std::string_view field) {
-    if (ui.refusedTypingFor == 0 || !ImGui::IsItemActive() || GImGui->LastItemData.ID != ui.refusedTypingFor) return;
-    const std::string text = "refused: " + who + std::string(field) + ": \"" + ui.refusedTyping +
-                             "\" is not a number (digits, '.', 'e', '+', '-', '*' and '/' can be typed)";
-    if (ed.status != text) ed.note(text);
-}
-
 /// "key [unit]", the label of a field's widget.
 std::string fieldLabel(std::string_view key, std::string_view unit) {
     std::string label(key);
@@ -187,6 +177,13 @@ std::string fieldLabel(std::string_view key, std::string_view unit) {
 }
 
 } // namespace
+
+void reportRefusedTyping(UiState& ui, Editor& ed, const std::string& who, std::string_view field) {
+    if (ui.refusedTypingFor == 0 || !ImGui::IsItemActive() || GImGui->LastItemData.ID != ui.refusedTypingFor) return;
+    const std::string text = "refused: " + who + std::string(field) + ": \"" + ui.refusedTyping +
+                             "\" is not a number (digits, '.', 'e', '+', '-', '*' and '/' can be typed)";
+    if (ed.status != text) ed.note(text);
+}
 
 bool worldFieldWidget(UiState& ui, Editor& ed, std::string_view key) {
     const WorldFieldInfo* info = findWorldField(key);
