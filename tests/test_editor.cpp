@@ -647,3 +647,14 @@ TEST(NumberFields, ARefusalOfUpperBelowLowerNamesUpper) {
     EXPECT_EQ(problem, "\"hinge\" joint.lower: expected at most upper (0.5), got 1");
     EXPECT_EQ(textOf(ed.doc.scene), before);
 }
+
+// A plank of the bridge goes with the two joints that hold it; the label
+// called them "2 entities".
+TEST(Editing, DeletingAPlankCountsItsJointsAsJoints) {
+    Fixture f("bridge.json");
+    f.ed.select({f.named("plank 2")});
+    EXPECT_EQ(f.ed.deleteLabel(f.ed.selection), "delete 1 body and 2 joints");
+    ASSERT_TRUE(f.ed.deleteSelection());
+    EXPECT_EQ(f.ed.status, "delete 1 body and 2 joints");
+    EXPECT_EQ(f.ed.commands.labels().back(), "delete 1 body and 2 joints");
+}

@@ -188,3 +188,27 @@ TEST_F(EditorSession, NanTypedIntoANumberFieldIsRefusedWithAMessageNamingTheFiel
     r = run(level("default.json"), "select bob\nclick " + centre(layout.state, "inspector/mass") + "\ntext \"nan\"\nwait 1\n");
     EXPECT_EQ(r.state.at("status"), "refused: \"bob\" mass" + why);
 }
+
+// ---- drags are linear ---------------------------------------------------------
+
+// The drag speed followed the value (0.5% of it a pixel), so a drag
+// compounded: 400 px on motor_speed went from 1 to -259 rad/s. The speed is
+// now fixed when the drag starts: 0.5% of 1.5 a pixel, 400 px = 3.
+TEST_F(EditorSession, DraggingMotorSpeedIsLinear) {
+    const std::string joints = (fs::path(STEPWISE_SOURCE_DIR) / "tests" / "data" / "joints_every_type.json").string();
+    // 1000 px high: the field is below the fold at 720.
+    const Run layout = run(joints, "select hinge\nwait 1\n", "1280x1000");
+    ASSERT_EQ(layout.exitCode, 0) << layout.err;
+    const nlohmann::json& r = layout.state.at("widgets").at("inspector/joint.motor_speed");
+    const int x = int(r[0].get<double>()) + 60, y = int(r[1].get<double>() + r[3].get<double>() / 2);
+    for (const int dx : {-400, 400}) {
+        const fs::path out = tmp.path / "out.json";
+        const Run d = run(joints, "select hinge\ndrag " + std::to_string(x) + " " + std::to_string(y) + " " +
+                                      std::to_string(x + dx) + " " + std::to_string(y) + " 40\nwait 1\nsaveas " +
+                                      out.string() + "\n", "1280x1000");
+        ASSERT_EQ(d.exitCode, 0) << d.err;
+        const stepwise::Scene saved = savedLevel(out);
+        const double speed = *saved.registry.tryGet<stepwise::Joint>(findNamed(saved, "hinge"))->motorSpeed;
+        EXPECT_NEAR(speed, 1.5 + dx * 0.0075, 1e-9) << dx << " px";
+    }
+}

@@ -242,3 +242,72 @@ TEST(Layout, ALayoutSavedAt1600x900OpensOnScreenAt1280x720AndResetRestoresTheDef
 }
 
 } // namespace
+
+// ---- the mouse spring is drawn ----------------------------------------------------
+
+// While playing, a drag on a body pulls it with a spring to the cursor; the
+// viewport drew nothing of it.
+TEST(SessionFrame, TheMouseSpringDrawsALineFromTheBodyToTheCursor) {
+    const int w = 800, h = 600;
+    auto context = stepwise::render::OffscreenRenderer::create(w, h);
+    ASSERT_TRUE(context.ok()) << context.error();
+    stepwise::ui::SessionOptions options;
+    options.persist = false;
+    options.deterministic = true;
+    options.builtinFont = true;
+    auto created = stepwise::ui::Session::create(
+        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    ASSERT_TRUE(created.ok()) << created.error();
+    stepwise::ui::Session& session = **created;
+    stepwise::editor::Editor& ed = session.editor();
+    stepwise::Scene scene;
+    scene.world.gravity = {0.0, 0.0};
+    const stepwise::Entity ball = scene.registry.create();
+    scene.registry.emplace<stepwise::Position>(ball, {{0.0, 0.0}});
+    scene.registry.emplace<stepwise::Mass>(ball, {1.0});
+    scene.registry.emplace<stepwise::Radius>(ball, {0.2});
+    const stepwise::Entity far = scene.registry.create();  // frames a view 10 m wide
+    scene.registry.emplace<stepwise::Position>(far, {{10.0, 0.0}});
+    scene.registry.emplace<stepwise::Static>(far, {});
+    scene.registry.emplace<stepwise::Radius>(far, {0.2});
+    ed.doc.reset(std::move(scene));
+    using stepwise::editor::InputEvent;
+    auto event = [](InputEvent::Type t, float x, float y) {
+        InputEvent e;
+        e.type = t;
+        e.x = x;
+        e.y = y;
+        return e;
+    };
+    session.frame(w, h, 1.0 / 60.0);
+    ed.fitView();
+    ed.togglePlay();
+    session.frame(w, h, 1.0 / 60.0);
+    const ImVec2 o = session.viewportPos();
+    const stepwise::Vec2 at = ed.view.toPixels({0.0, 0.0});
+    const float bx = o.x + float(at.x), by = o.y + float(at.y);
+    const float cursorX = bx + 160.0f;
+    session.queue(event(InputEvent::Type::MouseMove, bx, by));
+    session.frame(w, h, 1.0 / 60.0);
+    session.queue(event(InputEvent::Type::MouseDown, bx, by));
+    session.frame(w, h, 1.0 / 60.0);
+    session.queue(event(InputEvent::Type::MouseMove, cursorX, by));
+    session.frame(w, h, 1.0 / 60.0);
+    session.frame(w, h, 1.0 / 60.0);  // panels are built before a frame's events are routed
+    ASSERT_TRUE(ed.sim.mouseSpring.has_value()) << "the press did not grab the ball";
+    // The pixel halfway between the ball (where it is now) and the cursor.
+    const stepwise::Vec2 now = ed.view.toPixels(ed.doc.scene.registry.tryGet<stepwise::Position>(ball)->value);
+    const int midX = int(std::lround((o.x + float(now.x) + cursorX) / 2)), midY = int(std::lround(by));
+    const stepwise::render::Image image = session.capture(w, h);
+    // The line's colour (the editor's gold, 255 209 102) within 40 per channel,
+    // anywhere in the 5 rows around the line's row.
+    bool gold = false;
+    for (int y = midY - 2; y <= midY + 2; ++y) {
+        const std::uint8_t* p = image.pixel(midX, y);
+        gold = gold || (std::abs(p[0] - 255) <= 40 && std::abs(p[1] - 209) <= 40 && std::abs(p[2] - 102) <= 40);
+    }
+    EXPECT_TRUE(gold) << "no line at (" << midX << ", " << midY << ")";
+    session.queue(event(InputEvent::Type::MouseUp, cursorX, by));
+    session.frame(w, h, 1.0 / 60.0);
+    EXPECT_FALSE(ed.sim.mouseSpring.has_value());
+}

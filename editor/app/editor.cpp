@@ -255,14 +255,16 @@ Vec2 Editor::placementOffset(const Registry& src, const std::vector<Entity>& ent
 }
 
 std::string Editor::deleteLabel(const std::vector<Entity>& doomed) const {
-    // Says what goes, by kind: "delete 1 body and 1 spring".
+    // Says what goes, by kind: "delete 1 body and 1 spring",
+    // "delete 1 body and 2 joints".
     const Registry& reg = doc.scene.registry;
-    std::size_t bodies = 0, springs = 0, walls = 0, others = 0;
+    std::size_t bodies = 0, springs = 0, joints = 0, walls = 0, others = 0;
     std::vector<Entity> all = doomed;
     for (Entity s : attachedTo(reg, doomed)) all.push_back(s);
     for (Entity e : all) {
         if (!reg.alive(e)) continue;
         if (reg.has<Spring>(e)) ++springs;
+        else if (reg.has<Joint>(e)) ++joints;
         else if (reg.has<Plane>(e)) ++walls;
         else if (isBody(reg, e)) ++bodies;
         else ++others;
@@ -273,6 +275,7 @@ std::string Editor::deleteLabel(const std::vector<Entity>& doomed) const {
     };
     add(bodies, "body", "bodies");
     add(springs, "spring", "springs");
+    add(joints, "joint", "joints");
     add(walls, "wall", "walls");
     add(others, "entity", "entities");
     std::string label = "delete ";

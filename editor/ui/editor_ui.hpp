@@ -81,6 +81,10 @@ struct UiState {
     /// cannot be part of a number (ImGui drops them): its panel says so.
     std::string refusedTyping;
     ImGuiID refusedTypingFor = 0;
+    /// The number field being dragged and its speed per pixel, fixed from
+    /// its value when the drag started: drags are linear.
+    ImGuiID dragSpeedFor = 0;
+    float dragSpeed = 0.0f;
 
     // Timing (ms), averaged, for the status bar and the profile
     double frameMs = 0.0, uiMs = 0.0, sceneMs = 0.0, stepMs = 0.0;

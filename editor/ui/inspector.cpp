@@ -26,12 +26,39 @@ using editor::FieldValue;
 
 namespace {
 
-/// Drag speed: about 0.5% of the value per pixel, at least 0.001.
+/// Drag speed: 0.5% of the value per pixel, at least 0.001.
 float speedFor(double v) { return float(std::max(1e-3, std::abs(v) * 0.005)); }
+
+/// The speed of a drag on the field whose widget has id `id`, holding `v`
+/// now: taken from the value when the drag starts and kept for the whole
+/// drag, so a drag is linear (400 px on motor_speed 1 adds 2, where a speed
+/// following the value compounded 0.5% a pixel and went from 1 to -259).
+float dragSpeed(UiState& ui, ImGuiID id, double v) {
+    if (ImGui::GetActiveID() != id) {
+        if (ui.dragSpeedFor == id) ui.dragSpeedFor = 0;  // its drag ended
+        return speedFor(v);
+    }
+    if (ui.dragSpeedFor != id) {
+        ui.dragSpeedFor = id;
+        ui.dragSpeed = speedFor(v);
+    }
+    return ui.dragSpeed;
+}
+
+/// The id of component `i` of a DragScalarN labelled `label` (ImGui pushes
+/// the label, then the index, and gives each component the label "").
+ImGuiID componentId(const char* label, int i) {
+    ImGui::PushID(label);
+    ImGui::PushID(i);
+    const ImGuiID id = ImGui::GetID("");
+    ImGui::PopID();
+    ImGui::PopID();
+    return id;
+}
 
 /// Shows the widget for one field; returns true with `value` updated when
 /// the user changed it.
-bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const Registry& reg) {
+bool fieldWidget(UiState& ui, const FieldInfo& f, FieldValue& value, const char* label, const Registry& reg) {
     const double* lo = std::isfinite(f.range.min) ? &f.range.min : nullptr;
     const double* hi = std::isfinite(f.range.max) ? &f.range.max : nullptr;
     switch (f.kind) {
@@ -42,7 +69,7 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
         if (f.range.minExclusive && f.range.min == 0.0 && hi)
             return ImGui::DragScalar(label, ImGuiDataType_Double, &v, 0.01f, lo, hi, "%.6g",
                                      ImGuiSliderFlags_Logarithmic);
-        return ImGui::DragScalar(label, ImGuiDataType_Double, &v, speedFor(v), lo, hi, "%.6g");
+        return ImGui::DragScalar(label, ImGuiDataType_Double, &v, dragSpeed(ui, ImGui::GetID(label), v), lo, hi, "%.6g");
     }
     case FieldKind::Integer: {
         // Only world settings are integers; 0 there is "not given"
@@ -65,7 +92,7 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
             return changed;
         }
         double d = *v;
-        if (ImGui::DragScalar(label, ImGuiDataType_Double, &d, speedFor(d), lo, hi, "%.6g")) {
+        if (ImGui::DragScalar(label, ImGuiDataType_Double, &d, dragSpeed(ui, ImGui::GetID(label), d), lo, hi, "%.6g")) {
             v = d;
             changed = true;
         }
@@ -74,8 +101,15 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
     case FieldKind::Vector: {
         Vec2& v = std::get<Vec2>(value);
         double xy[2] = {v.x, v.y};
-        if (!ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, speedFor(std::max(std::abs(v.x), std::abs(v.y))),
-                                nullptr, nullptr, "%.5g"))
+        // One speed for both components (the larger's), kept while either is dragged.
+        const double larger = std::max(std::abs(v.x), std::abs(v.y));
+        float speed = speedFor(larger);
+        for (int i = 0; i < 2; ++i) {
+            const ImGuiID c = componentId(label, i);
+            const float own = dragSpeed(ui, c, larger);
+            if (ImGui::GetActiveID() == c) speed = own;
+        }
+        if (!ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, speed, nullptr, nullptr, "%.5g"))
             return false;
         v = {xy[0], xy[1]};
         return true;
@@ -191,7 +225,7 @@ bool worldFieldWidget(UiState& ui, Editor& ed, std::string_view key) {
     const FieldInfo& f = info->field;
     FieldValue value = editor::readField(f, &ed.doc.scene.world);
     const std::string label = fieldLabel(f.key, f.unit);
-    const bool changed = fieldWidget(f, value, label.c_str(), ed.doc.scene.registry);
+    const bool changed = fieldWidget(ui, f, value, label.c_str(), ed.doc.scene.registry);
     recordWidgetRect(ui, "world/" + std::string(key));
     reportRefusedTyping(ui, ed, "world.", f.key);
     if (ImGui::IsItemHovered() && !f.description.empty())
@@ -274,7 +308,7 @@ void drawInspector(UiState& ui, Editor& ed) {
                 if (mixed) label += " (mixed)";
                 ImGui::PushID(f.key.empty() ? "value" : f.key.data());
                 const ImGuiID id = ImGui::GetID(label.c_str());
-                const bool changed = fieldWidget(f, value, label.c_str(), reg);
+                const bool changed = fieldWidget(ui, f, value, label.c_str(), reg);
                 reportRefusedTyping(ui, ed, "\"" + editor::displayName(reg, primary) + "\" ",
                                     editor::fieldPathName(info, f.key));
                 {  // where the field is this frame, for --debug-state (tests click it wherever the layout puts it)

@@ -142,6 +142,15 @@ void viewportPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                 dl->AddLine(ImVec2(o.x + float(a.x), o.y + float(a.y)), ImVec2(o.x + float(b.x), o.y + float(b.y)),
                             ImGui::GetColorU32(kGold), 1.5f * ui.scale);
             }
+        // The mouse spring: a line from the pulled body to the cursor and a
+        // dot where it pulls, so the pull and its direction are seen.
+        if (ed.sim.mouseSpring)
+            if (const Position* p = ed.doc.scene.registry.tryGet<Position>(ed.sim.mouseSpring->first)) {
+                const Vec2 a = ed.view.toPixels(p->value), b = ed.view.toPixels(ed.sim.mouseSpring->second);
+                const ImVec2 from(o.x + float(a.x), o.y + float(a.y)), to(o.x + float(b.x), o.y + float(b.y));
+                dl->AddLine(from, to, ImGui::GetColorU32(kGold), 2.0f * ui.scale);
+                dl->AddCircleFilled(to, 3.5f * ui.scale, ImGui::GetColorU32(kGold));
+            }
         // Cursor readout, bottom right of the viewport.
         const Vec2 w = ed.view.toWorld(ed.mouseViewport());
         char text[96];
