@@ -311,3 +311,75 @@ TEST(SessionFrame, TheMouseSpringDrawsALineFromTheBodyToTheCursor) {
     session.frame(w, h, 1.0 / 60.0);
     EXPECT_FALSE(ed.sim.mouseSpring.has_value());
 }
+
+// ---- a failed open from the recent list -----------------------------------------
+
+// File > Open recent on a level deleted since: the Error modal with the
+// loader's reason, and the status line with it (it said "open failed: PATH").
+TEST(SessionFrame, OpenRecentOnADeletedLevelShowsTheReasonInTheModalAndTheStatusLine) {
+    const int w = 1280, h = 720;
+    auto context = stepwise::render::OffscreenRenderer::create(w, h);
+    ASSERT_TRUE(context.ok()) << context.error();
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("stepwise-recent-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path gone = dir / "gone.json";
+    std::filesystem::copy_file(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / "default.json", gone,
+                               std::filesystem::copy_options::overwrite_existing);
+    stepwise::ui::SessionOptions options;
+    options.persist = false;
+    options.deterministic = true;
+    options.builtinFont = true;
+    auto created = stepwise::ui::Session::create(
+        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    ASSERT_TRUE(created.ok()) << created.error();
+    stepwise::ui::Session& session = **created;
+    stepwise::editor::Editor& ed = session.editor();
+    ASSERT_TRUE(session.openAtStart(gone));
+    ASSERT_TRUE(ed.open(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / "orbit.json"));
+    std::filesystem::remove(gone);
+    using stepwise::editor::InputEvent;
+    auto click = [&](float x, float y) {
+        for (const InputEvent::Type t : {InputEvent::Type::MouseMove, InputEvent::Type::MouseDown, InputEvent::Type::MouseUp}) {
+            InputEvent e;
+            e.type = t;
+            e.x = x;
+            e.y = y;
+            session.queue(e);
+            session.frame(w, h, 1.0 / 60.0);
+        }
+    };
+    auto hover = [&](float x, float y) {
+        InputEvent e;
+        e.type = InputEvent::Type::MouseMove;
+        e.x = x;
+        e.y = y;
+        session.queue(e);
+        session.frame(w, h, 1.0 / 60.0);
+        session.frame(w, h, 1.0 / 60.0);
+    };
+    /// The middle of row `row` of a menu window.
+    auto rowOf = [](const char* menu, int row) {
+        const ImGuiWindow* win = ImGui::FindWindowByName(menu);
+        EXPECT_NE(win, nullptr) << menu;
+        if (!win) return ImVec2(0, 0);
+        const ImGuiStyle& style = ImGui::GetStyle();
+        const float rowHeight = ImGui::GetFontSize() + style.ItemSpacing.y;
+        return ImVec2(win->Pos.x + 30.0f, win->Pos.y + style.WindowPadding.y + rowHeight * (float(row) + 0.5f) - style.ItemSpacing.y / 2);
+    };
+    session.frame(w, h, 1.0 / 60.0);
+    click(20.0f, 10.0f);  // File
+    const ImVec2 recent = rowOf("##Menu_00", 2);  // New, Open..., Open recent
+    hover(recent.x, recent.y);
+    const ImVec2 first = rowOf("##Menu_01", 0);  // the newest recent file: orbit.json, then gone.json
+    const ImVec2 second(first.x, first.y + ImGui::GetFontSize() + ImGui::GetStyle().ItemSpacing.y);
+    hover(second.x, recent.y);  // along the row first, so the submenu stays open
+    click(second.x, second.y);
+    session.frame(w, h, 1.0 / 60.0);
+    const std::string loader = gone.string() + ": error: no such file";
+    EXPECT_EQ(ed.errorModal, loader);
+    EXPECT_EQ(ed.status, "open failed: " + loader);
+    EXPECT_EQ(session.dialogState().modal, "Error");
+    EXPECT_EQ(ed.doc.title(), "orbit.json");
+    std::filesystem::remove_all(dir);
+}
