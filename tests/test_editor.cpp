@@ -658,3 +658,28 @@ TEST(Editing, DeletingAPlankCountsItsJointsAsJoints) {
     EXPECT_EQ(f.ed.status, "delete 1 body and 2 joints");
     EXPECT_EQ(f.ed.commands.labels().back(), "delete 1 body and 2 joints");
 }
+
+// ---- edits while the simulation runs ---------------------------------------
+
+// Edits made while paused changed the running state with nothing to say so:
+// no `*`, Save wrote the level as at Play and Reset dropped them silently.
+TEST(RunningEdits, TheModeSaysWhereEditsGoAndResetSaysWhatItDiscards) {
+    Fixture f("default.json");
+    EXPECT_EQ(f.ed.runningEditsNote(), "");
+    f.ed.stepForward();
+    EXPECT_EQ(f.ed.runningEditsNote(),
+              "editing the running state: Reset discards any edit; Save writes the level as it was at Play");
+    ASSERT_TRUE(rename(f, f.named("crate 1"), "heavy"));
+    EXPECT_EQ(f.ed.editsSincePlay(), 1u);
+    EXPECT_EQ(f.ed.runningEditsNote(),
+              "editing the running state: Reset discards 1 edit; Save writes the level as it was at Play");
+    EXPECT_FALSE(f.ed.dirty()) << "the level is as it was at Play";
+    f.ed.select({f.named("heavy")});
+    ASSERT_TRUE(f.ed.deleteSelection());
+    EXPECT_EQ(f.ed.editsSincePlay(), 2u);
+    f.ed.resetSimulation();
+    EXPECT_EQ(f.ed.status, "reset to the edited level; discarded 2 edits made while running");
+    EXPECT_FALSE(f.named("crate 1").isNull());
+    EXPECT_EQ(f.ed.runningEditsNote(), "");
+    EXPECT_EQ(f.ed.editsSincePlay(), 0u);
+}

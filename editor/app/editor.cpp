@@ -341,6 +341,18 @@ std::string Editor::breakOnLabel() const {
     return sim.breakOnContact.isNull() ? std::string("off") : displayName(doc.scene.registry, sim.breakOnContact);
 }
 
+std::size_t Editor::editsSincePlay() const {
+    return sim.running() && commands.cursor() > playMark_ ? commands.cursor() - playMark_ : 0;
+}
+
+std::string Editor::runningEditsNote() const {
+    if (!sim.running()) return {};
+    const std::size_t n = editsSincePlay();
+    return "editing the running state: Reset discards " +
+           (n == 0 ? std::string("any edit") : std::to_string(n) + (n == 1 ? " edit" : " edits")) +
+           "; Save writes the level as it was at Play";
+}
+
 void Editor::togglePlay() {
     if (sim.state() == SimState::Playing) {
         sim.pause();
@@ -379,13 +391,16 @@ void Editor::stepBack() {
 }
 
 void Editor::resetSimulation() {
+    const std::size_t discarded = editsSincePlay();
     if (!sim.reset(doc.scene)) return;
     // Edits made while paused applied to the simulated state: they go with it.
     commands.truncate(playMark_);
     trails = render::TrailRecorder(trails.capacity());
     afterSceneReplaced();
     forgetRecoveryWhenClean();
-    note("reset to the edited level");
+    note(discarded == 0 ? std::string("reset to the edited level")
+                        : "reset to the edited level; discarded " + std::to_string(discarded) +
+                              (discarded == 1 ? " edit" : " edits") + " made while running");
 }
 
 void Editor::update(double frameSeconds) {

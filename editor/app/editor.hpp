@@ -115,6 +115,14 @@ public:
     /// What the Viewport's toolbar shows beside "Break on contact": the
     /// watched body's name, or "off".
     std::string breakOnLabel() const;
+    /// Edits made since Play (while the simulation runs): they change the
+    /// running state, not the level. Reset discards them; Save writes the
+    /// level as it was at Play.
+    std::size_t editsSincePlay() const;
+    /// The line the viewport shows while the simulation runs, saying where
+    /// edits go ("" while editing):
+    /// "editing the running state: Reset discards 2 edits; Save writes the level as it was at Play".
+    std::string runningEditsNote() const;
     void togglePlay();
     void stepForward();
     void stepBack();

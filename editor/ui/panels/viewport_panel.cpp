@@ -130,6 +130,16 @@ void viewportPanel(UiState& ui, Editor& ed, const PanelRects& r) {
         if (ed.sim.running())
             dl->AddRect(o, ImVec2(o.x + avail.x, o.y + avail.y),
                         ImGui::GetColorU32(ed.sim.state() == SimState::Playing ? kGreen : kGold), 0, 0, 2.0f * ui.scale);
+        // While the simulation runs, edits change the running state, not
+        // the level: said at the top of the scene, over a dark band.
+        if (const std::string note = ed.runningEditsNote(); !note.empty()) {
+            const ImVec2 ts = ImGui::CalcTextSize(note.c_str());
+            const float pad = 4 * ui.scale;
+            const ImVec2 at(o.x + 8 * ui.scale, o.y + 6 * ui.scale);
+            dl->AddRectFilled(ImVec2(at.x - pad, at.y - pad / 2), ImVec2(at.x + ts.x + pad, at.y + ts.y + pad / 2),
+                              IM_COL32(10, 12, 16, 200), 3 * ui.scale);
+            dl->AddText(at, ImGui::GetColorU32(ed.editsSincePlay() > 0 ? kGold : kDim), note.c_str());
+        }
         if (auto rect = ed.selectionRect()) {
             const ImVec2 a(o.x + float(rect->first.x), o.y + float(rect->first.y));
             const ImVec2 b(o.x + float(rect->second.x), o.y + float(rect->second.y));
