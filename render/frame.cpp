@@ -1096,7 +1096,7 @@ void Builder::contacts() {
         out_.notes.push_back("contacts: needs a World (not built)");
         return;
     }
-    const auto records = in_.world->contacts();
+    const std::span<const ContactRecord> records = in_.contacts ? *in_.contacts : in_.world->contacts();
     std::vector<double> mags;
     for (const ContactRecord& c : records) mags.push_back(std::abs(c.normalImpulse));
     const double ref = in_.scales.impulse > 0 ? in_.scales.impulse : autoReference(mags);

@@ -683,3 +683,67 @@ TEST(RunningEdits, TheModeSaysWhereEditsGoAndResetSaysWhatItDiscards) {
     EXPECT_EQ(f.ed.runningEditsNote(), "");
     EXPECT_EQ(f.ed.editsSincePlay(), 0u);
 }
+// Every edit while paused emptied the contacts table (and the overlay): the
+// World it recompiles has no contacts until its next step. An edit that
+// leaves the contacts as they were keeps them; one that moves a body does not.
+TEST(RunningEdits, AnEditThatLeavesTheContactsKeepsTheTable) {
+    Fixture f("default.json");
+    for (int i = 0; i < 60; ++i) f.ed.stepForward();
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    const std::vector<ContactRecord> before(f.ed.sim.contacts().begin(), f.ed.sim.contacts().end());
+    ASSERT_EQ(before.size(), 33u);
+    const ComponentInfo* mass = findComponent("mass");
+    std::string problem;
+    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
+        return setFieldOnAll(s, *mass, mass->fields[0], 3.0, {f.named("crate 1")}, &problem) > 0;
+    }));
+    ASSERT_TRUE(rename(f, f.named("crate 2"), "heavy"));
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    EXPECT_EQ(f.ed.sim.world()->contacts().size(), 0u) << "the recompiled World has none of its own";
+    ASSERT_EQ(f.ed.sim.contacts().size(), before.size());
+    for (std::size_t i = 0; i < before.size(); ++i) {
+        EXPECT_EQ(f.ed.sim.contacts()[i].a, before[i].a);
+        EXPECT_EQ(f.ed.sim.contacts()[i].b, before[i].b);
+        EXPECT_EQ(f.ed.sim.contacts()[i].depth, before[i].depth);
+    }
+    EXPECT_EQ(f.ed.frameInput().contacts->size(), before.size()) << "the overlay draws them too";
+    // A step makes its own; a move changes them.
+    f.ed.stepForward();
+    EXPECT_EQ(f.ed.sim.contacts().data(), f.ed.sim.world()->contacts().data());
+    const Entity crate = f.named("crate 3");
+    ASSERT_TRUE(f.ed.applyEdit("move", [&](Scene& s) {
+        s.registry.tryGet<Position>(crate)->value.x += 0.5;
+        return true;
+    }));
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    EXPECT_EQ(f.ed.sim.contacts().data(), f.ed.sim.world()->contacts().data());
+}
+
+// A mass edit on a sleeping crate wakes its island (the ten crates and the
+// ball resting on them); undoing it left them awake, with no contacts.
+TEST(RunningEdits, UndoingAnEditBeforeAnyStepPutsTheIslandsItWokeBackToSleep) {
+    Fixture f("default.json");
+    for (int i = 0; i < 900; ++i) f.ed.stepForward();
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    const std::vector<Entity> asleep = f.ed.sim.world()->sleepingBodies();
+    ASSERT_EQ(asleep.size(), 11u);
+    const std::size_t contacts = f.ed.sim.contacts().size();
+    const std::string before = textOf(f.ed.doc.scene);
+    const ComponentInfo* mass = findComponent("mass");
+    std::string problem;
+    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
+        return setFieldOnAll(s, *mass, mass->fields[0], 3.0, {f.named("crate 1")}, &problem) > 0;
+    }));
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    EXPECT_EQ(f.ed.sim.world()->sleepingBodyCount(), 0u) << "the edit wakes the crate's island";
+    ASSERT_TRUE(f.ed.undo());
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+    EXPECT_EQ(f.ed.sim.world()->sleepingBodies(), asleep);
+    EXPECT_EQ(f.ed.sim.contacts().size(), contacts);
+    // The run goes on as it would have without the edit and its undo.
+    Fixture g("default.json");
+    for (int i = 0; i < 960; ++i) g.ed.stepForward();
+    for (int i = 0; i < 60; ++i) f.ed.stepForward();
+    EXPECT_EQ(textOf(f.ed.doc.scene), textOf(g.ed.doc.scene));
+}

@@ -169,6 +169,7 @@ void Editor::resolvePending(Resolution r) {
 
 bool Editor::applyEdit(const std::string& label, const std::function<bool(Scene&)>& edit, std::uint64_t mergeKey) {
     if (commands.absoluteCursor() < savedCursor_) savedReachable_ = false;  // the saved state leaves the redo branch
+    sim.beforeEdit(commands.cursor());
     if (!commands.apply(doc.scene, label, edit, mergeKey)) return false;
     sim.sceneEdited(doc.scene, commands.lastEdit());
     pruneSelection();
@@ -184,6 +185,9 @@ bool Editor::undo() {
     const std::string label = commands.undo(doc.scene);
     if (label.empty()) return false;
     afterSceneReplaced();
+    // Back to the state before the run's edits with no step between: the
+    // islands they woke sleep again and the contacts are those of before.
+    if (sim.running()) sim.undoneTo(doc.scene, commands.cursor());
     forgetRecoveryWhenClean();
     note("undo: " + label);
     return true;
@@ -627,6 +631,7 @@ render::FrameInput Editor::frameInput() const {
     render::FrameInput in;
     in.scene = &doc.scene;
     in.world = sim.world();
+    if (in.world) in.contacts = sim.contacts();
     in.overlays = overlays;
     if (!in.world) in.overlays.bits &= ~(std::uint32_t(render::Overlay::Force) | std::uint32_t(render::Overlay::ForceField) |
                                          std::uint32_t(render::Overlay::Contacts) | std::uint32_t(render::Overlay::Joints));

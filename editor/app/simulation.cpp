@@ -128,6 +128,17 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
         return std::uint64_t(1) << std::size_t(findComponent(component) - componentTable().data());
     };
     static const std::uint64_t kPose = bit("position") | bit("velocity");
+    // What decides which pairs touch and where: an edit of any of these (or
+    // one that adds or removes entities) makes the last step's contacts stale.
+    static const std::uint64_t kContactShape = bit("position") | bit("angle") | bit("static") | bit("radius") |
+                                               bit("box") | bit("polygon") | bit("plane");
+    bool keepContacts = world_ && running() && !edit.beyondComponents;
+    for (const auto& [entity, changed] : edit.entities) keepContacts = keepContacts && (changed & kContactShape) == 0;
+    if (keepContacts && !contactsKept_) {
+        const std::span<const ContactRecord> shown = world_->contacts();
+        keptContacts_.assign(shown.begin(), shown.end());
+    }
+    contactsKept_ = keepContacts;
     bool inPlace = world_ && !stale_ && !edit.beyondComponents;
     for (const auto& [entity, changed] : edit.entities) {
         if (!inPlace) break;
@@ -137,6 +148,28 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
     }
     // A partly applied edit is rebuilt whole, like any other.
     if (!inPlace) stale_ = true;
+}
+
+void Simulation::beforeEdit(std::size_t cursor) {
+    if (!world_ || !running()) return;
+    if (beforeEdits_ && beforeEdits_->steps == steps_ && beforeEdits_->cursor <= cursor) return;  // kept already
+    // A World an earlier edit left stale still holds the state from before it.
+    const std::span<const ContactRecord> shown = contacts();
+    beforeEdits_ = BeforeEdits{cursor, steps_, world_->saveState(), {shown.begin(), shown.end()}};
+}
+
+bool Simulation::undoneTo(const Scene& scene, std::size_t cursor) {
+    if (!beforeEdits_ || beforeEdits_->steps != steps_ || beforeEdits_->cursor != cursor) return false;
+    if (!ensureWorld(scene) || !world_->restoreState(beforeEdits_->state)) return false;
+    keptContacts_ = beforeEdits_->contacts;
+    contactsKept_ = true;
+    return true;
+}
+
+std::span<const ContactRecord> Simulation::contacts() const {
+    if (contactsKept_) return keptContacts_;
+    if (const World* w = world()) return w->contacts();
+    return {};
 }
 
 bool Simulation::ensureWorld(const Scene& scene) {
@@ -298,6 +331,7 @@ bool Simulation::prepareStep(Scene& scene) {
 }
 
 bool Simulation::finishStep(Scene& scene) {
+    contactsKept_ = false;  // the step made contacts of its own
     world_->writeBack(scene);
     ++steps_;
     record();
@@ -376,6 +410,8 @@ bool Simulation::stepBack(Scene& scene) {
     state_ = SimState::Paused;
     HistoryEntry entry = std::move(history_.back());
     popHistory();
+    contactsKept_ = false;  // the restored step's contacts are replayed below
+    beforeEdits_.reset();
     scene = entry.restore();
     // The live World takes the state in place when it was compiled from
     // that entry's scene; after an edit (or a switched system, or a drag)
@@ -432,6 +468,8 @@ bool Simulation::reset(Scene& scene) {
     diverged_ = false;
     contactPair.reset();
     mouseSpring.reset();
+    contactsKept_ = false;
+    beforeEdits_.reset();
     return true;
 }
 

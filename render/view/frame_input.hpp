@@ -12,11 +12,14 @@
 #include "stepwise/scene.hpp"
 #include "stepwise/vec2.hpp"
 
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace stepwise {
 class World;
+struct ContactRecord;
 }
 
 namespace stepwise::render {
@@ -43,6 +46,10 @@ struct ArrowScales {
 struct FrameInput {
     const Scene* scene = nullptr;          ///< required
     const World* world = nullptr;          ///< optional; force, force-field, contacts need it
+    /// The contacts overlay's records instead of `world`'s: the editor keeps
+    /// the last step's across an edit that leaves them as they were (the
+    /// World recompiled by the edit has none until its next step).
+    std::optional<std::span<const ContactRecord>> contacts;
     OverlaySet overlays;
     Camera camera;
     std::vector<Entity> selection;         ///< drawn with a highlight ring
