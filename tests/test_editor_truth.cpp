@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 using namespace stepwise;
 using namespace stepwise::render;
@@ -261,18 +262,54 @@ TEST(EditorStepBack, TheContactsShownAreThoseOfTheRestoredStep) {
 
 namespace {
 
-TEST(SaveAsSuggestion, AnUntitledLevelGoesToTheFirstWritableFolder) {
+// A new level was proposed a place inside the program's own levels folder.
+TEST(SaveAsSuggestion, AnUntitledLevelGoesToTheWorkingFolderUnderAFreeName) {
     TempDir tmp;
     const fs::path levels = tmp.path / "levels", work = tmp.path / "work";
     fs::create_directories(levels);
     fs::create_directories(work);
-    // The levels folder when it exists (always absolute).
-    EXPECT_EQ(editor::saveAsSuggestion({}, levels, work), levels / "untitled.json");
-    // A levels folder that is not there (the executable moved, nothing
-    // found): the working folder, not a path that fails on Save.
-    EXPECT_EQ(editor::saveAsSuggestion({}, tmp.path / "missing", work), work / "untitled.json");
+    // The working folder, not the levels folder (always absolute).
+    EXPECT_EQ(editor::saveAsSuggestion({}, levels, work), work / "untitled.json");
+    // A name that is taken is not proposed.
+    std::ofstream(work / "untitled.json") << "{}";
+    EXPECT_EQ(editor::saveAsSuggestion({}, levels, work), work / "untitled_2.json");
+    // A working folder that is not there: not a path that fails on Save.
+    const fs::path fallback = editor::saveAsSuggestion({}, levels, tmp.path / "missing");
+    EXPECT_TRUE(fs::is_directory(fallback.parent_path())) << fallback;
+    EXPECT_EQ(fallback.filename().string().rfind("untitled", 0), 0u) << fallback;
     // A document keeps its own path, made absolute.
     EXPECT_EQ(editor::saveAsSuggestion("some/level.json", levels, work), fs::absolute("some/level.json"));
+}
+
+// "Save simulation state" proposed the last Save as path, of another level.
+TEST(SaveAsSuggestion, TheStateGoesBesideTheOpenLevelNamedAfterIt) {
+    TempDir tmp;
+    const fs::path levels = tmp.path / "levels", work = tmp.path / "work", mine = tmp.path / "mine";
+    for (const fs::path& d : {levels, work, mine}) fs::create_directories(d);
+    EXPECT_EQ(editor::saveStateSuggestion(mine / "bridge.json", levels, work), mine / "bridge_state.json");
+    std::ofstream(mine / "bridge_state.json") << "{}";
+    EXPECT_EQ(editor::saveStateSuggestion(mine / "bridge.json", levels, work), mine / "bridge_state_2.json");
+    EXPECT_EQ(editor::saveStateSuggestion({}, levels, work), work / "untitled_state.json");
+}
+
+// The recent list held "levels/a.json" and "/.../levels/a.json" both.
+TEST(RecentFiles, OneFileIsOneEntryHoweverItWasNamed) {
+    TempDir tmp;
+    const fs::path level = tmp.path / "a.json";
+    std::ofstream(level) << "{}";
+    editor::Settings settings;
+    const fs::path before = fs::current_path();
+    fs::current_path(tmp.path);
+    settings.addRecent("a.json");
+    settings.addRecent("./a.json");
+    settings.addRecent(level.string());
+    settings.addRecent((tmp.path / "sub" / ".." / "a.json").string());
+    fs::current_path(before);
+    ASSERT_EQ(settings.recentFiles.size(), 1u);
+    EXPECT_EQ(settings.recentFiles[0], fs::weakly_canonical(level).string());
+    // A settings file written before keeps one entry per file too.
+    std::ofstream(tmp.path / "settings.txt") << "recent " << level.string() << "\nrecent " << (tmp.path / "." / "a.json").string() << "\n";
+    EXPECT_EQ(editor::Settings::load(tmp.path).recentFiles.size(), 1u);
 }
 
 TEST(OpenList, ListsTheLevelFilesButNotTheSchema) {

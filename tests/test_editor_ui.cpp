@@ -383,3 +383,49 @@ TEST(SessionFrame, OpenRecentOnADeletedLevelShowsTheReasonInTheModalAndTheStatus
     EXPECT_EQ(ed.doc.title(), "orbit.json");
     std::filesystem::remove_all(dir);
 }
+
+// ---- where the save dialogs propose to write ---------------------------------------
+
+// "Save simulation state" kept the path last typed into Save as, for another
+// level; Save as on a new level proposed the program's own levels folder.
+TEST(SessionFrame, EachSaveDialogProposesAPathFromTheLevelOpenNow) {
+    const int w = 1280, h = 720;
+    auto context = stepwise::render::OffscreenRenderer::create(w, h);
+    ASSERT_TRUE(context.ok()) << context.error();
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("stepwise-proposals-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir / "mine");
+    const std::filesystem::path bridge = dir / "mine" / "bridge.json";
+    std::filesystem::copy_file(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / "bridge.json", bridge);
+    stepwise::ui::SessionOptions options;
+    options.persist = false;
+    options.deterministic = true;
+    options.builtinFont = true;
+    auto created = stepwise::ui::Session::create(
+        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    ASSERT_TRUE(created.ok()) << created.error();
+    stepwise::ui::Session& session = **created;
+    stepwise::editor::Editor& ed = session.editor();
+    stepwise::ui::UiState& ui = session.ui();
+    ASSERT_TRUE(session.openAtStart(bridge));
+    session.frame(w, h, 1.0 / 60.0);
+    ui.saveAsPath = (dir / "elsewhere" / "other.json").string();  // typed for another level, earlier
+    ed.stepForward();
+    ui.saveStateRequested = true;
+    session.frame(w, h, 1.0 / 60.0);
+    EXPECT_EQ(session.dialogState().modal, "Save simulation state");
+    EXPECT_EQ(ui.saveAsPath, (dir / "mine" / "bridge_state.json").string());
+    ImGui::ClosePopupToLevel(0, false);
+    ed.resetSimulation();
+    // A new level: the working folder.
+    const std::filesystem::path before = std::filesystem::current_path();
+    std::filesystem::current_path(dir);
+    ed.newDocument();
+    ui.saveAsDialogRequested = true;
+    session.frame(w, h, 1.0 / 60.0);
+    std::filesystem::current_path(before);
+    EXPECT_EQ(session.dialogState().modal, "Save as");
+    EXPECT_EQ(ui.saveAsPath, (dir / "untitled.json").string());
+    std::filesystem::remove_all(dir);
+}

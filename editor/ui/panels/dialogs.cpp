@@ -31,18 +31,18 @@ void dialogs(UiState& ui, Editor& ed) {
         ImGui::OpenPopup("Open level");
         ui.openDialogRequested = false;
     }
+    // Each dialog proposes afresh when it opens, from the level open now:
+    // a path typed for another level (or for the other dialog) is not kept.
     if (ui.saveAsDialogRequested) {
         ImGui::OpenPopup("Save as");
-        // An absolute suggestion in a folder that exists, wherever the
-        // editor was started from.
-        if (ui.saveAsPath.empty()) {
-            std::error_code cwd;
-            ui.saveAsPath = editor::saveAsSuggestion(ed.doc.path, ui.levelsDir, std::filesystem::current_path(cwd)).string();
-        }
+        std::error_code cwd;
+        ui.saveAsPath = editor::saveAsSuggestion(ed.doc.path, ui.levelsDir, std::filesystem::current_path(cwd)).string();
         ui.saveAsDialogRequested = false;
     }
     if (ui.saveStateRequested) {
         ImGui::OpenPopup("Save simulation state");
+        std::error_code cwd;
+        ui.saveAsPath = editor::saveStateSuggestion(ed.doc.path, ui.levelsDir, std::filesystem::current_path(cwd)).string();
         ui.saveStateRequested = false;
     }
     const ImVec2 center = ImGui::GetMainViewport()->GetCenter();
