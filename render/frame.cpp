@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <numbers>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace stepwise::render {
 
@@ -39,7 +40,9 @@ constexpr Rgba kDefaultBody = rgb(0x9fb3c8);
 constexpr Rgba kSpringColor = rgb(0xcbd5e0);
 constexpr Rgba kAnchorColor = rgb(0x718096);
 constexpr Rgba kVelocity = rgb(0x4fd1c5);
-constexpr Rgba kVelocityField = rgb(0x38b2ac, 0.8f);
+// Its own hue, apart from the bodies' velocity (teal) it averages: with both
+// overlays on, a sample arrow and a body's arrow must not be confused.
+constexpr Rgba kVelocityField = rgb(0x5a7dff, 0.85f);
 constexpr Rgba kForce = rgb(0xf6ad55);
 constexpr Rgba kNetForce = rgb(0xf687b3);
 constexpr Rgba kForceField = rgb(0xa78bfa, 0.5f);
@@ -1068,10 +1071,16 @@ void Builder::bodyArrows() {
         std::vector<Vec2> origins, velocities;  // pixels, m/s
         std::vector<double> mags;
         std::vector<bool> chosen;
+        // A sleeping body is at rest: the residue of velocity it fell asleep
+        // with (1e-5 m/s) would get an arrow, and would pull the reference
+        // down until every such arrow was drawn long.
+        std::unordered_set<Entity> asleep;
+        if (in_.world)
+            for (Entity e : in_.world->sleepingBodies()) asleep.insert(e);
         for (Entity e : scene_.registry.entities()) {
             const Position* p = scene_.registry.tryGet<Position>(e);
             const Velocity* v = scene_.registry.tryGet<Velocity>(e);
-            if (!p || !v || isStatic(scene_, e)) continue;
+            if (!p || !v || isStatic(scene_, e) || asleep.count(e)) continue;
             origins.push_back(toPx(p->value));
             velocities.push_back(v->value);
             mags.push_back(length(v->value));

@@ -19,6 +19,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <array>
+#include <set>
 
 using namespace stepwise;
 using namespace stepwise::render;
@@ -317,6 +319,76 @@ TEST(OpenList, ListsTheLevelFilesButNotTheSchema) {
     EXPECT_GT(files.size(), 10u);
     for (const std::string& f : files) EXPECT_EQ(fs::path(f).extension(), ".json") << f;
     EXPECT_EQ(std::count_if(files.begin(), files.end(), [](const std::string& f) { return f.find("schema") != std::string::npos; }), 0);
+}
+
+} // namespace
+
+namespace {
+
+// default.json after 900 steps: the crates and one ball sleep. Their
+// residual velocities (about 1e-5 m/s) got arrows and set the reference,
+// so resting bodies showed long arrows.
+TEST(VelocityOverlay, SleepingBodiesGetNoArrowAndDoNotSetTheScale) {
+    editor::Editor ed;
+    ASSERT_TRUE(ed.open(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "default.json"));
+    for (int i = 0; i < 900; ++i) ed.stepForward();
+    ASSERT_TRUE(ed.sim.ensureWorld(ed.doc.scene));
+    const std::vector<Entity> asleep = ed.sim.world()->sleepingBodies();
+    ASSERT_EQ(asleep.size(), 11u);
+    ed.setViewportSize(800, 600);
+    ed.fitView();
+    FrameInput in = ed.frameInput();
+    in.overlays = OverlaySet{};
+    in.overlays.add(Overlay::Velocity);
+    const DrawData data = buildDrawData(in, 800, 600);
+    // No arrow starts at a sleeping body.
+    std::size_t arrowsAtSleepers = 0, arrows = 0;
+    for (const Batch& b : data.batches) {
+        if (b.kind != BatchKind::Arrow) continue;
+        const std::size_t k = floatsPerInstance(BatchKind::Arrow);
+        for (std::size_t i = 0; i + k <= b.data.size(); i += k) {
+            ++arrows;
+            const Vec2 from{b.data[i], b.data[i + 1]};
+            for (Entity e : asleep) {
+                const Vec2 view = ed.view.toPixels(ed.doc.scene.registry.tryGet<Position>(e)->value);
+                const Vec2 at{view.x, 600.0 - view.y};  // the frame counts rows from the bottom
+                if (length(at - from) < 1.0) ++arrowsAtSleepers;
+            }
+        }
+    }
+    EXPECT_EQ(arrowsAtSleepers, 0u) << "of " << asleep.size() << " sleeping bodies";
+    EXPECT_EQ(arrows, 5u) << "the four moving bodies' arrows and the legend's sample";
+}
+
+} // namespace
+
+namespace {
+
+// "velocity" (teal, 4fd1c5) and "velocity field" (38b2ac) were drawn in
+// nearly the same colour, a sum of channel differences of 79 out of 765.
+TEST(VelocityOverlay, TheVelocityFieldHasAColourOfItsOwn) {
+    editor::Editor ed;
+    ASSERT_TRUE(ed.open(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "flock.json"));
+    ed.setViewportSize(800, 600);
+    ed.fitView();
+    FrameInput in = ed.frameInput();
+    in.overlays = OverlaySet{};
+    std::vector<std::array<int, 3>> colours;
+    for (const Overlay o : {Overlay::Velocity, Overlay::VelocityField}) {
+        in.overlays.bits = std::uint32_t(o);
+        const DrawData data = buildDrawData(in, 800, 600);
+        std::set<std::array<int, 3>> seen;
+        for (const Batch& b : data.batches)
+            if (b.kind == BatchKind::Arrow)
+                for (std::size_t i = 0; i + 9 <= b.data.size(); i += 9)
+                    seen.insert({int(std::lround(b.data[i + 5] * 255)), int(std::lround(b.data[i + 6] * 255)),
+                                 int(std::lround(b.data[i + 7] * 255))});
+        ASSERT_EQ(seen.size(), 1u) << "one colour per overlay";
+        colours.push_back(*seen.begin());
+    }
+    const int distance = std::abs(colours[0][0] - colours[1][0]) + std::abs(colours[0][1] - colours[1][1]) +
+                         std::abs(colours[0][2] - colours[1][2]);
+    EXPECT_GE(distance, 150);
 }
 
 } // namespace
