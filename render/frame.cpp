@@ -331,6 +331,8 @@ private:
     void bodyArrows();
     void contacts();
     void hud();
+    /// Pixels of the rectangle (x, y, w, h; y up) that moving bodies cover.
+    double coveredBodyArea(double x, double y, double w, double h) const;
 
     DrawData& out_;
     const FrameInput& in_;
@@ -1133,6 +1135,26 @@ void Builder::contacts() {
     legend_.push_back({"contact impulse", kContactNormal, ref, "N s"});
 }
 
+double Builder::coveredBodyArea(double x, double y, double w, double h) const {
+    // Pixels of the rectangle over the boxes around the moving bodies (a
+    // body with no shape counts as 8 x 8 px); static shapes do not count: a
+    // floor or a wall runs under any corner.
+    double area = 0.0;
+    for (Entity e : scene_.registry.entities()) {
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!p || isStatic(scene_, e)) continue;
+        Vec2 c = toPx(p->value), half{4.0, 4.0};
+        if (const std::optional<ShapeBox> b = shapeBox(scene_, e)) {
+            c = toPx(b->centre);
+            half = b->half * ppm_;
+        }
+        const double ox = std::min(x + w, c.x + half.x) - std::max(x, c.x - half.x);
+        const double oy = std::min(y + h, c.y + half.y) - std::max(y, c.y - half.y);
+        if (ox > 0 && oy > 0) area += ox * oy;
+    }
+    return area;
+}
+
 void Builder::hud() {
     const double s = textScale_;
     const double margin = 14.0 * s;
@@ -1193,7 +1215,17 @@ void Builder::hud() {
     const double pad = 9.0 * s;
     const double innerW = std::max(sampleW + 8 * s + labelW + 10 * s + valueW, noteW);
     const double panelW = innerW + 2 * pad, panelH = double(rows.size()) * rowH + 2 * pad - 4 * s;
-    const double x0 = w_ - margin - panelW, y0 = margin;
+    // Bottom right, unless the bodies there are more than at the top right:
+    // the legend goes where it hides least of the scene (a legend grown by
+    // many overlays hid half of a pyramid standing on the floor).
+    const double x0 = w_ - margin - panelW;
+    double y0 = margin;
+    const double topY0 = h_ - std::max(margin, in_.reservedTopPx + 0.5 * margin) - panelH;
+    const bool captionInTheWay = !in_.caption.empty() && margin + textWidth(in_.caption) + 7 * s > x0;
+    if (topY0 > y0 && !captionInTheWay && coveredBodyArea(x0, topY0, panelW, panelH) < coveredBodyArea(x0, y0, panelW, panelH))
+        y0 = topY0;
+    out_.legendBox = {x0, y0, panelW, panelH};
+    out_.legendCoversPx = coveredBodyArea(x0, y0, panelW, panelH);
     box({x0 + 0.5 * panelW, y0 + 0.5 * panelH}, {0.5 * panelW, 0.5 * panelH}, 0.0, kPanel, kFlat, 4.0 * s);
     box({x0 + 0.5 * panelW, y0 + 0.5 * panelH}, {0.5 * panelW, 0.5 * panelH}, 0.0, kPanelBorder, kOutline, 4.0 * s);
     double yTop = y0 + panelH - pad;

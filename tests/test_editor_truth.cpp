@@ -7,6 +7,7 @@
 
 #include "app/editor.hpp"
 #include "frame.hpp"
+#include "scene_bounds.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/world.hpp"
@@ -389,6 +390,47 @@ TEST(VelocityOverlay, TheVelocityFieldHasAColourOfItsOwn) {
     const int distance = std::abs(colours[0][0] - colours[1][0]) + std::abs(colours[0][1] - colours[1][1]) +
                          std::abs(colours[0][2] - colours[1][2]);
     EXPECT_GE(distance, 150);
+}
+
+} // namespace
+
+namespace {
+
+// With every overlay on, the legend grew up from the bottom right over the
+// right half of a pyramid standing on the floor; it now takes the top right
+// when fewer bodies are there.
+TEST(Legend, GoesToTheCornerWhereItHidesTheFewestBodies) {
+    editor::Editor ed;
+    ASSERT_TRUE(ed.open(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "pyramid.json"));
+    ed.setViewportSize(715, 475);  // the editor's viewport at 1280x800
+    ed.fitView();
+    ed.stepForward();
+    ASSERT_TRUE(ed.sim.ensureWorld(ed.doc.scene));
+    FrameInput in = ed.frameInput();
+    in.overlays.bits = ~std::uint32_t(0);
+    const DrawData data = buildDrawData(in, 715, 475);
+    ASSERT_GE(data.legend.size(), 6u);
+    // Pixels of a rectangle (y up) over the moving bodies' boxes, measured here.
+    const auto covered = [&](double x, double y, double w, double h) {
+        double area = 0.0;
+        for (Entity e : ed.doc.scene.registry.entities()) {
+            const std::optional<ShapeBox> b = shapeBox(ed.doc.scene, e);
+            if (!b || isStatic(ed.doc.scene, e)) continue;
+            const Vec2 c = ed.view.toPixels(b->centre), half = b->half * ed.view.pixelsPerMetre();
+            const double cy = 475.0 - c.y;
+            const double ox = std::min(x + w, c.x + half.x) - std::max(x, c.x - half.x);
+            const double oy = std::min(y + h, cy + half.y) - std::max(y, cy - half.y);
+            if (ox > 0 && oy > 0) area += ox * oy;
+        }
+        return area;
+    };
+    const auto [x, y, w, h] = data.legendBox;
+    // The bottom-right place: the same margin below as the top one has above.
+    const double bottom = covered(x, 475.0 - y - h, w, h);
+    EXPECT_GT(y, 475.0 / 2) << "at the top";
+    EXPECT_NEAR(data.legendCoversPx, covered(x, y, w, h), 1e-6);
+    EXPECT_LT(data.legendCoversPx, 0.5 * bottom) << "covers " << data.legendCoversPx << " px there, " << bottom
+                                                 << " px at the bottom right";
 }
 
 } // namespace

@@ -320,6 +320,9 @@ void Session::frame(int width, int height, double frameSeconds, const std::funct
         }
     }
     input.caption.clear();
+    // The viewport's line about edits while running (viewport_panel.cpp)
+    // sits at the top of the scene: the legend stays below it.
+    if (!editor_.runningEditsNote().empty()) input.reservedTopPx = ImGui::GetFontSize() + 10 * ui_.scale;
     const render::DrawData drawn = render::buildDrawData(input, vw, vh);
     const double buildMs = msSince(t2);
 

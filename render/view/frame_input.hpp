@@ -57,6 +57,9 @@ struct FrameInput {
     ArrowScales scales;                    ///< 0 entries are chosen per frame
     std::string caption;                   ///< top-left text ("" for none)
     bool hud = true;                       ///< scale bar, legend, caption
+    /// Pixels at the top of the image that the caller draws over (the
+    /// editor's line about edits while running): the legend keeps below.
+    double reservedTopPx = 0.0;
     /// The editor's polygon tool: the outline it would make (world metres,
     /// counter-clockwise) and the vertices clicked so far. Empty: none.
     std::vector<Vec2> polygonPreview, polygonClicks;
