@@ -212,3 +212,28 @@ TEST_F(EditorSession, DraggingMotorSpeedIsLinear) {
         EXPECT_NEAR(speed, 1.5 + dx * 0.0075, 1e-9) << dx << " px";
     }
 }
+
+// ---- layout at common sizes ----------------------------------------------------
+
+// At 1600x900 the joint type was below the fold of the Tools panel, among
+// the overlay boxes; at 1280x720 the overlay labels were cut ("velocity-f").
+TEST_F(EditorSession, TheToolsPanelShowsTheJointTypeAndWholeOverlayLabels) {
+    for (const std::string size : {"1280x720", "1600x900"}) {
+        const Run r = run(level("default.json"), "tool joint\nwait 1\n", size);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        const nlohmann::json& panel = r.state.at("windows").at("Tools");
+        const double right = panel[0].get<double>() + panel[2].get<double>();
+        const double bottom = panel[1].get<double>() + panel[3].get<double>();
+        const nlohmann::json& joint = r.state.at("widgets").at("tools/jointtype");
+        EXPECT_LE(joint[1].get<double>() + joint[3].get<double>(), bottom) << size << ": the joint type is below the fold";
+        int overlays = 0;
+        for (const auto& [key, rect] : r.state.at("widgets").items()) {
+            if (key.rfind("tools/overlay/", 0) != 0) continue;
+            ++overlays;
+            // The box and its whole label inside the panel, less its padding
+            // (8 px) and a scrollbar (14 px) that may be there.
+            EXPECT_LE(rect[0].get<double>() + rect[2].get<double>(), right - 22.0) << size << ": " << key << " is cut";
+        }
+        EXPECT_EQ(overlays, 9) << size;
+    }
+}
