@@ -235,7 +235,7 @@ void Session::route(const std::vector<InputEvent>& events) {
     // very frame (a number field just clicked opens its text field as the
     // mouse is released).
     const ImGuiID active = ImGui::GetActiveID();
-    const bool typing = io.WantTextInput || (active != 0 && ImGui::GetInputTextState(active) != nullptr);
+    const bool typing = io.WantTextInput || (active != 0 && GImGui->TempInputId == active);
     const ImVec2 o = ui_.viewportPos;
     // Any open popup (modal, menu, combo) owns the input until it closes.
     const bool modal = ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId);
