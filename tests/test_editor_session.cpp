@@ -187,6 +187,10 @@ TEST_F(EditorSession, NanTypedIntoANumberFieldIsRefusedWithAMessageNamingTheFiel
     EXPECT_EQ(saved.registry.tryGet<stepwise::Mass>(findNamed(saved, "bob"))->value, 1.5);
     r = run(level("default.json"), "select bob\nclick " + centre(layout.state, "inspector/mass") + "\ntext \"nan\"\nwait 1\n");
     EXPECT_EQ(r.state.at("status"), "refused: \"bob\" mass" + why);
+    // The snap spacing, a number field of the Tools panel, the same.
+    r = run(level("default.json"), "click " + centre(layout.state, "tools/snap") + "\ntext \"inf\"\nwait 1\n");
+    EXPECT_EQ(r.state.at("status"), "refused: snap spacing: \"inf\" is not a number (digits, '.', 'e', '+', '-', '*' and '/' can be typed)");
+    EXPECT_EQ(r.state.at("tool"), "Select");
 }
 
 // ---- drags are linear ---------------------------------------------------------

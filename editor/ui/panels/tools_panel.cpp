@@ -68,6 +68,7 @@ void toolsPanel(UiState& ui, Editor& ed, const PanelRects& r) {
         ImGui::SameLine();
         ImGui::SetNextItemWidth(-1);
         ImGui::DragScalar("##snap", ImGuiDataType_Double, &ed.snapSpacing, 0.01f, nullptr, nullptr, "%.3g m");
+        recordWidgetRect(ui, "tools/snap");
         reportRefusedTyping(ui, ed, "", "snap spacing");
         ed.snapSpacing = std::max(ed.snapSpacing, 1e-3);
         ImGui::TextColored(kDim, "Overlays");
