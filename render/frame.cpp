@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <numbers>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace stepwise::render {
 
@@ -39,7 +40,9 @@ constexpr Rgba kDefaultBody = rgb(0x9fb3c8);
 constexpr Rgba kSpringColor = rgb(0xcbd5e0);
 constexpr Rgba kAnchorColor = rgb(0x718096);
 constexpr Rgba kVelocity = rgb(0x4fd1c5);
-constexpr Rgba kVelocityField = rgb(0x38b2ac, 0.8f);
+// Its own hue, apart from the bodies' velocity (teal) it averages: with both
+// overlays on, a sample arrow and a body's arrow must not be confused.
+constexpr Rgba kVelocityField = rgb(0x5a7dff, 0.85f);
 constexpr Rgba kForce = rgb(0xf6ad55);
 constexpr Rgba kNetForce = rgb(0xf687b3);
 constexpr Rgba kForceField = rgb(0xa78bfa, 0.5f);
@@ -328,6 +331,8 @@ private:
     void bodyArrows();
     void contacts();
     void hud();
+    /// Pixels of the rectangle (x, y, w, h; y up) that moving bodies cover.
+    double coveredBodyArea(double x, double y, double w, double h) const;
 
     DrawData& out_;
     const FrameInput& in_;
@@ -1068,10 +1073,16 @@ void Builder::bodyArrows() {
         std::vector<Vec2> origins, velocities;  // pixels, m/s
         std::vector<double> mags;
         std::vector<bool> chosen;
+        // A sleeping body is at rest: the residue of velocity it fell asleep
+        // with (1e-5 m/s) would get an arrow, and would pull the reference
+        // down until every such arrow was drawn long.
+        std::unordered_set<Entity> asleep;
+        if (in_.world)
+            for (Entity e : in_.world->sleepingBodies()) asleep.insert(e);
         for (Entity e : scene_.registry.entities()) {
             const Position* p = scene_.registry.tryGet<Position>(e);
             const Velocity* v = scene_.registry.tryGet<Velocity>(e);
-            if (!p || !v || isStatic(scene_, e)) continue;
+            if (!p || !v || isStatic(scene_, e) || asleep.count(e)) continue;
             origins.push_back(toPx(p->value));
             velocities.push_back(v->value);
             mags.push_back(length(v->value));
@@ -1096,7 +1107,7 @@ void Builder::contacts() {
         out_.notes.push_back("contacts: needs a World (not built)");
         return;
     }
-    const auto records = in_.world->contacts();
+    const std::span<const ContactRecord> records = in_.contacts ? *in_.contacts : in_.world->contacts();
     std::vector<double> mags;
     for (const ContactRecord& c : records) mags.push_back(std::abs(c.normalImpulse));
     const double ref = in_.scales.impulse > 0 ? in_.scales.impulse : autoReference(mags);
@@ -1122,6 +1133,26 @@ void Builder::contacts() {
         disc(p, thin.active() ? 2.0 : 3.0, 0.0, kContactPoint, kFlat);
     }
     legend_.push_back({"contact impulse", kContactNormal, ref, "N s"});
+}
+
+double Builder::coveredBodyArea(double x, double y, double w, double h) const {
+    // Pixels of the rectangle over the boxes around the moving bodies (a
+    // body with no shape counts as 8 x 8 px); static shapes do not count: a
+    // floor or a wall runs under any corner.
+    double area = 0.0;
+    for (Entity e : scene_.registry.entities()) {
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!p || isStatic(scene_, e)) continue;
+        Vec2 c = toPx(p->value), half{4.0, 4.0};
+        if (const std::optional<ShapeBox> b = shapeBox(scene_, e)) {
+            c = toPx(b->centre);
+            half = b->half * ppm_;
+        }
+        const double ox = std::min(x + w, c.x + half.x) - std::max(x, c.x - half.x);
+        const double oy = std::min(y + h, c.y + half.y) - std::max(y, c.y - half.y);
+        if (ox > 0 && oy > 0) area += ox * oy;
+    }
+    return area;
 }
 
 void Builder::hud() {
@@ -1184,7 +1215,17 @@ void Builder::hud() {
     const double pad = 9.0 * s;
     const double innerW = std::max(sampleW + 8 * s + labelW + 10 * s + valueW, noteW);
     const double panelW = innerW + 2 * pad, panelH = double(rows.size()) * rowH + 2 * pad - 4 * s;
-    const double x0 = w_ - margin - panelW, y0 = margin;
+    // Bottom right, unless the bodies there are more than at the top right:
+    // the legend goes where it hides least of the scene (a legend grown by
+    // many overlays hid half of a pyramid standing on the floor).
+    const double x0 = w_ - margin - panelW;
+    double y0 = margin;
+    const double topY0 = h_ - std::max(margin, in_.reservedTopPx + 0.5 * margin) - panelH;
+    const bool captionInTheWay = !in_.caption.empty() && margin + textWidth(in_.caption) + 7 * s > x0;
+    if (topY0 > y0 && !captionInTheWay && coveredBodyArea(x0, topY0, panelW, panelH) < coveredBodyArea(x0, y0, panelW, panelH))
+        y0 = topY0;
+    out_.legendBox = {x0, y0, panelW, panelH};
+    out_.legendCoversPx = coveredBodyArea(x0, y0, panelW, panelH);
     box({x0 + 0.5 * panelW, y0 + 0.5 * panelH}, {0.5 * panelW, 0.5 * panelH}, 0.0, kPanel, kFlat, 4.0 * s);
     box({x0 + 0.5 * panelW, y0 + 0.5 * panelH}, {0.5 * panelW, 0.5 * panelH}, 0.0, kPanelBorder, kOutline, 4.0 * s);
     double yTop = y0 + panelH - pad;

@@ -9,6 +9,7 @@
 #include "frame_input.hpp"
 
 #include <cstdint>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,11 @@ struct DrawData {
     ArrowScales scales;           ///< the references used (auto ones resolved)
     std::vector<std::string> notes;  ///< e.g. "force-field: no World (scene has shapes)"
     std::vector<std::string> legend; ///< the legend's arrow rows, e.g. "applied force = 20 N"
+    /// The legend's panel, pixels (x, y, width, height; y up from the
+    /// bottom); all zero when there is none.
+    std::array<double, 4> legendBox{};
+    /// Pixels of the legend's panel over moving bodies (their boxes).
+    double legendCoversPx = 0.0;
     std::size_t instanceCount() const;
 };
 

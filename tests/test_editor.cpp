@@ -474,3 +474,276 @@ TEST(ContactTable, FiltersByEitherNameAndSortsStablyByTheChosenColumn) {
     EXPECT_EQ(rows("", {true, ContactColumn::A, false}), (V{1, 0, 2, 4, 5, 3}));
     EXPECT_EQ(rows("", {true, ContactColumn::A, true}), (V{3, 0, 2, 4, 5, 1}));
 }
+
+// ---- recovery copies live only as long as the changes they hold ------------
+
+namespace {
+
+/// A copy of levels/`level` in the fixture's folder, opened, edited (G) and
+/// autosaved: its recovery copy exists.
+std::filesystem::path editAndAutosave(Fixture& f, const std::string& level, const std::string& as) {
+    const std::filesystem::path file = f.tmp.path / as;
+    std::filesystem::copy_file(kLevels / level, file);
+    EXPECT_TRUE(f.ed.open(file)) << f.ed.errorModal;
+    EXPECT_FALSE(f.ed.tickAutosave(0.0));
+    EXPECT_TRUE(f.ed.applyEdit("G", [](Scene& s) {
+        s.world.G = 7.0;
+        return true;
+    }));
+    EXPECT_TRUE(f.ed.tickAutosave(31.0));
+    EXPECT_TRUE(std::filesystem::exists(f.ed.doc.recoveryPath(f.ed.configDir)));
+    return file;
+}
+
+/// Whether a fresh editor opening `file` would be offered a recovery copy.
+bool offeredOnReopen(const Fixture& f, const std::filesystem::path& file) {
+    Editor again;
+    again.configDir = f.ed.configDir;
+    EXPECT_TRUE(again.open(file)) << again.errorModal;
+    return again.recoveryAvailable().has_value();
+}
+
+} // namespace
+
+// Recover, then open another level and choose Discard: reopening the first
+// level offered the discarded changes again.
+TEST(Recovery, RecoveredChangesDiscardedForAnotherLevelAreNotOfferedAgain) {
+    Fixture f("orbit.json");
+    const std::filesystem::path bridge = editAndAutosave(f, "default.json", "bridge.json");
+    Editor crashed;  // the editor that autosaved is gone; a new one recovers
+    crashed.configDir = f.ed.configDir;
+    ASSERT_TRUE(crashed.open(bridge));
+    const auto copy = crashed.recoveryAvailable();
+    ASSERT_TRUE(copy);
+    ASSERT_TRUE(crashed.recover(*copy));
+    ASSERT_TRUE(crashed.dirty());
+    crashed.request(PendingAction::Open, kLevels / "orbit.json");
+    ASSERT_EQ(crashed.uiRequest, UiRequest::ConfirmDiscard);
+    crashed.resolvePending(Editor::Resolution::Discard);
+    EXPECT_EQ(crashed.doc.title(), "orbit.json");
+    EXPECT_FALSE(std::filesystem::exists(*copy));
+    EXPECT_FALSE(offeredOnReopen(f, bridge));
+}
+
+// Opening another level or a new one and discarding the changes deletes
+// their copy; choosing Save writes them and deletes it too.
+TEST(Recovery, ChangesReplacedByAnotherLevelTakeTheirCopyWithThem) {
+    for (const PendingAction action : {PendingAction::Open, PendingAction::New}) {
+        for (const Editor::Resolution answer : {Editor::Resolution::Discard, Editor::Resolution::Save}) {
+            Fixture f("orbit.json");
+            const std::filesystem::path file = editAndAutosave(f, "default.json", "level.json");
+            const std::filesystem::path copy = f.ed.doc.recoveryPath(f.ed.configDir);
+            f.ed.request(action, kLevels / "orbit.json");
+            ASSERT_EQ(f.ed.uiRequest, UiRequest::ConfirmDiscard);
+            f.ed.resolvePending(answer);
+            EXPECT_EQ(f.ed.doc.title(), action == PendingAction::Open ? "orbit.json" : "untitled");
+            EXPECT_FALSE(std::filesystem::exists(copy)) << int(action) << " " << int(answer);
+            EXPECT_FALSE(offeredOnReopen(f, file)) << int(action) << " " << int(answer);
+        }
+    }
+}
+
+// A rename, autosaved, then undone back to the file's state: the copy went
+// on to be offered later.
+TEST(Recovery, UndoingBackToTheFilesStateDeletesTheCopy) {
+    Fixture f("orbit.json");
+    const std::filesystem::path file = f.tmp.path / "level.json";
+    std::filesystem::copy_file(kLevels / "default.json", file);
+    ASSERT_TRUE(f.ed.open(file));
+    EXPECT_FALSE(f.ed.tickAutosave(0.0));
+    ASSERT_TRUE(rename(f, f.named("bob"), "robert"));
+    ASSERT_TRUE(f.ed.tickAutosave(31.0));
+    const std::filesystem::path copy = f.ed.doc.recoveryPath(f.ed.configDir);
+    ASSERT_TRUE(std::filesystem::exists(copy));
+    ASSERT_TRUE(f.ed.undo());
+    EXPECT_FALSE(f.ed.dirty());
+    EXPECT_FALSE(std::filesystem::exists(copy));
+    EXPECT_FALSE(offeredOnReopen(f, file));
+    // Redo makes the changes unsaved again; the next autosave writes a copy.
+    ASSERT_TRUE(f.ed.redo());
+    EXPECT_TRUE(f.ed.tickAutosave(62.0));
+    EXPECT_TRUE(offeredOnReopen(f, file));
+}
+
+// ---- break on contact ------------------------------------------------------
+
+namespace {
+
+/// Steps until the simulation's message changes (at most `limit` steps).
+std::string nextBreak(Fixture& f, int limit = 400) {
+    const std::string before = f.ed.sim.message();
+    for (int i = 0; i < limit && f.ed.sim.message() == before; ++i) f.ed.stepForward();
+    return f.ed.sim.message();
+}
+
+} // namespace
+
+// The ball rolling down default.json's ramp first met it as a speculative
+// contact (a gap of 2.35 cm), and the message said "touches".
+TEST(BreakOnContact, TheMessageSaysWhetherThePairTouchesOrIsAboutTo) {
+    Fixture f("default.json");
+    f.ed.setBreakOnContact(f.named("ball 1"));
+    EXPECT_EQ(nextBreak(f), "break on contact: ball 1 is about to touch ramp at t = 0.4000 s (speculative contact, gap 0.0235 m)");
+    EXPECT_EQ(f.ed.status, f.ed.sim.message());
+    // A pair seen about to touch pauses again when it touches.
+    std::string touching;
+    for (int i = 0; i < 20 && touching.empty(); ++i)
+        if (const std::string m = nextBreak(f); m.find(" touches ") != std::string::npos) touching = m;
+    EXPECT_EQ(touching, "break on contact: ball 1 touches ramp at t = 1.4833 s (depth 2.78e-17 m)");
+    // Crates resting on the floor meet it at a depth of zero within round-off.
+    Fixture g("default.json");
+    g.ed.setBreakOnContact(g.named("crate 1"));
+    EXPECT_EQ(nextBreak(g), "break on contact: crate 1 touches floor at t = 0.0167 s (depth 0 m)");
+}
+
+// The watched body stayed whatever was selected later, nothing named it, and
+// it stayed watched in the next level opened.
+TEST(BreakOnContact, TheWatchedBodyIsNamedKeptAndClearedWithTheLevel) {
+    Fixture f("orbit.json");
+    RecordingHost host;
+    EXPECT_EQ(f.ed.breakOnLabel(), "off");
+    ASSERT_TRUE(runLine(f.ed, host, "breakon comet"));
+    EXPECT_EQ(f.ed.sim.breakOnContact, f.named("comet"));
+    EXPECT_EQ(f.ed.breakOnLabel(), "comet");
+    EXPECT_EQ(f.ed.status, "break on contact: watching comet");
+    f.ed.select({f.named("planet")});
+    EXPECT_EQ(f.ed.breakOnLabel(), "comet") << "a choice, not the selection";
+    ASSERT_TRUE(runLine(f.ed, host, "open " + (kLevels / "spring_chain.json").string()));
+    EXPECT_TRUE(f.ed.sim.breakOnContact.isNull());
+    EXPECT_EQ(f.ed.breakOnLabel(), "off");
+    // Deleting the watched body stops the watch.
+    ASSERT_TRUE(runLine(f.ed, host, "breakon link5"));
+    f.ed.select({f.named("link5")});
+    ASSERT_TRUE(f.ed.deleteSelection());
+    EXPECT_TRUE(f.ed.sim.breakOnContact.isNull());
+    EXPECT_EQ(f.ed.breakOnLabel(), "off");
+    EXPECT_TRUE(host.errors.empty());
+}
+
+// ---- number fields name the field edited -----------------------------------
+
+// Setting a hinge's upper below its lower was refused with a message that
+// named lower, the field not touched.
+TEST(NumberFields, ARefusalOfUpperBelowLowerNamesUpper) {
+    TempDir tmp;
+    Editor ed;
+    ed.configDir = tmp.path / "config";
+    ASSERT_TRUE(ed.open(std::filesystem::path(STEPWISE_SOURCE_DIR) / "tests" / "data" / "joints_every_type.json"));
+    const Entity hinge = findByName(ed.doc.scene.registry, "hinge");
+    const ComponentInfo* joint = findComponent("joint");
+    ASSERT_NE(joint, nullptr);
+    const auto fieldNamed = [&](std::string_view key) {
+        for (const FieldInfo& f : joint->fields)
+            if (f.key == key) return &f;
+        return static_cast<const FieldInfo*>(nullptr);
+    };
+    const std::string before = textOf(ed.doc.scene);
+    std::string problem;
+    EXPECT_EQ(setFieldOnAll(ed.doc.scene, *joint, *fieldNamed("upper"), std::optional<double>(-1.0), {hinge}, &problem), 0u);
+    EXPECT_EQ(problem, "\"hinge\" joint.upper: conflicts with joint.lower: expected at most upper (-1), got -0.5");
+    EXPECT_EQ(textOf(ed.doc.scene), before);
+    // Editing lower above upper names lower, as before.
+    EXPECT_EQ(setFieldOnAll(ed.doc.scene, *joint, *fieldNamed("lower"), std::optional<double>(1.0), {hinge}, &problem), 0u);
+    EXPECT_EQ(problem, "\"hinge\" joint.lower: expected at most upper (0.5), got 1");
+    EXPECT_EQ(textOf(ed.doc.scene), before);
+}
+
+// A plank of the bridge goes with the two joints that hold it; the label
+// called them "2 entities".
+TEST(Editing, DeletingAPlankCountsItsJointsAsJoints) {
+    Fixture f("bridge.json");
+    f.ed.select({f.named("plank 2")});
+    EXPECT_EQ(f.ed.deleteLabel(f.ed.selection), "delete 1 body and 2 joints");
+    ASSERT_TRUE(f.ed.deleteSelection());
+    EXPECT_EQ(f.ed.status, "delete 1 body and 2 joints");
+    EXPECT_EQ(f.ed.commands.labels().back(), "delete 1 body and 2 joints");
+}
+
+// ---- edits while the simulation runs ---------------------------------------
+
+// Edits made while paused changed the running state with nothing to say so:
+// no `*`, Save wrote the level as at Play and Reset dropped them silently.
+TEST(RunningEdits, TheModeSaysWhereEditsGoAndResetSaysWhatItDiscards) {
+    Fixture f("default.json");
+    EXPECT_EQ(f.ed.runningEditsNote(), "");
+    f.ed.stepForward();
+    EXPECT_EQ(f.ed.runningEditsNote(),
+              "editing the running state: Reset discards any edit; Save writes the level as it was at Play");
+    ASSERT_TRUE(rename(f, f.named("crate 1"), "heavy"));
+    EXPECT_EQ(f.ed.editsSincePlay(), 1u);
+    EXPECT_EQ(f.ed.runningEditsNote(),
+              "editing the running state: Reset discards 1 edit; Save writes the level as it was at Play");
+    EXPECT_FALSE(f.ed.dirty()) << "the level is as it was at Play";
+    f.ed.select({f.named("heavy")});
+    ASSERT_TRUE(f.ed.deleteSelection());
+    EXPECT_EQ(f.ed.editsSincePlay(), 2u);
+    f.ed.resetSimulation();
+    EXPECT_EQ(f.ed.status, "reset to the edited level; discarded 2 edits made while running");
+    EXPECT_FALSE(f.named("crate 1").isNull());
+    EXPECT_EQ(f.ed.runningEditsNote(), "");
+    EXPECT_EQ(f.ed.editsSincePlay(), 0u);
+}
+// Every edit while paused emptied the contacts table (and the overlay): the
+// World it recompiles has no contacts until its next step. An edit that
+// leaves the contacts as they were keeps them; one that moves a body does not.
+TEST(RunningEdits, AnEditThatLeavesTheContactsKeepsTheTable) {
+    Fixture f("default.json");
+    for (int i = 0; i < 60; ++i) f.ed.stepForward();
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    const std::vector<ContactRecord> before(f.ed.sim.contacts().begin(), f.ed.sim.contacts().end());
+    ASSERT_EQ(before.size(), 33u);
+    const ComponentInfo* mass = findComponent("mass");
+    std::string problem;
+    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
+        return setFieldOnAll(s, *mass, mass->fields[0], 3.0, {f.named("crate 1")}, &problem) > 0;
+    }));
+    ASSERT_TRUE(rename(f, f.named("crate 2"), "heavy"));
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    EXPECT_EQ(f.ed.sim.world()->contacts().size(), 0u) << "the recompiled World has none of its own";
+    ASSERT_EQ(f.ed.sim.contacts().size(), before.size());
+    for (std::size_t i = 0; i < before.size(); ++i) {
+        EXPECT_EQ(f.ed.sim.contacts()[i].a, before[i].a);
+        EXPECT_EQ(f.ed.sim.contacts()[i].b, before[i].b);
+        EXPECT_EQ(f.ed.sim.contacts()[i].depth, before[i].depth);
+    }
+    EXPECT_EQ(f.ed.frameInput().contacts->size(), before.size()) << "the overlay draws them too";
+    // A step makes its own; a move changes them.
+    f.ed.stepForward();
+    EXPECT_EQ(f.ed.sim.contacts().data(), f.ed.sim.world()->contacts().data());
+    const Entity crate = f.named("crate 3");
+    ASSERT_TRUE(f.ed.applyEdit("move", [&](Scene& s) {
+        s.registry.tryGet<Position>(crate)->value.x += 0.5;
+        return true;
+    }));
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    EXPECT_EQ(f.ed.sim.contacts().data(), f.ed.sim.world()->contacts().data());
+}
+
+// A mass edit on a sleeping crate wakes its island (the ten crates and the
+// ball resting on them); undoing it left them awake, with no contacts.
+TEST(RunningEdits, UndoingAnEditBeforeAnyStepPutsTheIslandsItWokeBackToSleep) {
+    Fixture f("default.json");
+    for (int i = 0; i < 900; ++i) f.ed.stepForward();
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    const std::vector<Entity> asleep = f.ed.sim.world()->sleepingBodies();
+    ASSERT_EQ(asleep.size(), 11u);
+    const std::size_t contacts = f.ed.sim.contacts().size();
+    const std::string before = textOf(f.ed.doc.scene);
+    const ComponentInfo* mass = findComponent("mass");
+    std::string problem;
+    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
+        return setFieldOnAll(s, *mass, mass->fields[0], 3.0, {f.named("crate 1")}, &problem) > 0;
+    }));
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    EXPECT_EQ(f.ed.sim.world()->sleepingBodyCount(), 0u) << "the edit wakes the crate's island";
+    ASSERT_TRUE(f.ed.undo());
+    ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+    EXPECT_EQ(f.ed.sim.world()->sleepingBodies(), asleep);
+    EXPECT_EQ(f.ed.sim.contacts().size(), contacts);
+    // The run goes on as it would have without the edit and its undo.
+    Fixture g("default.json");
+    for (int i = 0; i < 960; ++i) g.ed.stepForward();
+    for (int i = 0; i < 60; ++i) f.ed.stepForward();
+    EXPECT_EQ(textOf(f.ed.doc.scene), textOf(g.ed.doc.scene));
+}

@@ -367,3 +367,38 @@ TEST(EditorWindow, FromAnotherFolderRenameThenPlayAndSaveAsAsksBeforeReplacing) 
     fs::remove_all(tmp);
 }
 
+
+// The default 1280x800 window on a 720-pixel screen opened with its menu bar
+// above the top edge. It now fits the screen it opens on.
+TEST(EditorWindow, TheDefaultWindowFitsA1280x720Screen) {
+    if (!have("Xvfb") || !have("xdotool")) GTEST_SKIP() << "needs Xvfb and xdotool (tests/setup-debian.sh installs them)";
+    const fs::path tmp = fs::temp_directory_path() / ("stepwise-e2e-fit-" + std::to_string(getpid()));
+    fs::remove_all(tmp);
+    fs::create_directories(tmp);
+    const fs::path state = tmp / "state.json";
+    const XDisplay x(tmp, "1280x720x24");
+    ASSERT_TRUE(x.error.empty()) << x.error;
+    {
+        Child editor({STEPWISE_BINARY, "edit", (fs::path(STEPWISE_SOURCE_DIR) / "levels" / "default.json").string(),
+                      "--builtin-font", "--font-size", "13", "--debug-state", state.string()},
+                     x.env, tmp / "editor.log");
+        ASSERT_GT(editor.pid, 0);
+        ASSERT_TRUE(waitFor([&] { return !readState(state).is_null(); }, 30s)) << readFile(tmp / "editor.log");
+        const nlohmann::json s = readState(state);
+        EXPECT_EQ(double(s["window"][0]), 1280.0) << s.dump();
+        EXPECT_LE(double(s["window"][1]), 720.0) << s.dump();
+        // The window's place on the screen: whole, from its top edge down.
+        const std::string geometry = tmp / "geometry.txt";
+        const std::string cmd = "DISPLAY=" + x.name + " xdotool search --name Stepwise getwindowgeometry --shell > " +
+                                geometry + " 2>&1";
+        ASSERT_EQ(std::system(cmd.c_str()), 0) << readFile(geometry);
+        const std::string g = readFile(geometry);
+        const auto value = [&](const std::string& key) {
+            const std::size_t at = g.find(key + "=");
+            return at == std::string::npos ? -1 : std::stoi(g.substr(at + key.size() + 1));
+        };
+        EXPECT_GE(value("Y"), 0) << g;
+        EXPECT_LE(value("Y") + value("HEIGHT"), 720) << g;
+    }  // the editor is stopped (TERM) here
+    fs::remove_all(tmp);
+}

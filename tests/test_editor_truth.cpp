@@ -7,6 +7,7 @@
 
 #include "app/editor.hpp"
 #include "frame.hpp"
+#include "scene_bounds.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/world.hpp"
@@ -18,6 +19,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <array>
+#include <set>
 
 using namespace stepwise;
 using namespace stepwise::render;
@@ -261,18 +265,54 @@ TEST(EditorStepBack, TheContactsShownAreThoseOfTheRestoredStep) {
 
 namespace {
 
-TEST(SaveAsSuggestion, AnUntitledLevelGoesToTheFirstWritableFolder) {
+// A new level was proposed a place inside the program's own levels folder.
+TEST(SaveAsSuggestion, AnUntitledLevelGoesToTheWorkingFolderUnderAFreeName) {
     TempDir tmp;
     const fs::path levels = tmp.path / "levels", work = tmp.path / "work";
     fs::create_directories(levels);
     fs::create_directories(work);
-    // The levels folder when it exists (always absolute).
-    EXPECT_EQ(editor::saveAsSuggestion({}, levels, work), levels / "untitled.json");
-    // A levels folder that is not there (the executable moved, nothing
-    // found): the working folder, not a path that fails on Save.
-    EXPECT_EQ(editor::saveAsSuggestion({}, tmp.path / "missing", work), work / "untitled.json");
+    // The working folder, not the levels folder (always absolute).
+    EXPECT_EQ(editor::saveAsSuggestion({}, levels, work), work / "untitled.json");
+    // A name that is taken is not proposed.
+    std::ofstream(work / "untitled.json") << "{}";
+    EXPECT_EQ(editor::saveAsSuggestion({}, levels, work), work / "untitled_2.json");
+    // A working folder that is not there: not a path that fails on Save.
+    const fs::path fallback = editor::saveAsSuggestion({}, levels, tmp.path / "missing");
+    EXPECT_TRUE(fs::is_directory(fallback.parent_path())) << fallback;
+    EXPECT_EQ(fallback.filename().string().rfind("untitled", 0), 0u) << fallback;
     // A document keeps its own path, made absolute.
     EXPECT_EQ(editor::saveAsSuggestion("some/level.json", levels, work), fs::absolute("some/level.json"));
+}
+
+// "Save simulation state" proposed the last Save as path, of another level.
+TEST(SaveAsSuggestion, TheStateGoesBesideTheOpenLevelNamedAfterIt) {
+    TempDir tmp;
+    const fs::path levels = tmp.path / "levels", work = tmp.path / "work", mine = tmp.path / "mine";
+    for (const fs::path& d : {levels, work, mine}) fs::create_directories(d);
+    EXPECT_EQ(editor::saveStateSuggestion(mine / "bridge.json", levels, work), mine / "bridge_state.json");
+    std::ofstream(mine / "bridge_state.json") << "{}";
+    EXPECT_EQ(editor::saveStateSuggestion(mine / "bridge.json", levels, work), mine / "bridge_state_2.json");
+    EXPECT_EQ(editor::saveStateSuggestion({}, levels, work), work / "untitled_state.json");
+}
+
+// The recent list held "levels/a.json" and "/.../levels/a.json" both.
+TEST(RecentFiles, OneFileIsOneEntryHoweverItWasNamed) {
+    TempDir tmp;
+    const fs::path level = tmp.path / "a.json";
+    std::ofstream(level) << "{}";
+    editor::Settings settings;
+    const fs::path before = fs::current_path();
+    fs::current_path(tmp.path);
+    settings.addRecent("a.json");
+    settings.addRecent("./a.json");
+    settings.addRecent(level.string());
+    settings.addRecent((tmp.path / "sub" / ".." / "a.json").string());
+    fs::current_path(before);
+    ASSERT_EQ(settings.recentFiles.size(), 1u);
+    EXPECT_EQ(settings.recentFiles[0], fs::weakly_canonical(level).string());
+    // A settings file written before keeps one entry per file too.
+    std::ofstream(tmp.path / "settings.txt") << "recent " << level.string() << "\nrecent " << (tmp.path / "." / "a.json").string() << "\n";
+    EXPECT_EQ(editor::Settings::load(tmp.path).recentFiles.size(), 1u);
 }
 
 TEST(OpenList, ListsTheLevelFilesButNotTheSchema) {
@@ -280,6 +320,117 @@ TEST(OpenList, ListsTheLevelFilesButNotTheSchema) {
     EXPECT_GT(files.size(), 10u);
     for (const std::string& f : files) EXPECT_EQ(fs::path(f).extension(), ".json") << f;
     EXPECT_EQ(std::count_if(files.begin(), files.end(), [](const std::string& f) { return f.find("schema") != std::string::npos; }), 0);
+}
+
+} // namespace
+
+namespace {
+
+// default.json after 900 steps: the crates and one ball sleep. Their
+// residual velocities (about 1e-5 m/s) got arrows and set the reference,
+// so resting bodies showed long arrows.
+TEST(VelocityOverlay, SleepingBodiesGetNoArrowAndDoNotSetTheScale) {
+    editor::Editor ed;
+    ASSERT_TRUE(ed.open(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "default.json"));
+    for (int i = 0; i < 900; ++i) ed.stepForward();
+    ASSERT_TRUE(ed.sim.ensureWorld(ed.doc.scene));
+    const std::vector<Entity> asleep = ed.sim.world()->sleepingBodies();
+    ASSERT_EQ(asleep.size(), 11u);
+    ed.setViewportSize(800, 600);
+    ed.fitView();
+    FrameInput in = ed.frameInput();
+    in.overlays = OverlaySet{};
+    in.overlays.add(Overlay::Velocity);
+    const DrawData data = buildDrawData(in, 800, 600);
+    // No arrow starts at a sleeping body.
+    std::size_t arrowsAtSleepers = 0, arrows = 0;
+    for (const Batch& b : data.batches) {
+        if (b.kind != BatchKind::Arrow) continue;
+        const std::size_t k = floatsPerInstance(BatchKind::Arrow);
+        for (std::size_t i = 0; i + k <= b.data.size(); i += k) {
+            ++arrows;
+            const Vec2 from{b.data[i], b.data[i + 1]};
+            for (Entity e : asleep) {
+                const Vec2 view = ed.view.toPixels(ed.doc.scene.registry.tryGet<Position>(e)->value);
+                const Vec2 at{view.x, 600.0 - view.y};  // the frame counts rows from the bottom
+                if (length(at - from) < 1.0) ++arrowsAtSleepers;
+            }
+        }
+    }
+    EXPECT_EQ(arrowsAtSleepers, 0u) << "of " << asleep.size() << " sleeping bodies";
+    EXPECT_EQ(arrows, 5u) << "the four moving bodies' arrows and the legend's sample";
+}
+
+} // namespace
+
+namespace {
+
+// "velocity" (teal, 4fd1c5) and "velocity field" (38b2ac) were drawn in
+// nearly the same colour, a sum of channel differences of 79 out of 765.
+TEST(VelocityOverlay, TheVelocityFieldHasAColourOfItsOwn) {
+    editor::Editor ed;
+    ASSERT_TRUE(ed.open(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "flock.json"));
+    ed.setViewportSize(800, 600);
+    ed.fitView();
+    FrameInput in = ed.frameInput();
+    in.overlays = OverlaySet{};
+    std::vector<std::array<int, 3>> colours;
+    for (const Overlay o : {Overlay::Velocity, Overlay::VelocityField}) {
+        in.overlays.bits = std::uint32_t(o);
+        const DrawData data = buildDrawData(in, 800, 600);
+        std::set<std::array<int, 3>> seen;
+        for (const Batch& b : data.batches)
+            if (b.kind == BatchKind::Arrow)
+                for (std::size_t i = 0; i + 9 <= b.data.size(); i += 9)
+                    seen.insert({int(std::lround(b.data[i + 5] * 255)), int(std::lround(b.data[i + 6] * 255)),
+                                 int(std::lround(b.data[i + 7] * 255))});
+        ASSERT_EQ(seen.size(), 1u) << "one colour per overlay";
+        colours.push_back(*seen.begin());
+    }
+    const int distance = std::abs(colours[0][0] - colours[1][0]) + std::abs(colours[0][1] - colours[1][1]) +
+                         std::abs(colours[0][2] - colours[1][2]);
+    EXPECT_GE(distance, 150);
+}
+
+} // namespace
+
+namespace {
+
+// With every overlay on, the legend grew up from the bottom right over the
+// right half of a pyramid standing on the floor; it now takes the top right
+// when fewer bodies are there.
+TEST(Legend, GoesToTheCornerWhereItHidesTheFewestBodies) {
+    editor::Editor ed;
+    ASSERT_TRUE(ed.open(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "pyramid.json"));
+    ed.setViewportSize(715, 475);  // the editor's viewport at 1280x800
+    ed.fitView();
+    ed.stepForward();
+    ASSERT_TRUE(ed.sim.ensureWorld(ed.doc.scene));
+    FrameInput in = ed.frameInput();
+    in.overlays.bits = ~std::uint32_t(0);
+    const DrawData data = buildDrawData(in, 715, 475);
+    ASSERT_GE(data.legend.size(), 6u);
+    // Pixels of a rectangle (y up) over the moving bodies' boxes, measured here.
+    const auto covered = [&](double x, double y, double w, double h) {
+        double area = 0.0;
+        for (Entity e : ed.doc.scene.registry.entities()) {
+            const std::optional<ShapeBox> b = shapeBox(ed.doc.scene, e);
+            if (!b || isStatic(ed.doc.scene, e)) continue;
+            const Vec2 c = ed.view.toPixels(b->centre), half = b->half * ed.view.pixelsPerMetre();
+            const double cy = 475.0 - c.y;
+            const double ox = std::min(x + w, c.x + half.x) - std::max(x, c.x - half.x);
+            const double oy = std::min(y + h, cy + half.y) - std::max(y, cy - half.y);
+            if (ox > 0 && oy > 0) area += ox * oy;
+        }
+        return area;
+    };
+    const auto [x, y, w, h] = data.legendBox;
+    // The bottom-right place: the same margin below as the top one has above.
+    const double bottom = covered(x, 475.0 - y - h, w, h);
+    EXPECT_GT(y, 475.0 / 2) << "at the top";
+    EXPECT_NEAR(data.legendCoversPx, covered(x, y, w, h), 1e-6);
+    EXPECT_LT(data.legendCoversPx, 0.5 * bottom) << "covers " << data.legendCoversPx << " px there, " << bottom
+                                                 << " px at the bottom right";
 }
 
 } // namespace

@@ -242,3 +242,190 @@ TEST(Layout, ALayoutSavedAt1600x900OpensOnScreenAt1280x720AndResetRestoresTheDef
 }
 
 } // namespace
+
+// ---- the mouse spring is drawn ----------------------------------------------------
+
+// While playing, a drag on a body pulls it with a spring to the cursor; the
+// viewport drew nothing of it.
+TEST(SessionFrame, TheMouseSpringDrawsALineFromTheBodyToTheCursor) {
+    const int w = 800, h = 600;
+    auto context = stepwise::render::OffscreenRenderer::create(w, h);
+    ASSERT_TRUE(context.ok()) << context.error();
+    stepwise::ui::SessionOptions options;
+    options.persist = false;
+    options.deterministic = true;
+    options.builtinFont = true;
+    auto created = stepwise::ui::Session::create(
+        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    ASSERT_TRUE(created.ok()) << created.error();
+    stepwise::ui::Session& session = **created;
+    stepwise::editor::Editor& ed = session.editor();
+    stepwise::Scene scene;
+    scene.world.gravity = {0.0, 0.0};
+    const stepwise::Entity ball = scene.registry.create();
+    scene.registry.emplace<stepwise::Position>(ball, {{0.0, 0.0}});
+    scene.registry.emplace<stepwise::Mass>(ball, {1.0});
+    scene.registry.emplace<stepwise::Radius>(ball, {0.2});
+    const stepwise::Entity far = scene.registry.create();  // frames a view 10 m wide
+    scene.registry.emplace<stepwise::Position>(far, {{10.0, 0.0}});
+    scene.registry.emplace<stepwise::Static>(far, {});
+    scene.registry.emplace<stepwise::Radius>(far, {0.2});
+    ed.doc.reset(std::move(scene));
+    using stepwise::editor::InputEvent;
+    auto event = [](InputEvent::Type t, float x, float y) {
+        InputEvent e;
+        e.type = t;
+        e.x = x;
+        e.y = y;
+        return e;
+    };
+    session.frame(w, h, 1.0 / 60.0);
+    ed.fitView();
+    ed.togglePlay();
+    session.frame(w, h, 1.0 / 60.0);
+    const ImVec2 o = session.viewportPos();
+    const stepwise::Vec2 at = ed.view.toPixels({0.0, 0.0});
+    const float bx = o.x + float(at.x), by = o.y + float(at.y);
+    const float cursorX = bx + 160.0f;
+    session.queue(event(InputEvent::Type::MouseMove, bx, by));
+    session.frame(w, h, 1.0 / 60.0);
+    session.queue(event(InputEvent::Type::MouseDown, bx, by));
+    session.frame(w, h, 1.0 / 60.0);
+    session.queue(event(InputEvent::Type::MouseMove, cursorX, by));
+    session.frame(w, h, 1.0 / 60.0);
+    session.frame(w, h, 1.0 / 60.0);  // panels are built before a frame's events are routed
+    ASSERT_TRUE(ed.sim.mouseSpring.has_value()) << "the press did not grab the ball";
+    // The pixel halfway between the ball (where it is now) and the cursor.
+    const stepwise::Vec2 now = ed.view.toPixels(ed.doc.scene.registry.tryGet<stepwise::Position>(ball)->value);
+    const int midX = int(std::lround((o.x + float(now.x) + cursorX) / 2)), midY = int(std::lround(by));
+    const stepwise::render::Image image = session.capture(w, h);
+    // The line's colour (the editor's gold, 255 209 102) within 40 per channel,
+    // anywhere in the 5 rows around the line's row.
+    bool gold = false;
+    for (int y = midY - 2; y <= midY + 2; ++y) {
+        const std::uint8_t* p = image.pixel(midX, y);
+        gold = gold || (std::abs(p[0] - 255) <= 40 && std::abs(p[1] - 209) <= 40 && std::abs(p[2] - 102) <= 40);
+    }
+    EXPECT_TRUE(gold) << "no line at (" << midX << ", " << midY << ")";
+    session.queue(event(InputEvent::Type::MouseUp, cursorX, by));
+    session.frame(w, h, 1.0 / 60.0);
+    EXPECT_FALSE(ed.sim.mouseSpring.has_value());
+}
+
+// ---- a failed open from the recent list -----------------------------------------
+
+// File > Open recent on a level deleted since: the Error modal with the
+// loader's reason, and the status line with it (it said "open failed: PATH").
+TEST(SessionFrame, OpenRecentOnADeletedLevelShowsTheReasonInTheModalAndTheStatusLine) {
+    const int w = 1280, h = 720;
+    auto context = stepwise::render::OffscreenRenderer::create(w, h);
+    ASSERT_TRUE(context.ok()) << context.error();
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("stepwise-recent-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path gone = dir / "gone.json";
+    std::filesystem::copy_file(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / "default.json", gone,
+                               std::filesystem::copy_options::overwrite_existing);
+    stepwise::ui::SessionOptions options;
+    options.persist = false;
+    options.deterministic = true;
+    options.builtinFont = true;
+    auto created = stepwise::ui::Session::create(
+        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    ASSERT_TRUE(created.ok()) << created.error();
+    stepwise::ui::Session& session = **created;
+    stepwise::editor::Editor& ed = session.editor();
+    ASSERT_TRUE(session.openAtStart(gone));
+    ASSERT_TRUE(ed.open(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / "orbit.json"));
+    std::filesystem::remove(gone);
+    using stepwise::editor::InputEvent;
+    auto click = [&](float x, float y) {
+        for (const InputEvent::Type t : {InputEvent::Type::MouseMove, InputEvent::Type::MouseDown, InputEvent::Type::MouseUp}) {
+            InputEvent e;
+            e.type = t;
+            e.x = x;
+            e.y = y;
+            session.queue(e);
+            session.frame(w, h, 1.0 / 60.0);
+        }
+    };
+    auto hover = [&](float x, float y) {
+        InputEvent e;
+        e.type = InputEvent::Type::MouseMove;
+        e.x = x;
+        e.y = y;
+        session.queue(e);
+        session.frame(w, h, 1.0 / 60.0);
+        session.frame(w, h, 1.0 / 60.0);
+    };
+    /// The middle of row `row` of a menu window.
+    auto rowOf = [](const char* menu, int row) {
+        const ImGuiWindow* win = ImGui::FindWindowByName(menu);
+        EXPECT_NE(win, nullptr) << menu;
+        if (!win) return ImVec2(0, 0);
+        const ImGuiStyle& style = ImGui::GetStyle();
+        const float rowHeight = ImGui::GetFontSize() + style.ItemSpacing.y;
+        return ImVec2(win->Pos.x + 30.0f, win->Pos.y + style.WindowPadding.y + rowHeight * (float(row) + 0.5f) - style.ItemSpacing.y / 2);
+    };
+    session.frame(w, h, 1.0 / 60.0);
+    click(20.0f, 10.0f);  // File
+    const ImVec2 recent = rowOf("##Menu_00", 2);  // New, Open..., Open recent
+    hover(recent.x, recent.y);
+    const ImVec2 first = rowOf("##Menu_01", 0);  // the newest recent file: orbit.json, then gone.json
+    const ImVec2 second(first.x, first.y + ImGui::GetFontSize() + ImGui::GetStyle().ItemSpacing.y);
+    hover(second.x, recent.y);  // along the row first, so the submenu stays open
+    click(second.x, second.y);
+    session.frame(w, h, 1.0 / 60.0);
+    const std::string loader = gone.string() + ": error: no such file";
+    EXPECT_EQ(ed.errorModal, loader);
+    EXPECT_EQ(ed.status, "open failed: " + loader);
+    EXPECT_EQ(session.dialogState().modal, "Error");
+    EXPECT_EQ(ed.doc.title(), "orbit.json");
+    std::filesystem::remove_all(dir);
+}
+
+// ---- where the save dialogs propose to write ---------------------------------------
+
+// "Save simulation state" kept the path last typed into Save as, for another
+// level; Save as on a new level proposed the program's own levels folder.
+TEST(SessionFrame, EachSaveDialogProposesAPathFromTheLevelOpenNow) {
+    const int w = 1280, h = 720;
+    auto context = stepwise::render::OffscreenRenderer::create(w, h);
+    ASSERT_TRUE(context.ok()) << context.error();
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("stepwise-proposals-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir / "mine");
+    const std::filesystem::path bridge = dir / "mine" / "bridge.json";
+    std::filesystem::copy_file(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / "bridge.json", bridge);
+    stepwise::ui::SessionOptions options;
+    options.persist = false;
+    options.deterministic = true;
+    options.builtinFont = true;
+    auto created = stepwise::ui::Session::create(
+        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    ASSERT_TRUE(created.ok()) << created.error();
+    stepwise::ui::Session& session = **created;
+    stepwise::editor::Editor& ed = session.editor();
+    stepwise::ui::UiState& ui = session.ui();
+    ASSERT_TRUE(session.openAtStart(bridge));
+    session.frame(w, h, 1.0 / 60.0);
+    ui.saveAsPath = (dir / "elsewhere" / "other.json").string();  // typed for another level, earlier
+    ed.stepForward();
+    ui.saveStateRequested = true;
+    session.frame(w, h, 1.0 / 60.0);
+    EXPECT_EQ(session.dialogState().modal, "Save simulation state");
+    EXPECT_EQ(ui.saveAsPath, (dir / "mine" / "bridge_state.json").string());
+    ImGui::ClosePopupToLevel(0, false);
+    ed.resetSimulation();
+    // A new level: the working folder.
+    const std::filesystem::path before = std::filesystem::current_path();
+    std::filesystem::current_path(dir);
+    ed.newDocument();
+    ui.saveAsDialogRequested = true;
+    session.frame(w, h, 1.0 / 60.0);
+    std::filesystem::current_path(before);
+    EXPECT_EQ(session.dialogState().modal, "Save as");
+    EXPECT_EQ(ui.saveAsPath, (dir / "untitled.json").string());
+    std::filesystem::remove_all(dir);
+}

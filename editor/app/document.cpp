@@ -104,17 +104,55 @@ std::vector<std::string> levelFiles(const std::filesystem::path& folder) {
     return out;
 }
 
+namespace {
+
+/// The first writable folder of `folders`, else the last one; absolute.
+std::filesystem::path writableFolder(const std::vector<std::filesystem::path>& folders) {
+    std::error_code ec;
+    for (const std::filesystem::path& f : folders)
+        if (!f.empty() && std::filesystem::is_directory(f, ec) && ::access(f.c_str(), W_OK) == 0)
+            return std::filesystem::absolute(f, ec);
+    return folders.empty() ? std::filesystem::path() : std::filesystem::absolute(folders.back(), ec);
+}
+
+/// `folder`/`stem`.json, or `stem`_2.json, _3 ... when that file exists: a
+/// proposal never names a file that Save would replace.
+std::filesystem::path freeName(const std::filesystem::path& folder, const std::string& stem) {
+    std::error_code ec;
+    std::filesystem::path p = folder / (stem + ".json");
+    for (int n = 2; std::filesystem::exists(p, ec) && n < 1000; ++n) p = folder / (stem + "_" + std::to_string(n) + ".json");
+    return p;
+}
+
+/// Where a new file goes: the open level's folder, else (an untitled level)
+/// the working folder, the home folder or the levels folder, the first that
+/// can be written.
+std::filesystem::path proposalFolder(const std::filesystem::path& documentPath, const std::filesystem::path& levelsDir,
+                                     const std::filesystem::path& workingDir) {
+    std::error_code ec;
+    std::vector<std::filesystem::path> folders;
+    if (!documentPath.empty()) folders.push_back(std::filesystem::absolute(documentPath, ec).parent_path());
+    folders.push_back(workingDir);
+    if (const char* home = std::getenv("HOME"); home && *home) folders.emplace_back(home);
+    folders.push_back(levelsDir);
+    return writableFolder(folders);
+}
+
+} // namespace
+
 std::filesystem::path saveAsSuggestion(const std::filesystem::path& documentPath,
                                        const std::filesystem::path& levelsDir,
                                        const std::filesystem::path& workingDir) {
     std::error_code ec;
     if (!documentPath.empty()) return std::filesystem::absolute(documentPath, ec);
-    std::vector<std::filesystem::path> folders{levelsDir, workingDir};
-    if (const char* home = std::getenv("HOME"); home && *home) folders.emplace_back(home);
-    for (const std::filesystem::path& f : folders)
-        if (!f.empty() && std::filesystem::is_directory(f, ec) && ::access(f.c_str(), W_OK) == 0)
-            return std::filesystem::absolute(f, ec) / "untitled.json";
-    return std::filesystem::absolute(levelsDir, ec) / "untitled.json";
+    return freeName(proposalFolder(documentPath, levelsDir, workingDir), "untitled");
+}
+
+std::filesystem::path saveStateSuggestion(const std::filesystem::path& documentPath,
+                                          const std::filesystem::path& levelsDir,
+                                          const std::filesystem::path& workingDir) {
+    const std::string stem = documentPath.empty() ? std::string("untitled") : documentPath.stem().string();
+    return freeName(proposalFolder(documentPath, levelsDir, workingDir), stem + "_state");
 }
 
 bool replacesAnotherFile(const std::filesystem::path& target, const std::filesystem::path& documentPath) {
@@ -123,9 +161,18 @@ bool replacesAnotherFile(const std::filesystem::path& target, const std::filesys
     return documentPath.empty() || !std::filesystem::equivalent(target, documentPath, ec);
 }
 
+std::string recentKey(const std::string& file) {
+    // One entry per file, however it was named: "levels/a.json" and
+    // "/home/x/levels/a.json" are the same file.
+    std::error_code ec;
+    const std::filesystem::path p = std::filesystem::weakly_canonical(std::filesystem::absolute(file, ec), ec);
+    return ec || p.empty() ? file : p.string();
+}
+
 void Settings::addRecent(const std::string& file) {
-    std::erase(recentFiles, file);
-    recentFiles.insert(recentFiles.begin(), file);
+    const std::string key = recentKey(file);
+    std::erase_if(recentFiles, [&](const std::string& f) { return recentKey(f) == key; });
+    recentFiles.insert(recentFiles.begin(), key);
     if (recentFiles.size() > 10) recentFiles.resize(10);
 }
 
@@ -136,7 +183,10 @@ Settings Settings::load(const std::filesystem::path& configDir) {
         const auto space = line.find(' ');
         if (space == std::string::npos) continue;
         const std::string key = line.substr(0, space), value = line.substr(space + 1);
-        if (key == "recent" && !value.empty() && s.recentFiles.size() < 10) s.recentFiles.push_back(value);
+        if (key == "recent" && !value.empty() && s.recentFiles.size() < 10 &&
+            std::none_of(s.recentFiles.begin(), s.recentFiles.end(),
+                         [&](const std::string& f) { return recentKey(f) == recentKey(value); }))
+            s.recentFiles.push_back(recentKey(value));
         else if (key == "font_size") {
             char* end = nullptr;
             const float f = std::strtof(value.c_str(), &end);

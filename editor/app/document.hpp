@@ -71,12 +71,24 @@ std::filesystem::path dialogFolder(const std::filesystem::path& documentPath, co
 std::vector<std::string> levelFiles(const std::filesystem::path& folder);
 
 /// Where Save as proposes to write: the document's own path; for an untitled
-/// level, untitled.json in the first folder that exists and can be written
-/// of `levelsDir`, `workingDir` and the home folder (an installed levels
-/// folder is read-only), else in `levelsDir`. Absolute.
+/// level, untitled.json (untitled_2.json, ... when taken) in the first folder
+/// that exists and can be written of `workingDir`, the home folder and
+/// `levelsDir` (never the program's own levels unless nothing else can be
+/// written). Absolute.
 std::filesystem::path saveAsSuggestion(const std::filesystem::path& documentPath,
                                        const std::filesystem::path& levelsDir,
                                        const std::filesystem::path& workingDir);
+
+/// Where "Save simulation state as" proposes to write: NAME_state.json
+/// (NAME_state_2.json, ... when taken) beside the open level NAME.json, or
+/// untitled_state.json where Save as would put an untitled level. Absolute.
+std::filesystem::path saveStateSuggestion(const std::filesystem::path& documentPath,
+                                          const std::filesystem::path& levelsDir,
+                                          const std::filesystem::path& workingDir);
+
+/// The form a file takes in the recent list: absolute, with no "." or ".."
+/// and symbolic links resolved, so one file is one entry.
+std::string recentKey(const std::string& file);
 
 /// True when saving to `target` would write over a file other than the
 /// document's own (`documentPath`): Save as asks first.

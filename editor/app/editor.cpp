@@ -34,8 +34,13 @@ void Editor::note(std::string text) {
 bool Editor::open(const std::filesystem::path& file) {
     Document next;
     if (Result<void> r = next.open(file); !r) {
+        // The loader's message names the file and the place in it (line and
+        // column, or why it cannot be read): the modal shows it whole and the
+        // status line carries it too, whichever way the open was asked for.
         errorModal = r.error();
-        note("open failed: " + file.string());
+        std::string line = "open failed: " + r.error();
+        std::replace(line.begin(), line.end(), '\n', ' ');
+        note(std::move(line));
         return false;
     }
     replaceDocument(std::move(next));
@@ -51,7 +56,14 @@ void Editor::newDocument() {
 }
 
 void Editor::replaceDocument(Document next) {
+    // The level being replaced had its changes saved, discarded (the
+    // unsaved-changes question) or had none: its recovery copy recovers
+    // nothing any more, and left behind it would offer the discarded
+    // changes the next time that level opens.
+    discardRecovery();
     if (sim.running()) sim.reset(doc.scene);
+    // A handle into the old level means nothing in the new one.
+    sim.breakOnContact = {};
     doc = std::move(next);
     ++documentSerial_;
     commands.clear();
@@ -157,6 +169,7 @@ void Editor::resolvePending(Resolution r) {
 
 bool Editor::applyEdit(const std::string& label, const std::function<bool(Scene&)>& edit, std::uint64_t mergeKey) {
     if (commands.absoluteCursor() < savedCursor_) savedReachable_ = false;  // the saved state leaves the redo branch
+    sim.beforeEdit(commands.cursor());
     if (!commands.apply(doc.scene, label, edit, mergeKey)) return false;
     sim.sceneEdited(doc.scene, commands.lastEdit());
     pruneSelection();
@@ -172,6 +185,10 @@ bool Editor::undo() {
     const std::string label = commands.undo(doc.scene);
     if (label.empty()) return false;
     afterSceneReplaced();
+    // Back to the state before the run's edits with no step between: the
+    // islands they woke sleep again and the contacts are those of before.
+    if (sim.running()) sim.undoneTo(doc.scene, commands.cursor());
+    forgetRecoveryWhenClean();
     note("undo: " + label);
     return true;
 }
@@ -180,13 +197,21 @@ bool Editor::redo() {
     const std::string label = commands.redo(doc.scene);
     if (label.empty()) return false;
     afterSceneReplaced();
+    forgetRecoveryWhenClean();
     note("redo: " + label);
     return true;
+}
+
+void Editor::forgetRecoveryWhenClean() {
+    // Back at the file's own state (undo, redo or Reset got there): the
+    // recovery copy holds changes that are no longer wanted.
+    if (!dirty()) discardRecovery();
 }
 
 void Editor::pruneSelection() {
     std::erase_if(selection, [&](Entity e) { return !doc.scene.registry.alive(e); });
     if (!doc.scene.registry.alive(springStart_)) springStart_ = {};
+    if (!sim.breakOnContact.isNull() && !doc.scene.registry.alive(sim.breakOnContact)) sim.breakOnContact = {};
 }
 
 void Editor::startReferencePick(const ComponentInfo& component, const FieldInfo& field, std::vector<Entity> entities) {
@@ -234,14 +259,16 @@ Vec2 Editor::placementOffset(const Registry& src, const std::vector<Entity>& ent
 }
 
 std::string Editor::deleteLabel(const std::vector<Entity>& doomed) const {
-    // Says what goes, by kind: "delete 1 body and 1 spring".
+    // Says what goes, by kind: "delete 1 body and 1 spring",
+    // "delete 1 body and 2 joints".
     const Registry& reg = doc.scene.registry;
-    std::size_t bodies = 0, springs = 0, walls = 0, others = 0;
+    std::size_t bodies = 0, springs = 0, joints = 0, walls = 0, others = 0;
     std::vector<Entity> all = doomed;
     for (Entity s : attachedTo(reg, doomed)) all.push_back(s);
     for (Entity e : all) {
         if (!reg.alive(e)) continue;
         if (reg.has<Spring>(e)) ++springs;
+        else if (reg.has<Joint>(e)) ++joints;
         else if (reg.has<Plane>(e)) ++walls;
         else if (isBody(reg, e)) ++bodies;
         else ++others;
@@ -252,6 +279,7 @@ std::string Editor::deleteLabel(const std::vector<Entity>& doomed) const {
     };
     add(bodies, "body", "bodies");
     add(springs, "spring", "springs");
+    add(joints, "joint", "joints");
     add(walls, "wall", "walls");
     add(others, "entity", "entities");
     std::string label = "delete ";
@@ -307,6 +335,28 @@ bool Editor::paste() {
 
 // ---- simulation ------------------------------------------------------------------
 
+void Editor::setBreakOnContact(Entity body) {
+    sim.breakOnContact = doc.scene.registry.alive(body) ? body : Entity{};
+    note(sim.breakOnContact.isNull() ? std::string("break on contact: off")
+                                     : "break on contact: watching " + breakOnLabel());
+}
+
+std::string Editor::breakOnLabel() const {
+    return sim.breakOnContact.isNull() ? std::string("off") : displayName(doc.scene.registry, sim.breakOnContact);
+}
+
+std::size_t Editor::editsSincePlay() const {
+    return sim.running() && commands.cursor() > playMark_ ? commands.cursor() - playMark_ : 0;
+}
+
+std::string Editor::runningEditsNote() const {
+    if (!sim.running()) return {};
+    const std::size_t n = editsSincePlay();
+    return "editing the running state: Reset discards " +
+           (n == 0 ? std::string("any edit") : std::to_string(n) + (n == 1 ? " edit" : " edits")) +
+           "; Save writes the level as it was at Play";
+}
+
 void Editor::togglePlay() {
     if (sim.state() == SimState::Playing) {
         sim.pause();
@@ -345,12 +395,16 @@ void Editor::stepBack() {
 }
 
 void Editor::resetSimulation() {
+    const std::size_t discarded = editsSincePlay();
     if (!sim.reset(doc.scene)) return;
     // Edits made while paused applied to the simulated state: they go with it.
     commands.truncate(playMark_);
     trails = render::TrailRecorder(trails.capacity());
     afterSceneReplaced();
-    note("reset to the edited level");
+    forgetRecoveryWhenClean();
+    note(discarded == 0 ? std::string("reset to the edited level")
+                        : "reset to the edited level; discarded " + std::to_string(discarded) +
+                              (discarded == 1 ? " edit" : " edits") + " made while running");
 }
 
 void Editor::update(double frameSeconds) {
@@ -577,6 +631,7 @@ render::FrameInput Editor::frameInput() const {
     render::FrameInput in;
     in.scene = &doc.scene;
     in.world = sim.world();
+    if (in.world) in.contacts = sim.contacts();
     in.overlays = overlays;
     if (!in.world) in.overlays.bits &= ~(std::uint32_t(render::Overlay::Force) | std::uint32_t(render::Overlay::ForceField) |
                                          std::uint32_t(render::Overlay::Contacts) | std::uint32_t(render::Overlay::Joints));

@@ -107,6 +107,22 @@ public:
     bool hasClipboard() const { return !clipboardEntities_.empty(); }
 
     // ---- simulation -----------------------------------------------------
+    /// Break on contact: the run pauses at the step where `body` starts
+    /// touching something (null: off). A body chosen here stays watched
+    /// whatever is selected later; it is cleared with the level (Open, New)
+    /// and when the body is deleted. Says what is watched in the status line.
+    void setBreakOnContact(Entity body);
+    /// What the Viewport's toolbar shows beside "Break on contact": the
+    /// watched body's name, or "off".
+    std::string breakOnLabel() const;
+    /// Edits made since Play (while the simulation runs): they change the
+    /// running state, not the level. Reset discards them; Save writes the
+    /// level as it was at Play.
+    std::size_t editsSincePlay() const;
+    /// The line the viewport shows while the simulation runs, saying where
+    /// edits go ("" while editing):
+    /// "editing the running state: Reset discards 2 edits; Save writes the level as it was at Play".
+    std::string runningEditsNote() const;
     void togglePlay();
     void stepForward();
     void stepBack();
@@ -163,6 +179,9 @@ public:
     /// A recovery file for the current document that is newer than it.
     std::optional<std::filesystem::path> recoveryAvailable() const;
     bool recover(const std::filesystem::path& recoveryFile);
+    /// Deletes the document's recovery copy. Also done when the changes it
+    /// holds are saved, discarded, undone back to the file's state, or
+    /// replaced by another level (Open, New): a copy outlives only a crash.
     void discardRecovery();
 
     /// Frame input for the renderer: scene, world, overlays, camera, selection.
@@ -174,6 +193,7 @@ public:
 
 private:
     void afterSceneReplaced();
+    void forgetRecoveryWhenClean();
     /// Open and New: the new document replaces the old one with a fresh
     /// undo history, selection, trails and view.
     void replaceDocument(Document next);

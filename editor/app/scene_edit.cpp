@@ -134,6 +134,8 @@ std::string finishMessage(const ComponentInfo& component, const Error& why) {
 
 } // namespace
 
+std::string fieldPathName(const ComponentInfo& component, std::string_view key) { return fieldPath(component, key); }
+
 std::string describeRefusal(const Scene& scene, const std::string& problem, const std::string& context) {
     static constexpr std::string_view kPrefix = "/entities/";
     if (problem.rfind(kPrefix, 0) != 0) return problem;
@@ -188,8 +190,21 @@ std::size_t setFieldOnAll(Scene& scene, const ComponentInfo& component, const Fi
     // Springs and joints that point at a touched entity are checked too.
     for (Entity s : attachedTo(scene.registry, touched)) touched.push_back(s);
     if (std::optional<Error> why = checkEdited(scene, touched, fieldPath(component, field.key))) {
+        std::string message = why->message;
+        // A component's own check names the field it finds wrong, which can
+        // be another one than the field edited (upper set below lower is
+        // reported on lower): the message then starts with the edited field.
+        if (!checkField(field, value) && component.finish)
+            for (const auto& [e, v] : old)
+                if (std::optional<Error> own = component.finish(component.get(scene.registry, e));
+                    own && !own->where.empty() &&
+                    own->where.substr(0, own->where.find_first_of("/.")) != field.key) {
+                    message = "\"" + displayName(scene.registry, e) + "\" " + fieldPath(component, field.key) +
+                              ": conflicts with " + finishMessage(component, *own);
+                    break;
+                }
         for (const auto& [e, v] : old) writeField(field, component.get(scene.registry, e), v);
-        if (problem) *problem = why->message;
+        if (problem) *problem = message;
         return 0;
     }
     return old.size();

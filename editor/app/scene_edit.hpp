@@ -46,6 +46,10 @@ std::optional<Error> checkField(const FieldInfo& field, const FieldValue& value)
 /// unchanged. The World panel's edits go through here.
 std::optional<Error> setWorldField(Scene& scene, const WorldFieldInfo& info, const FieldValue& value);
 
+/// "component.field" ("velocity" for an inline component, whose field has
+/// no key): how messages name a field.
+std::string fieldPathName(const ComponentInfo& component, std::string_view key);
+
 /// The checks the loader makes, on entities edited in memory: every field of
 /// every component (finite, in range), each component's own check
 /// (`finish`, which e.g. normalises a plane's normal) and the relations

@@ -146,7 +146,7 @@ void breakOn(ScriptActionRun& r) {
     const std::vector<std::string>& args = r.c.args;
     const Entity e = args[0] == "none" ? Entity{} : findEntity(ed, args[0]);
     if (args[0] != "none" && e.isNull()) r.failLine("breakon: no entity named \"" + args[0] + "\"");
-    else ed.sim.breakOnContact = e;
+    else ed.setBreakOnContact(e);
 }
 
 void window(ScriptActionRun& r) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdio>
 #include <functional>
 #include <cmath>
 
@@ -14,6 +15,25 @@ namespace stepwise::editor {
 
 namespace {
 constexpr std::size_t kMaxSamples = 4096;  // plots show the last ~68 s at 60 steps/s
+}
+
+bool touches(const ContactRecord& c) {
+    // Bodies resting on each other meet at a depth of zero give or take the
+    // round-off of their positions (4e-16 m on a crate at rest): that is
+    // touching, not a gap. A nanometre is far above that round-off and far
+    // below any gap a speculative contact is made for.
+    return c.depth > -1e-9;
+}
+
+std::string breakMessage(const Registry& reg, const ContactRecord& c, double time) {
+    char numbers[96];
+    const std::string a = displayName(reg, c.a), b = displayName(reg, c.b);
+    if (touches(c)) {
+        std::snprintf(numbers, sizeof numbers, " at t = %.4f s (depth %.3g m)", time, c.depth > 0.0 ? c.depth : 0.0);
+        return "break on contact: " + a + " touches " + b + numbers;
+    }
+    std::snprintf(numbers, sizeof numbers, " at t = %.4f s (speculative contact, gap %.3g m)", time, -c.depth);
+    return "break on contact: " + a + " is about to touch " + b + numbers;
 }
 
 bool Simulation::canDisable(std::string_view system) {
@@ -108,6 +128,17 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
         return std::uint64_t(1) << std::size_t(findComponent(component) - componentTable().data());
     };
     static const std::uint64_t kPose = bit("position") | bit("velocity");
+    // What decides which pairs touch and where: an edit of any of these (or
+    // one that adds or removes entities) makes the last step's contacts stale.
+    static const std::uint64_t kContactShape = bit("position") | bit("angle") | bit("static") | bit("radius") |
+                                               bit("box") | bit("polygon") | bit("plane");
+    bool keepContacts = world_ && running() && !edit.beyondComponents;
+    for (const auto& [entity, changed] : edit.entities) keepContacts = keepContacts && (changed & kContactShape) == 0;
+    if (keepContacts && !contactsKept_) {
+        const std::span<const ContactRecord> shown = world_->contacts();
+        keptContacts_.assign(shown.begin(), shown.end());
+    }
+    contactsKept_ = keepContacts;
     bool inPlace = world_ && !stale_ && !edit.beyondComponents;
     for (const auto& [entity, changed] : edit.entities) {
         if (!inPlace) break;
@@ -117,6 +148,28 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
     }
     // A partly applied edit is rebuilt whole, like any other.
     if (!inPlace) stale_ = true;
+}
+
+void Simulation::beforeEdit(std::size_t cursor) {
+    if (!world_ || !running()) return;
+    if (beforeEdits_ && beforeEdits_->steps == steps_ && beforeEdits_->cursor <= cursor) return;  // kept already
+    // A World an earlier edit left stale still holds the state from before it.
+    const std::span<const ContactRecord> shown = contacts();
+    beforeEdits_ = BeforeEdits{cursor, steps_, world_->saveState(), {shown.begin(), shown.end()}};
+}
+
+bool Simulation::undoneTo(const Scene& scene, std::size_t cursor) {
+    if (!beforeEdits_ || beforeEdits_->steps != steps_ || beforeEdits_->cursor != cursor) return false;
+    if (!ensureWorld(scene) || !world_->restoreState(beforeEdits_->state)) return false;
+    keptContacts_ = beforeEdits_->contacts;
+    contactsKept_ = true;
+    return true;
+}
+
+std::span<const ContactRecord> Simulation::contacts() const {
+    if (contactsKept_) return keptContacts_;
+    if (const World* w = world()) return w->contacts();
+    return {};
 }
 
 bool Simulation::ensureWorld(const Scene& scene) {
@@ -182,7 +235,7 @@ bool Simulation::play(Scene& scene) {
         historyStateBytes_ = 0;
         samples_.clear();
         steps_ = 0;
-        touchingBefore_ = false;
+        contactStageBefore_ = 0;
         initialEnergy_ = world_->energy().total();
         record();
     } else if (!ensureWorld(scene)) {
@@ -278,25 +331,29 @@ bool Simulation::prepareStep(Scene& scene) {
 }
 
 bool Simulation::finishStep(Scene& scene) {
+    contactsKept_ = false;  // the step made contacts of its own
     world_->writeBack(scene);
     ++steps_;
     record();
     if (!breakOnContact.isNull()) {
-        std::optional<std::pair<Entity, Entity>> pair;
+        // The deepest contact of the watched body: a pair that touches wins
+        // over one that is only speculative (a gap the solver keeps from
+        // closing within the step, depth < 0).
+        const ContactRecord* deepest = nullptr;
         for (const ContactRecord& c : world_->contacts())
-            if (c.a == breakOnContact || c.b == breakOnContact) {
-                pair = std::make_pair(c.a, c.b);
-                break;
-            }
-        if (pair && !touchingBefore_) {
-            contactPair = pair;
+            if ((c.a == breakOnContact || c.b == breakOnContact) && (!deepest || c.depth > deepest->depth))
+                deepest = &c;
+        // 0 no contact, 1 speculative, 2 touching: the run pauses when the
+        // stage rises, so a pair seen about to touch pauses again when it does.
+        const int stage = !deepest ? 0 : touches(*deepest) ? 2 : 1;
+        const bool rose = stage > contactStageBefore_;
+        contactStageBefore_ = stage;
+        if (rose) {
+            contactPair = std::make_pair(deepest->a, deepest->b);
             state_ = SimState::Paused;
-            message_ = "break on contact: " + displayName(scene.registry, pair->first) + " touches " +
-                       displayName(scene.registry, pair->second) + " at t = " + std::to_string(world_->time()) + " s";
-            touchingBefore_ = true;
+            message_ = breakMessage(scene.registry, *deepest, world_->time());
             return false;
         }
-        touchingBefore_ = pair.has_value();
     }
     return true;
 }
@@ -353,6 +410,8 @@ bool Simulation::stepBack(Scene& scene) {
     state_ = SimState::Paused;
     HistoryEntry entry = std::move(history_.back());
     popHistory();
+    contactsKept_ = false;  // the restored step's contacts are replayed below
+    beforeEdits_.reset();
     scene = entry.restore();
     // The live World takes the state in place when it was compiled from
     // that entry's scene; after an edit (or a switched system, or a drag)
@@ -391,7 +450,7 @@ bool Simulation::stepBack(Scene& scene) {
     if (!samples_.empty()) samples_.pop_back();
     if (steps_ > 0) --steps_;
     diverged_ = false;
-    touchingBefore_ = false;
+    contactStageBefore_ = 0;
     return true;
 }
 
@@ -409,6 +468,8 @@ bool Simulation::reset(Scene& scene) {
     diverged_ = false;
     contactPair.reset();
     mouseSpring.reset();
+    contactsKept_ = false;
+    beforeEdits_.reset();
     return true;
 }
 

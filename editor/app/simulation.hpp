@@ -34,6 +34,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,13 @@ struct SimSample {
     double momentum = 0.0;  ///< |p|, kg*m/s
     double contacts = 0.0;
 };
+
+/// A contact whose bodies touch (depth >= 0 within round-off), not a
+/// speculative one with a gap still open.
+bool touches(const ContactRecord& c);
+/// What a break on contact says: whether the pair touches (depth >= 0)
+/// or is a speculative contact about to touch (its gap), and when.
+std::string breakMessage(const Registry& reg, const ContactRecord& c, double time);
 
 class Simulation {
 public:
@@ -70,7 +78,10 @@ public:
 
     /// The scene was changed from outside (edit, undo): rebuild before the
     /// next step.
-    void sceneChanged() { stale_ = true; }
+    void sceneChanged() {
+        stale_ = true;
+        contactsKept_ = false;
+    }
     /// After an undoable edit: one that only moved bodies (their position
     /// or velocity) goes to the live World in place (World::moveBody), so
     /// the rest keeps its warm start and nothing is rebuilt; any other edit
@@ -128,6 +139,21 @@ public:
     /// Last message: divergence, break on contact, refusal. Empty when none.
     const std::string& message() const { return message_; }
     bool diverged() const { return diverged_; }
+    /// The contacts the panels and the overlay show: the last step's. An edit
+    /// that leaves the contacts as they were (a mass, a colour, a name, a
+    /// velocity: not a position, angle, shape, wall or static flag, and no
+    /// entity added or removed) keeps them, though the World it recompiles
+    /// has none until its next step.
+    std::span<const ContactRecord> contacts() const;
+    /// Before an edit while the simulation runs (`cursor`: the undo stack's
+    /// position before it): keeps the World's state, sleeping islands and
+    /// contacts as they are, once per step, so that undoing back to here
+    /// restores them (undoneTo) instead of leaving what the edit woke awake.
+    void beforeEdit(std::size_t cursor);
+    /// After an undo to `cursor`: when no step ran since the state kept at
+    /// that cursor, the World (recompiled from `scene`) takes it back. True
+    /// when it did.
+    bool undoneTo(const Scene& scene, std::size_t cursor);
     /// The pair a break on contact stopped at.
     std::optional<std::pair<Entity, Entity>> contactPair;
 
@@ -204,7 +230,16 @@ private:
     double frameStepMs_ = 0.0;
     std::string message_;
     bool diverged_ = false;
-    bool touchingBefore_ = false;
+    struct BeforeEdits {
+        std::size_t cursor = 0;       ///< undo stack position before the first edit since a step
+        std::uint64_t steps = 0;      ///< steps_ then
+        WorldState state;
+        std::vector<ContactRecord> contacts;
+    };
+    std::optional<BeforeEdits> beforeEdits_;
+    std::vector<ContactRecord> keptContacts_;  ///< the last step's, while contactsKept_
+    bool contactsKept_ = false;
+    int contactStageBefore_ = 0;  ///< break on contact: 0 none, 1 speculative, 2 touching, last step
     bool behind_ = false;
     std::uint64_t worldBuilds_ = 0;
     /// The mouse spring the current World was built with: its body and its

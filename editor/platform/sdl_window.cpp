@@ -80,12 +80,29 @@ Result<void> runWindow(const EditOptions& o, int width, int height) {
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_MINOR_VERSION, 3);
     SDL_GL_SetAttribute(SDL_GL_DOUBLEBUFFER, 1);
     SDL_GL_SetAttribute(SDL_GL_DEPTH_SIZE, 0);
+    // The window fits the screen it opens on: a 1280x800 window on a
+    // 720-pixel screen opened with its menu bar above the top edge.
+    SDL_Rect usable{};
+    const bool bounded = SDL_GetDisplayUsableBounds(0, &usable) == 0 && usable.w > 0 && usable.h > 0;
+    if (bounded) {
+        width = std::min(width, usable.w);
+        height = std::min(height, usable.h);
+    }
     SDL_Window* window = SDL_CreateWindow("Stepwise", SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, width, height,
                                           SDL_WINDOW_OPENGL | SDL_WINDOW_RESIZABLE);
     if (!window) {
         Error e{std::string("cannot open a window: ") + SDL_GetError()};
         SDL_Quit();
         return e;
+    }
+    // Its frame (title bar) is known only now: the whole, frame included, fits.
+    int top = 0, left = 0, bottom = 0, right = 0;
+    if (bounded && SDL_GetWindowBordersSize(window, &top, &left, &bottom, &right) == 0 &&
+        (height + top + bottom > usable.h || width + left + right > usable.w)) {
+        width = std::min(width, usable.w - left - right);
+        height = std::min(height, usable.h - top - bottom);
+        SDL_SetWindowSize(window, width, height);
+        SDL_SetWindowPosition(window, usable.x + left, usable.y + top);
     }
     SDL_GLContext context = SDL_GL_CreateContext(window);
     if (!context) {

@@ -30,7 +30,10 @@ void writeDebugState(const std::string& path, ui::Session& session, std::uint64_
     const ui::Session::DialogState d = session.dialogState();
     out << ",\n  \"modal\": " << nlohmann::json(d.modal).dump() << ",\n  \"status\": " << nlohmann::json(d.status).dump()
         << ",\n  \"open_folder\": " << nlohmann::json(d.openFolder).dump() << ",\n  \"open_files\": " << d.openFiles
-        << ",\n  \"save_as_suggestion\": " << nlohmann::json(d.saveAsSuggestion).dump();
+        << ",\n  \"save_as_suggestion\": " << nlohmann::json(d.saveAsSuggestion).dump()
+        << ",\n  \"error\": " << nlohmann::json(ed.errorModal).dump()
+        << ",\n  \"window\": [" << ImGui::GetIO().DisplaySize.x << ", " << ImGui::GetIO().DisplaySize.y << "]"
+        << ",\n  \"tool\": " << nlohmann::json(std::string(editor::toolName(ed.tool))).dump();
     // Rectangles (x, y, w, h) in window pixels of the panels and of the
     // inspector's fields, from the last frame.
     nlohmann::json windows = nlohmann::json::object(), widgets = nlohmann::json::object();

@@ -39,7 +39,10 @@ PanelRects defaultLayout(float width, float height, float scale) {
     const float bottom = std::round(std::min(230.0f * scale, 0.3f * height));
     const float top = menu, usable = height - menu - status;
     const float centerW = width - left - right;
-    const float toolsH = std::round(std::min(300.0f * scale, usable * 0.45f));
+    // Tall enough for the tools, the active tool's options and the overlay
+    // boxes in one column (two do not fit their labels in 230 px) where the
+    // window allows; the entity list scrolls.
+    const float toolsH = std::round(std::min(480.0f * scale, usable * 0.5f));
     r.toolsPos = {0, top};
     r.toolsSize = {left, toolsH};
     r.entitiesPos = {0, top + toolsH};
@@ -203,6 +206,11 @@ void endLayout(UiState& ui, ImVec2 display) {
 }
 
 } // namespace
+
+void recordWidgetRect(UiState& ui, const std::string& key) {
+    const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+    ui.widgetRects[key] = ImVec4(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y);
+}
 
 std::string displayableText(const std::string& text) {
     // Typographic quotes and dashes (UTF-8 E2 80 xx) that the font has no

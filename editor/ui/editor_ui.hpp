@@ -64,6 +64,8 @@ struct UiState {
     /// --debug-state reports them, so a test clicks a field wherever the
     /// layout and the window size put it.
     std::map<std::string, ImVec4, std::less<>> widgetRects;
+    /// The Error modal's Enter: set once Enter is up while the modal shows.
+    bool errorEnterArmed = false;
 
     // Dialog buffers
     std::string openPath, saveAsPath, entityFilter, contactFilter;
@@ -75,9 +77,14 @@ struct UiState {
     // Inspector edit coalescing: the widget being dragged and its merge key.
     ImGuiID activeWidget = 0;
     std::uint64_t activeKey = 0;
-    /// A number field clicked once without a drag: it takes typed text
-    /// from the next frame on.
-    ImGuiID typeInto = 0;
+    /// Characters typed into the number field `refusedTypingFor` that
+    /// cannot be part of a number (ImGui drops them): its panel says so.
+    std::string refusedTyping;
+    ImGuiID refusedTypingFor = 0;
+    /// The number field being dragged and its speed per pixel, fixed from
+    /// its value when the drag started: drags are linear.
+    ImGuiID dragSpeedFor = 0;
+    float dragSpeed = 0.0f;
 
     // Timing (ms), averaged, for the status bar and the profile
     double frameMs = 0.0, uiMs = 0.0, sceneMs = 0.0, stepMs = 0.0;
@@ -127,6 +134,14 @@ void drawInspector(UiState& ui, editor::Editor& ed);
 /// by the world-settings table: range, unit and description from the table,
 /// the edit checked as the loader checks it (editor::setWorldField).
 bool worldFieldWidget(UiState& ui, editor::Editor& ed, std::string_view key);
+
+/// While the number field just drawn is typed into, ImGui drops the
+/// characters that cannot be part of a number; this puts them in the status
+/// line, naming the field (`who` "world." or "\"bob\" ", `field` "dt").
+void reportRefusedTyping(UiState& ui, editor::Editor& ed, const std::string& who, std::string_view field);
+
+/// Records the last item's rectangle in `ui.widgetRects` under `key`.
+void recordWidgetRect(UiState& ui, const std::string& key);
 
 /// `text` with the typographic quotes and dashes the current font has no
 /// glyph for replaced by ASCII (else ImGui draws '?').

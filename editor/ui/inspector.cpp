@@ -12,6 +12,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/world_fields.hpp"
 
+#include <imgui_internal.h>
 #include <imgui_stdlib.h>
 
 #include <algorithm>
@@ -25,32 +26,55 @@ using editor::FieldValue;
 
 namespace {
 
-/// Drag speed: about 0.5% of the value per pixel, at least 0.001.
+/// Drag speed: 0.5% of the value per pixel, at least 0.001.
 float speedFor(double v) { return float(std::max(1e-3, std::abs(v) * 0.005)); }
+
+/// The speed of a drag on the field whose widget has id `id`, holding `v`
+/// now: taken from the value when the drag starts and kept for the whole
+/// drag, so a drag is linear (400 px on motor_speed 1 adds 2, where a speed
+/// following the value compounded 0.5% a pixel and went from 1 to -259).
+float dragSpeed(UiState& ui, ImGuiID id, double v) {
+    if (ImGui::GetActiveID() != id) {
+        if (ui.dragSpeedFor == id) ui.dragSpeedFor = 0;  // its drag ended
+        return speedFor(v);
+    }
+    if (ui.dragSpeedFor != id) {
+        ui.dragSpeedFor = id;
+        ui.dragSpeed = speedFor(v);
+    }
+    return ui.dragSpeed;
+}
+
+/// The id of component `i` of a DragScalarN labelled `label` (ImGui pushes
+/// the label, then the index, and gives each component the label "").
+ImGuiID componentId(const char* label, int i) {
+    ImGui::PushID(label);
+    ImGui::PushID(i);
+    const ImGuiID id = ImGui::GetID("");
+    ImGui::PopID();
+    ImGui::PopID();
+    return id;
+}
 
 /// Shows the widget for one field; returns true with `value` updated when
 /// the user changed it.
-/// `typeNow`: focus the number field so typing goes into it (a single click
-/// on it, last frame, without a drag).
-bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const Registry& reg, bool typeNow) {
+bool fieldWidget(UiState& ui, const FieldInfo& f, FieldValue& value, const char* label, const Registry& reg) {
     const double* lo = std::isfinite(f.range.min) ? &f.range.min : nullptr;
     const double* hi = std::isfinite(f.range.max) ? &f.range.max : nullptr;
     switch (f.kind) {
     case FieldKind::Number: {
         double& v = std::get<double>(value);
-        if (typeNow) ImGui::SetKeyboardFocusHere();
         // A range (0, max] (dt, a tolerance) is dragged on a log scale: its
         // useful values span decades.
         if (f.range.minExclusive && f.range.min == 0.0 && hi)
             return ImGui::DragScalar(label, ImGuiDataType_Double, &v, 0.01f, lo, hi, "%.6g",
                                      ImGuiSliderFlags_Logarithmic);
-        return ImGui::DragScalar(label, ImGuiDataType_Double, &v, speedFor(v), lo, hi, "%.6g");
+        return ImGui::DragScalar(label, ImGuiDataType_Double, &v, dragSpeed(ui, ImGui::GetID(label), v), lo, hi, "%.6g");
     }
     case FieldKind::Integer: {
         // Only world settings are integers; 0 there is "not given"
         // (the engine chooses), shown as "auto" until dragged.
         int& v = std::get<int>(value);
-        if (typeNow) ImGui::SetKeyboardFocusHere();
         const int intLo = lo ? int(*lo) : 0, intHi = hi ? int(*hi) : 0;
         if (!ImGui::DragInt(label, &v, 0.1f, intLo, intHi, v == 0 ? "auto" : "%d")) return false;
         if (lo && hi) v = std::clamp(v, intLo, intHi);
@@ -68,8 +92,7 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
             return changed;
         }
         double d = *v;
-        if (typeNow) ImGui::SetKeyboardFocusHere();
-        if (ImGui::DragScalar(label, ImGuiDataType_Double, &d, speedFor(d), lo, hi, "%.6g")) {
+        if (ImGui::DragScalar(label, ImGuiDataType_Double, &d, dragSpeed(ui, ImGui::GetID(label), d), lo, hi, "%.6g")) {
             v = d;
             changed = true;
         }
@@ -78,9 +101,15 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
     case FieldKind::Vector: {
         Vec2& v = std::get<Vec2>(value);
         double xy[2] = {v.x, v.y};
-        if (typeNow) ImGui::SetKeyboardFocusHere();
-        if (!ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, speedFor(std::max(std::abs(v.x), std::abs(v.y))),
-                                nullptr, nullptr, "%.5g"))
+        // One speed for both components (the larger's), kept while either is dragged.
+        const double larger = std::max(std::abs(v.x), std::abs(v.y));
+        float speed = speedFor(larger);
+        for (int i = 0; i < 2; ++i) {
+            const ImGuiID c = componentId(label, i);
+            const float own = dragSpeed(ui, c, larger);
+            if (ImGui::GetActiveID() == c) speed = own;
+        }
+        if (!ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, speed, nullptr, nullptr, "%.5g"))
             return false;
         v = {xy[0], xy[1]};
         return true;
@@ -96,7 +125,6 @@ bool fieldWidget(const FieldInfo& f, FieldValue& value, const char* label, const
             return changed;
         }
         double xy[2] = {v->x, v->y};
-        if (typeNow) ImGui::SetKeyboardFocusHere();
         if (ImGui::DragScalarN(label, ImGuiDataType_Double, xy, 2, 0.01f, nullptr, nullptr, "%.5g")) {
             v = Vec2{xy[0], xy[1]};
             changed = true;
@@ -184,13 +212,22 @@ std::string fieldLabel(std::string_view key, std::string_view unit) {
 
 } // namespace
 
+void reportRefusedTyping(UiState& ui, Editor& ed, const std::string& who, std::string_view field) {
+    if (ui.refusedTypingFor == 0 || !ImGui::IsItemActive() || GImGui->LastItemData.ID != ui.refusedTypingFor) return;
+    const std::string text = "refused: " + who + std::string(field) + ": \"" + ui.refusedTyping +
+                             "\" is not a number (digits, '.', 'e', '+', '-', '*' and '/' can be typed)";
+    if (ed.status != text) ed.note(text);
+}
+
 bool worldFieldWidget(UiState& ui, Editor& ed, std::string_view key) {
     const WorldFieldInfo* info = findWorldField(key);
     if (!info) return false;
     const FieldInfo& f = info->field;
     FieldValue value = editor::readField(f, &ed.doc.scene.world);
     const std::string label = fieldLabel(f.key, f.unit);
-    const bool changed = fieldWidget(f, value, label.c_str(), ed.doc.scene.registry, false);
+    const bool changed = fieldWidget(ui, f, value, label.c_str(), ed.doc.scene.registry);
+    recordWidgetRect(ui, "world/" + std::string(key));
+    reportRefusedTyping(ui, ed, "world.", f.key);
     if (ImGui::IsItemHovered() && !f.description.empty())
         ImGui::SetTooltip("%.*s%s%s", int(f.description.size()), f.description.data(),
                           f.kind == FieldKind::Number || f.kind == FieldKind::Integer ? "\nrange: " : "",
@@ -271,9 +308,9 @@ void drawInspector(UiState& ui, Editor& ed) {
                 if (mixed) label += " (mixed)";
                 ImGui::PushID(f.key.empty() ? "value" : f.key.data());
                 const ImGuiID id = ImGui::GetID(label.c_str());
-                const bool typeNow = ui.typeInto == id;
-                if (typeNow) ui.typeInto = 0;
-                const bool changed = fieldWidget(f, value, label.c_str(), reg, typeNow);
+                const bool changed = fieldWidget(ui, f, value, label.c_str(), reg);
+                reportRefusedTyping(ui, ed, "\"" + editor::displayName(reg, primary) + "\" ",
+                                    editor::fieldPathName(info, f.key));
                 {  // where the field is this frame, for --debug-state (tests click it wherever the layout puts it)
                     const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
                     std::string key = "inspector/";
@@ -284,16 +321,6 @@ void drawInspector(UiState& ui, Editor& ed) {
                     }
                     ui.widgetRects[key] = ImVec4(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y);
                 }
-                // ImGui's drag fields take typed text only after a double
-                // click; a designer clicks once and types, and the digits
-                // would go to the tool shortcuts. A click released without
-                // a drag opens the text field on the next frame.
-                const bool numeric = f.kind == FieldKind::Number || f.kind == FieldKind::OptionalNumber ||
-                                     f.kind == FieldKind::Vector || f.kind == FieldKind::OptionalVector;
-                const ImGuiIO& io = ImGui::GetIO();
-                if (numeric && ImGui::IsItemDeactivated() && ImGui::IsMouseReleased(ImGuiMouseButton_Left) &&
-                    io.MouseDragMaxDistanceSqr[0] < io.MouseDragThreshold * io.MouseDragThreshold)
-                    ui.typeInto = id;
                 if (f.kind == FieldKind::EntityRef) {
                     ImGui::SameLine();
                     if (ImGui::SmallButton("pick")) ed.startReferencePick(info, f, selection);

@@ -75,6 +75,10 @@ Result<std::unique_ptr<Session>> Session::create(render::GetProcAddress getProc,
     }
     if (options.deterministic) io.ConfigInputTextCursorBlink = false;
     io.ConfigWindowsMoveFromTitleBarOnly = true;  // dragging inside a panel is for its widgets
+    // One rule for every number field (inspector, World panel, colour
+    // channels, snap spacing): a click released without a drag opens the
+    // field for typing, so the typed digits never reach the tool keys.
+    io.ConfigDragClickToInputText = true;
     // Our Key enum values index KeysDown directly.
     io.KeyMap[ImGuiKey_Tab] = int(Key::Tab);
     io.KeyMap[ImGuiKey_LeftArrow] = int(Key::Left);
@@ -192,7 +196,10 @@ void Session::feedImGui(const std::vector<InputEvent>& events, int width, int he
             if (e.key != Key::None) io.KeysDown[int(e.key)] = e.type == InputEvent::Type::KeyDown;
             mods_ = e.mods;
             break;
-        case InputEvent::Type::Text: io.AddInputCharactersUTF8(e.text.c_str()); break;
+        case InputEvent::Type::Text:
+            noteRefusedTyping(e.text);
+            io.AddInputCharactersUTF8(e.text.c_str());
+            break;
         }
         if (e.type == InputEvent::Type::KeyDown || e.type == InputEvent::Type::KeyUp) {
             io.KeyCtrl = (e.mods & editor::kModCtrl) != 0;
@@ -202,8 +209,33 @@ void Session::feedImGui(const std::vector<InputEvent>& events, int width, int he
     }
 }
 
+void Session::noteRefusedTyping(const std::string& text) {
+    // A number field being typed into (ImGui's text field over a drag
+    // widget) drops every character that cannot be part of a number, so
+    // "nan" or "inf" would vanish without a word: the dropped characters
+    // are kept for the field's panel to report (ui_.refusedTyping). ImGui
+    // types into a number only through its "temporary input" over a drag or
+    // slider widget, with the filter of ImGuiInputTextFlags_CharsScientific
+    // (integers drop 'e' as well; ImGui 1.86 does not record which filter).
+    const ImGuiContext& g = *ImGui::GetCurrentContext();
+    if (g.ActiveId == 0 || g.TempInputId != g.ActiveId || !ImGui::GetInputTextState(g.ActiveId)) return;
+    if (ui_.refusedTypingFor != g.ActiveId) ui_.refusedTyping.clear();
+    for (const char c : text) {
+        const bool kept = (c >= '0' && c <= '9') || c == '.' || c == '+' || c == '-' || c == '*' || c == '/' ||
+                          c == 'e' || c == 'E';
+        if (!kept) ui_.refusedTyping += c;
+    }
+    if (!ui_.refusedTyping.empty()) ui_.refusedTypingFor = g.ActiveId;
+}
+
 void Session::route(const std::vector<InputEvent>& events) {
     const ImGuiIO& io = ImGui::GetIO();
+    // Keys belong to a text field while one has the keyboard: one that
+    // was active last frame (WantTextInput) or that became active in this
+    // very frame (a number field just clicked opens its text field as the
+    // mouse is released).
+    const ImGuiID active = ImGui::GetActiveID();
+    const bool typing = io.WantTextInput || (active != 0 && GImGui->TempInputId == active);
     const ImVec2 o = ui_.viewportPos;
     // Any open popup (modal, menu, combo) owns the input until it closes.
     const bool modal = ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId);
@@ -212,7 +244,7 @@ void Session::route(const std::vector<InputEvent>& events) {
         case InputEvent::Type::KeyDown:
             // Keys belong to a text field while one is active, and to a
             // modal while one is open.
-            if (!io.WantTextInput && !modal) editor_.handleShortcut(e.key, e.mods);
+            if (!typing && !modal) editor_.handleShortcut(e.key, e.mods);
             break;
         case InputEvent::Type::MouseDown:
         case InputEvent::Type::MouseUp:
@@ -288,6 +320,9 @@ void Session::frame(int width, int height, double frameSeconds, const std::funct
         }
     }
     input.caption.clear();
+    // The viewport's line about edits while running (viewport_panel.cpp)
+    // sits at the top of the scene: the legend stays below it.
+    if (!editor_.runningEditsNote().empty()) input.reservedTopPx = ImGui::GetFontSize() + 10 * ui_.scale;
     const render::DrawData drawn = render::buildDrawData(input, vw, vh);
     const double buildMs = msSince(t2);
 

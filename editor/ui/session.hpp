@@ -86,6 +86,7 @@ private:
     void loadFonts();
     void feedImGui(const std::vector<editor::InputEvent>& events, int width, int height, double frameSeconds);
     void route(const std::vector<editor::InputEvent>& events);
+    void noteRefusedTyping(const std::string& text);
 
     editor::Editor editor_;
     UiState ui_;

@@ -12,11 +12,14 @@
 #include "stepwise/scene.hpp"
 #include "stepwise/vec2.hpp"
 
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace stepwise {
 class World;
+struct ContactRecord;
 }
 
 namespace stepwise::render {
@@ -43,6 +46,10 @@ struct ArrowScales {
 struct FrameInput {
     const Scene* scene = nullptr;          ///< required
     const World* world = nullptr;          ///< optional; force, force-field, contacts need it
+    /// The contacts overlay's records instead of `world`'s: the editor keeps
+    /// the last step's across an edit that leaves them as they were (the
+    /// World recompiled by the edit has none until its next step).
+    std::optional<std::span<const ContactRecord>> contacts;
     OverlaySet overlays;
     Camera camera;
     std::vector<Entity> selection;         ///< drawn with a highlight ring
@@ -50,6 +57,9 @@ struct FrameInput {
     ArrowScales scales;                    ///< 0 entries are chosen per frame
     std::string caption;                   ///< top-left text ("" for none)
     bool hud = true;                       ///< scale bar, legend, caption
+    /// Pixels at the top of the image that the caller draws over (the
+    /// editor's line about edits while running): the legend keeps below.
+    double reservedTopPx = 0.0;
     /// The editor's polygon tool: the outline it would make (world metres,
     /// counter-clockwise) and the vertices clicked so far. Empty: none.
     std::vector<Vec2> polygonPreview, polygonClicks;

@@ -32,7 +32,7 @@ void contactsTab(UiState& ui, Editor& ed) {
         ImGui::TextColored(kDim, "Contacts appear while the simulation runs (Space plays, Right steps).");
         return;
     }
-    const auto contacts = w->contacts();
+    const auto contacts = ed.sim.contacts();
     const Registry& reg = ed.doc.scene.registry;
     ImGui::Text("%zu contacts this step", contacts.size());
     ImGui::SameLine();

@@ -31,18 +31,18 @@ void dialogs(UiState& ui, Editor& ed) {
         ImGui::OpenPopup("Open level");
         ui.openDialogRequested = false;
     }
+    // Each dialog proposes afresh when it opens, from the level open now:
+    // a path typed for another level (or for the other dialog) is not kept.
     if (ui.saveAsDialogRequested) {
         ImGui::OpenPopup("Save as");
-        // An absolute suggestion in a folder that exists, wherever the
-        // editor was started from.
-        if (ui.saveAsPath.empty()) {
-            std::error_code cwd;
-            ui.saveAsPath = editor::saveAsSuggestion(ed.doc.path, ui.levelsDir, std::filesystem::current_path(cwd)).string();
-        }
+        std::error_code cwd;
+        ui.saveAsPath = editor::saveAsSuggestion(ed.doc.path, ui.levelsDir, std::filesystem::current_path(cwd)).string();
         ui.saveAsDialogRequested = false;
     }
     if (ui.saveStateRequested) {
         ImGui::OpenPopup("Save simulation state");
+        std::error_code cwd;
+        ui.saveAsPath = editor::saveStateSuggestion(ed.doc.path, ui.levelsDir, std::filesystem::current_path(cwd)).string();
         ui.saveStateRequested = false;
     }
     const ImVec2 center = ImGui::GetMainViewport()->GetCenter();
@@ -80,10 +80,20 @@ void dialogs(UiState& ui, Editor& ed) {
                 }
             }
         ImGui::EndChild();
+        // The path field takes the keyboard whenever nothing else in the
+        // dialog is active (Ctrl+O, then type), and selects what it holds
+        // when it takes it, so typing replaces a path chosen in the list
+        // instead of appending to it.
+        if (!ImGui::IsAnyItemActive()) ImGui::SetKeyboardFocusHere();
         ImGui::SetNextItemWidth(-1);
         const bool enter = ImGui::InputTextWithHint("##path", "path/to/level.json", &ui.openPath,
-                                                    ImGuiInputTextFlags_EnterReturnsTrue);
-        if ((ImGui::Button("Open") || enter) && !ui.openPath.empty()) {
+                                                    ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll);
+        recordWidgetRect(ui, "open/path");
+        const bool clicked = ImGui::Button("Open");
+        recordWidgetRect(ui, "open/button");
+        // Enter and the button take the same path: a failed open shows the
+        // loader's message in the Error modal and the status line.
+        if ((clicked || enter) && !ui.openPath.empty()) {
             ImGui::CloseCurrentPopup();
             ed.request(editor::PendingAction::Open, ui.openPath);
         }
@@ -162,14 +172,23 @@ void dialogs(UiState& ui, Editor& ed) {
         ImGui::EndPopup();
     }
     // A bad file (or any refused operation) gets the loader's message.
-    if (!ed.errorModal.empty() && !ImGui::IsPopupOpen("Error")) ImGui::OpenPopup("Error");
+    if (!ed.errorModal.empty() && !ImGui::IsPopupOpen("Error")) {
+        ImGui::OpenPopup("Error");
+        // Enter dismisses the modal only once it has been let go of since
+        // the modal opened: the Enter that confirmed a path in the Open
+        // dialog (and opened this modal in the same frame) must not also
+        // close it before it is seen.
+        ui.errorEnterArmed = false;
+    }
+    const int enterKey = ImGui::GetKeyIndex(ImGuiKey_Enter);
+    if (!ImGui::IsKeyDown(enterKey)) ui.errorEnterArmed = true;
     ImGui::SetNextWindowPos(center, ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
     ImGui::SetNextWindowSizeConstraints(ImVec2(360 * ui.scale, 0), ImVec2(900 * ui.scale, 600 * ui.scale));
     if (ImGui::BeginPopupModal("Error", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
         ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + 640 * ui.scale);
         ImGui::TextColored(kRed, "%s", displayableText(ed.errorModal).c_str());
         ImGui::PopTextWrapPos();
-        if (ImGui::Button("OK") || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Enter))) {
+        if (ImGui::Button("OK") || (ui.errorEnterArmed && ImGui::IsKeyPressed(enterKey, false))) {
             ed.errorModal.clear();
             ImGui::CloseCurrentPopup();
         }

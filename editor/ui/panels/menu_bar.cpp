@@ -93,7 +93,11 @@ void menuBar(UiState& ui, Editor& ed) {
     }
     // Right side: level name and mode.
     const std::string title = levelLabel(ed);
-    const char* mode = ed.sim.state() == SimState::Playing ? "PLAYING" : ed.sim.state() == SimState::Paused ? "PAUSED" : "EDIT";
+    std::string modeText = ed.sim.state() == SimState::Playing ? "PLAYING" : ed.sim.state() == SimState::Paused ? "PAUSED" : "EDIT";
+    // Edits made while running are not in the level (no `*`): the mode says
+    // how many the run holds.
+    if (const std::size_t n = ed.editsSincePlay(); n > 0) modeText += " +" + std::to_string(n) + (n == 1 ? " run edit" : " run edits");
+    const char* mode = modeText.c_str();
     const float w = ImGui::CalcTextSize(title.c_str()).x + ImGui::CalcTextSize(mode).x + 40 * ui.scale;
     ImGui::SameLine(ImGui::GetWindowWidth() - w);
     ImGui::TextColored(kDim, "%s", title.c_str());

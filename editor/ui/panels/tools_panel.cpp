@@ -45,20 +45,6 @@ void toolsPanel(UiState& ui, Editor& ed, const PanelRects& r) {
             ImGui::TextColored(kDim, ed.polygonSides == 0 ? "Click vertices; Enter or right click ends"
                                                           : "Drag from the centre out to a vertex");
         }
-        ImGui::Separator();
-        ImGui::Checkbox("Snap (G)", &ed.snap);
-        ImGui::SameLine();
-        ImGui::SetNextItemWidth(-1);
-        ImGui::DragScalar("##snap", ImGuiDataType_Double, &ed.snapSpacing, 0.01f, nullptr, nullptr, "%.3g m");
-        ed.snapSpacing = std::max(ed.snapSpacing, 1e-3);
-        ImGui::TextColored(kDim, "Overlays");
-        int i = 0;
-        for (const auto& [name, overlay] : render::overlayNames()) {
-            bool on = ed.overlays.has(overlay);
-            if (ImGui::Checkbox(std::string(name).c_str(), &on))
-                ed.overlays.bits = on ? ed.overlays.bits | std::uint32_t(overlay) : ed.overlays.bits & ~std::uint32_t(overlay);
-            if (++i % 2 == 1) ImGui::SameLine(bw + ImGui::GetStyle().ItemSpacing.x + ImGui::GetStyle().WindowPadding.x);
-        }
         if (ed.tool == Tool::Joint) {
             ImGui::SetNextItemWidth(-1);
             if (ImGui::BeginCombo("##jointtype", ed.jointType.c_str())) {
@@ -66,6 +52,7 @@ void toolsPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                     if (ImGui::Selectable(std::string(type).c_str(), ed.jointType == type)) ed.jointType = std::string(type);
                 ImGui::EndCombo();
             }
+            recordWidgetRect(ui, "tools/jointtype");
             ImGui::TextWrapped("%s", ed.springStart().isNull()
                                          ? "Click a body, then a second body or empty space (the world) at the anchor."
                                          : "Now click the other body or empty space, at the anchor (Esc cancels).");
@@ -73,6 +60,34 @@ void toolsPanel(UiState& ui, Editor& ed, const PanelRects& r) {
         if (ed.tool == Tool::Spring)
             ImGui::TextWrapped("%s", ed.springStart().isNull() ? "Click a body, then a second body or empty space."
                                                                : "Now click the other end (Esc cancels).");
+        // Snap and the overlays come after the tool's own options, which
+        // then sit right under the tool buttons (the joint type was below
+        // the fold at 1600x900, among the overlay boxes).
+        ImGui::Separator();
+        ImGui::Checkbox("Snap (G)", &ed.snap);
+        ImGui::SameLine();
+        ImGui::SetNextItemWidth(-1);
+        ImGui::DragScalar("##snap", ImGuiDataType_Double, &ed.snapSpacing, 0.01f, nullptr, nullptr, "%.3g m");
+        recordWidgetRect(ui, "tools/snap");
+        reportRefusedTyping(ui, ed, "", "snap spacing");
+        ed.snapSpacing = std::max(ed.snapSpacing, 1e-3);
+        ImGui::TextColored(kDim, "Overlays");
+        // Two columns when the longest label fits in half the panel, else
+        // one: a label cut to "velocity-f" cannot be read.
+        const ImGuiStyle& style = ImGui::GetStyle();
+        float longest = 0.0f;
+        for (const auto& [name, overlay] : render::overlayNames())
+            longest = std::max(longest, ImGui::CalcTextSize(std::string(name).c_str()).x);
+        const float boxWidth = ImGui::GetFrameHeight() + style.ItemInnerSpacing.x + longest;
+        const bool twoColumns = 2 * boxWidth + style.ItemSpacing.x <= ImGui::GetContentRegionAvail().x;
+        int i = 0;
+        for (const auto& [name, overlay] : render::overlayNames()) {
+            bool on = ed.overlays.has(overlay);
+            if (ImGui::Checkbox(std::string(name).c_str(), &on))
+                ed.overlays.bits = on ? ed.overlays.bits | std::uint32_t(overlay) : ed.overlays.bits & ~std::uint32_t(overlay);
+            recordWidgetRect(ui, "tools/overlay/" + std::string(name));
+            if (twoColumns && ++i % 2 == 1) ImGui::SameLine(bw + style.ItemSpacing.x + style.WindowPadding.x);
+        }
     }
     ImGui::End();
 }

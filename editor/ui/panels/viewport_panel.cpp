@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 namespace stepwise::ui {
 
@@ -41,17 +42,49 @@ void simToolbar(UiState& ui, Editor& ed) {
     ImGui::SameLine(0, 4 * ui.scale);
     ImGui::Text("time x%.2f", ed.sim.timeScale);
     ImGui::SameLine();
+    // The watched body is named beside the box and chosen there; it does
+    // not follow the selection (a break selects the pair it stopped at,
+    // which would then change what is watched).
     bool breakOn = !ed.sim.breakOnContact.isNull();
-    const bool canBreak = ed.selection.size() == 1;
+    const Registry& reg = ed.doc.scene.registry;
+    const bool canBreak = ed.selection.size() == 1 && editor::isBody(reg, ed.selection[0]);
     ImGui::BeginDisabled(!canBreak && !breakOn);
-    if (ImGui::Checkbox("Break on contact", &breakOn))
-        ed.sim.breakOnContact = breakOn && canBreak ? ed.selection[0] : Entity{};
+    if (ImGui::Checkbox("Break on contact", &breakOn)) ed.setBreakOnContact(breakOn && canBreak ? ed.selection[0] : Entity{});
     ImGui::EndDisabled();
-    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
-        ImGui::SetTooltip("Pause at the step where the selected body first touches something");
-    ImGui::SameLine();
-    ImGui::TextColored(kDim, "t = %.3f s  step %llu  history %zu", ed.doc.scene.world.time,
-                       static_cast<unsigned long long>(ed.sim.steps()), ed.sim.historySize());
+    const char* breakHelp = "Pause at the step where the watched body first touches something, or is about to "
+                            "(a speculative contact). Ticking the box watches the selected body; the list "
+                            "picks any body. Selecting another body later does not change it.";
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", breakHelp);
+    ImGui::SameLine(0, 4 * ui.scale);
+    ImGui::SetNextItemWidth(96 * ui.scale);
+    if (ImGui::BeginCombo("##breakon", ed.breakOnLabel().c_str(), ImGuiComboFlags_HeightLarge)) {
+        if (ImGui::Selectable("off", !breakOn)) ed.setBreakOnContact({});
+        std::vector<Entity> bodies;
+        for (Entity e : reg.entities())
+            if (editor::isBody(reg, e)) bodies.push_back(e);
+        ImGuiListClipper clipper;
+        clipper.Begin(int(bodies.size()));
+        while (clipper.Step())
+            for (int i = clipper.DisplayStart; i < clipper.DisplayEnd; ++i) {
+                const Entity e = bodies[std::size_t(i)];
+                ImGui::PushID(int(e.index));
+                if (ImGui::Selectable(editor::displayName(reg, e).c_str(), e == ed.sim.breakOnContact))
+                    ed.setBreakOnContact(e);
+                ImGui::PopID();
+            }
+        ImGui::EndCombo();
+    }
+    recordWidgetRect(ui, "viewport/breakon");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", breakHelp);
+    char clock[96];
+    std::snprintf(clock, sizeof clock, "t = %.3f s  step %llu  history %zu", ed.doc.scene.world.time,
+                  static_cast<unsigned long long>(ed.sim.steps()), ed.sim.historySize());
+    // On the same row when it fits, else on a row of its own: cut off at
+    // the panel's edge it would hide the step count.
+    const float right = ImGui::GetItemRectMax().x + ImGui::GetStyle().ItemSpacing.x + ImGui::CalcTextSize(clock).x;
+    if (right <= ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x) ImGui::SameLine();
+    else ImGui::SetCursorPosX(ImGui::GetCursorPosX() + 6 * ui.scale);
+    ImGui::TextColored(kDim, "%s", clock);
 }
 
 } // namespace
@@ -97,6 +130,16 @@ void viewportPanel(UiState& ui, Editor& ed, const PanelRects& r) {
         if (ed.sim.running())
             dl->AddRect(o, ImVec2(o.x + avail.x, o.y + avail.y),
                         ImGui::GetColorU32(ed.sim.state() == SimState::Playing ? kGreen : kGold), 0, 0, 2.0f * ui.scale);
+        // While the simulation runs, edits change the running state, not
+        // the level: said at the top of the scene, over a dark band.
+        if (const std::string note = ed.runningEditsNote(); !note.empty()) {
+            const ImVec2 ts = ImGui::CalcTextSize(note.c_str());
+            const float pad = 4 * ui.scale;
+            const ImVec2 at(o.x + 8 * ui.scale, o.y + 6 * ui.scale);
+            dl->AddRectFilled(ImVec2(at.x - pad, at.y - pad / 2), ImVec2(at.x + ts.x + pad, at.y + ts.y + pad / 2),
+                              IM_COL32(10, 12, 16, 200), 3 * ui.scale);
+            dl->AddText(at, ImGui::GetColorU32(ed.editsSincePlay() > 0 ? kGold : kDim), note.c_str());
+        }
         if (auto rect = ed.selectionRect()) {
             const ImVec2 a(o.x + float(rect->first.x), o.y + float(rect->first.y));
             const ImVec2 b(o.x + float(rect->second.x), o.y + float(rect->second.y));
@@ -108,6 +151,15 @@ void viewportPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                 const Vec2 a = ed.view.toPixels(p->value), b = ed.mouseViewport();
                 dl->AddLine(ImVec2(o.x + float(a.x), o.y + float(a.y)), ImVec2(o.x + float(b.x), o.y + float(b.y)),
                             ImGui::GetColorU32(kGold), 1.5f * ui.scale);
+            }
+        // The mouse spring: a line from the pulled body to the cursor and a
+        // dot where it pulls, so the pull and its direction are seen.
+        if (ed.sim.mouseSpring)
+            if (const Position* p = ed.doc.scene.registry.tryGet<Position>(ed.sim.mouseSpring->first)) {
+                const Vec2 a = ed.view.toPixels(p->value), b = ed.view.toPixels(ed.sim.mouseSpring->second);
+                const ImVec2 from(o.x + float(a.x), o.y + float(a.y)), to(o.x + float(b.x), o.y + float(b.y));
+                dl->AddLine(from, to, ImGui::GetColorU32(kGold), 2.0f * ui.scale);
+                dl->AddCircleFilled(to, 3.5f * ui.scale, ImGui::GetColorU32(kGold));
             }
         // Cursor readout, bottom right of the viewport.
         const Vec2 w = ed.view.toWorld(ed.mouseViewport());
