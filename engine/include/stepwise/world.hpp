@@ -159,8 +159,9 @@ struct WorldState {
 ///    and 10% of the thinnest static support's thickness (strong gravity);
 ///  * the joints: the heaviest group of jointed bodies (its mass over its
 ///    lightest body's), its expected widest opening under 1% of a link.
-/// Contacts stop stiffening past 4 substeps at 60 Hz (contactHertz), so a
-/// contact rule that cannot hold stops where more substeps stop helping.
+/// Contacts stop stiffening at 60 Hz (contactHertz): past 4 substeps, or 8
+/// for a deep column, so a contact rule that cannot hold stops where more
+/// substeps stop helping.
 /// docs/collisions.md "Substeps when the level gives none".
 struct ContactSettingsChoice {
     int substeps = 1;
@@ -179,6 +180,10 @@ struct ContactSettingsChoice {
     /// implicit or adaptive integrator, which need no rule).
     double springRate = 0.0;
     int springSubsteps = 1;    ///< the fewest with h * springRate <= 1
+    /// Contact stiffness cap as a fraction of the substep rate: 0.25, or
+    /// 0.125 (with one colour order) when columnHeight > kDeepColumn
+    /// (SolverSettings::hertzFraction); the rules above use the same cap.
+    double hertzFraction = 0.25;
     /// "pile 12 deep ...": what made the choice.
     std::string reason() const;
 };
@@ -193,18 +198,30 @@ struct SystemSwitches {
     bool disable(std::string_view system);
 };
 ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwitches& switches = {});
+/// A column of flat-faced bodies taller than this gets Box2D v3.1's contacts:
+/// stiffness capped at an eighth of the substep rate instead of a quarter,
+/// and every solver pass in one colour order instead of alternating.
+/// Measured with Box2D's pyramid layout at 4 substeps and 1 iteration: with
+/// a quarter and alternation, 10 rows come to rest, 14 keep 7e-5 J moving
+/// after 5 s, 20 rows 0.55 J and 60 rows slide 112 mm; with both changes,
+/// 14 to 60 rows end within 7 mm. Shallower stacks keep the stiffer,
+/// alternating contacts: 4 times less overlap, and they settle and sleep
+/// sooner (docs/collisions.md, "Deep columns").
+inline constexpr int kDeepColumn = 12;
 /// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
 /// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
-/// compresses by load / (m_n omega^2), omega = 2 pi min(60 Hz, 1 / (4 h)),
+/// compresses by load / (m_n omega^2), omega = 2 pi min(60 Hz, f / h) with
+/// f the contacts' cap (ContactSettingsChoice::hertzFraction),
 /// with a factor measured on the 30-row pile (docs/collisions.md, "Substeps
 /// when the level gives none"). The lowest
 /// contact between bodies carries (depth - 1) heavy bodies on a light one:
 /// load (depth - 1) M g over m_n = m M / (m + M), i.e. (depth - 1)(1 + R)
 /// m_n g with R = M / m (2 (depth - 1) for equal bodies).
-double expectedPileOverlap(int depth, double gravity, double h, double massRatio = 1.0);
+double expectedPileOverlap(int depth, double gravity, double h, double massRatio = 1.0, double hertzFraction = 0.25);
 /// Expected overlap (m) of the contact under the bottom body of a pile
 /// `depth` deep on static ground: load ((depth - 1) R + 1) m g over m_n = m.
-double expectedSupportOverlap(int depth, double gravity, double h, double massRatio = 1.0);
+double expectedSupportOverlap(int depth, double gravity, double h, double massRatio = 1.0,
+                              double hertzFraction = 0.25);
 /// world.restitution_threshold when the level gives none: four times the
 /// speed gravity adds in one substep (m/s), so resting contacts never bounce
 /// and, with zero gravity, every approach does.

@@ -625,10 +625,10 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     }
     // Contact stiffness may not exceed a quarter of the substep rate, or the
     // soft constraint itself becomes unstable (Box2D v3.0's cap; v3.1
-    // lowered it to an eighth). Contacts
+    // lowered it to an eighth, which a deep column gets: hertzFraction). Contacts
     // with static bodies may be twice as stiff, but under the same cap:
     // above it a heavy box on light boxes never comes to rest.
-    const double hertz = std::min(settings_.contactHertz, 0.25 / h);
+    const double hertz = std::min(settings_.contactHertz, settings_.hertzFraction / h);
     const Softness soft = Softness::make(hertz, settings_.dampingRatio, h);
     Softness staticSoft = Softness::make(std::min(2.0 * hertz, 0.25 / h), settings_.dampingRatio, h);
     // Contacts with the static world turn rigid before the slop
@@ -676,7 +676,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // tens of m/s. Ordinary scenes have no crowd and are unchanged.
     bool reverse = false;
     if (jointed) directJoints_.factor(joints_, bodies_, directSoft, true);
-    for (int it = 0; it < settings_.iterations; ++it, reverse = !reverse) {
+    const bool alternate = !settings_.oneColourOrder;
+    for (int it = 0; it < settings_.iterations; ++it, reverse = alternate && !reverse) {
         if (jointed) {
             joints::solveJoints(joints_, bodies_, h, jointSoft, directSoft, true);
             directJoints_.solve(joints_, bodies_);
@@ -721,7 +722,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         b.dp = centreOfMass(i, std::span<const Vec2>(x.data(), x.size())) - stepStart_[i];
     }
     if (jointed) directJoints_.factor(joints_, bodies_, directSoft, false);
-    for (int it = 0; it < settings_.relaxIterations; ++it, reverse = !reverse) {
+    for (int it = 0; it < settings_.relaxIterations; ++it, reverse = alternate && !reverse) {
         if (jointed) {
             joints::solveJoints(joints_, bodies_, h, jointSoft, directSoft, false);
             directJoints_.solve(joints_, bodies_);

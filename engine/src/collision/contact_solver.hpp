@@ -104,6 +104,19 @@ struct SolverSettings {
     /// eighth). Box2D v3's default is 30 Hz; 60 gives 4x less overlap in a
     /// 25-deep circle pile at the same cost.
     double contactHertz = 60.0;
+    /// The cap on contactHertz, as a fraction of the substep rate: a quarter
+    /// (Box2D v3.0's), or an eighth (v3.1's) for a scene with a column of
+    /// boxes deeper than kDeepColumn, where at a quarter (h omega = pi/2)
+    /// the soft contacts keep a tall pyramid in motion and it slides apart
+    /// (world.hpp, docs/collisions.md "Deep columns").
+    double hertzFraction = 0.25;
+    /// Every pass in the same colour order (Box2D v3's), instead of
+    /// alternating forward and reverse from pass to pass. Alternating lets
+    /// resting piles and stacks come to rest and sleep sooner; in a column
+    /// deeper than kDeepColumn the two orders pull it sideways by turns: the
+    /// top of a 100-row pyramid drifts 44 mm in 5 s at 8 substeps (6.5 mm in
+    /// one order).
+    bool oneColourOrder = false;
     double dampingRatio = 10.0;        ///< heavily over-damped: pushes out without bounce
     double pushMaxVelocity = 3.0;      ///< m/s; caps the speed of overlap recovery
     double restitutionThreshold = 1.0; ///< m/s; slower impacts do not bounce (resting contact stays put)

@@ -841,7 +841,8 @@ std::optional<PileHint> World::pileHint() const {
     // Equal bodies: the warning's model is the one measured on the 30-row
     // pile; the choice also weighs the mass ratio (a heavy body on a light
     // one), so it never gets less than this asks for.
-    const double overlap = expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(substeps));
+    const double overlap =
+        expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(substeps), 1.0, c.hertzFraction);
     if (!(overlap > limit)) return std::nullopt;
     PileHint hint;
     hint.stackDepth = c.stackDepth;
@@ -850,7 +851,7 @@ std::optional<PileHint> World::pileHint() const {
     hint.substeps = substeps;
     hint.substepsNeeded = 16;
     for (int s = substeps + 1; s <= 16; ++s)
-        if (expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(s)) <= limit) {
+        if (expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(s), 1.0, c.hertzFraction) <= limit) {
             hint.substepsNeeded = s;
             break;
         }

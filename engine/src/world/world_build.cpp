@@ -256,6 +256,9 @@ std::optional<Error> compileCollisions(const Scene& scene, const SystemSwitches&
     const WorldSettings& ws = w.settings;
     const double substepLength = ws.dt / double(w.settings.substeps);
     w.collision->settings().iterations = w.settings.solverIterations;
+    // From the scene's structure, whatever substeps the level gives.
+    w.collision->settings().hertzFraction = w.contactChoice.hertzFraction;
+    w.collision->settings().oneColourOrder = w.contactChoice.hertzFraction < 0.25;
     if (ws.jointHz) w.collision->jointSettings().hertz = *ws.jointHz;
     if (ws.jointDampingRatio) w.collision->jointSettings().dampingRatio = *ws.jointDampingRatio;
     w.collision->settings().restitutionThreshold =

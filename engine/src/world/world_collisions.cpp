@@ -184,9 +184,10 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// omega^2 of the resting soft contact at substeps of h seconds.
-double contactOmega2(double h) {
-    const double hertz = std::min(collision::SolverSettings{}.contactHertz, 0.25 / h);
+/// omega^2 of the resting soft contact at substeps of h seconds, its
+/// stiffness capped at `fraction` of the substep rate.
+double contactOmega2(double h, double fraction) {
+    const double hertz = std::min(collision::SolverSettings{}.contactHertz, fraction / h);
     const double omega = 2.0 * kPi * hertz;
     return omega * omega;
 }
@@ -291,7 +292,7 @@ double springRate(const Scene& scene, const SystemSwitches& switches) {
 
 } // namespace
 
-double expectedPileOverlap(int depth, double gravity, double h, double massRatio) {
+double expectedPileOverlap(int depth, double gravity, double h, double massRatio, double hertzFraction) {
     // A resting soft contact compresses by load / (m_n omega^2). In a pile
     // `depth` bodies deep the lowest contacts between bodies carry about
     // (depth - 1) heavy bodies on a light one (world.hpp). kMeasured folds in
@@ -301,13 +302,13 @@ double expectedPileOverlap(int depth, double gravity, double h, double massRatio
     constexpr double kMeasured = 1.0;
     if (depth < 2 || !(gravity > 0.0) || !(h > 0.0)) return 0.0;
     const double ratio = std::max(1.0, massRatio);
-    return kMeasured * double(depth - 1) * (1.0 + ratio) * gravity / contactOmega2(h);
+    return kMeasured * double(depth - 1) * (1.0 + ratio) * gravity / contactOmega2(h, hertzFraction);
 }
 
-double expectedSupportOverlap(int depth, double gravity, double h, double massRatio) {
+double expectedSupportOverlap(int depth, double gravity, double h, double massRatio, double hertzFraction) {
     if (depth < 1 || !(gravity > 0.0) || !(h > 0.0)) return 0.0;
     const double ratio = std::max(1.0, massRatio);
-    return (double(depth - 1) * ratio + 1.0) * gravity / contactOmega2(h);
+    return (double(depth - 1) * ratio + 1.0) * gravity / contactOmega2(h, hertzFraction);
 }
 
 double derivedRestitutionThreshold(double gravity, double h) { return 4.0 * gravity * h; }
@@ -492,20 +493,28 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         choice.stackDepth = int(std::min<long long>(depth, 1'000'000));
     }
 
+    // A deep column of boxes gets softer contacts (kDeepColumn), and the
+    // rules below count with them.
+    choice.hertzFraction = choice.columnHeight > kDeepColumn ? 0.125 : 0.25;
+    const double fraction = choice.hertzFraction;
+
     // The fewest substeps (up to 16) that hold every rule.
     const double dt = scene.world.dt;
     const auto pileHolds = [&](int s) {
-        return expectedPileOverlap(choice.stackDepth, choice.gravity, dt / s, choice.massRatio) <= 0.01 * choice.diameter;
+        return expectedPileOverlap(choice.stackDepth, choice.gravity, dt / s, choice.massRatio, fraction) <=
+               0.01 * choice.diameter;
     };
     const auto loadHolds = [&](int s) {
         if (choice.stackDepth < 1) return true;
         double limit = 0.01 * choice.diameter;
         if (choice.support > 0.0) limit = std::min(limit, 0.1 * choice.support);
-        return expectedSupportOverlap(choice.stackDepth, choice.gravity, dt / s, choice.massRatio) <= limit;
+        return expectedSupportOverlap(choice.stackDepth, choice.gravity, dt / s, choice.massRatio, fraction) <= limit;
     };
     // A contact rule that cannot hold stops where more substeps stop
     // stiffening the contacts (contactHertz's cap).
-    const auto contactsSaturated = [&](int s) { return contactOmega2(dt / s) == contactOmega2(dt / (2 * s)); };
+    const auto contactsSaturated = [&](int s) {
+        return contactOmega2(dt / s, fraction) == contactOmega2(dt / (2 * s), fraction);
+    };
     const auto fewest = [&](const auto& holds, bool contact) {
         int s = 1;
         for (; s < 16; s *= 2)
@@ -518,7 +527,8 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     const auto columnHolds = [&](int s) {
         if (choice.columnHeight < 2) return true;
         const double n = double(choice.columnHeight);
-        return 0.5 * n * (n - 1.0) * expectedPileOverlap(2, choice.gravity, dt / s) <= 0.01 * choice.columnWidth;
+        return 0.5 * n * (n - 1.0) * expectedPileOverlap(2, choice.gravity, dt / s, 1.0, fraction) <=
+               0.01 * choice.columnWidth;
     };
     choice.pileSubsteps = std::max(fewest(pileHolds, true), fewest(columnHolds, true));
     choice.loadSubsteps = fewest(loadHolds, true);
