@@ -424,15 +424,6 @@ TEST(LoaderRegressions, EscapingControlCharactersDoesNotPushAMessagePastTheBound
 
 namespace {
 
-/// `stepwise run --out`'s file: state and solver state.
-std::string savedRun(const World& world, Scene scene) {
-    world.writeBack(scene);
-    scene.solverState.reset();
-    SolverState solver = world.solverState();
-    if (!solver.empty()) scene.solverState = std::move(solver);
-    return sceneToJsonText(scene);
-}
-
 std::string number(double v) { return formatNumber(v); }
 
 } // namespace
@@ -487,7 +478,7 @@ TEST(LoaderRegressions, ExtremeLevelsStepWithFiniteNumbersAndSaveWhatLoads) {
                                 }
                                 if (!ok) continue;
                                 ++ran;
-                                const std::string saved = savedRun(*world, *scene);
+                                const std::string saved = test::savedRunText(*world, *scene);
                                 Result<Scene> again = parseScene(saved, "saved.json");
                                 EXPECT_TRUE(again) << again.error() << "\n" << saved;
                             }

@@ -183,4 +183,14 @@ inline CommandResult runCommand(const std::string& line) {
     return r;
 }
 
+/// The scene as `stepwise run --out` writes it: the world's state written
+/// back, and its solver state when it carries any.
+inline std::string savedRunText(const World& world, Scene scene) {
+    world.writeBack(scene);
+    scene.solverState.reset();
+    SolverState solver = world.solverState();
+    if (!solver.empty()) scene.solverState = std::move(solver);
+    return sceneToJsonText(scene);
+}
+
 } // namespace stepwise::test

@@ -35,14 +35,7 @@ constexpr auto build = &test::buildWorld;
 
 using test::shippedLevels;
 
-/// The scene as `stepwise run --out` writes it: state and solver state.
-std::string savedText(const World& world, Scene scene) {
-    world.writeBack(scene);
-    scene.solverState.reset();
-    SolverState solver = world.solverState();
-    if (!solver.empty()) scene.solverState = std::move(solver);
-    return sceneToJsonText(scene);
-}
+constexpr auto savedText = &test::savedRunText;
 
 /// n + m straight steps against n steps, save as text, parse, m steps: the
 /// two saved texts (every number round-trips to its double) must be equal.
