@@ -394,25 +394,45 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         heaviestMass = std::max(heaviestMass, m);
     }
     // Columns: flat-faced bodies (boxes, polygons) stand on one another as
-    // placed, where circles roll off into a heap. The fullest column, in
-    // bins one median flat body wide across gravity, is how tall a stack
-    // the scene has. (A resumed run uses its recorded choice, so where the
-    // bodies are now only matters for a level as authored.)
+    // placed, where circles roll off into a heap. The tallest stack, in
+    // bins one median flat body wide across gravity, of bodies that touch
+    // the one below (a gap under a quarter of a body), is how tall a stack
+    // the scene has; bodies placed apart (ragdolls waiting to fall) are no
+    // stack. (A resumed run uses its recorded choice, so where the bodies
+    // are now only matters for a level as authored.)
     {
-        std::vector<std::pair<double, double>> flat;  // (position across gravity, size)
+        struct Flat {
+            double across, bottom, top, size;
+        };
+        std::vector<Flat> flat;
         for (std::uint32_t i = 0; i < bodies.size(); ++i) {
             const Entity e = bodies[i];
             if (!switches.collisions || !(reg.has<Box>(e) || reg.has<Polygon>(e))) continue;
             if (jointed[i] && groupAnchored[findRoot(parent, i)]) continue;
-            flat.emplace_back(dot(reg.tryGet<Position>(e)->value, across), sizeOf(e));
+            const Vec2 p = reg.tryGet<Position>(e)->value;
+            // Height against gravity: the centre, then half the extent.
+            const double up = -(dot(p, down) + centreAlong(reg, e, down)), half = halfExtentAlong(reg, e, down);
+            flat.push_back({dot(p, across) + centreAlong(reg, e, across), up - half, up + half, sizeOf(e)});
         }
         std::vector<double> flatSizes;
-        for (const auto& f : flat) flatSizes.push_back(f.second);
+        for (const Flat& f : flat) flatSizes.push_back(f.size);
         const double width = median(flatSizes);
         if (width > 0.0) {
-            std::map<long long, int> columns;
-            for (const auto& f : flat) ++columns[(long long)std::floor(f.first / width)];
-            for (const auto& [column, count] : columns) choice.columnHeight = std::max(choice.columnHeight, count);
+            std::map<long long, std::vector<const Flat*>> columns;
+            for (const Flat& f : flat) columns[(long long)std::floor(f.across / width)].push_back(&f);
+            for (auto& [column, members] : columns) {
+                std::sort(members.begin(), members.end(), [](const Flat* a, const Flat* b) {
+                    return a->bottom != b->bottom ? a->bottom < b->bottom : a->top < b->top;
+                });
+                int run = 1;
+                double reach = members.front()->top;
+                for (std::size_t k = 1; k < members.size(); ++k) {
+                    run = members[k]->bottom - reach <= 0.25 * width ? run + 1 : 1;
+                    reach = run == 1 ? members[k]->top : std::max(reach, members[k]->top);
+                    choice.columnHeight = std::max(choice.columnHeight, run);
+                }
+                choice.columnHeight = std::max(choice.columnHeight, 1);
+            }
             choice.columnWidth = width;
         }
     }
