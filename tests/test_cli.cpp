@@ -957,6 +957,43 @@ TEST_F(Cli, AnImplicitSolveThatFailsOrLosesAccuracyExitsThreeNamingItsBodies) {
         }
 }
 
+// A saved impulse larger than any run of the scene can leave (here 1.6e10
+// N*s: the bound is loose, since it must hold for any run a level's ranges
+// allow) is dropped with a warning naming the bound, and the balls stay
+// where they rest; a plausible one is kept.
+TEST_F(Cli, ASavedImpulseNoRunCouldWriteIsDroppedWithAWarning) {
+    const auto level = [](const char* impulse) {
+        return std::string(R"({"entities": [
+            {"name": "floor", "position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 10, "height": 1}},
+            {"name": "a", "position": {"x": 0, "y": 0.5}, "radius": 0.5, "mass": 1},
+            {"name": "b", "position": {"x": 0, "y": 1.5}, "radius": 0.5, "mass": 1}],
+            "solver_state": {"contacts": [
+              {"a": "floor", "b": "a", "feature": 0, "normal_impulse": )") + impulse + R"(, "tangent_impulse": 0},
+              {"a": "a", "b": "b", "feature": 0, "normal_impulse": )" + impulse + R"(, "tangent_impulse": 0}]}})";
+    };
+    const fs::path wild = write("wild.json", level("1e11")), out = dir_ / "out.json";
+    Outcome o = stepwise("run " + wild.string() + " --steps 60 --out " + out.string());
+    EXPECT_EQ(o.exitCode, 0) << o.err;
+    const std::string warning = ": warning: solver_state: 2 saved contact impulses up to 1e+11 N*s dropped: no "
+                                "run of this scene can leave more than 16000000001.308 N*s on a contact (4 x its "
+                                "dynamic mass x (2 x 1e9 m/s + g dt)); those contacts start cold, so the run does "
+                                "not resume exactly\n";
+    EXPECT_EQ(o.err, wild.string() + warning);
+    // b, still resting on a, is where it was placed (a warm start of 1e11
+    // would have thrown it kilometres).
+    const std::string saved = readFile(out);
+    const std::size_t b = saved.find("\"name\": \"b\"");
+    ASSERT_NE(b, std::string::npos) << saved;
+    const std::size_t y = saved.find("\"y\": ", saved.find("\"position\"", b));
+    EXPECT_NEAR(std::stod(saved.substr(y + 5)), 1.5, 0.01) << saved.substr(b, 200);
+    o = stepwise("validate " + wild.string());
+    EXPECT_NE(o.err.find(wild.string() + warning), std::string::npos) << o.err;
+    const fs::path calm = write("calm.json", level("0.16"));
+    o = stepwise("run " + calm.string() + " --steps 60");
+    EXPECT_EQ(o.exitCode, 0);
+    EXPECT_EQ(o.err.find("warning"), std::string::npos) << o.err;
+}
+
 // Values the engine cannot step (their energy, inertia or area leaves the
 // doubles, or a contact's answer drowns in a speed's rounding) are refused
 // when the level is read, at the field, with exit 2 and nothing written;

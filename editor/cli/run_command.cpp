@@ -189,6 +189,8 @@ int run(const RunOptions& options) {
     // the summary on stdout stays one line).
     if (const std::optional<PileHint> pile = world.pileHint())
         std::cerr << options.level << ": warning: " << pile->message() << "\n";
+    if (const std::optional<DroppedImpulses> dropped = world.droppedImpulses())
+        std::cerr << options.level << ": warning: " << dropped->message() << "\n";
 
     // The trace and contacts stream into temporaries next to their targets
     // (memory stays flat however long the run); they are put in place only

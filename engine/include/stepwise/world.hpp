@@ -237,6 +237,16 @@ struct PileHint {
     std::string message() const;
 };
 
+/// A warning after a resume: saved contact impulses larger than any run of
+/// this scene can write were dropped (World::setSolverState), so the run
+/// starts those contacts cold and is not an exact resume.
+struct DroppedImpulses {
+    std::size_t count = 0;
+    double largest = 0.0;  ///< N*s, the largest dropped
+    double bound = 0.0;    ///< N*s, the most a run can write here
+    std::string message() const;
+};
+
 class WorldImpl;
 
 class World {
@@ -333,6 +343,8 @@ public:
     /// Set when the scene's deepest pile would sink more than 2% of a
     /// diameter at the running substeps (see PileHint).
     std::optional<PileHint> pileHint() const;
+    /// Set when the last setSolverState dropped impulses no run could write.
+    std::optional<DroppedImpulses> droppedImpulses() const;
 
     /// Net force a unit-mass probe at `point` would feel from the scene's
     /// field forces: gravity and attractors, through the same code the step

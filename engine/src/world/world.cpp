@@ -533,15 +533,38 @@ void World::setSolverState(const SolverState& state) {
         w.sleepChanged();
         w.sleptUnder = w.settings;  // a resume steps on under the settings it is given
     }
+    w.dropped.reset();
     if (!w.collision) return;
     std::unordered_map<Entity, std::uint32_t> colliderOf;
     const std::vector<Entity>& colliders = w.layout->colliders;
     for (std::size_t c = 0; c < colliders.size(); ++c) colliderOf.emplace(colliders[c], std::uint32_t(c));
+    // The most impulse a run can leave on one contact, when contacts,
+    // gravity and drag are all that act (springs, attractors, boids and
+    // joints can press with any force, so no bound is claimed for them). A
+    // contact's impulse over a substep passes through the bodies it holds up
+    // or stops: at most every dynamic body's mass times what the substep
+    // can change of its velocity, from the fastest a level holds to the
+    // fastest the other way, plus a step of gravity; four times that. A
+    // saved impulse past it would fling the bodies it warms (1e10 N*s on two
+    // 1 kg balls threw them 4.8e6 m), so it is dropped with a warning.
+    const detail::ForceModel& f = w.model;
+    const bool bounded = f.springs.empty() && f.attractors.empty() && f.boids.body.empty() &&
+                         w.collision->jointConstraints().empty();
+    double totalMass = 0.0;
+    for (const double m : f.mass) totalMass += m;
+    const double bound = 4.0 * totalMass * (2.0 * kMaxSpeed + length(w.settings.gravity) * w.settings.dt);
     std::vector<CachedImpulse> cache;
     cache.reserve(state.contacts.size());
     for (const ContactImpulse& c : state.contacts) {
         const auto a = colliderOf.find(c.a), b = colliderOf.find(c.b);
         if (a == colliderOf.end() || b == colliderOf.end()) continue;  // no longer collides: nothing to warm
+        const double largest = std::max(std::abs(c.normalImpulse), std::abs(c.tangentImpulse));
+        if (bounded && !(largest <= bound)) {
+            if (!w.dropped) w.dropped = DroppedImpulses{.bound = bound};
+            ++w.dropped->count;
+            w.dropped->largest = std::max(w.dropped->largest, largest);
+            continue;
+        }
         cache.push_back({CachedImpulse::makeKey(a->second, b->second, c.feature), c.normalImpulse, c.tangentImpulse});
     }
     // Kept in the given order when it is sorted (always, for a state this
@@ -827,6 +850,15 @@ std::vector<StiffnessHint> World::stiffnessHints() const {
         hints.push_back(std::move(hint));
     }
     return hints;
+}
+
+std::optional<DroppedImpulses> World::droppedImpulses() const { return impl_->dropped; }
+
+std::string DroppedImpulses::message() const {
+    return "solver_state: " + std::to_string(count) + " saved contact impulse" + (count == 1 ? "" : "s") +
+           " up to " + formatNumber(largest) + " N*s dropped: no run of this scene can leave more than " +
+           formatNumber(bound) + " N*s on a contact (4 x its dynamic mass x (2 x 1e9 m/s + g dt)); those contacts "
+           "start cold, so the run does not resume exactly";
 }
 
 std::optional<PileHint> World::pileHint() const {

@@ -57,6 +57,7 @@ public:
     /// no shapes (then the step has no collision stages). It owns the
     /// rotation of the bodies that have shapes: only contacts make torque.
     std::unique_ptr<collision::CollisionSystem> collision;
+    std::optional<DroppedImpulses> dropped;  ///< by the last setSolverState
     ContactSettingsChoice contactChoice;  ///< the scene's deepest pile (pileHint) and the engine's choice
     World::SettingsSource settingsSource = World::SettingsSource::Given;  ///< where substeps came from
     bool substepsGiven = false, iterationsGiven = false;  ///< by the level's world object
