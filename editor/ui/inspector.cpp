@@ -64,9 +64,11 @@ bool fieldWidget(UiState& ui, const FieldInfo& f, FieldValue& value, const char*
     switch (f.kind) {
     case FieldKind::Number: {
         double& v = std::get<double>(value);
-        // A range (0, max] (dt, a tolerance) is dragged on a log scale: its
-        // useful values span decades.
-        if (f.range.minExclusive && f.range.min == 0.0 && hi)
+        // A range (0, max] with a setting's own cap (dt, a tolerance,
+        // joint_hz) is dragged on a log scale: its useful values span
+        // decades. The level-wide bounds (1e9 for speeds, 1e30 for the rest)
+        // are no such cap: a log drag across them would leap.
+        if (f.range.minExclusive && f.range.min == 0.0 && hi && *hi < kMaxSpeed)
             return ImGui::DragScalar(label, ImGuiDataType_Double, &v, 0.01f, lo, hi, "%.6g",
                                      ImGuiSliderFlags_Logarithmic);
         return ImGui::DragScalar(label, ImGuiDataType_Double, &v, dragSpeed(ui, ImGui::GetID(label), v), lo, hi, "%.6g");
