@@ -172,6 +172,7 @@ struct ContactSettingsChoice {
     double massRatio = 1.0;    ///< heaviest / lightest dynamic shape that can pile
     double support = 0.0;      ///< m, thinnest static support along gravity (0: none)
     int columnHeight = 0;      ///< flat-faced bodies in the fullest column as placed
+    int stackHeight = 0;       ///< of them, the most that touch one on another
     double columnWidth = 0.0;  ///< m, the median flat-faced body's size
     int pileSubsteps = 1;      ///< what each rule alone needs (the pile's and the column's)
     int loadSubsteps = 1;
@@ -181,8 +182,9 @@ struct ContactSettingsChoice {
     double springRate = 0.0;
     int springSubsteps = 1;    ///< the fewest with h * springRate <= 1
     /// Contact stiffness cap as a fraction of the substep rate: 0.25, or
-    /// 0.125 (with one colour order) when columnHeight > kDeepColumn
-    /// (SolverSettings::hertzFraction); the rules above use the same cap.
+    /// 0.125 (with one colour order) when stackHeight > kDeepColumn under
+    /// gravity (SolverSettings::hertzFraction); the rules above use the
+    /// same cap.
     double hertzFraction = 0.25;
     /// "pile 12 deep ...": what made the choice.
     std::string reason() const;

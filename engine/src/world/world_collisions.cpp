@@ -394,12 +394,15 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         heaviestMass = std::max(heaviestMass, m);
     }
     // Columns: flat-faced bodies (boxes, polygons) stand on one another as
-    // placed, where circles roll off into a heap. The tallest stack, in
-    // bins one median flat body wide across gravity, of bodies that touch
-    // the one below (a gap under a quarter of a body), is how tall a stack
-    // the scene has; bodies placed apart (ragdolls waiting to fall) are no
-    // stack. (A resumed run uses its recorded choice, so where the bodies
-    // are now only matters for a level as authored.)
+    // placed, where circles roll off into a heap. In bins one median flat
+    // body wide across gravity: the fullest bin is how tall a stack the
+    // bodies can make (columnHeight, the column rule below), and the
+    // tallest run of bodies that touch the one below (a gap under a quarter
+    // of a body) is how tall a stack stands as placed (stackHeight, the
+    // deep-column contacts); bodies placed apart, such as ragdolls waiting
+    // to fall, make the first but not the second. (A resumed run uses its
+    // recorded choice, so where the bodies are now only matters for a level
+    // as authored.)
     {
         struct Flat {
             double across, bottom, top, size;
@@ -412,7 +415,7 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
             const Vec2 p = reg.tryGet<Position>(e)->value;
             // Height against gravity: the centre, then half the extent.
             const double up = -(dot(p, down) + centreAlong(reg, e, down)), half = halfExtentAlong(reg, e, down);
-            flat.push_back({dot(p, across) + centreAlong(reg, e, across), up - half, up + half, sizeOf(e)});
+            flat.push_back({dot(p, across), up - half, up + half, sizeOf(e)});
         }
         std::vector<double> flatSizes;
         for (const Flat& f : flat) flatSizes.push_back(f.size);
@@ -421,17 +424,18 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
             std::map<long long, std::vector<const Flat*>> columns;
             for (const Flat& f : flat) columns[(long long)std::floor(f.across / width)].push_back(&f);
             for (auto& [column, members] : columns) {
+                choice.columnHeight = std::max(choice.columnHeight, int(members.size()));
                 std::sort(members.begin(), members.end(), [](const Flat* a, const Flat* b) {
                     return a->bottom != b->bottom ? a->bottom < b->bottom : a->top < b->top;
                 });
                 int run = 1;
                 double reach = members.front()->top;
+                choice.stackHeight = std::max(choice.stackHeight, 1);
                 for (std::size_t k = 1; k < members.size(); ++k) {
                     run = members[k]->bottom - reach <= 0.25 * width ? run + 1 : 1;
                     reach = run == 1 ? members[k]->top : std::max(reach, members[k]->top);
-                    choice.columnHeight = std::max(choice.columnHeight, run);
+                    choice.stackHeight = std::max(choice.stackHeight, run);
                 }
-                choice.columnHeight = std::max(choice.columnHeight, 1);
             }
             choice.columnWidth = width;
         }
@@ -513,9 +517,9 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         choice.stackDepth = int(std::min<long long>(depth, 1'000'000));
     }
 
-    // A deep column of boxes gets softer contacts (kDeepColumn), and the
-    // rules below count with them.
-    choice.hertzFraction = choice.columnHeight > kDeepColumn ? 0.125 : 0.25;
+    // A deep column of boxes standing under gravity gets softer contacts
+    // (kDeepColumn), and the rules below count with them.
+    choice.hertzFraction = choice.gravity > 0.0 && choice.stackHeight > kDeepColumn ? 0.125 : 0.25;
     const double fraction = choice.hertzFraction;
 
     // The fewest substeps (up to 16) that hold every rule.
