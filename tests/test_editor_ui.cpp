@@ -22,6 +22,17 @@
 
 namespace {
 
+/// An editor session on the current offscreen context, as the tests want it:
+/// no settings read or written, a fixed clock, the built-in font.
+auto headlessSession() {
+    stepwise::ui::SessionOptions options;
+    options.persist = false;
+    options.deterministic = true;
+    options.builtinFont = true;
+    return stepwise::ui::Session::create(
+        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+}
+
 using stepwise::ui::applyTheme;
 using stepwise::ui::beginPanel;
 
@@ -109,12 +120,7 @@ TEST(SessionFrame, PresentsThePreviousFrameAfterPhysicsAndBeforeDrawing) {
     const int w = 640, h = 400;
     auto context = stepwise::render::OffscreenRenderer::create(w, h);
     ASSERT_TRUE(context.ok()) << context.error();
-    stepwise::ui::SessionOptions options;
-    options.persist = false;
-    options.deterministic = true;
-    options.builtinFont = true;
-    auto created = stepwise::ui::Session::create(
-        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    auto created = headlessSession();
     ASSERT_TRUE(created.ok()) << created.error();
     stepwise::ui::Session& session = **created;
     stepwise::editor::Editor& ed = session.editor();
@@ -251,12 +257,7 @@ TEST(SessionFrame, TheMouseSpringDrawsALineFromTheBodyToTheCursor) {
     const int w = 800, h = 600;
     auto context = stepwise::render::OffscreenRenderer::create(w, h);
     ASSERT_TRUE(context.ok()) << context.error();
-    stepwise::ui::SessionOptions options;
-    options.persist = false;
-    options.deterministic = true;
-    options.builtinFont = true;
-    auto created = stepwise::ui::Session::create(
-        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    auto created = headlessSession();
     ASSERT_TRUE(created.ok()) << created.error();
     stepwise::ui::Session& session = **created;
     stepwise::editor::Editor& ed = session.editor();
@@ -326,12 +327,7 @@ TEST(SessionFrame, OpenRecentOnADeletedLevelShowsTheReasonInTheModalAndTheStatus
     const std::filesystem::path gone = dir / "gone.json";
     std::filesystem::copy_file(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / "default.json", gone,
                                std::filesystem::copy_options::overwrite_existing);
-    stepwise::ui::SessionOptions options;
-    options.persist = false;
-    options.deterministic = true;
-    options.builtinFont = true;
-    auto created = stepwise::ui::Session::create(
-        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    auto created = headlessSession();
     ASSERT_TRUE(created.ok()) << created.error();
     stepwise::ui::Session& session = **created;
     stepwise::editor::Editor& ed = session.editor();
@@ -398,12 +394,7 @@ TEST(SessionFrame, EachSaveDialogProposesAPathFromTheLevelOpenNow) {
     std::filesystem::create_directories(dir / "mine");
     const std::filesystem::path bridge = dir / "mine" / "bridge.json";
     std::filesystem::copy_file(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / "bridge.json", bridge);
-    stepwise::ui::SessionOptions options;
-    options.persist = false;
-    options.deterministic = true;
-    options.builtinFont = true;
-    auto created = stepwise::ui::Session::create(
-        [](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }, options);
+    auto created = headlessSession();
     ASSERT_TRUE(created.ok()) << created.error();
     stepwise::ui::Session& session = **created;
     stepwise::editor::Editor& ed = session.editor();
