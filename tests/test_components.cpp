@@ -23,6 +23,8 @@ void setDistinct(const FieldInfo& field, void* component, int salt, Entity targe
     switch (field.kind) {
     case FieldKind::Number: *static_cast<double*>(m) = field.range.contains(v * 7.3) ? v * 7.3 : v; break;
     case FieldKind::Integer: *static_cast<int*>(m) = int(field.range.min) + salt; break;
+    // High bits set too, so a save that kept only 31 bits would be caught.
+    case FieldKind::Bits: *static_cast<std::uint32_t*>(m) = 0x80000001u + std::uint32_t(salt); break;
     case FieldKind::OptionalNumber: *static_cast<std::optional<double>*>(m) = v * 3.1; break;
     case FieldKind::Vector: *static_cast<Vec2*>(m) = {0.1 * salt + 1.0 / 3.0, -2.0 / 7.0}; break;
     case FieldKind::OptionalVector: *static_cast<std::optional<Vec2>*>(m) = Vec2{1e-300, -9.87654321e29}; break;
@@ -49,6 +51,7 @@ bool fieldEquals(const FieldInfo& field, const void* a, const void* b, const Reg
     switch (field.kind) {
     case FieldKind::Number: return *static_cast<const double*>(ma) == *static_cast<const double*>(mb);
     case FieldKind::Integer: return *static_cast<const int*>(ma) == *static_cast<const int*>(mb);
+    case FieldKind::Bits: return *static_cast<const std::uint32_t*>(ma) == *static_cast<const std::uint32_t*>(mb);
     case FieldKind::OptionalNumber:
         return *static_cast<const std::optional<double>*>(ma) == *static_cast<const std::optional<double>*>(mb);
     case FieldKind::Vector: return *static_cast<const Vec2*>(ma) == *static_cast<const Vec2*>(mb);

@@ -7,6 +7,8 @@
 
 #include "stepwise/world_fields.hpp"
 
+#include "app/collision_pairs.hpp"
+
 using namespace stepwise;
 using namespace stepwise::editor;
 using namespace stepwise::editor_test;
@@ -172,4 +174,43 @@ TEST(EntityList, EveryShapeAndLinkIsNamedForWhatItIs) {
     const Registry& springs = chain.ed.doc.scene.registry;
     EXPECT_EQ(entityKind(springs, findByName(springs, "spring0")), "spring");
     EXPECT_EQ(entityKind(springs, findByName(springs, "link0")), "point");
+}
+
+TEST(Inspector, ExcludedPartnersFollowFiltersAndJointsOfTheSelectedBody) {
+    {
+        Fixture f("filters.json");
+        const Scene& scene = f.ed.doc.scene;
+        const auto names = [&](const std::vector<ExcludedPartner>& list) {
+            std::map<std::string, std::string> out;
+            for (const ExcludedPartner& p : list) out[displayName(scene.registry, p.body)] = p.reason;
+            return out;
+        };
+        // A ragdoll's bones share a negative group: the torso meets none of
+        // the other nine bones of its own ragdoll, and every bone of the other.
+        const auto torso = names(excludedPartners(scene, f.named("A torso")));
+        EXPECT_EQ(torso.size(), 9u);
+        for (const auto& [name, reason] : torso) {
+            EXPECT_EQ(name.substr(0, 2), "A ") << name;
+            EXPECT_EQ(reason, "filter") << name;
+        }
+        // A ghost ball leaves the gate's category out of its mask.
+        EXPECT_EQ(names(excludedPartners(scene, f.named("ghost ball 0"))),
+                  (std::map<std::string, std::string>{{"gate", "filter"}}));
+        EXPECT_TRUE(excludedPartners(scene, f.named("crate 0")).empty());
+        // The gate is static: against the other static bodies nothing is
+        // excluded, since those pairs never meet anyway.
+        EXPECT_EQ(excludedPartners(scene, f.named("gate")).size(), 4u);
+    }
+    {
+        // Without filters, a joint with collide_connected false excludes its pair.
+        Fixture f("ragdoll.json");
+        std::map<std::string, std::string> torso;
+        for (const ExcludedPartner& p : excludedPartners(f.ed.doc.scene, f.named("torso")))
+            torso[displayName(f.ed.doc.scene.registry, p.body)] = p.reason;
+        EXPECT_EQ(torso, (std::map<std::string, std::string>{{"head", "joint neck"},
+                                                             {"upper arm L", "joint shoulder L"},
+                                                             {"upper arm R", "joint shoulder R"},
+                                                             {"thigh L", "joint hip L"},
+                                                             {"thigh R", "joint hip R"}}));
+    }
 }

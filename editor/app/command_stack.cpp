@@ -50,6 +50,7 @@ void encodeComponent(std::string& out, std::size_t c, const void* component) {
         switch (f.kind) {
         case FieldKind::Number: put(out, *static_cast<const double*>(field)); break;
         case FieldKind::Integer: put(out, *static_cast<const int*>(field)); break;
+        case FieldKind::Bits: put(out, *static_cast<const std::uint32_t*>(field)); break;
         case FieldKind::VectorList: {
             const auto& list = *static_cast<const std::vector<Vec2>*>(field);
             put(out, std::uint32_t(list.size()));
@@ -128,6 +129,7 @@ void decodeEntity(const std::string& in, Registry& reg, Entity e) {
             switch (f.kind) {
             case FieldKind::Number: *static_cast<double*>(field) = take<double>(in, at); break;
             case FieldKind::Integer: *static_cast<int*>(field) = take<int>(in, at); break;
+            case FieldKind::Bits: *static_cast<std::uint32_t*>(field) = take<std::uint32_t>(in, at); break;
             case FieldKind::VectorList: {
                 auto& list = *static_cast<std::vector<Vec2>*>(field);
                 list.resize(take<std::uint32_t>(in, at));

@@ -21,6 +21,7 @@ void copyField(const FieldInfo& field, const void* src, void* dst) {
     switch (field.kind) {
     case FieldKind::Number: *static_cast<double*>(to) = *static_cast<const double*>(from); break;
     case FieldKind::Integer: *static_cast<int*>(to) = *static_cast<const int*>(from); break;
+    case FieldKind::Bits: *static_cast<std::uint32_t*>(to) = *static_cast<const std::uint32_t*>(from); break;
     case FieldKind::OptionalNumber:
         *static_cast<std::optional<double>*>(to) = *static_cast<const std::optional<double>*>(from);
         break;
@@ -43,6 +44,7 @@ FieldValue readField(const FieldInfo& field, const void* component) {
     switch (field.kind) {
     case FieldKind::Number: return *static_cast<const double*>(at);
     case FieldKind::Integer: return *static_cast<const int*>(at);
+    case FieldKind::Bits: return *static_cast<const std::uint32_t*>(at);
     case FieldKind::OptionalNumber: return *static_cast<const std::optional<double>*>(at);
     case FieldKind::Vector: return *static_cast<const Vec2*>(at);
     case FieldKind::OptionalVector: return *static_cast<const std::optional<Vec2>*>(at);
@@ -65,6 +67,7 @@ void writeField(const FieldInfo& field, void* component, const FieldValue& value
             const bool matches =
                 (std::is_same_v<V, double> && field.kind == FieldKind::Number) ||
                 (std::is_same_v<V, int> && field.kind == FieldKind::Integer) ||
+                (std::is_same_v<V, std::uint32_t> && field.kind == FieldKind::Bits) ||
                 (std::is_same_v<V, std::optional<double>> && field.kind == FieldKind::OptionalNumber) ||
                 (std::is_same_v<V, Vec2> && field.kind == FieldKind::Vector) ||
                 (std::is_same_v<V, std::optional<Vec2>> && field.kind == FieldKind::OptionalVector) ||
@@ -85,6 +88,7 @@ bool valueFitsKind(const FieldInfo& field, const FieldValue& value) {
             switch (field.kind) {
             case FieldKind::Number: return std::is_same_v<V, double>;
             case FieldKind::Integer: return std::is_same_v<V, int>;
+            case FieldKind::Bits: return std::is_same_v<V, std::uint32_t>;
             case FieldKind::OptionalNumber: return std::is_same_v<V, std::optional<double>>;
             case FieldKind::Vector: return std::is_same_v<V, Vec2>;
             case FieldKind::OptionalVector: return std::is_same_v<V, std::optional<Vec2>>;

@@ -6,6 +6,7 @@
 
 #include "ui/panels/panels.hpp"
 
+#include "app/collision_pairs.hpp"
 #include "app/scene_edit.hpp"
 
 #include "stepwise/component_table.hpp"
@@ -74,11 +75,12 @@ bool fieldWidget(UiState& ui, const FieldInfo& f, FieldValue& value, const char*
         return ImGui::DragScalar(label, ImGuiDataType_Double, &v, dragSpeed(ui, ImGui::GetID(label), v), lo, hi, "%.6g");
     }
     case FieldKind::Integer: {
-        // Only world settings are integers; 0 there is "not given"
-        // (the engine chooses), shown as "auto" until dragged.
+        // In the world settings, whose integers are never negative, 0 is
+        // "not given" (the engine chooses), shown as "auto" until dragged.
         int& v = std::get<int>(value);
         const int intLo = lo ? int(*lo) : 0, intHi = hi ? int(*hi) : 0;
-        if (!ImGui::DragInt(label, &v, 0.1f, intLo, intHi, v == 0 ? "auto" : "%d")) return false;
+        const bool autoAtZero = lo && *lo >= 0.0;
+        if (!ImGui::DragInt(label, &v, 0.1f, intLo, intHi, v == 0 && autoAtZero ? "auto" : "%d")) return false;
         if (lo && hi) v = std::clamp(v, intLo, intHi);
         return true;
     }
@@ -142,6 +144,12 @@ bool fieldWidget(UiState& ui, const FieldInfo& f, FieldValue& value, const char*
         return true;
     }
     case FieldKind::Bool: return ImGui::Checkbox(label, &std::get<bool>(value));
+    case FieldKind::Bits: {
+        // Bit fields read best in hexadecimal, one digit per four bits.
+        std::uint32_t& v = std::get<std::uint32_t>(value);
+        return ImGui::InputScalar(label, ImGuiDataType_U32, &v, nullptr, nullptr, "%08X",
+                                  ImGuiInputTextFlags_CharsHexadecimal);
+    }
     case FieldKind::VectorList: {
         // One row per vertex, grouped so the whole list is one item (one
         // undo step per drag). The component's check refuses an edit that
@@ -255,6 +263,20 @@ bool worldFieldWidget(UiState& ui, Editor& ed, std::string_view key) {
     return changed;
 }
 
+/// What the selected body never collides with (filters, joints), so a
+/// designer sees the effect of a filter without running the level.
+void drawExcludedPartners(const Scene& scene, Entity body) {
+    const std::vector<editor::ExcludedPartner> excluded = editor::excludedPartners(scene, body);
+    if (excluded.empty()) return;
+    const std::string header = "never collides with (" + std::to_string(excluded.size()) + ")";
+    if (!ImGui::CollapsingHeader(header.c_str())) return;
+    constexpr std::size_t kListed = 20;
+    for (std::size_t i = 0; i < excluded.size() && i < kListed; ++i)
+        ImGui::TextColored(kDim, "%s  (%s)", editor::displayName(scene.registry, excluded[i].body).c_str(),
+                           excluded[i].reason.c_str());
+    if (excluded.size() > kListed) ImGui::TextColored(kDim, "... and %zu more", excluded.size() - kListed);
+}
+
 void drawInspector(UiState& ui, Editor& ed) {
     if (!beginPanel("Inspector", &ui.showInspector)) {
         ImGui::End();
@@ -358,6 +380,7 @@ void drawInspector(UiState& ui, Editor& ed) {
         }
         ImGui::PopID();
     }
+    if (selection.size() == 1) drawExcludedPartners(ed.doc.scene, primary);
     if (toRemove) {
         const ComponentInfo& info = *toRemove;
         std::string problem;

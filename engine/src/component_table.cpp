@@ -25,6 +25,7 @@ constexpr NumberRange kNonNegative{0.0, kMaxMagnitude, false};
 /// its inverse) stay normal doubles.
 constexpr NumberRange kSize{kMinSize, kMaxMagnitude, false};
 constexpr NumberRange kUnit{0.0, 1.0, false};
+constexpr NumberRange kGroup{-2147483647.0, 2147483647.0, false};
 
 template <auto Member>
 FieldInfo field(std::string_view key, NumberRange range, std::string_view unit, std::string_view description) {
@@ -169,6 +170,12 @@ std::vector<ComponentInfo> buildTable() {
                               {field<&Friction::value>("", kNonNegative, "", "Coulomb friction coefficient")}));
     t.push_back(row<Drag>("drag", "viscous damping b: force -b*v", true, needsPosition,
                           {field<&Drag::value>("", kNonNegative, "kg/s", "viscous damping coefficient")}));
+    t.push_back(row<Filter>(
+        "filter", "which pairs collide: categories, masks and groups (Box2D's rule)", false, {},
+        {field<&Filter::category>("category", kAny, "", "the bits this shape is"),
+         field<&Filter::mask>("mask", kAny, "", "the categories it collides with"),
+         field<&Filter::group>("group", kGroup, "",
+                               "same non-zero group: always collide if positive, never if negative")}));
     t.push_back(row<Plane>("plane", "infinite wall: bodies stay where normal.p >= offset", false, {},
                            {field<&Plane::normal>("normal", kAny, "", "outward normal; normalised on load"),
                             field<&Plane::offset>("offset", kAny, "m", "distance of the wall along the normal")},
@@ -246,7 +253,9 @@ std::span<const std::string_view> jointTypeNames() { return kJointTypes; }
 
 std::string NumberRange::describe(bool integer) const {
     std::ostringstream out;
-    auto num = [](double v) {
+    auto num = [integer](double v) {
+        // An integer bound in full: 2147483647, not 2.14748e+09.
+        if (integer) return std::to_string(static_cast<long long>(v));
         std::ostringstream s;
         s << v;
         return s.str();
@@ -316,6 +325,7 @@ std::optional<Error> fieldValueProblem(const FieldInfo& field, const void* membe
         return Error{message};
     }
     case FieldKind::Bool:
+    case FieldKind::Bits:
     case FieldKind::EntityRef: return std::nullopt;
     }
     return std::nullopt;

@@ -6,6 +6,7 @@
 #include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -33,6 +34,7 @@ template <class M>
 constexpr FieldKind kindOf() {
     if constexpr (std::is_same_v<M, double>) return FieldKind::Number;
     else if constexpr (std::is_same_v<M, int>) return FieldKind::Integer;
+    else if constexpr (std::is_same_v<M, std::uint32_t>) return FieldKind::Bits;
     else if constexpr (std::is_same_v<M, std::optional<double>>) return FieldKind::OptionalNumber;
     else if constexpr (std::is_same_v<M, Vec2>) return FieldKind::Vector;
     else if constexpr (std::is_same_v<M, std::optional<Vec2>>) return FieldKind::OptionalVector;

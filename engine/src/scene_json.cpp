@@ -178,6 +178,9 @@ void readField(const FieldInfo& field, const Json& v, void* component, const std
     case FieldKind::OptionalNumber:
         *static_cast<std::optional<double>*>(member) = readNumber(v, pointer, NumberRange{}, field.range);
         break;
+    case FieldKind::Bits:
+        *static_cast<std::uint32_t*>(member) = std::uint32_t(readInteger(v, pointer, 0, 0xFFFFFFFFL));
+        break;
     case FieldKind::Vector: *static_cast<Vec2*>(member) = readVector(v, pointer, field.range); break;
     case FieldKind::OptionalVector:
         *static_cast<std::optional<Vec2>*>(member) = readVector(v, pointer, field.range);
@@ -227,6 +230,7 @@ Json fieldJson(const FieldInfo& field, const void* component, const Registry& re
     switch (field.kind) {
     case FieldKind::Number: return *static_cast<const double*>(member);
     case FieldKind::Integer: return *static_cast<const int*>(member);
+    case FieldKind::Bits: return *static_cast<const std::uint32_t*>(member);
     case FieldKind::OptionalNumber: {
         const auto& o = *static_cast<const std::optional<double>*>(member);
         return o ? Json(*o) : Json(Json::value_t::discarded);

@@ -36,6 +36,7 @@ Json fieldSchema(const FieldInfo& f) {
         if (std::isfinite(f.range.min)) j[f.range.minExclusive ? "exclusiveMinimum" : "minimum"] = long(f.range.min);
         if (std::isfinite(f.range.max)) j["maximum"] = long(f.range.max);
         break;
+    case FieldKind::Bits: j = Json{{"type", "integer"}, {"minimum", 0}, {"maximum", 4294967295u}}; break;
     case FieldKind::Vector:
     case FieldKind::OptionalVector:
         // Speeds have a tighter bound than the shared vector's.

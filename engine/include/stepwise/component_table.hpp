@@ -38,6 +38,9 @@ enum class FieldKind {
     EntityRef,
     /// std::vector<Vec2>, JSON [{"x","y"}, ...]; `range` bounds the count
     VectorList,
+    /// std::uint32_t bit field, a JSON integer in [0, 2^32 - 1] (collision
+    /// categories and masks); every value is valid
+    Bits,
 };
 
 /// Inclusive/exclusive bounds for Number fields. Every number must also be

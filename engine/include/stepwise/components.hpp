@@ -13,6 +13,7 @@
 #include "stepwise/result.hpp"
 #include "stepwise/vec2.hpp"
 
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -77,6 +78,27 @@ struct Restitution { double value = 0.0; };
 struct Friction { double value = 0.2; };
 /// Viscous damping coefficient b, kg/s: force -b*v.
 struct Drag { double value = 0.0; };
+
+/// Which pairs of shapes collide (Box2D's collision filter). Two shapes
+/// with the same non-zero `group` always collide when it is positive and
+/// never when it is negative; otherwise they collide when each one's
+/// `category` bits meet the other's `mask` (shouldCollide). Absent: category
+/// 1, every mask bit, group 0, which collides with everything that has no
+/// filter.
+struct Filter {
+    std::uint32_t category = 1;           ///< the bits this shape is
+    std::uint32_t mask = 0xFFFFFFFFu;     ///< the bits it collides with
+    int group = 0;                        ///< same non-zero group: always (> 0) or never (< 0)
+};
+
+/// Box2D's rule for whether shapes with filters `a` and `b` collide.
+inline bool shouldCollide(const Filter& a, const Filter& b) {
+    if (a.group == b.group && a.group != 0) return a.group > 0;
+    return (a.mask & b.category) != 0 && (a.category & b.mask) != 0;
+}
+inline bool operator==(const Filter& a, const Filter& b) {
+    return a.category == b.category && a.mask == b.mask && a.group == b.group;
+}
 
 /// Infinite wall: bodies stay where dot(normal, p) >= offset (+ radius).
 /// `normal` is unit length after loading.

@@ -60,6 +60,7 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
         colliders_.back().shape.polygon = &polygons_.back();
     }
     const bool dynamic = c.body >= 0 && c.mass > 0.0;
+    filtered_ = filtered_ || !(c.filter == Filter{});
     colliderAsleep_.push_back(0);
     if (dynamic) awakeSolverColliders_.push_back(index);
     angles_.push_back(angle);
@@ -281,6 +282,7 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
     for (const ProxyPair& pair : pairs_) {
         const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
         if (!colliderAsleep_[a] && !colliderAsleep_[b]) continue;
+        if (!collides(a, b)) continue;
         if (!noCollide_.empty()) {
             const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
             if (std::binary_search(noCollide_.begin(), noCollide_.end(), key)) continue;
@@ -518,6 +520,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     for (const ProxyPair& pair : pairs_) {
         const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
         if (colliderAsleep_[a] || colliderAsleep_[b]) continue;  // no manifold: it would have woken them
+        if (!collides(a, b)) continue;
         if (!noCollide_.empty()) {
             // Bodies joined with collide_connected false do not collide.
             const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
@@ -548,7 +551,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     for (const std::uint32_t p : planes_) {
         for (std::size_t k = 0, count = anySleeping_ ? awakeProxies_.size() : finite_.size(); k < count; ++k) {
             const std::uint32_t b = finite_[anySleeping_ ? awakeProxies_[k] : k];
-            if (colliders_[b].body < 0) continue;
+            if (colliders_[b].body < 0 || !collides(p, b)) continue;
             const Manifold m = collide(colliders_[p].shape, {}, {}, colliders_[b].shape, centres_[b], rots[b],
                                        pairMargin(p, b));
             addManifold(p, b, m, centres_);

@@ -15,6 +15,7 @@
 #include "joints/direct_joints.hpp"
 #include "joints/joint_solver.hpp"
 
+#include "stepwise/components.hpp"
 #include "stepwise/entity.hpp"
 #include "stepwise/world.hpp"
 
@@ -35,6 +36,7 @@ struct Collider {
     double mass = 0.0;           ///< kg; 0 for static
     double restitution = 0.0;
     double friction = 0.2;
+    Filter filter;               ///< which other colliders it meets (shouldCollide)
     Entity entity;
     /// A body with no shape that is in the solver only because a joint
     /// holds it: it turns and takes impulses but never collides.
@@ -240,6 +242,13 @@ private:
     std::vector<std::pair<std::uint32_t, double>> stiffened_;  // bodies whose inertia a joint raised this substep
     std::vector<double> stiffenScratch_;
     std::vector<std::uint64_t> noCollide_;  // sorted (min collider << 32 | max collider)
+    /// Whether any collider has a filter other than the default: without
+    /// one every pair passes and the test is skipped.
+    bool filtered_ = false;
+    /// Whether colliders a and b may meet under their filters.
+    bool collides(std::uint32_t a, std::uint32_t b) const {
+        return !filtered_ || shouldCollide(colliders_[a].filter, colliders_[b].filter);
+    }
     std::vector<JointRecord> jointRecords_;
     double lastH_ = 0.0;
     // Sleeping: see refreshSleeping(). With nothing asleep these are the
