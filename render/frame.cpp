@@ -55,6 +55,7 @@ constexpr Rgba kJointForce = rgb(0x9ae6b4);
 constexpr double kPiD = 3.14159265358979323846;
 constexpr Rgba kAabb = rgb(0x68d391, 0.75f);
 constexpr Rgba kSelectionRing = rgb(0xffd166);  // the shaders' uHighlight (renderer.cpp)
+constexpr Rgba kKinematicMark = rgb(0x8be9fd);  // a kinematic body's diamond and motion marks
 constexpr Rgba kAabbCell = rgb(0x68d391, 0.06f);
 // The overlay's layer (Builder::boundingBoxes) is one colour with alpha per pixel.
 static_assert(kAabbCell.r == kAabb.r && kAabbCell.g == kAabb.g && kAabbCell.b == kAabb.b);
@@ -319,6 +320,7 @@ private:
     void trails();
     void springs();
     void bodies();
+    void kinematicMarks();
     void joints();
     void jointForces();
     void polygonPreview();
@@ -791,6 +793,40 @@ void Builder::bodies() {
             // A point mass: a fixed-size dot, larger for an attractor.
             const double dot = scene_.registry.has<Attractor>(e) ? 6.0 : 4.0;
             disc(toPx(p->value), dot, 0.0, c, flags);
+        }
+    }
+    kinematicMarks();
+}
+
+void Builder::kinematicMarks() {
+    // A kinematic body looks like any other by its colour; a diamond at its
+    // centre says it is kinematic, a fixed-length arrow which way it moves,
+    // and an arc with an arrow head which way it turns (marks, not
+    // measures: the velocity overlay gives the size).
+    for (Entity e : scene_.registry.entities()) {
+        const Kinematic* k = scene_.registry.tryGet<Kinematic>(e);
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!k || !k->value || !p) continue;
+        const Vec2 c = toPx(p->value);
+        constexpr double d = 6.0;
+        const Vec2 corner[4] = {c + Vec2{d, 0}, c + Vec2{0, d}, c + Vec2{-d, 0}, c + Vec2{0, -d}};
+        for (int i = 0; i < 4; ++i) segment(corner[i], corner[(i + 1) % 4], 1.5, kKinematicMark);
+        if (const Velocity* v = scene_.registry.tryGet<Velocity>(e); v && length(v->value) > 0.0) {
+            const Vec2 dir = v->value / length(v->value);
+            arrow(c + dir * (d + 2.0), c + dir * (d + 26.0), 2.0, kKinematicMark);
+        }
+        if (const AngularVelocity* w = scene_.registry.tryGet<AngularVelocity>(e); w && w->value != 0.0) {
+            // Three quarters of a circle, 14 px round, ending in a head
+            // pointing the way of the turn (counter-clockwise for w > 0).
+            constexpr double r = 14.0, pi = 3.14159265358979323846;
+            const double sense = w->value > 0.0 ? 1.0 : -1.0;
+            constexpr int pieces = 12;
+            for (int i = 0; i < pieces; ++i) {
+                const double a0 = sense * 1.5 * pi * i / pieces, a1 = sense * 1.5 * pi * (i + 1) / pieces;
+                const Vec2 q0 = c + r * Vec2{std::cos(a0), std::sin(a0)}, q1 = c + r * Vec2{std::cos(a1), std::sin(a1)};
+                if (i + 1 < pieces) segment(q0, q1, 1.5, kKinematicMark);
+                else arrow(q0, q1 + (q1 - q0), 1.5, kKinematicMark);
+            }
         }
     }
 }

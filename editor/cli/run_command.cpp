@@ -330,8 +330,10 @@ int run(const RunOptions& options) {
             }
     std::cout << options.level << ": ran " << taken << " steps of " << number(world.settings().dt) << " s ("
               << world.settings().substeps << " substep" << (world.settings().substeps == 1 ? "" : "s") << ") with "
-              << world.settings().integrator << "; t = " << number(world.time()) << " s; " << world.bodyCount()
-              << " dynamic bodies; total energy " << number(energy.total()) << " J; "
+               << world.settings().integrator << "; t = " << number(world.time()) << " s; "
+              << world.bodyCount() - world.kinematicCount() << " dynamic bodies"
+              << (world.kinematicCount() ? " and " + std::to_string(world.kinematicCount()) + " kinematic" : std::string())
+              << "; total energy " << number(energy.total()) << " J; "
               << number(taken ? 1e3 * seconds / double(taken) : 0.0) << " ms/step";
     if (options.out) std::cout << "; wrote " << *options.out;
     if (options.trace) std::cout << "; trace " << *options.trace;

@@ -41,6 +41,13 @@ std::vector<std::string> ineffectiveComponents(const Scene& scene) {
             if (r.has<Mass>(e) && !r.has<Attractor>(e))
                 notes.push_back(label + ": \"mass\" on a static body has no effect (static mass is infinite)");
         }
+        if (r.has<Kinematic>(e) && r.tryGet<Kinematic>(e)->value) {
+            if (r.has<Mass>(e)) notes.push_back(label + ": \"mass\" on a kinematic body has no effect (its mass is infinite)");
+            if (r.has<Drag>(e))
+                notes.push_back(label + ": \"drag\" on a kinematic body has no effect (only its velocity moves it)");
+            if (r.has<Boid>(e))
+                notes.push_back(label + ": \"boid\" on a kinematic body has no effect (only its velocity moves it)");
+        }
         if (!hasShape) {
             if (r.has<Restitution>(e))
                 notes.push_back(label + ": \"restitution\" has no effect: the entity has no shape, so it never collides");

@@ -142,6 +142,9 @@ std::vector<ComponentInfo> buildTable() {
                           {field<&Mass::value>("", kSize, "kg", "mass of a dynamic body")}));
     t.push_back(row<Static>("static", "immovable: infinite mass, never integrated", true, needsPosition,
                             {field<&Static::value>("", kAny, "", "immovable when true")}));
+    t.push_back(row<Kinematic>("kinematic", "moved only by its velocity and angular velocity; pushes, is never pushed",
+                               true, needsPosition,
+                               {field<&Kinematic::value>("", kAny, "", "moves at its own velocity when true")}));
     t.push_back(row<Radius>("radius", "circle shape; the body collides", true, needsPosition,
                             {field<&Radius::value>("", kSize, "m", "circle radius")}));
     t.push_back(row<Box>("box", "box shape, rotated by angle; the body collides", false, needsPosition,

@@ -713,6 +713,9 @@ std::string relationsProblem(const Scene& scene) {
         if (shapes > 1)
             return child("/entities", i) + ": an entity has at most one shape (radius, box, polygon or plane), got " +
                    std::to_string(shapes);
+        if (registry.has<Static>(e) && registry.tryGet<Static>(e)->value && registry.has<Kinematic>(e) &&
+            registry.tryGet<Kinematic>(e)->value)
+            return child("/entities", i) + "/kinematic: a body is static or kinematic, not both";
         if (registry.has<Plane>(e) && registry.has<Position>(e))
             return child("/entities", i) + "/position: a plane is placed by its normal and offset, not a position";
         // The loader checks this per entity as it reads (readEntity); a scene

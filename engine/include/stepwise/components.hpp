@@ -34,6 +34,11 @@ struct Velocity { Vec2 value; };
 struct Mass { double value = 1.0; };
 /// Immovable when `value` is true: infinite mass, never integrated.
 struct Static { bool value = true; };
+/// Moved only by its own `Velocity` and `AngularVelocity` when `value` is
+/// true (a moving platform, a spinning paddle): infinite mass, so neither
+/// forces nor contacts change its motion, while it pushes and carries the
+/// dynamic bodies it meets. Its velocity is its centre of mass's.
+struct Kinematic { bool value = true; };
 /// Circle shape of this radius, metres (> 0).
 struct Radius { double value = 0.5; };
 /// Box shape, full width and height in metres (> 0), rotated by `Angle`.

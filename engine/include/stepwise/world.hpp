@@ -370,8 +370,10 @@ public:
     /// file resumes as the session goes on). True if it woke something.
     bool wakeIfSettingsChanged();
 
-    /// Dynamic bodies, in the order of the state vector.
+    /// Moving bodies (dynamic and kinematic), in the order of the state vector.
     std::size_t bodyCount() const;
+    /// How many of them are kinematic.
+    std::size_t kinematicCount() const;
     Entity bodyEntity(std::size_t body) const;
     Vec2 bodyPosition(std::size_t body) const;
     Vec2 bodyVelocity(std::size_t body) const;

@@ -59,14 +59,19 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
         polygons_.push_back(*c.shape.polygon);
         colliders_.back().shape.polygon = &polygons_.back();
     }
-    const bool dynamic = c.body >= 0 && c.mass > 0.0;
+    // A kinematic body moves like a dynamic one (a solver body, turned by
+    // its spin) with zero inverse mass and inertia.
+    const bool dynamic = c.body >= 0 && (c.mass > 0.0 || c.kinematic);
     filtered_ = filtered_ || !(c.filter == Filter{});
+    anyKinematic_ = anyKinematic_ || c.kinematic;
     colliderAsleep_.push_back(0);
     if (dynamic) awakeSolverColliders_.push_back(index);
     angles_.push_back(angle);
     angularVelocities_.push_back(dynamic ? angularVelocity : 0.0);
-    invMass_.push_back(dynamic ? 1.0 / c.mass : 0.0);
-    const double inertia = !dynamic ? 0.0 : c.solverOnly ? c.inertia : momentOfInertia(c.shape, c.mass);
+    invMass_.push_back(dynamic && !c.kinematic ? 1.0 / c.mass : 0.0);
+    const double inertia = !dynamic || c.kinematic ? 0.0
+                           : c.solverOnly         ? c.inertia
+                                                  : momentOfInertia(c.shape, c.mass);
     colliders_.back().inertia = inertia;
     invInertia_.push_back(inertia > 0.0 ? 1.0 / inertia : 0.0);
     maxExtent_.push_back(c.solverOnly                          ? 0.0
@@ -233,11 +238,15 @@ void CollisionSystem::bodyEdges(std::vector<std::pair<std::uint32_t, std::uint32
         for (int i = 0; i < c.pointCount; ++i)
             touching = touching || d.separation[i] < kLinearSlop || c.points[i].normalImpulse > 0.0;
         if (!touching) continue;
+        // A kinematic body joins no island (as in Box2D): a platform would
+        // otherwise tie every pile it touches into one.
+        if (colliders_[d.colliderA].kinematic || colliders_[d.colliderB].kinematic) continue;
         const std::int32_t a = colliders_[d.colliderA].body, b = colliders_[d.colliderB].body;
         if (a >= 0 && b >= 0) out.emplace_back(std::uint32_t(a), std::uint32_t(b));
     }
     for (const joints::JointConstraint& j : joints_) {
         if (j.a.collider < 0 || j.b.collider < 0) continue;
+        if (colliders_[std::size_t(j.a.collider)].kinematic || colliders_[std::size_t(j.b.collider)].kinematic) continue;
         const std::int32_t a = colliders_[std::size_t(j.a.collider)].body, b = colliders_[std::size_t(j.b.collider)].body;
         if (a >= 0 && b >= 0) out.emplace_back(std::uint32_t(a), std::uint32_t(b));
     }
@@ -326,7 +335,8 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
     detail.restitution = std::max(colliders_[a].restitution, colliders_[b].restitution);
     c.bodyA = solverIndex_[a];
     c.bodyB = solverIndex_[b];
-    c.touchesStatic = c.bodyA == 0 || c.bodyB == 0;
+    // A kinematic side counts as static (Box2D's rule: zero inverse mass).
+    c.touchesStatic = c.bodyA == 0 || c.bodyB == 0 || colliders_[a].kinematic || colliders_[b].kinematic;
     c.roundA = colliders_[a].shape.kind == ShapeKind::Circle;
     c.roundB = colliders_[b].shape.kind == ShapeKind::Circle;
     c.normal = m.normal;
@@ -551,7 +561,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     for (const std::uint32_t p : planes_) {
         for (std::size_t k = 0, count = anySleeping_ ? awakeProxies_.size() : finite_.size(); k < count; ++k) {
             const std::uint32_t b = finite_[anySleeping_ ? awakeProxies_[k] : k];
-            if (colliders_[b].body < 0 || !collides(p, b)) continue;
+            if (colliders_[b].body < 0 || colliders_[b].kinematic || !collides(p, b)) continue;
             const Manifold m = collide(colliders_[p].shape, {}, {}, colliders_[b].shape, centres_[b], rots[b],
                                        pairMargin(p, b));
             addManifold(p, b, m, centres_);

@@ -37,6 +37,9 @@ struct Collider {
     double restitution = 0.0;
     double friction = 0.2;
     Filter filter;               ///< which other colliders it meets (shouldCollide)
+    /// A kinematic body: in the state vector (`body` >= 0) and moving, with
+    /// zero inverse mass and inertia, so contacts push others but never it.
+    bool kinematic = false;
     Entity entity;
     /// A body with no shape that is in the solver only because a joint
     /// holds it: it turns and takes impulses but never collides.
@@ -245,8 +248,13 @@ private:
     /// Whether any collider has a filter other than the default: without
     /// one every pair passes and the test is skipped.
     bool filtered_ = false;
-    /// Whether colliders a and b may meet under their filters.
+    /// Whether any collider is kinematic: then pairs of two bodies that
+    /// nothing moves (kinematic or static) are skipped.
+    bool anyKinematic_ = false;
+    /// Whether colliders a and b may meet: under their filters, and when at
+    /// least one of them can be pushed.
     bool collides(std::uint32_t a, std::uint32_t b) const {
+        if (anyKinematic_ && invMass_[a] == 0.0 && invMass_[b] == 0.0) return false;
         return !filtered_ || shouldCollide(colliders_[a].filter, colliders_[b].filter);
     }
     std::vector<JointRecord> jointRecords_;

@@ -244,6 +244,10 @@ Result<void> World::step() {
             w.current = next;  // the undo below expects the output buffer current
             break;
         }
+        if (!w.kinematicBody.empty()) {
+            w.holdKinematic(w.x[w.current].data(), w.x[next].data(), w.v[next].data(), h);
+            verifiedInRange = false;  // the integrator's check saw other values
+        }
         // --- contact solve on the integrator's end-of-substep state
         if (contacts) {
             contacts->solveSubstep(detail::asVec2(w.x[next].data(), f.n), detail::asVec2(w.v[next].data(), f.n), h);
@@ -734,6 +738,7 @@ EnergyReport World::energy() const {
     const double* v = w.vs();
     EnergyReport e;
     for (std::size_t b = 0; b < f.n; ++b) {
+        if (!w.isKinematic.empty() && w.isKinematic[b]) continue;  // infinite mass: outside the balance
         const double m = f.mass[b];
         e.kinetic += 0.5 * m * (v[2 * b] * v[2 * b] + v[2 * b + 1] * v[2 * b + 1]);
         // -m g.p: zero at the origin, so that kinetic + gravity is conserved.
@@ -744,7 +749,7 @@ EnergyReport World::energy() const {
     if (const collision::CollisionSystem* contacts = w.collision.get()) {
         for (std::size_t c = 0; c < contacts->colliderCount(); ++c) {
             const collision::Collider& col = contacts->collider(c);
-            if (col.body < 0) continue;
+            if (col.body < 0 || col.kinematic) continue;
             const double spin = contacts->angularVelocity(c);
             e.kinetic += 0.5 * col.inertia * spin * spin;
             // Gravity acts at the centre of mass, which the state's position
@@ -907,6 +912,8 @@ Vec2 World::probeForce(Vec2 point, Vec2) const {
 }
 
 std::size_t World::bodyCount() const { return impl_->bodyEntity.size(); }
+
+std::size_t World::kinematicCount() const { return impl_->kinematicBody.size(); }
 Entity World::bodyEntity(std::size_t body) const { return impl_->bodyEntity.at(body); }
 Vec2 World::bodyPosition(std::size_t body) const {
     const double* x = impl_->xs();

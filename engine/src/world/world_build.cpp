@@ -51,6 +51,13 @@ std::optional<Error> compileBodies(const Registry& reg, WorldImpl& w, BodyIndex&
         const Velocity* vel = reg.tryGet<Velocity>(e);
         const Mass* m = reg.tryGet<Mass>(e);
         const double mv = m ? m->value : 1.0;
+        if (const Kinematic* k = reg.tryGet<Kinematic>(e); k && k->value) {
+            w.isKinematic.resize(w.bodyEntity.size() + 1, 0);
+            w.isKinematic.back() = 1;
+            w.kinematicBody.push_back(std::uint32_t(w.bodyEntity.size()));
+            w.kinematicVelocity.push_back(vel ? vel->value.x : 0.0);
+            w.kinematicVelocity.push_back(vel ? vel->value.y : 0.0);
+        }
         if (!(mv > 0.0) || !std::isfinite(mv))
             return Error{entityLabel(i, name ? &name->value : nullptr) + ": mass must be a finite number > 0"};
         bodies.ofSlot.emplace(e.index, std::uint32_t(w.bodyEntity.size()));
@@ -68,6 +75,11 @@ std::optional<Error> compileBodies(const Registry& reg, WorldImpl& w, BodyIndex&
     f.mass = std::move(mass);
     f.invMass.resize(f.n);
     for (std::size_t b = 0; b < f.n; ++b) f.invMass[b] = 1.0 / f.mass[b];
+    // A kinematic body keeps its mass in the model (the implicit
+    // integrators' mass matrix must stay invertible) but takes no force:
+    // its inverse mass is 0, and the step sets its state after each substep.
+    if (!w.isKinematic.empty()) w.isKinematic.resize(f.n, 0);
+    for (const std::uint32_t k : w.kinematicBody) f.invMass[k] = 0.0;
     return std::nullopt;
 }
 

@@ -74,7 +74,8 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         const std::uint32_t body = c.shape.kind == collision::ShapeKind::Plane ? noBody : bodyOf(e);
         c.body = body == noBody ? -1 : std::int32_t(body);
         if (const Position* p = reg.tryGet<Position>(e)) c.staticPosition = p->value;
-        c.mass = c.body >= 0 ? (reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0) : 0.0;
+        c.kinematic = c.body >= 0 && reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value;
+        c.mass = c.body >= 0 && !c.kinematic ? (reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0) : 0.0;
         c.restitution = reg.has<Restitution>(e) ? reg.tryGet<Restitution>(e)->value : Restitution{}.value;
         c.friction = reg.has<Friction>(e) ? reg.tryGet<Friction>(e)->value : Friction{}.value;
         if (const Filter* f = reg.tryGet<Filter>(e)) c.filter = *f;
@@ -128,7 +129,8 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
                 // A shapeless dynamic body: into the solver, never colliding.
                 collision::Collider c;
                 c.body = std::int32_t(body);
-                c.mass = reg.has<Mass>(end) ? reg.tryGet<Mass>(end)->value : 1.0;
+                c.kinematic = reg.has<Kinematic>(end) && reg.tryGet<Kinematic>(end)->value;
+                c.mass = c.kinematic ? 0.0 : reg.has<Mass>(end) ? reg.tryGet<Mass>(end)->value : 1.0;
                 c.entity = end;
                 c.solverOnly = true;
                 c.inertia = 0.5 * c.mass * kShapelessRadius * kShapelessRadius;
@@ -269,6 +271,7 @@ double springRate(const Scene& scene, const SystemSwitches& switches) {
     const auto dynamicMass = [&](Entity e) -> double {
         if (e.isNull() || !reg.alive(e) || !reg.has<Position>(e)) return 0.0;
         if (const Static* st = reg.tryGet<Static>(e); st && st->value) return 0.0;
+        if (const Kinematic* k = reg.tryGet<Kinematic>(e); k && k->value) return 0.0;
         return reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0;
     };
     std::unordered_map<std::uint32_t, std::pair<double, double>> rows;  // entity index -> (stiffness, damping)
@@ -338,9 +341,11 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     choice.gravity = length(gravity);
     const Vec2 down = choice.gravity > 0.0 ? gravity / choice.gravity : Vec2{0.0, -1.0};
     const Vec2 across{-down.y, down.x};
+    // A kinematic body carries loads like a static one.
     const auto isStatic = [&](Entity e) {
         const Static* st = reg.tryGet<Static>(e);
-        return st && st->value;
+        const Kinematic* k = reg.tryGet<Kinematic>(e);
+        return (st && st->value) || (k && k->value);
     };
     // With contacts switched off no shape takes part.
     const auto hasShape = [&](Entity e) {

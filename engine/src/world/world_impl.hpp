@@ -42,6 +42,24 @@ public:
     bool stepStartKnown = false;
     const double* stepStartV() const { return settings.substeps > 1 ? backupV.data() : v[1 - current].data(); }
 
+    /// Kinematic bodies (state vector indices, ascending) and their
+    /// velocities (interleaved, m/s): each substep sets their state to
+    /// x + h v, v, whatever the forces did, so nothing but their own
+    /// velocity moves them. Empty in a level without one.
+    std::vector<std::uint32_t> kinematicBody;
+    std::vector<double> kinematicVelocity;
+    /// 1 for a kinematic body, by state index; empty when there is none.
+    std::vector<std::uint8_t> isKinematic;
+    void holdKinematic(const double* xFrom, double* xTo, double* vTo, double h) const {
+        for (std::size_t k = 0; k < kinematicBody.size(); ++k) {
+            const std::size_t i = 2 * std::size_t(kinematicBody[k]);
+            vTo[i] = kinematicVelocity[2 * k];
+            vTo[i + 1] = kinematicVelocity[2 * k + 1];
+            xTo[i] = xFrom[i] + h * vTo[i];
+            xTo[i + 1] = xFrom[i + 1] + h * vTo[i + 1];
+        }
+    }
+
     // Bodies with angle and angular_velocity (angle += h * omega).
     std::vector<std::uint32_t> spinBody;  ///< dynamic body index
     std::vector<double> angle, angularVelocity, angleBackup;
