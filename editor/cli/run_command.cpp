@@ -102,6 +102,13 @@ void appendContactLine(std::string& jsonl, std::uint64_t step, const World& worl
         jsonl += "]";
     }
     jsonl += "}\n";
+    // A line of its own for each body entering or leaving a sensor, after
+    // the step's line: {"step", "time", "event": "begin" or "end",
+    // "sensor", "body"}.
+    for (const SensorEvent& e : world.sensorEvents())
+        jsonl += "{\"step\": " + std::to_string(step) + ", \"time\": " + number(world.time()) + ", \"event\": \"" +
+                 (e.begin ? "begin" : "end") + "\", \"sensor\": " + jsonString(entityRef(scene, e.sensor)) +
+                 ", \"body\": " + jsonString(entityRef(scene, e.body)) + "}\n";
 }
 
 /// Ctrl-C (SIGINT) or SIGTERM during the steps: the loop stops, the
@@ -358,7 +365,8 @@ void addRunCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--contacts", options->contacts,
                     "Write one JSON line per step: the step, the time and every contact (entities, point, normal, "
                     "depth, normal and tangent impulse); with joints, every joint too (anchors, separation, "
-                    "reaction force and torque on b, angle)")
+                    "reaction force and torque on b, angle); a line of its own for each body entering or leaving a "
+                    "sensor (\"event\": \"begin\" or \"end\", \"sensor\", \"body\")")
         ->check(outputFileName());
     cmd->callback([options, &exitCode] { exitCode = run(*options); });
 }

@@ -173,6 +173,8 @@ std::vector<ComponentInfo> buildTable() {
                               {field<&Friction::value>("", kNonNegative, "", "Coulomb friction coefficient")}));
     t.push_back(row<Drag>("drag", "viscous damping b: force -b*v", true, needsPosition,
                           {field<&Drag::value>("", kNonNegative, "kg/s", "viscous damping coefficient")}));
+    t.push_back(row<Sensor>("sensor", "the shape detects bodies entering and leaving but never pushes", true, {},
+                            {field<&Sensor::value>("", kAny, "", "detects overlaps only when true")}));
     t.push_back(row<Filter>(
         "filter", "which pairs collide: categories, masks and groups (Box2D's rule)", false, {},
         {field<&Filter::category>("category", kAny, "", "the bits this shape is"),

@@ -84,6 +84,11 @@ struct Friction { double value = 0.2; };
 /// Viscous damping coefficient b, kg/s: force -b*v.
 struct Drag { double value = 0.0; };
 
+/// The shape detects overlaps but never pushes when `value` is true: a
+/// goal zone, a trigger. Bodies entering and leaving it are reported
+/// (World::sensorEvents); nothing about any body's motion changes.
+struct Sensor { bool value = true; };
+
 /// Which pairs of shapes collide (Box2D's collision filter). Two shapes
 /// with the same non-zero `group` always collide when it is positive and
 /// never when it is negative; otherwise they collide when each one's

@@ -68,6 +68,14 @@ struct ContactRecord {
     double tangentImpulse = 0.0;  ///< N*s
 };
 
+/// A body entering (`begin`) or leaving a sensor's shape in the last step.
+struct SensorEvent {
+    Entity sensor;  ///< the entity whose shape is a sensor
+    Entity body;    ///< the entity that entered or left it
+    bool begin = true;
+    friend bool operator==(const SensorEvent&, const SensorEvent&) = default;
+};
+
 /// One joint at the end of the last step, for the debugging views.
 struct JointRecord {
     Entity joint;              ///< the joint's entity
@@ -336,6 +344,12 @@ public:
     std::string nonFiniteEnergyTerm() const;
     /// Contacts of the last step (empty when the scene has no shapes).
     std::span<const ContactRecord> contacts() const;
+    /// Bodies that entered or left a sensor in the last step, in the order
+    /// of (sensor, body) collider pairs. A body overlapping a sensor when
+    /// the world is built (or restored) is inside from the start: no event.
+    std::span<const SensorEvent> sensorEvents() const;
+    /// Every (sensor, body) pair overlapping at the end of the last step.
+    std::vector<std::pair<Entity, Entity>> sensorOverlaps() const;
     /// Joints of the last step, in scene order: anchors, separation and
     /// reaction force and torque (empty when the scene has no joints).
     std::span<const JointRecord> joints() const;

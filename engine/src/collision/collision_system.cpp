@@ -64,6 +64,7 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     const bool dynamic = c.body >= 0 && (c.mass > 0.0 || c.kinematic);
     filtered_ = filtered_ || !(c.filter == Filter{});
     anyKinematic_ = anyKinematic_ || c.kinematic;
+    anySensor_ = anySensor_ || c.sensor;
     colliderAsleep_.push_back(0);
     if (dynamic) awakeSolverColliders_.push_back(index);
     angles_.push_back(angle);
@@ -291,6 +292,7 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
     for (const ProxyPair& pair : pairs_) {
         const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
         if (!colliderAsleep_[a] && !colliderAsleep_[b]) continue;
+        if (colliders_[a].sensor || colliders_[b].sensor) continue;  // a sensor wakes nothing
         if (!collides(a, b)) continue;
         if (!noCollide_.empty()) {
             const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
@@ -513,6 +515,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     const auto narrowStart = std::chrono::steady_clock::now();
     constraints_.clear();
     details_.clear();
+    sensorCandidates_.clear();
     // At most one manifold a pair (and a plane against each movable shape):
     // reserving once avoids the copies and the doubled capacity of growth
     // (a crowd of 100,000 makes hundreds of thousands of manifolds).
@@ -530,6 +533,15 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     for (const ProxyPair& pair : pairs_) {
         const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
         if (colliderAsleep_[a] || colliderAsleep_[b]) continue;  // no manifold: it would have woken them
+        if (anySensor_ && (colliders_[a].sensor || colliders_[b].sensor)) {
+            // Tested at the step's end (updateSensors); never a contact.
+            // Sensors do not sense each other (Box2D's rule).
+            if (colliders_[a].sensor != colliders_[b].sensor &&
+                (!filtered_ || shouldCollide(colliders_[a].filter, colliders_[b].filter)))
+                sensorCandidates_.push_back(colliders_[a].sensor ? (std::uint64_t(a) << 32) | b
+                                                                 : (std::uint64_t(b) << 32) | a);
+            continue;
+        }
         if (!collides(a, b)) continue;
         if (!noCollide_.empty()) {
             // Bodies joined with collide_connected false do not collide.
@@ -561,7 +573,15 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     for (const std::uint32_t p : planes_) {
         for (std::size_t k = 0, count = anySleeping_ ? awakeProxies_.size() : finite_.size(); k < count; ++k) {
             const std::uint32_t b = finite_[anySleeping_ ? awakeProxies_[k] : k];
-            if (colliders_[b].body < 0 || colliders_[b].kinematic || !collides(p, b)) continue;
+            if (colliders_[b].body < 0 || colliders_[b].kinematic) continue;
+            if (anySensor_ && (colliders_[p].sensor || colliders_[b].sensor)) {
+                if (colliders_[p].sensor != colliders_[b].sensor &&
+                    (!filtered_ || shouldCollide(colliders_[p].filter, colliders_[b].filter)))
+                    sensorCandidates_.push_back(colliders_[p].sensor ? (std::uint64_t(p) << 32) | b
+                                                                     : (std::uint64_t(b) << 32) | p);
+                continue;
+            }
+            if (!collides(p, b)) continue;
             const Manifold m = collide(colliders_[p].shape, {}, {}, colliders_[b].shape, centres_[b], rots[b],
                                        pairMargin(p, b));
             addManifold(p, b, m, centres_);
@@ -769,7 +789,10 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         v[sb.body] = bodies_[sb.solver].v;
         angularVelocities_[sb.collider] = bodies_[sb.solver].w;
     }
-    if (++substepsDone_ == substeps_) correctStepPositions(x);
+    if (++substepsDone_ == substeps_) {
+        correctStepPositions(x);
+        if (anySensor_) updateSensors(x);
+    }
     timings_.solveMs += msSince(start);
 }
 
@@ -855,6 +878,79 @@ void CollisionSystem::endStep() {
     // Usually already in order (constraints follow the sorted pairs); the
     // check is cheaper than sorting sorted data.
     if (!std::is_sorted(cache_.begin(), cache_.end())) std::sort(cache_.begin(), cache_.end());
+}
+
+bool CollisionSystem::sensorOverlap(std::uint32_t s, std::uint32_t o, std::span<const Vec2> x) const {
+    const Collider& cs = colliders_[s];
+    const Collider& co = colliders_[o];
+    const bool planeS = cs.shape.kind == ShapeKind::Plane, planeO = co.shape.kind == ShapeKind::Plane;
+    const Manifold m = collide(cs.shape, planeS ? Vec2{} : centreOfMass(s, x),
+                               planeS ? Rot{} : Rot::fromAngle(angles_[s]), co.shape,
+                               planeO ? Vec2{} : centreOfMass(o, x), planeO ? Rot{} : Rot::fromAngle(angles_[o]), 0.0);
+    for (int i = 0; i < m.pointCount; ++i)
+        if (m.points[i].separation < 0.0) return true;
+    return false;
+}
+
+void CollisionSystem::updateSensors(std::span<const Vec2> x) {
+    std::vector<std::uint64_t> now;
+    now.reserve(sensorCandidates_.size());
+    for (const std::uint64_t key : sensorCandidates_)
+        if (sensorOverlap(std::uint32_t(key >> 32), std::uint32_t(key & 0xFFFFFFFFu), x)) now.push_back(key);
+    // A sleeping body stays where it was, and so does its overlap: its
+    // pairs are not looked at while it sleeps.
+    for (const std::uint64_t key : sensorOverlaps_)
+        if (colliderAsleep_[key >> 32] || colliderAsleep_[key & 0xFFFFFFFFu]) now.push_back(key);
+    std::sort(now.begin(), now.end());
+    now.erase(std::unique(now.begin(), now.end()), now.end());
+    sensorEvents_.clear();
+    const auto event = [&](std::uint64_t key, bool begin) {
+        sensorEvents_.push_back({colliders_[key >> 32].entity, colliders_[key & 0xFFFFFFFFu].entity, begin});
+    };
+    // Both lists are sorted: one merge finds what began and what ended.
+    std::size_t i = 0, j = 0;
+    while (i < now.size() || j < sensorOverlaps_.size()) {
+        if (j == sensorOverlaps_.size() || (i < now.size() && now[i] < sensorOverlaps_[j])) event(now[i++], true);
+        else if (i == now.size() || sensorOverlaps_[j] < now[i]) event(sensorOverlaps_[j++], false);
+        else ++i, ++j;
+    }
+    sensorOverlaps_.swap(now);
+}
+
+void CollisionSystem::initSensors(std::span<const Vec2> x) {
+    sensorOverlaps_.clear();
+    sensorEvents_.clear();
+    if (!anySensor_) return;
+    // Every sensor against every shape that could be inside it: sensors are
+    // few, and this runs once per build or restore.
+    const std::size_t n = colliders_.size();
+    for (std::uint32_t s = 0; s < n; ++s) {
+        if (!colliders_[s].sensor || colliders_[s].solverOnly) continue;
+        for (std::uint32_t o = 0; o < n; ++o) {
+            const Collider& other = colliders_[o];
+            if (o == s || other.sensor || other.solverOnly) continue;
+            // The pairs a step looks at: a plane meets only dynamic shapes,
+            // and two shapes meet when at least one moves.
+            const bool planeS = colliders_[s].shape.kind == ShapeKind::Plane, planeO = other.shape.kind == ShapeKind::Plane;
+            if (planeS && planeO) continue;
+            if (planeS || planeO) {
+                const Collider& finite = planeS ? other : colliders_[s];
+                if (finite.body < 0 || finite.kinematic) continue;
+            } else if (colliders_[s].body < 0 && other.body < 0) {
+                continue;
+            }
+            if (filtered_ && !shouldCollide(colliders_[s].filter, other.filter)) continue;
+            if (sensorOverlap(s, o, x)) sensorOverlaps_.push_back((std::uint64_t(s) << 32) | o);
+        }
+    }
+}
+
+std::vector<std::pair<Entity, Entity>> CollisionSystem::sensorOverlaps() const {
+    std::vector<std::pair<Entity, Entity>> out;
+    out.reserve(sensorOverlaps_.size());
+    for (const std::uint64_t key : sensorOverlaps_)
+        out.emplace_back(colliders_[key >> 32].entity, colliders_[key & 0xFFFFFFFFu].entity);
+    return out;
 }
 
 } // namespace stepwise::collision

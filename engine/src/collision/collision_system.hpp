@@ -40,6 +40,8 @@ struct Collider {
     /// A kinematic body: in the state vector (`body` >= 0) and moving, with
     /// zero inverse mass and inertia, so contacts push others but never it.
     bool kinematic = false;
+    /// A sensor: overlaps are detected and reported, never solved.
+    bool sensor = false;
     Entity entity;
     /// A body with no shape that is in the solver only because a joint
     /// holds it: it turns and takes impulses but never collides.
@@ -117,6 +119,13 @@ public:
     void endStep();
 
     std::span<const ContactRecord> contacts() const { return records_; }
+    /// Sensor events of the last step and the overlaps at its end.
+    std::span<const SensorEvent> sensorEvents() const { return sensorEvents_; }
+    std::vector<std::pair<Entity, Entity>> sensorOverlaps() const;
+    bool hasSensors() const { return anySensor_; }
+    /// Sets the overlaps from the positions `x` without events: at build,
+    /// and after a restore (what is inside then was inside before).
+    void initSensors(std::span<const Vec2> x);
     /// Forgets the last step's contacts (a restore replaced that step); the
     /// sleeping islands' contacts stay listed.
     void clearContactRecords() {
@@ -248,6 +257,19 @@ private:
     /// Whether any collider has a filter other than the default: without
     /// one every pair passes and the test is skipped.
     bool filtered_ = false;
+    /// Sensors: whether there are any, the pairs the broad phase found for
+    /// them this step (sensor collider << 32 | other), the overlapping ones
+    /// at the end of the last step (sorted, same keys), and its events.
+    bool anySensor_ = false;
+    std::vector<std::uint64_t> sensorCandidates_;
+    std::vector<std::uint64_t> sensorOverlaps_;
+    std::vector<SensorEvent> sensorEvents_;
+    /// Whether sensor collider s and collider o overlap at the centres and
+    /// rotations given.
+    bool sensorOverlap(std::uint32_t s, std::uint32_t o, std::span<const Vec2> x) const;
+    /// At the end of a step: overlaps of this step's candidates, plus those
+    /// kept by sleeping bodies; events for the differences.
+    void updateSensors(std::span<const Vec2> x);
     /// Whether any collider is kinematic: then pairs of two bodies that
     /// nothing moves (kinematic or static) are skipped.
     bool anyKinematic_ = false;

@@ -640,6 +640,7 @@ Result<void> World::restoreState(const WorldState& s) {
         const std::span<joints::JointConstraint> joints = w.collision->jointConstraints();
         for (std::size_t k = 0; k < joints.size(); ++k) joints::setImpulses(joints[k], s.joints[k]);
         w.collision->clearContactRecords();  // they described the step this state replaces
+        if (w.collision->hasSensors()) w.collision->initSensors(detail::asVec2(w.xs(), w.model.n));
     }
     w.stats.contactCount = 0;
     w.stepStartKnown = false;  // the other buffer holds no step's start
@@ -808,6 +809,14 @@ std::string World::nonFiniteEnergyTerm() const {
 
 std::span<const ContactRecord> World::contacts() const {
     return impl_->collision ? impl_->collision->contacts() : std::span<const ContactRecord>{};
+}
+
+std::span<const SensorEvent> World::sensorEvents() const {
+    return impl_->collision ? impl_->collision->sensorEvents() : std::span<const SensorEvent>{};
+}
+
+std::vector<std::pair<Entity, Entity>> World::sensorOverlaps() const {
+    return impl_->collision ? impl_->collision->sensorOverlaps() : std::vector<std::pair<Entity, Entity>>{};
 }
 
 std::span<const JointRecord> World::joints() const {

@@ -418,6 +418,7 @@ Result<World> World::build(const Scene& scene, const SystemSwitches& switches) {
     listActiveSystems(w);
     allocateState(w, start, *kind);
     w.layout = makeLayout(w);
+    if (w.collision && w.collision->hasSensors()) w.collision->initSensors(detail::asVec2(w.xs(), w.model.n));
 
     World world(std::move(impl));
     if (scene.solverState) world.setSolverState(*scene.solverState);

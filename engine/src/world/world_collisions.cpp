@@ -79,6 +79,7 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         c.restitution = reg.has<Restitution>(e) ? reg.tryGet<Restitution>(e)->value : Restitution{}.value;
         c.friction = reg.has<Friction>(e) ? reg.tryGet<Friction>(e)->value : Friction{}.value;
         if (const Filter* f = reg.tryGet<Filter>(e)) c.filter = *f;
+        c.sensor = reg.has<Sensor>(e) && reg.tryGet<Sensor>(e)->value;
         c.entity = e;
         const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
         const double spin = reg.has<AngularVelocity>(e) ? reg.tryGet<AngularVelocity>(e)->value : 0.0;
