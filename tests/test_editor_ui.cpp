@@ -434,7 +434,7 @@ TEST(SessionFrame, WithEveryOverlayOnTheLegendTakesASmallShareOfTheViewport) {
         double most;  // of the viewport's height
     };
     for (const char* level : {"car.json", "pyramid.json"})
-        for (const Size size : {Size{800, 600, 0.30}, Size{1280, 720, 0.15}, Size{1600, 900, 0.15}, Size{1920, 1080, 0.15}}) {
+        for (const Size size : {Size{800, 600, 0.20}, Size{1280, 720, 0.15}, Size{1600, 900, 0.15}, Size{1920, 1080, 0.15}}) {
             auto context = stepwise::render::OffscreenRenderer::create(size.w, size.h);
             ASSERT_TRUE(context.ok()) << context.error();
             auto created = headlessSession();
@@ -463,4 +463,54 @@ TEST(SessionFrame, WithEveryOverlayOnTheLegendTakesASmallShareOfTheViewport) {
             std::printf("legend %s: %.0f x %.0f px in %.0f x %.0f, %.1f%% of the height\n", at.c_str(), w, h, viewport.x,
                         viewport.y, 100.0 * fraction);
         }
+}
+
+// ---- the Tools panel at common window sizes -----------------------------------
+
+// At 1280x720 the Tools panel scrolled to reach its last overlay boxes, and
+// with the Joint tool its hint and half the overlays were below the fold.
+// Every tool's panel now shows every control whole, with nothing to scroll.
+TEST(Layout, TheToolsPanelShowsEveryControlWholeWithoutScrolling) {
+    for (const auto& [w, h] : {std::pair{1280, 720}, std::pair{1600, 900}, std::pair{1024, 768}}) {
+        auto context = stepwise::render::OffscreenRenderer::create(w, h);
+        ASSERT_TRUE(context.ok()) << context.error();
+        auto created = headlessSession();
+        ASSERT_TRUE(created.ok()) << created.error();
+        stepwise::ui::Session& session = **created;
+        stepwise::editor::Editor& ed = session.editor();
+        ASSERT_TRUE(ed.open(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / "default.json"));
+        for (int t = 0; t < int(stepwise::editor::Tool::Count); ++t) {
+            ed.tool = stepwise::editor::Tool(t);
+            session.ui().widgetRects.clear();
+            for (int i = 0; i < 3; ++i) session.frame(w, h, 1.0 / 60.0);
+            const std::string at = std::string(stepwise::editor::toolName(ed.tool)) + " tool at " + std::to_string(w) +
+                                   "x" + std::to_string(h);
+            const ImGuiWindow* tools = ImGui::FindWindowByName("Tools");
+            ASSERT_NE(tools, nullptr);
+            EXPECT_EQ(tools->ScrollMax.y, 0.0f) << at << ": " << tools->ScrollMax.y << " px to scroll";
+            // Every control (its label too) inside the panel's visible inside.
+            const ImRect inside = tools->InnerClipRect;
+            int controls = 0, buttons = 0;
+            for (const auto& [key, r] : session.ui().widgetRects) {
+                if (key.rfind("tools/", 0) != 0) continue;
+                ++controls;
+                EXPECT_GE(r.x, inside.Min.x - 0.5f) << at << ": " << key;
+                EXPECT_GE(r.y, inside.Min.y - 0.5f) << at << ": " << key;
+                EXPECT_LE(r.x + r.z, inside.Max.x + 0.5f) << at << ": " << key << " is cut at the right";
+                EXPECT_LE(r.y + r.w, inside.Max.y + 0.5f) << at << ": " << key << " is below the fold";
+                if (key.rfind("tools/tool/", 0) == 0) {
+                    // A tool button's label ("7  Attractor") fits between its frame's paddings.
+                    ++buttons;
+                    const stepwise::editor::Tool tool = *stepwise::editor::toolFromScriptName(key.substr(11));
+                    const std::string label = std::string(stepwise::editor::keyName(stepwise::editor::toolKey(tool))) +
+                                              "  " + std::string(stepwise::editor::toolName(tool));
+                    EXPECT_LE(ImGui::CalcTextSize(label.c_str()).x + 2 * ImGui::GetStyle().FramePadding.x, r.z + 0.5f)
+                        << at << ": " << label << " is cut";
+                }
+            }
+            EXPECT_EQ(buttons, int(stepwise::editor::Tool::Count)) << at;
+            // The tool buttons, snap, the overlay boxes, and the tool's own options.
+            EXPECT_GE(controls, int(stepwise::editor::Tool::Count) + 1 + 9) << at;
+        }
+    }
 }
