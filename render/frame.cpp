@@ -1259,7 +1259,7 @@ void Builder::hud() {
         flow(mid);
         (rowCount() <= rows ? hi : lo) = mid;
     }
-    const double innerW = std::max(flow(hi), std::min(noteW, maxInner));
+    const double innerW = std::max(flow(hi), noteW);
     const double panelW = innerW + 2 * pad;
     const double panelH = double(rows + out_.notes.size()) * rowH - (rowH - textHeight()) + 2 * pad;
     // The bottom right, above the scale bar when the two would meet; or the
