@@ -403,10 +403,11 @@ private:
         return {0.55f * c.r, 0.55f * c.g, 0.55f * c.b, c.a};
     }
     struct LegendRow {
-        std::string label;
+        std::string label;  ///< in full words (DrawData::legend)
         Rgba colour;
         double reference;  ///< magnitude drawn arrowRef_ long
         std::string unit;
+        std::string shortLabel = {};  ///< what the drawn legend says, when shorter than `label`
     };
     std::vector<LegendRow> legend_;
 };
@@ -924,7 +925,7 @@ void Builder::jointForces() {
         const double len = std::max(8.0, arrowLength(m, ref, arrowRef_, 3.2 * arrowRef_));
         arrow(p, p - r.force / m * len, 1.6, kJointForce);
     }
-    legend_.push_back({"joint force on a", kJointForce, ref, "N"});
+    legend_.push_back({"joint force on a", kJointForce, ref, "N", "joint force"});
 }
 
 void Builder::polygonPreview() {
@@ -1101,7 +1102,7 @@ void Builder::bodyArrows() {
                 out_.notes.push_back("net force: shown once a step is taken");
             } else {
                 draw(netForces, kNetForce);
-                legend_.push_back({"net force (m dv/dt)", kNetForce, ref, "N"});
+                legend_.push_back({"net force (m dv/dt)", kNetForce, ref, "N", "net force"});
             }
         }
     }
@@ -1194,10 +1195,14 @@ double Builder::coveredBodyArea(double x, double y, double w, double h) const {
 void Builder::hud() {
     const double s = textScale_;
     const double margin = 14.0 * s;
+    // Where the caption's and the scale bar's panels end: the legend keeps clear.
+    double captionRight = 0.0, captionBottom = h_, scaleRight = 0.0, scaleTop = 0.0;
     // ---- caption, top-left -------------------------------------------
     if (!in_.caption.empty()) {
         const double th = textHeight();
         const double width = textWidth(in_.caption);
+        captionRight = margin + width + 7 * s;
+        captionBottom = h_ - margin - th - 5 * s;
         box({margin + 0.5 * width, h_ - margin - 0.5 * th}, {0.5 * width + 7 * s, 0.5 * th + 5 * s}, 0.0, kPanel,
             kFlat, 4.0 * s);
         text(margin, h_ - margin, in_.caption, kText);
@@ -1211,6 +1216,9 @@ void Builder::hud() {
         const double th = textHeight();
         const double panelW = std::max(px, textWidth(label)) + 16 * s;
         const double panelH = th + 20 * s;
+        scaleRight = margin + panelW;
+        scaleTop = margin + panelH;
+        out_.scaleBarBox = {margin, margin, panelW, panelH};
         box({margin + 0.5 * panelW, margin + 0.5 * panelH}, {0.5 * panelW, 0.5 * panelH}, 0.0, kPanel, kFlat, 4.0 * s);
         const double x0 = std::floor(margin + 8 * s) + 0.5, y = std::floor(margin + 7 * s) + 0.5;
         segment({x0, y}, {x0 + px, y}, 2.0, kText);
@@ -1218,68 +1226,118 @@ void Builder::hud() {
         segment({x0 + px, y - 3 * s}, {x0 + px, y + 4 * s}, 1.5, kText);
         text(x0 + 0.5 * px - 0.5 * textWidth(label), y + 6 * s + th, label, kText);
     }
-    // ---- legend, bottom-right -----------------------------------------
+    // ---- legend, a corner on the right ---------------------------------
     if (legend_.empty() && out_.notes.empty() && !in_.overlays.has(Overlay::Aabb) && !in_.overlays.has(Overlay::Trails))
         return;
-    struct Row {
+    // A cell per overlay (a sample, its name, its reference), the cells
+    // flowing left to right in as few rows as the viewport's width allows,
+    // and the notes in rows of their own below. One row per overlay took
+    // 44% of the editor's viewport at 1280x720 with every overlay on.
+    struct Cell {
         std::string label, value;
         Rgba colour;
-        int kind;  // 0 arrow, 1 swatch box, 2 line, 3 note
+        int kind;  // 0 arrow, 1 swatch box, 2 line, 3 text only
+        double width = 0.0;
     };
-    std::vector<Row> rows;
+    std::vector<Cell> cells;
     for (const LegendRow& r : legend_) {
-        rows.push_back({r.label, "= " + formatNumber(r.reference) + " " + r.unit, r.colour, 0});
-        out_.legend.push_back(r.label + " " + rows.back().value);
+        cells.push_back({r.shortLabel.empty() ? r.label : r.shortLabel, formatNumber(r.reference) + " " + r.unit, r.colour, 0});
+        out_.legend.push_back(r.label + " = " + cells.back().value);
     }
-    if (in_.overlays.has(Overlay::Aabb)) rows.push_back({"bounding boxes", "", kAabb, 1});
+    // The overlay's own name: "bounding boxes" took the width that kept
+    // every overlay in three rows at 1280x720.
+    if (in_.overlays.has(Overlay::Aabb)) cells.push_back({"aabb", "", kAabb, 1});
     if (in_.overlays.has(Overlay::Trails) && in_.trails)
-        rows.push_back({"trails", std::to_string(in_.trails->capacity()) + " steps", rgb(0x9fb3c8, 0.8f), 2});
-    for (const std::string& n : out_.notes) rows.push_back({n, "", kTextDim, 3});
-    if (!legend_.empty()) rows.push_back({"arrow length ~ log2(1 + |x| / ref)", "", kTextDim, 3});
-
-    const double rowH = 14.0 * s;
-    const double sampleW = arrowRef_;
-    double labelW = 0, valueW = 0, noteW = 0;
-    for (const Row& r : rows) {
-        if (r.kind == 3) {
-            noteW = std::max(noteW, textWidth(r.label));
-        } else {
-            labelW = std::max(labelW, textWidth(r.label));
-            valueW = std::max(valueW, textWidth(r.value));
-        }
+        cells.push_back({"trails", std::to_string(in_.trails->capacity()) + " steps", rgb(0x9fb3c8, 0.8f), 2});
+    if (!legend_.empty()) cells.push_back({"length ~ log2(1+|x|/ref)", "", kTextDim, 3});
+    const double sampleW = arrowRef_;  // a reference-magnitude arrow's length
+    const double sampleGap = 5.0 * s, valueGap = 5.0 * s, cellGap = 11.0 * s;
+    double widest = 0.0;
+    for (Cell& c : cells) {
+        c.width = (c.kind == 3 ? 0.0 : sampleW + sampleGap) + textWidth(c.label) +
+                  (c.value.empty() ? 0.0 : valueGap + textWidth(c.value));
+        widest = std::max(widest, c.width);
     }
-    const double pad = 9.0 * s;
-    const double innerW = std::max(sampleW + 8 * s + labelW + 10 * s + valueW, noteW);
-    const double panelW = innerW + 2 * pad, panelH = double(rows.size()) * rowH + 2 * pad - 4 * s;
-    // Bottom right, unless the bodies there are more than at the top right:
-    // the legend goes where it hides least of the scene (a legend grown by
-    // many overlays hid half of a pyramid standing on the floor).
+    double noteW = 0.0;
+    for (const std::string& n : out_.notes) noteW = std::max(noteW, textWidth(n));
+    // Each cell's row and left edge (from the panel's inner left) for
+    // rows at most `innerW` wide; returns the widest row.
+    std::vector<std::size_t> rowOf(cells.size());
+    std::vector<double> leftOf(cells.size());
+    const auto flow = [&](double innerW) {
+        std::size_t row = 0;
+        double x = 0.0, widestRow = 0.0;
+        for (std::size_t i = 0; i < cells.size(); ++i) {
+            if (i > 0 && x + cellGap + cells[i].width > innerW) {
+                ++row;
+                x = 0.0;
+            } else if (i > 0) {
+                x += cellGap;
+            }
+            rowOf[i] = row;
+            leftOf[i] = x;
+            x += cells[i].width;
+            widestRow = std::max(widestRow, x);
+        }
+        return widestRow;
+    };
+    const auto rowCount = [&] { return cells.empty() ? std::size_t(0) : rowOf.back() + 1; };
+    const double rowH = 10.0 * s, pad = 5.0 * s;
+    // As few rows as the width allows, then the narrowest panel with that
+    // many (rows of about even length read better than one long row and
+    // a short one).
+    const double maxInner = std::max(widest, w_ - 2 * margin - 2 * pad);
+    flow(maxInner);
+    const std::size_t rows = rowCount();
+    double lo = widest, hi = maxInner;
+    for (int k = 0; k < 40 && hi - lo > 0.5; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        flow(mid);
+        (rowCount() <= rows ? hi : lo) = mid;
+    }
+    const double innerW = std::max(flow(hi), noteW);
+    const double panelW = innerW + 2 * pad;
+    const double panelH = double(rows + out_.notes.size()) * rowH - (rowH - textHeight()) + 2 * pad;
+    // The bottom right, above the scale bar when the two would meet; or the
+    // top right, below the caption when the two would meet (and below the
+    // editor's line at the top), when that hides fewer moving bodies: a
+    // pile or a pyramid stands on the floor.
     const double x0 = w_ - margin - panelW;
-    double y0 = margin;
-    const double topY0 = h_ - std::max(margin, in_.reservedTopPx + 0.5 * margin) - panelH;
-    const bool captionInTheWay = !in_.caption.empty() && margin + textWidth(in_.caption) + 7 * s > x0;
-    if (topY0 > y0 && !captionInTheWay && coveredBodyArea(x0, topY0, panelW, panelH) < coveredBodyArea(x0, y0, panelW, panelH))
-        y0 = topY0;
+    const double bottomY = x0 < scaleRight + margin ? scaleTop + 0.5 * margin : margin;
+    double topEdge = h_ - std::max(margin, in_.reservedTopPx + 0.5 * margin);
+    if (!in_.caption.empty() && x0 < captionRight + margin) topEdge = std::min(topEdge, captionBottom - 0.5 * margin);
+    const double topY = topEdge - panelH;
+    // As few in both: the top, unless the bottom one is in the corner
+    // itself (raised above the scale bar, it is in the middle of the scene).
+    double y0 = bottomY;
+    if (topY > bottomY) {
+        const double coverTop = coveredBodyArea(x0, topY, panelW, panelH);
+        const double coverBottom = coveredBodyArea(x0, bottomY, panelW, panelH);
+        if (coverTop < coverBottom || (coverTop == coverBottom && bottomY > margin)) y0 = topY;
+    }
     out_.legendBox = {x0, y0, panelW, panelH};
     out_.legendCoversPx = coveredBodyArea(x0, y0, panelW, panelH);
     box({x0 + 0.5 * panelW, y0 + 0.5 * panelH}, {0.5 * panelW, 0.5 * panelH}, 0.0, kPanel, kFlat, 4.0 * s);
     box({x0 + 0.5 * panelW, y0 + 0.5 * panelH}, {0.5 * panelW, 0.5 * panelH}, 0.0, kPanelBorder, kOutline, 4.0 * s);
-    double yTop = y0 + panelH - pad;
-    for (const Row& r : rows) {
-        const double mid = std::floor(yTop - 0.5 * textHeight()) + 0.5;
-        double x = x0 + pad;
-        if (r.kind == 3) {
-            text(x, yTop, r.label, kTextDim);
-        } else {
-            if (r.kind == 0) arrow({x, mid}, {x + sampleW, mid}, 2.0, withAlpha(r.colour, 1.0f));
-            if (r.kind == 1) box({x + 0.5 * sampleW, mid}, {0.5 * sampleW, 4.0 * s}, 0.0, r.colour, kOutline);
-            if (r.kind == 2) segment({x, mid}, {x + sampleW, mid}, 1.6, r.colour);
-            x += sampleW + 8 * s;
-            text(x, yTop, r.label, kText);
-            text(x + labelW + 10 * s, yTop, r.value, kTextDim);
+    const double firstTop = y0 + panelH - pad;  // the first row's text top
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+        const Cell& c = cells[i];
+        const double yTop = firstTop - double(rowOf[i]) * rowH;
+        double x = x0 + pad + leftOf[i];
+        if (c.kind == 3) {
+            text(x, yTop, c.label, kTextDim);
+            continue;
         }
-        yTop -= rowH;
+        const double mid = std::floor(yTop - 0.5 * textHeight()) + 0.5;
+        if (c.kind == 0) arrow({x, mid}, {x + sampleW, mid}, 1.6, withAlpha(c.colour, 1.0f));
+        if (c.kind == 1) box({x + 0.5 * sampleW, mid}, {0.5 * sampleW, 3.5 * s}, 0.0, c.colour, kOutline);
+        if (c.kind == 2) segment({x, mid}, {x + sampleW, mid}, 1.6, c.colour);
+        x += sampleW + sampleGap;
+        x += text(x, yTop, c.label, kText);
+        if (!c.value.empty()) text(x + valueGap, yTop, c.value, kTextDim);
     }
+    for (std::size_t j = 0; j < out_.notes.size(); ++j)
+        text(x0 + pad, firstTop - double(rows + j) * rowH, out_.notes[j], kTextDim);
 }
 
 } // namespace

@@ -56,12 +56,17 @@ struct DrawData {
     std::vector<PixelLayer> images;  ///< what Image batches draw
     ArrowScales scales;           ///< the references used (auto ones resolved)
     std::vector<std::string> notes;  ///< e.g. "force-field: no World (scene has shapes)"
-    std::vector<std::string> legend; ///< the legend's arrow rows, e.g. "applied force = 20 N"
+    /// The legend's arrow overlays in full words, e.g. "applied force = 20 N"
+    /// (the drawn legend may name one shorter: "net force" for "net force (m dv/dt)").
+    std::vector<std::string> legend;
     /// The legend's panel, pixels (x, y, width, height; y up from the
     /// bottom); all zero when there is none.
     std::array<double, 4> legendBox{};
     /// Pixels of the legend's panel over moving bodies (their boxes).
     double legendCoversPx = 0.0;
+    /// The scale bar's panel, bottom left (x, y, width, height; y up); all
+    /// zero without the HUD. A legend that would meet it goes above it.
+    std::array<double, 4> scaleBarBox{};
     std::size_t instanceCount() const;
 };
 

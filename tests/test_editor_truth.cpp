@@ -398,7 +398,7 @@ namespace {
 
 // With every overlay on, the legend grew up from the bottom right over the
 // right half of a pyramid standing on the floor; it now takes the top right
-// when fewer bodies are there.
+// when fewer bodies are there (and is a few rows high: test_editor_ui.cpp).
 TEST(Legend, GoesToTheCornerWhereItHidesTheFewestBodies) {
     editor::Editor ed;
     ASSERT_TRUE(ed.open(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "pyramid.json"));
@@ -425,10 +425,16 @@ TEST(Legend, GoesToTheCornerWhereItHidesTheFewestBodies) {
         return area;
     };
     const auto [x, y, w, h] = data.legendBox;
-    // The bottom-right place: the same margin below as the top one has above.
-    const double bottom = covered(x, 475.0 - y - h, w, h);
+    // The bottom-right place: the same margin below as the top one has above,
+    // or above the scale bar (half that margin between) for a legend wide
+    // enough to meet it there, as the one that shares rows is.
+    const double margin = 475.0 - y - h;
+    const auto [sx, sy, sw, sh] = data.scaleBarBox;
+    ASSERT_GT(sw, 0.0);
+    const double bottom = covered(x, x < sx + sw + margin ? sy + sh + 0.5 * margin : margin, w, h);
     EXPECT_GT(y, 475.0 / 2) << "at the top";
     EXPECT_NEAR(data.legendCoversPx, covered(x, y, w, h), 1e-6);
+    EXPECT_EQ(data.legendCoversPx, 0.0) << "the top right is free of bodies";
     EXPECT_LT(data.legendCoversPx, 0.5 * bottom) << "covers " << data.legendCoversPx << " px there, " << bottom
                                                  << " px at the bottom right";
 }

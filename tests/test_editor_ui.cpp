@@ -17,6 +17,7 @@
 
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 
@@ -419,4 +420,97 @@ TEST(SessionFrame, EachSaveDialogProposesAPathFromTheLevelOpenNow) {
     EXPECT_EQ(session.dialogState().modal, "Save as");
     EXPECT_EQ(ui.saveAsPath, (dir / "untitled.json").string());
     std::filesystem::remove_all(dir);
+}
+
+// ---- the legend leaves the scene to the scene -------------------------------------
+
+// With every overlay on, the legend was one row per overlay, a column that
+// took 44% of the viewport's height at 1280x720 and hid half of a pyramid.
+// Its cells now share rows, at every common window size, in the editor's own
+// viewport (the render command draws the same legend: ViewportMatchesRender).
+TEST(SessionFrame, WithEveryOverlayOnTheLegendTakesASmallShareOfTheViewport) {
+    struct Size {
+        int w, h;
+        double most;  // of the viewport's height
+    };
+    for (const char* level : {"car.json", "pyramid.json"})
+        for (const Size size : {Size{800, 600, 0.20}, Size{1280, 720, 0.15}, Size{1600, 900, 0.15}, Size{1920, 1080, 0.15}}) {
+            auto context = stepwise::render::OffscreenRenderer::create(size.w, size.h);
+            ASSERT_TRUE(context.ok()) << context.error();
+            auto created = headlessSession();
+            ASSERT_TRUE(created.ok()) << created.error();
+            stepwise::ui::Session& session = **created;
+            stepwise::editor::Editor& ed = session.editor();
+            ASSERT_TRUE(ed.open(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / level));
+            for (const auto& [name, overlay] : stepwise::render::overlayNames()) ed.overlays.add(overlay);
+            session.frame(size.w, size.h, 1.0 / 60.0);
+            ed.fitView();
+            ed.togglePlay();
+            for (int i = 0; i < 30; ++i) session.frame(size.w, size.h, 1.0 / 60.0);
+            const std::string at = std::string(level) + " at " + std::to_string(size.w) + "x" + std::to_string(size.h);
+            const stepwise::ui::UiState::FrameParts& frame = session.ui().lastFrame;
+            const auto [x, y, w, h] = frame.legendBox;
+            const ImVec2 viewport = session.viewportSize();
+            // Every arrow overlay's reference is there (the pyramid has no joints).
+            EXPECT_GE(frame.legendRows, std::string(level) == "car.json" ? 7u : 6u) << at;
+            EXPECT_GT(h, 0.0) << at;
+            EXPECT_GE(x, 0.0) << at;
+            EXPECT_GE(y, 0.0) << at;
+            EXPECT_LE(x + w, viewport.x) << at;
+            EXPECT_LE(y + h, viewport.y) << at;
+            const double fraction = h / viewport.y;
+            EXPECT_LT(fraction, size.most) << at << ": the legend is " << h << " of " << viewport.y << " px high";
+            std::printf("legend %s: %.0f x %.0f px in %.0f x %.0f, %.1f%% of the height\n", at.c_str(), w, h, viewport.x,
+                        viewport.y, 100.0 * fraction);
+        }
+}
+
+// ---- the Tools panel at common window sizes -----------------------------------
+
+// At 1280x720 the Tools panel scrolled to reach its last overlay boxes, and
+// with the Joint tool its hint and half the overlays were below the fold.
+// Every tool's panel now shows every control whole, with nothing to scroll.
+TEST(Layout, TheToolsPanelShowsEveryControlWholeWithoutScrolling) {
+    for (const auto& [w, h] : {std::pair{1280, 720}, std::pair{1600, 900}, std::pair{1024, 768}}) {
+        auto context = stepwise::render::OffscreenRenderer::create(w, h);
+        ASSERT_TRUE(context.ok()) << context.error();
+        auto created = headlessSession();
+        ASSERT_TRUE(created.ok()) << created.error();
+        stepwise::ui::Session& session = **created;
+        stepwise::editor::Editor& ed = session.editor();
+        ASSERT_TRUE(ed.open(std::filesystem::path(STEPWISE_SOURCE_DIR) / "levels" / "default.json"));
+        for (int t = 0; t < int(stepwise::editor::Tool::Count); ++t) {
+            ed.tool = stepwise::editor::Tool(t);
+            session.ui().widgetRects.clear();
+            for (int i = 0; i < 3; ++i) session.frame(w, h, 1.0 / 60.0);
+            const std::string at = std::string(stepwise::editor::toolName(ed.tool)) + " tool at " + std::to_string(w) +
+                                   "x" + std::to_string(h);
+            const ImGuiWindow* tools = ImGui::FindWindowByName("Tools");
+            ASSERT_NE(tools, nullptr);
+            EXPECT_EQ(tools->ScrollMax.y, 0.0f) << at << ": " << tools->ScrollMax.y << " px to scroll";
+            // Every control (its label too) inside the panel's visible inside.
+            const ImRect inside = tools->InnerClipRect;
+            int controls = 0, buttons = 0;
+            for (const auto& [key, r] : session.ui().widgetRects) {
+                if (key.rfind("tools/", 0) != 0) continue;
+                ++controls;
+                EXPECT_GE(r.x, inside.Min.x - 0.5f) << at << ": " << key;
+                EXPECT_GE(r.y, inside.Min.y - 0.5f) << at << ": " << key;
+                EXPECT_LE(r.x + r.z, inside.Max.x + 0.5f) << at << ": " << key << " is cut at the right";
+                EXPECT_LE(r.y + r.w, inside.Max.y + 0.5f) << at << ": " << key << " is below the fold";
+                if (key.rfind("tools/tool/", 0) == 0) {
+                    // A tool button's label ("7  Attractor") fits between its frame's paddings.
+                    ++buttons;
+                    const stepwise::editor::Tool tool = *stepwise::editor::toolFromScriptName(key.substr(11));
+                    const std::string label = std::string(stepwise::editor::keyName(stepwise::editor::toolKey(tool))) +
+                                              "  " + std::string(stepwise::editor::toolName(tool));
+                    EXPECT_LE(ImGui::CalcTextSize(label.c_str()).x + 2 * ImGui::GetStyle().FramePadding.x, r.z + 0.5f)
+                        << at << ": " << label << " is cut";
+                }
+            }
+            EXPECT_EQ(buttons, int(stepwise::editor::Tool::Count)) << at;
+            // The tool buttons, snap, the overlay boxes, and the tool's own options.
+            EXPECT_GE(controls, int(stepwise::editor::Tool::Count) + 1 + 9) << at;
+        }
+    }
 }

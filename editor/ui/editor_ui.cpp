@@ -39,10 +39,10 @@ PanelRects defaultLayout(float width, float height, float scale) {
     const float bottom = std::round(std::min(230.0f * scale, 0.3f * height));
     const float top = menu, usable = height - menu - status;
     const float centerW = width - left - right;
-    // Tall enough for the tools, the active tool's options and the overlay
-    // boxes in one column (two do not fit their labels in 230 px) where the
-    // window allows; the entity list scrolls.
-    const float toolsH = std::round(std::min(480.0f * scale, usable * 0.5f));
+    // Tall enough for the tools, the active tool's options (the Joint
+    // tool's are the tallest) and the overlay boxes in two columns, from a
+    // 720 px window up; the entity list below scrolls.
+    const float toolsH = std::round(std::min(480.0f * scale, usable * 0.56f));
     r.toolsPos = {0, top};
     r.toolsSize = {left, toolsH};
     r.entitiesPos = {0, top + toolsH};

@@ -10,6 +10,7 @@
 
 #include <imgui.h>
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -96,6 +97,10 @@ struct UiState {
         std::size_t instances = 0;  ///< instances the viewport drew
         int drawCalls = 0;          ///< the viewport's draw calls
         int steps = 0;
+        /// The viewport's legend panel, pixels (x, y, width, height; y up
+        /// from the viewport's bottom, as render::DrawData::legendBox).
+        std::array<double, 4> legendBox{};
+        std::size_t legendRows = 0;  ///< its arrow overlays' references (DrawData::legend)
     } lastFrame;
     std::map<std::string, double, std::less<>> stageAverage;  ///< ms per step, moving average
 

@@ -339,6 +339,8 @@ void Session::frame(int width, int height, double frameSeconds, const std::funct
     renderer_->draw(drawn, int(ui_.viewportPos.x), height - int(ui_.viewportPos.y) - vh);
     ui_.lastFrame.instances = drawn.instanceCount();
     ui_.lastFrame.drawCalls = renderer_->lastDrawCalls();
+    ui_.lastFrame.legendBox = drawn.legendBox;
+    ui_.lastFrame.legendRows = drawn.legend.size();
     const double sceneMs = buildMs + msSince(tDraw);
     const auto t3 = Clock::now();
     renderer_->flush();  // llvmpipe starts on the viewport while ImGui's lists are submitted
