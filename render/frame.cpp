@@ -398,7 +398,9 @@ private:
     /// A body's fill: its colour, dimmed to 55% (towards black, so it stays
     /// its hue on the dark background) while its island sleeps.
     Rgba bodyColour(Entity e) const {
-        const Rgba c = colourOf(scene_, e, kDefaultBody);
+        Rgba c = colourOf(scene_, e, kDefaultBody);
+        // A sensor is a zone, not a solid: see-through, so what is inside shows.
+        if (const Sensor* sensor = scene_.registry.tryGet<Sensor>(e); sensor && sensor->value) c.a *= 0.35f;
         if (sleeping_.empty() || !sleeping_.count(e)) return c;
         return {0.55f * c.r, 0.55f * c.g, 0.55f * c.b, c.a};
     }

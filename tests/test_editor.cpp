@@ -596,6 +596,39 @@ TEST(BreakOnContact, TheMessageSaysWhetherThePairTouchesOrIsAboutTo) {
     EXPECT_EQ(nextBreak(g), "break on contact: crate 1 touches floor at t = 0.0167 s (depth 0 m)");
 }
 
+// Break on sensor pauses at the step a body enters or leaves a sensor,
+// names both, and logs every event of the run; the script turns it on and
+// a new level turns it off.
+TEST(BreakOnSensor, PausesAtEachEventAndTheLogKeepsThemAll) {
+    Fixture f("sensors.json");
+    RecordingHost host;
+    ASSERT_TRUE(runLine(f.ed, host, "breakonsensor on"));
+    EXPECT_TRUE(f.ed.sim.breakOnSensor);
+    // The same events a headless run gives, in order (stepwise run --contacts).
+    Scene scene = f.ed.doc.scene;
+    World world = stepwise::test::buildWorld(scene);
+    std::vector<std::string> expected;
+    for (int s = 0; s < 240; ++s) {
+        ASSERT_TRUE(world.step());
+        const std::span<const SensorEvent> events = world.sensorEvents();
+        if (events.empty()) continue;
+        char when[48];
+        std::snprintf(when, sizeof when, " at t = %.4f s", world.time());
+        const auto& e = events.front();
+        expected.push_back("break on sensor: " + displayName(scene.registry, e.body) + (e.begin ? " entered " : " left ") +
+                           displayName(scene.registry, e.sensor) + when +
+                           (events.size() > 1 ? " (and " + std::to_string(events.size() - 1) + " more)" : std::string()));
+    }
+    ASSERT_GE(expected.size(), 4u);
+    for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(nextBreak(f), expected[k]) << k;
+    EXPECT_GE(f.ed.sim.sensorLog().size(), 4u);
+    ASSERT_TRUE(runLine(f.ed, host, "open " + (kLevels / "spring_chain.json").string()));
+    EXPECT_FALSE(f.ed.sim.breakOnSensor);
+    EXPECT_FALSE(runLine(f.ed, host, "breakonsensor maybe"));
+    EXPECT_EQ(host.errors.back().substr(host.errors.back().find("breakonsensor")),
+              "breakonsensor: expected on or off, got \"maybe\"");
+}
+
 // The watched body stayed whatever was selected later, nothing named it, and
 // it stayed watched in the next level opened.
 TEST(BreakOnContact, TheWatchedBodyIsNamedKeptAndClearedWithTheLevel) {

@@ -64,6 +64,7 @@ void Editor::replaceDocument(Document next) {
     if (sim.running()) sim.reset(doc.scene);
     // A handle into the old level means nothing in the new one.
     sim.breakOnContact = {};
+    sim.breakOnSensor = false;
     doc = std::move(next);
     ++documentSerial_;
     commands.clear();

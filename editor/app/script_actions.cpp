@@ -141,6 +141,12 @@ void snap(ScriptActionRun& r) {
 
 void timeScale(ScriptActionRun& r) { r.ed.sim.timeScale = r.c.number; }
 
+void breakOnSensor(ScriptActionRun& r) {
+    const std::string& arg = r.c.args[0];
+    if (arg != "on" && arg != "off") r.failLine("breakonsensor: expected on or off, got \"" + arg + "\"");
+    else r.ed.sim.breakOnSensor = arg == "on";
+}
+
 void breakOn(ScriptActionRun& r) {
     Editor& ed = r.ed;
     const std::vector<std::string>& args = r.c.args;
@@ -182,6 +188,7 @@ const std::vector<ScriptAction>& scriptActions() {
         {"snap", 1, 1, "snap on|off", nullptr, snap},
         {"timescale", 1, 1, "timescale X", parseTimeScale, timeScale},
         {"breakon", 1, 1, "breakon NAME|none", nullptr, breakOn},
+        {"breakonsensor", 1, 1, "breakonsensor on|off", nullptr, breakOnSensor},
         {"fit", 0, 0, "fit", nullptr, [](ScriptActionRun& r) { r.ed.fitView(); }},
         {"new", 0, 0, "new", nullptr, [](ScriptActionRun& r) { r.ed.newDocument(); }},
         {"open", 1, 1, "open PATH", nullptr, open},

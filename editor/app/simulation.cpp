@@ -25,6 +25,13 @@ bool touches(const ContactRecord& c) {
     return c.depth > -1e-9;
 }
 
+/// "ball entered goal at t = 1.2000 s" (or "left").
+std::string sensorMessage(const Registry& reg, const SensorEvent& e, double time) {
+    char when[48];
+    std::snprintf(when, sizeof when, " at t = %.4f s", time);
+    return displayName(reg, e.body) + (e.begin ? " entered " : " left ") + displayName(reg, e.sensor) + when;
+}
+
 std::string breakMessage(const Registry& reg, const ContactRecord& c, double time) {
     char numbers[96];
     const std::string a = displayName(reg, c.a), b = displayName(reg, c.b);
@@ -234,6 +241,7 @@ bool Simulation::play(Scene& scene) {
         history_.clear();
         historyStateBytes_ = 0;
         samples_.clear();
+        sensorLog_.clear();
         steps_ = 0;
         contactStageBefore_ = 0;
         initialEnergy_ = world_->energy().total();
@@ -335,6 +343,17 @@ bool Simulation::finishStep(Scene& scene) {
     world_->writeBack(scene);
     ++steps_;
     record();
+    for (const SensorEvent& e : world_->sensorEvents()) {
+        sensorLog_.push_back(sensorMessage(scene.registry, e, world_->time()));
+        if (sensorLog_.size() > kSensorLogLength) sensorLog_.pop_front();
+    }
+    if (breakOnSensor && !world_->sensorEvents().empty()) {
+        const std::span<const SensorEvent> events = world_->sensorEvents();
+        state_ = SimState::Paused;
+        message_ = "break on sensor: " + sensorMessage(scene.registry, events.front(), world_->time()) +
+                   (events.size() > 1 ? " (and " + std::to_string(events.size() - 1) + " more)" : std::string());
+        return false;
+    }
     if (!breakOnContact.isNull()) {
         // The deepest contact of the watched body: a pair that touches wins
         // over one that is only speculative (a gap the solver keeps from
@@ -468,6 +487,7 @@ bool Simulation::reset(Scene& scene) {
     diverged_ = false;
     contactPair.reset();
     mouseSpring.reset();
+    sensorLog_.clear();
     contactsKept_ = false;
     beforeEdits_.reset();
     return true;

@@ -117,6 +117,12 @@ public:
     bool behind() const { return behind_; }
     /// Pause when this body starts touching something (null: off).
     Entity breakOnContact;
+    /// Pause at a step where a body enters or leaves a sensor.
+    bool breakOnSensor = false;
+    /// The run's sensor events, newest last ("t = 1.2000 s: ball entered
+    /// goal"), the last kSensorLogLength of them; cleared with the run.
+    static constexpr std::size_t kSensorLogLength = 200;
+    const std::deque<std::string>& sensorLog() const { return sensorLog_; }
     /// Mouse spring while playing: pulls `dragBody` toward `dragTarget`.
     std::optional<std::pair<Entity, Vec2>> mouseSpring;
 
@@ -157,6 +163,7 @@ public:
     /// The pair a break on contact stopped at.
     std::optional<std::pair<Entity, Entity>> contactPair;
 
+
     std::size_t historySize() const { return history_.size(); }
     std::size_t historyCapacity() const { return historyCapacity_; }
     /// Memory budget of the step-back history, bytes: the oldest states go
@@ -175,6 +182,7 @@ public:
     double lastFrameStepMs() const { return frameStepMs_; }
 
 private:
+    std::deque<std::string> sensorLog_;  ///< sensorLog()
     /// One step-back entry: the World's state before a step, and the scene
     /// (as of the last edit) whose other components go with it.
     /// A body that gained a Velocity (1), Angle (2) or AngularVelocity (4)

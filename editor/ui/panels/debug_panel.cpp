@@ -11,6 +11,7 @@
 #include <imgui_stdlib.h>
 
 #include <algorithm>
+#include <deque>
 #include <cmath>
 #include <cstdio>
 
@@ -24,6 +25,23 @@ void helpMarker(const char* text) {
     ImGui::SameLine();
     ImGui::TextDisabled("(?)");
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text);
+}
+
+/// Sensors: who is inside which now, and the run's events, newest first.
+void sensorRows(Editor& ed) {
+    const World* w = ed.sim.world();
+    const std::deque<std::string>& log = ed.sim.sensorLog();
+    const std::vector<std::pair<Entity, Entity>> inside = w ? w->sensorOverlaps() : std::vector<std::pair<Entity, Entity>>{};
+    if (inside.empty() && log.empty()) return;
+    const Registry& reg = ed.doc.scene.registry;
+    if (!ImGui::CollapsingHeader(("sensors: " + std::to_string(inside.size()) + " inside, " + std::to_string(log.size()) +
+                                  " events###sensors")
+                                     .c_str(),
+                                 ImGuiTreeNodeFlags_DefaultOpen))
+        return;
+    for (const auto& [sensor, body] : inside)
+        ImGui::Text("%s is inside %s", editor::displayName(reg, body).c_str(), editor::displayName(reg, sensor).c_str());
+    for (auto it = log.rbegin(); it != log.rend() && it - log.rbegin() < 8; ++it) ImGui::TextColored(kDim, "%s", it->c_str());
 }
 
 void contactsTab(UiState& ui, Editor& ed) {
@@ -44,6 +62,7 @@ void contactsTab(UiState& ui, Editor& ed) {
         ImGui::SetTooltip("normal: unit, from a to b. depth > 0: the shapes overlap by that much; depth < 0: a gap "
                           "(a speculative contact, not touching yet).\nimpulse: normal and tangent (friction) "
                           "impulse the solver applied this step. The pair that stopped the run is in red.");
+    sensorRows(ed);
     if (contacts.empty()) return;
     if (ImGui::BeginTable("contacts", 7, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_Borders |
                                              ImGuiTableFlags_Resizable | ImGuiTableFlags_Sortable)) {

@@ -76,6 +76,11 @@ void simToolbar(UiState& ui, Editor& ed) {
     }
     recordWidgetRect(ui, "viewport/breakon");
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", breakHelp);
+    ImGui::SameLine();
+    ImGui::Checkbox("Break on sensor", &ed.sim.breakOnSensor);
+    recordWidgetRect(ui, "viewport/breakonsensor");
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("Pause at the step where a body enters or leaves a sensor (a shape with \"sensor\": true).");
     char clock[96];
     std::snprintf(clock, sizeof clock, "t = %.3f s  step %llu  history %zu", ed.doc.scene.world.time,
                   static_cast<unsigned long long>(ed.sim.steps()), ed.sim.historySize());
