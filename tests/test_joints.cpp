@@ -633,3 +633,212 @@ TEST(JointSweep, ChainsStayJoinedAtEverySoftnessAndSolverSetting) {
 }
 
 } // namespace
+
+// ---------------------------------------------------------------- hinge spring
+
+namespace {
+
+/// A hinge's rotational spring with gravity off: body "rotor" (a disc of
+/// `radius` and `mass`) pinned at its centre to the world, or to a second
+/// free disc "stator" (then the relative angle oscillates with the joint's
+/// axial mass 1 / (1/I_a + 1/I_b)), released at `theta0` from the reference
+/// angle 0 with no spin.
+Scene springScene(double hz, double ratio, double radius, double mass, int substeps, double theta0,
+                  bool twoBodies = false, double statorMass = 1.0) {
+    std::ostringstream s;
+    // Sleep off: an undamped spring still loses amplitude (the soft step is
+    // implicit), and a swing that has decayed under the sleep speed would
+    // stop the measurement.
+    std::string w = world(substeps, 0.0);
+    w.insert(w.size() - 1, R"(, "sleep": false)");
+    s << "{" << w << R"(, "entities": [)"
+      << R"({"name": "rotor", "position": {"x": 0, "y": 0}, "angle": )" << num(theta0) << R"(, "mass": )" << num(mass)
+      << R"(, "radius": )" << num(radius) << "}";
+    // The stator has no shape (it turns like a small disc, kShapelessRadius):
+    // two shapes on one spot would be a deep overlap, which the contact
+    // solver treats as a crowd whatever the joint says.
+    if (twoBodies) s << R"(, {"name": "stator", "position": {"x": 0, "y": 0}, "mass": )" << num(statorMass) << "}";
+    s << R"(, {"name": "pin", "joint": {"type": "hinge", "a": ")" << (twoBodies ? "stator" : "rotor") << "\"";
+    if (twoBodies) s << R"(, "b": "rotor")";
+    s << R"(, "anchor": {"x": 0, "y": 0}, "reference_angle": 0, "spring_hz": )" << num(hz)
+      << R"(, "spring_damping_ratio": )" << num(ratio) << "}}]}";
+    return load(s.str());
+}
+
+/// The joint's angle over `steps` steps (JointRecord::angle), signed so
+/// that it starts positive (with the world as b the angle is -rotor's).
+std::vector<double> springAngles(World& w, int steps) {
+    std::vector<double> out;
+    for (int i = 0; i < steps; ++i) {
+        const Result<void> stepped = w.step();
+        EXPECT_TRUE(stepped) << stepped.error();
+        if (!stepped) break;
+        out.push_back(w.joints()[0].angle);
+    }
+    if (!out.empty() && out[0] < 0.0)
+        for (double& a : out) a = -a;
+    return out;
+}
+
+/// Mean period from the downward zero crossings of the angle (interpolated).
+double periodOf(const std::vector<double>& angle, double dt) {
+    std::vector<double> crossings;
+    for (std::size_t i = 1; i < angle.size(); ++i)
+        if (angle[i - 1] > 0.0 && angle[i] <= 0.0)
+            crossings.push_back(dt * (double(i) + angle[i - 1] / (angle[i - 1] - angle[i])));
+    if (crossings.size() < 2) return std::numeric_limits<double>::quiet_NaN();
+    return (crossings.back() - crossings.front()) / double(crossings.size() - 1);
+}
+
+} // namespace
+
+/// Undamped, the spring's period is 1 / spring_hz for any inertia: the
+/// row works on the joint's axial mass, so k = I_eff (2 pi f)^2. The soft
+/// step is an implicit scheme, so its error grows with w h (w = 2 pi f,
+/// h the substep): measured 0.46 (w h)^2 at every inertia (0.126% at
+/// 0.5 Hz and 1 substep, 3.05% at 10 Hz and 4 substeps, 41.6% at 10 Hz
+/// and 1 substep, where w h = 1.05); the bound is 1e-4 + 0.5 (w h)^2. A
+/// spring on the wrong mass (a world pin's I for the two-body case) would
+/// be off by the square root of the inertia ratio.
+TEST(HingeSpring, PeriodIsOneOverSpringHzAcrossFrequenciesInertiasAndSubsteps) {
+    const double dt = 1.0 / 60.0;
+    double worst = 0.0, worstOmegaH = 0.0;
+    for (const int substeps : {1, 4}) {
+        for (const double hz : {0.5, 1.0, 2.0, 5.0, 10.0}) {
+            for (const auto& [radius, mass] : {std::pair{0.25, 0.5}, std::pair{1.0, 2.0}, std::pair{2.0, 50.0}}) {
+                for (const bool two : {false, true}) {
+                    const Scene scene = springScene(hz, 0.0, radius, mass, substeps, 0.3, two, 3.0);
+                    World w = build(scene);
+                    const int steps = int(std::ceil(6.5 / hz / dt));
+                    const double period = periodOf(springAngles(w, steps), dt);
+                    const double omegaH = 2.0 * kPi * hz * dt / substeps;
+                    const double error = std::abs(period * hz - 1.0);
+                    std::printf("  %4.1f Hz r %.2f m %4.1f %s %d substeps: period error %.3g%% (w h %.3f)\n", hz,
+                                radius, mass, two ? "two bodies" : "world pin ", substeps, 100.0 * error, omegaH);
+                    if (error > worst) {
+                        worst = error;
+                        worstOmegaH = omegaH;
+                    }
+                    EXPECT_LT(error, 1e-4 + 0.5 * omegaH * omegaH)
+                        << hz << " Hz, r " << radius << ", m " << mass << (two ? ", two bodies" : "") << ", "
+                        << substeps << " substeps: period " << period << " s";
+                }
+            }
+        }
+    }
+    std::printf("hinge spring: largest period error %.3g%% (at w h = %.3f)\n", 100.0 * worst, worstOmegaH);
+}
+
+/// Critically (ratio 1) and over-damped springs released from rest come
+/// back to the reference angle without crossing it; an under-damped one
+/// (ratio 0.1) crosses: the check can fail.
+TEST(HingeSpring, CriticalDampingDoesNotOvershootAndLightDampingDoes) {
+    for (const int substeps : {1, 4}) {
+        for (const double hz : {0.5, 2.0, 10.0}) {
+            for (const double mass : {0.5, 20.0}) {
+                for (const double ratio : {0.1, 1.0, 2.0}) {
+                    World w = build(springScene(hz, ratio, 0.5, mass, substeps, 0.4));
+                    const std::vector<double> angle = springAngles(w, int(std::ceil(4.0 / hz * 60.0)));
+                    const double lowest = *std::min_element(angle.begin(), angle.end());
+                    if (ratio >= 1.0) {
+                        EXPECT_GE(lowest, -1e-9) << hz << " Hz, ratio " << ratio << ", m " << mass << ", " << substeps;
+                        EXPECT_LT(std::abs(angle.back()), 0.4 * 0.05) << "it comes back: " << hz << " Hz ratio " << ratio;
+                    } else if (2.0 * kPi * hz / 60.0 / substeps < 0.6) {
+                        // Past w h = 0.6 the implicit step's own damping
+                        // (10 Hz at one substep) hides a ratio of 0.1.
+                        EXPECT_LT(lowest, -0.1) << hz << " Hz, ratio 0.1 overshoots, m " << mass << ", " << substeps;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A spring on a chain's hinge leaves the chain's exact solve intact (the
+/// spring is an axial row, like a motor): a two-link pendulum whose
+/// middle hinge is a stiff spring swings with its links at the reference
+/// angle to each other, and the joints stay closed.
+TEST(HingeSpring, StiffSpringOnAChainHingeHoldsTheLinksStraightAndTheChainClosed) {
+    Scene scene = load(chainLevel(2, 0.5, 1.0, 1.0, 4));
+    Joint* elbow = scene.registry.tryGet<Joint>(named(scene, "pin1"));
+    ASSERT_NE(elbow, nullptr);
+    for (const double hz : {2.0, 8.0}) {
+        elbow->springHz = hz;
+        elbow->springDampingRatio = 0.7;
+        World w = build(scene);
+        double worstAngle = 0.0, worstGap = 0.0;
+        for (int i = 0; i < 180; ++i) {
+            ASSERT_TRUE(w.step());
+            worstAngle = std::max(worstAngle, std::abs(w.joints()[1].angle));
+            worstGap = std::max(worstGap, largestSeparation(w));
+        }
+        std::printf("chain elbow spring %.0f Hz: largest bend %.4f rad, largest opening %.3f mm\n", hz, worstAngle,
+                    1e3 * worstGap);
+        EXPECT_LT(worstGap, 0.001);
+        // A stiffer spring bends less under the same swing.
+        EXPECT_LT(worstAngle, hz > 4.0 ? 0.12 : 0.6);
+    }
+}
+
+// ---------------------------------------------------------------- breaking
+
+namespace {
+
+/// A ball of `mass` kg hanging 1 m under a world point on a joint of `type`
+/// with max_force `maxForce`, gravity 10 m/s^2 (slider: the axis is
+/// horizontal, so its sideways row carries the weight).
+Scene hangingOn(const std::string& type, double mass, double maxForce, int substeps) {
+    std::string anchor = R"("anchor": {"x": 0, "y": 0})";
+    if (type == "distance" || type == "rope")
+        anchor = R"("local_a": {"x": 0, "y": 0}, "local_b": {"x": 0, "y": 0}, "length": 1)";
+    if (type == "slider") anchor = R"("anchor": {"x": 0, "y": -1}, "axis": {"x": 1, "y": 0})";
+    return load("{" + world(substeps, -10.0) + R"(, "entities": [
+        {"name": "weight", "position": {"x": 0, "y": -1}, "mass": )" + num(mass) + R"(, "radius": 0.2},
+        {"name": "hook", "joint": {"type": ")" + type + R"(", "a": "weight", )" + anchor +
+                R"(, "max_force": )" + num(maxForce) + "}}]}");
+}
+
+} // namespace
+
+/// A weight m under a joint with max_force F breaks exactly when m g > F:
+/// a sweep of m from half to one and a half times F / g, as close as 1e-4
+/// on either side, for every joint type, at 1 and 4 substeps. A weight at
+/// rest under its joint pulls with m g from the first substep, so one that
+/// breaks does so after the first step, and the reported force is m g.
+TEST(JointBreaking, AHangingWeightBreaksItsJointExactlyWhenItsWeightExceedsMaxForce) {
+    const double F = 100.0, g = 10.0;
+    double worstForceError = 0.0;
+    for (const std::string type : {"hinge", "weld", "slider", "distance", "rope"}) {
+        for (const int substeps : {1, 4}) {
+            for (const double delta : {-0.5, -0.1, -0.01, -1e-3, -1e-4, 1e-4, 1e-3, 0.01, 0.1, 0.5}) {
+                const double m = F / g * (1.0 + delta);
+                const Scene scene = hangingOn(type, m, F, substeps);
+                World w = build(scene);
+                double largest = 0.0;
+                for (int i = 0; i < 120; ++i) {
+                    ASSERT_TRUE(w.step());
+                    for (const JointRecord& r : w.joints()) largest = std::max(largest, length(r.force));
+                }
+                const std::string what = type + ", " + std::to_string(substeps) + " substeps, m g / F - 1 = " +
+                                         std::to_string(delta);
+                worstForceError = std::max(worstForceError, std::abs(largest / (m * g) - 1.0));
+                if (delta > 0.0) {
+                    ASSERT_EQ(w.jointBreaks().size(), 1u) << what;
+                    const JointBreak& b = w.jointBreaks()[0];
+                    EXPECT_EQ(b.joint, named(scene, "hook")) << what;
+                    EXPECT_EQ(b.a, named(scene, "weight")) << what;
+                    EXPECT_EQ(b.step, 1u) << what;
+                    EXPECT_NEAR(b.force, m * g, 1e-6 * m * g) << what;
+                    EXPECT_EQ(b.maxForce, F);
+                    EXPECT_TRUE(w.joints().empty()) << what << ": a broken joint has no record after its step";
+                    // Free fall from there: 119 steps of gravity alone.
+                    EXPECT_LT(w.bodyPosition(0).y, -1.0 - 0.5 * g * 1.9 * 1.9) << what;
+                } else {
+                    EXPECT_TRUE(w.jointBreaks().empty()) << what << ": broke at force " << w.jointBreaks()[0].force;
+                    EXPECT_NEAR(w.bodyPosition(0).y, -1.0, 0.01) << what;
+                }
+            }
+        }
+    }
+    std::printf("hanging weights: largest joint force within %.3g of m g\n", worstForceError);
+}

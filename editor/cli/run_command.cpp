@@ -104,6 +104,25 @@ void appendContactLine(std::string& jsonl, std::uint64_t step, const World& worl
     jsonl += "}\n";
 }
 
+/// One JSON line per joint that broke in this step, after the step's line:
+/// which joint, its ends, the step and the force that broke it.
+void appendBreakLines(std::string& jsonl, std::uint64_t step, const World& world, const Scene& scene) {
+    for (const JointBreak& b : world.jointBreaks()) {
+        if (b.step != step) continue;
+        jsonl += "{\"event\": \"break\", \"step\": " + std::to_string(step) + ", \"time\": " + number(world.time()) +
+                 ", \"joint\": " + jsonString(entityRef(scene, b.joint)) + ", \"a\": " + jsonString(entityRef(scene, b.a)) +
+                 ", \"b\": " + (b.b.isNull() ? std::string("null") : jsonString(entityRef(scene, b.b))) +
+                 ", \"force\": " + number(b.force) + ", \"max_force\": " + number(b.maxForce) + "}\n";
+    }
+}
+
+/// "step 12: joint \"left rope\" broke: force 1250.3 N past its max_force 1000 N".
+std::string breakNote(const JointBreak& b, const Scene& scene) {
+    char forces[96];
+    std::snprintf(forces, sizeof forces, "force %.6g N past its max_force %.6g N", b.force, b.maxForce);
+    return "step " + std::to_string(b.step) + ": joint " + jsonString(entityRef(scene, b.joint)) + " broke: " + forces;
+}
+
 /// Ctrl-C (SIGINT) or SIGTERM during the steps: the loop stops, the
 /// temporaries are removed and nothing is written.
 
@@ -243,7 +262,15 @@ int run(const RunOptions& options) {
              }
              if (contacts) {
                  appendContactLine(row, step, world, *scene);
+                 appendBreakLines(row, step, world, *scene);
                  emit(contacts);
+             }
+             // A break is news whether or not a trace is written.
+             if (!world.jointBreaks().empty() && world.jointBreaks().back().step == step) {
+                 if (progressShown) std::fputc('\n', stderr);
+                 progressShown = false;
+                 for (const JointBreak& b : world.jointBreaks())
+                     if (b.step == step) std::cerr << options.level << ": note: " << breakNote(b, *scene) << "\n";
              }
              // A clock read every 256 steps: a progress line on a terminal twice
              // a second, and once, after a second, the estimate of the whole run
@@ -333,6 +360,8 @@ int run(const RunOptions& options) {
               << world.settings().integrator << "; t = " << number(world.time()) << " s; " << world.bodyCount()
               << " dynamic bodies; total energy " << number(energy.total()) << " J; "
               << number(taken ? 1e3 * seconds / double(taken) : 0.0) << " ms/step";
+    if (const std::size_t broke = world.jointBreaks().size())
+        std::cout << "; " << broke << " joint" << (broke == 1 ? "" : "s") << " broke";
     if (options.out) std::cout << "; wrote " << *options.out;
     if (options.trace) std::cout << "; trace " << *options.trace;
     std::cout << "\n";

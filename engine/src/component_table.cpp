@@ -220,6 +220,11 @@ std::vector<ComponentInfo> buildTable() {
              field<&Joint::length>("length", kNonNegative, "m", "distance, rope: length; absent: as loaded"),
              field<&Joint::stiffnessHz>("stiffness_hz", kNonNegative, "Hz", "weld, distance: softness; 0 rigid"),
              field<&Joint::dampingRatio>("damping_ratio", kNonNegative, "", "weld, distance: damping; absent 1"),
+             field<&Joint::springHz>("spring_hz", kNonNegative, "Hz",
+                                     "hinge: rotational spring toward reference_angle; absent or 0 none"),
+             field<&Joint::springDampingRatio>("spring_damping_ratio", kNonNegative, "",
+                                               "hinge spring's damping ratio; absent 1"),
+             field<&Joint::maxForce>("max_force", kPositive, "N", "breaks past this force; absent never"),
              field<&Joint::collideConnected>("collide_connected", kAny, "", "a and b still collide")},
             &finishJoint));
     }

@@ -168,7 +168,8 @@ std::string sceneJsonSchema() {
               {"axial_impulse", impulse("distance: along the anchors' line, N*s")},
               {"motor_impulse", impulse("hinge motor N*m*s, slider motor N*s")},
               {"lower_impulse", oneSided("hinge, slider: lower limit")},
-              {"upper_impulse", oneSided("hinge, slider: upper limit; rope: its pull, N*s")}}}};
+              {"upper_impulse", oneSided("hinge, slider: upper limit; rope: its pull, N*s")},
+              {"spring_impulse", impulse("hinge spring (spring_hz): relative rotation, N*m*s")}}}};
     Json bodySleep = Json{
         {"type", "object"},
         {"description", "one dynamic body's sleep state: seconds it has been still and, while it sleeps, its island "

@@ -149,6 +149,13 @@ struct Joint {
     std::optional<double> length;
     std::optional<double> stiffnessHz;    ///< weld, distance: spring frequency, Hz; absent or 0 = rigid
     std::optional<double> dampingRatio;   ///< weld, distance: with stiffness_hz; absent = 1 (critical)
+    /// hinge: a rotational spring toward reference_angle of this frequency,
+    /// Hz (Box2D's revolute spring); absent or 0 = no spring.
+    std::optional<double> springHz;
+    std::optional<double> springDampingRatio;  ///< hinge spring's damping ratio; absent = 1 (critical)
+    /// Any type: the joint breaks (is removed from the run) after a step
+    /// whose constraint force exceeds this, newtons (> 0); absent: never.
+    std::optional<double> maxForce;
     bool collideConnected = false;        ///< whether a and b still collide with each other
 };
 

@@ -105,6 +105,7 @@ struct JointImpulse {
     double motor = 0.0;          ///< hinge N*m*s, slider N*s
     double lower = 0.0;          ///< hinge, slider: lower limit (>= 0)
     double upper = 0.0;          ///< hinge, slider: upper limit; rope: its pull (>= 0)
+    double spring = 0.0;         ///< hinge spring (spring_hz), N*m*s
 
     friend bool operator==(const JointImpulse&, const JointImpulse&) = default;
 };

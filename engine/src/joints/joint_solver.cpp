@@ -91,9 +91,24 @@ void solvePoint(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pa
     p.applyLinear(impulse, rA, rB);
 }
 
-/// One-sided angular limits and the motor of a hinge (axial rows).
+/// The rotational spring, one-sided angular limits and the motor of a hinge
+/// (axial rows).
 void solveHingeAxial(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
                      const Softness& soft, bool useBias) {
+    if (j.springHz > 0.0) {
+        // Box2D v3's revolute spring: a soft row toward the reference angle
+        // on the axial mass, in both passes (it is a force, not an error to
+        // correct, so the relax pass must not drop it). With the soft step's
+        // mass and impulse scales this is the implicit spring-damper of
+        // frequency springHz on the joint's relative rotation.
+        const Softness spring = Softness::make(j.springHz, j.springDampingRatio, h);
+        const double angle = j.deltaAngle + angleOf(b.dq) - angleOf(a.dq);
+        const double cdot = p.wB - p.wA;
+        const double impulse = -j.axialMass * spring.massScale * (cdot + spring.biasRate * angle) -
+                               spring.impulseScale * j.springImpulse;
+        j.springImpulse += impulse;
+        p.applyAngular(impulse);
+    }
     if (j.motor) {
         const double cdot = p.wB - p.wA - j.motorSpeed;
         const double maxImpulse = j.maxMotor * h;
@@ -234,7 +249,8 @@ void solveSlider(JointConstraint& j, const SolverBody& a, const SolverBody& b, P
 } // namespace
 
 JointImpulse impulsesOf(const JointConstraint& j) {
-    return {j.entity, j.linearImpulse, j.angularImpulse, j.axialImpulse, j.motorImpulse, j.lowerImpulse, j.upperImpulse};
+    return {j.entity,       j.linearImpulse, j.angularImpulse, j.axialImpulse, j.motorImpulse,
+            j.lowerImpulse, j.upperImpulse,  j.springImpulse};
 }
 
 void setImpulses(JointConstraint& j, const JointImpulse& in) {
@@ -245,6 +261,7 @@ void setImpulses(JointConstraint& j, const JointImpulse& in) {
     j.motorImpulse = hingeLike && j.motor ? in.motor : 0.0;
     j.lowerImpulse = hingeLike && j.hasLower ? in.lower : 0.0;
     j.upperImpulse = (hingeLike && j.hasUpper) || j.kind == JointKind::Rope ? in.upper : 0.0;
+    j.springImpulse = j.kind == JointKind::Hinge && j.springHz > 0.0 ? in.spring : 0.0;
 }
 
 void prepareJoints(std::span<JointConstraint> joints, std::span<const SolverBody> bodies,
@@ -279,8 +296,11 @@ void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bo
         switch (j.kind) {
         case JointKind::Hinge:
         case JointKind::Weld: {
-            const double axial = j.kind == JointKind::Weld ? j.angularImpulse
-                                                           : j.motorImpulse + j.lowerImpulse - j.upperImpulse;
+            double axial = j.kind == JointKind::Weld ? j.angularImpulse
+                                                     : j.motorImpulse + j.lowerImpulse - j.upperImpulse;
+            // Only a hinge with a spring adds it: 0 + x could turn a -0 into
+            // +0 and change the bits of a level without springs.
+            if (j.springHz > 0.0) axial += j.springImpulse;
             p.applyLinear(j.linearImpulse, rA, rB);
             p.applyAngular(axial);
             break;
@@ -401,7 +421,11 @@ Vec2 jointForce(const JointConstraint& j, double h) {
 double jointTorque(const JointConstraint& j, double h) {
     const double invH = h > 0.0 ? 1.0 / h : 0.0;
     switch (j.kind) {
-    case JointKind::Hinge: return invH * (j.motorImpulse + j.lowerImpulse - j.upperImpulse);
+    case JointKind::Hinge: {
+        double axial = j.motorImpulse + j.lowerImpulse - j.upperImpulse;
+        if (j.springHz > 0.0) axial += j.springImpulse;
+        return invH * axial;
+    }
     case JointKind::Weld: return invH * j.angularImpulse;
     case JointKind::Slider: return invH * j.linearImpulse.y;
     default: return 0.0;

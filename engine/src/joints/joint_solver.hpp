@@ -80,6 +80,23 @@ struct alignas(64) JointConstraint {
     double length = 0.0;           ///< distance, rope: metres
     double stiffnessHz = 0.0;      ///< weld, distance: 0 = rigid
     double dampingRatio = 1.0;
+    /// Hinge: rotational spring toward referenceAngle, Hz (0: none), solved
+    /// in both passes as Box2D's revolute spring, on the axial mass.
+    double springHz = 0.0;
+    double springDampingRatio = 1.0;
+    double springImpulse = 0.0;    ///< accumulated, N*m*s (warm started)
+    /// Breaks after a step whose constraint force |jointForce| exceeds this,
+    /// newtons; 0: never (CollisionSystem only looks at joints listed as
+    /// breakable, so an unbreakable level pays nothing).
+    double maxForce = 0.0;
+    /// Broke: out of the run. It stays in the array (snapshots and the
+    /// layout keep their shape; a restore before the break brings it back)
+    /// with `asleep` set, so every pass skips it as it skips a sleeping one,
+    /// and no group, island edge or record includes it.
+    bool broken = false;
+    /// Its (min collider << 32 | max collider) entry in the no-collide list
+    /// (collide_connected false, both ends with a collider); 0: none.
+    std::uint64_t noCollideKey = 0;
     Entity entity;                 ///< the joint's own entity
     Entity entityA, entityB;       ///< its ends (entityB null: the world)
 

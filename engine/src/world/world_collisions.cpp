@@ -170,6 +170,11 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         j.length = joint->length.value_or(0.0);
         j.stiffnessHz = joint->stiffnessHz.value_or(0.0);
         j.dampingRatio = joint->dampingRatio.value_or(1.0);
+        if (j.kind == joints::JointKind::Hinge) {
+            j.springHz = joint->springHz.value_or(0.0);
+            j.springDampingRatio = joint->springDampingRatio.value_or(1.0);
+        }
+        j.maxForce = joint->maxForce.value_or(0.0);
         makeSystem();
         system->addJoint(j, filter[0], filter[1], joint->collideConnected);
     }
