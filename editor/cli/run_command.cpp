@@ -385,7 +385,8 @@ void addRunCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--contacts", options->contacts,
                     "Write one JSON line per step: the step, the time and every contact (entities, point, normal, "
                     "depth, normal and tangent impulse); with joints, every joint too (anchors, separation, "
-                    "reaction force and torque on b, angle)")
+                    "reaction force and torque on b, angle), and after a step in which a joint broke, a line "
+                    "{\"event\": \"break\", ...} naming it with the force that broke it")
         ->check(outputFileName());
     cmd->callback([options, &exitCode] { exitCode = run(*options); });
 }
