@@ -842,3 +842,113 @@ TEST(JointBreaking, AHangingWeightBreaksItsJointExactlyWhenItsWeightExceedsMaxFo
     }
     std::printf("hanging weights: largest joint force within %.3g of m g\n", worstForceError);
 }
+
+namespace {
+
+/// A door on a sprung hinge knocked by a ball that swings down on a
+/// breakable rod and flies off at the bottom of its swing (the rod's
+/// tension passes its max_force, 1.5 m g, on the way down), onto a floor;
+/// an arm on a sprung hinge, released level, whose weld to a heavy bob
+/// breaks on the way down too.
+const char* kSpringsAndBreaks = R"({"world": {"gravity": {"x": 0, "y": -9.81}, "dt": 0.016666666666666666, "substeps": 4},
+  "entities": [
+    {"name": "floor", "position": {"x": 0, "y": -3}, "static": true, "box": {"width": 30, "height": 1}},
+    {"name": "door", "position": {"x": 2, "y": -1.5}, "mass": 3, "box": {"width": 0.2, "height": 1.5}},
+    {"name": "hinge", "joint": {"type": "hinge", "a": "door", "anchor": {"x": 2, "y": -0.75}, "spring_hz": 1.5,
+                                "spring_damping_ratio": 0.2}},
+    {"name": "ball", "position": {"x": -1.5, "y": 0}, "mass": 2, "radius": 0.25},
+    {"name": "rod", "joint": {"type": "distance", "a": "ball", "local_b": {"x": 0, "y": 0}, "max_force": 30}},
+    {"name": "arm", "position": {"x": -4.5, "y": -0.5}, "mass": 1, "box": {"width": 1, "height": 0.2}},
+    {"name": "shoulder", "joint": {"type": "hinge", "a": "arm", "anchor": {"x": -5, "y": -0.5}, "spring_hz": 3,
+                                   "spring_damping_ratio": 0.05}},
+    {"name": "bob", "position": {"x": -3.7, "y": -0.5}, "mass": 4, "radius": 0.3},
+    {"name": "wrist", "joint": {"type": "weld", "a": "arm", "b": "bob", "anchor": {"x": -4, "y": -0.5}, "max_force": 78}}
+  ]})";
+
+std::string savedWith(const World& w, Scene scene) {
+    w.writeBack(scene);
+    scene.solverState.reset();
+    if (SolverState s = w.solverState(); !s.empty()) scene.solverState = std::move(s);
+    return sceneToJsonText(scene);
+}
+
+} // namespace
+
+/// Save mid-run, load and go on equals running on, bit for bit, with
+/// hinge springs and before and after each break; so does a snapshot
+/// taken before the breaks and restored after them (the joints come back
+/// and break again at the same steps).
+TEST(JointBreaking, ResumeFromAFileOrASnapshotIsExactWithSpringsAndBreaks) {
+    const Scene scene = load(kSpringsAndBreaks);
+    World straight = build(scene);
+    ASSERT_TRUE(advance(straight, 240).ok());
+    ASSERT_EQ(straight.jointBreaks().size(), 2u);
+    std::vector<std::uint64_t> breakSteps;
+    for (const JointBreak& b : straight.jointBreaks()) breakSteps.push_back(b.step);
+    std::printf("breaks: \"%s\" at step %llu (%.2f N), \"%s\" at step %llu (%.2f N)\n",
+                straight.jointBreaks()[0].joint == named(scene, "rod") ? "rod" : "wrist",
+                (unsigned long long)breakSteps[0], straight.jointBreaks()[0].force,
+                straight.jointBreaks()[1].joint == named(scene, "rod") ? "rod" : "wrist",
+                (unsigned long long)breakSteps[1], straight.jointBreaks()[1].force);
+    const std::uint64_t first = std::min(breakSteps[0], breakSteps[1]), last = std::max(breakSteps[0], breakSteps[1]);
+    ASSERT_GT(first, 2u);
+    ASSERT_GT(last, first + 2);
+    const std::string once = savedWith(straight, scene);
+    EXPECT_EQ(once.find("\"rod\""), std::string::npos);
+    EXPECT_EQ(once.find("\"wrist\""), std::string::npos);
+    // Splits before both breaks, between them and after both.
+    for (const std::uint64_t split : {first - 1, first, (first + last) / 2, last, last + 30}) {
+        World w = build(scene);
+        ASSERT_TRUE(advance(w, split).ok());
+        Result<Scene> middle = parseScene(savedWith(w, scene), "middle.json");
+        ASSERT_TRUE(middle) << middle.error();
+        World resumed = build(*middle);
+        ASSERT_TRUE(advance(resumed, 240 - split).ok());
+        EXPECT_TRUE(savedWith(resumed, *middle) == once) << "saved at step " << split;
+    }
+    // A snapshot before the breaks, restored after them.
+    World w = build(scene);
+    ASSERT_TRUE(advance(w, first - 1).ok());
+    const WorldState before = w.saveState();
+    ASSERT_TRUE(advance(w, 240 - (first - 1)).ok());
+    ASSERT_EQ(w.jointBreaks().size(), 2u);
+    ASSERT_TRUE(w.restoreState(before).ok());
+    EXPECT_TRUE(w.jointBreaks().empty());
+    ASSERT_TRUE(advance(w, 240 - (first - 1)).ok());
+    EXPECT_TRUE(std::equal(w.jointBreaks().begin(), w.jointBreaks().end(), straight.jointBreaks().begin(),
+                           straight.jointBreaks().end()));
+    EXPECT_TRUE(savedWith(w, scene) == once) << "restore before the breaks and run on";
+    // A snapshot's writeBack leaves out the joints broken as of it.
+    Scene fromSnapshot = scene;
+    const WorldState after = w.saveState();
+    after.writeBack(fromSnapshot);
+    EXPECT_FALSE(fromSnapshot.registry.alive(named(scene, "rod")));
+    Scene fromBefore = scene;
+    before.writeBack(fromBefore);
+    EXPECT_TRUE(fromBefore.registry.alive(named(scene, "rod")));
+}
+
+/// After a break the two bodies collide again: a hinge kept them from it
+/// (collide_connected false), and once broken the ball falls through the
+/// plank it was pinned to no more.
+TEST(JointBreaking, BodiesOfABrokenJointCollideAgain) {
+    const Scene scene = load("{" + world(4) + R"(, "entities": [
+        {"name": "shelf", "position": {"x": 0, "y": 0}, "static": true, "box": {"width": 4, "height": 0.2}},
+        {"name": "ball", "position": {"x": 0, "y": -0.3}, "mass": 1, "radius": 0.25},
+        {"name": "pin", "joint": {"type": "hinge", "a": "ball", "b": "shelf", "anchor": {"x": 0, "y": -0.3}, "max_force": 5}},
+        {"name": "floor", "position": {"x": 0, "y": -3}, "static": true, "box": {"width": 4, "height": 1}}]})");
+    World w = build(scene);
+    ASSERT_TRUE(advance(w, 120).ok());
+    ASSERT_EQ(w.jointBreaks().size(), 1u);
+    EXPECT_EQ(w.jointBreaks()[0].step, 1u);
+    // Overlapping the shelf it was pinned inside, the freed ball is pushed
+    // out of it and lands on the floor (top at y = -2.5).
+    EXPECT_NEAR(w.bodyPosition(0).y, -2.25, 0.02);
+    bool touchedShelf = false;
+    World again = build(scene);
+    for (int i = 0; i < 5; ++i) {
+        ASSERT_TRUE(again.step());
+        for (const ContactRecord& c : again.contacts()) touchedShelf = touchedShelf || c.b == named(scene, "shelf");
+    }
+    EXPECT_TRUE(touchedShelf) << "the joint's no-collide pair left with it";
+}
