@@ -952,3 +952,45 @@ TEST(JointBreaking, BodiesOfABrokenJointCollideAgain) {
     }
     EXPECT_TRUE(touchedShelf) << "the joint's no-collide pair left with it";
 }
+
+/// levels/breaking_bridge.json: 13 planks hinged in a sagging arc between
+/// two piers, every pin with a max_force (4 kN for the middle one, "pin 6",
+/// 12 kN for the others), and a crate dropped 0.14 m onto the middle. The
+/// shipped 150 kg crate breaks the middle pin and falls to the ground,
+/// the halves hanging from the piers; crates of up to 30 kg ride the bridge
+/// for 10 s without a break. The largest pin force of each run is printed.
+TEST(JointLevels, TheBreakingBridgeBreaksUnderAHeavyCrateAndHoldsALightOne) {
+    Result<Scene> loaded = loadSceneFile(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "breaking_bridge.json");
+    ASSERT_TRUE(loaded) << loaded.error();
+    const Scene& shipped = *loaded;
+    const Entity crate = named(shipped, "crate"), middle = named(shipped, "pin 6");
+    ASSERT_FALSE(crate.isNull());
+    ASSERT_FALSE(middle.isNull());
+    EXPECT_EQ(shipped.registry.tryGet<Mass>(crate)->value, 150.0);
+    for (const double mass : {5.0, 10.0, 20.0, 30.0, 80.0, 150.0, 300.0}) {
+        Scene scene = shipped;
+        scene.registry.emplace<Mass>(crate, Mass{mass});
+        World w = build(scene);
+        double largest = 0.0;
+        std::size_t crateBody = 0;
+        for (std::size_t b = 0; b < w.bodyCount(); ++b)
+            if (w.bodyEntity(b) == crate) crateBody = b;
+        for (int i = 0; i < 600; ++i) {
+            ASSERT_TRUE(w.step());
+            for (const JointRecord& r : w.joints()) largest = std::max(largest, length(r.force));
+        }
+        const double crateY = w.bodyPosition(crateBody).y;
+        std::printf("breaking bridge, %5.0f kg crate: largest pin force %6.0f N, %zu joints broke, crate at y = %.2f m\n",
+                    mass, largest, w.jointBreaks().size(), crateY);
+        if (mass <= 30.0) {
+            EXPECT_TRUE(w.jointBreaks().empty()) << mass << " kg";
+            EXPECT_GT(crateY, -2.0) << mass << " kg: the crate rides the bridge";
+            EXPECT_LT(largest, 4000.0);
+        } else {
+            ASSERT_FALSE(w.jointBreaks().empty()) << mass << " kg";
+            EXPECT_EQ(w.jointBreaks()[0].joint, middle) << mass << " kg: the weak middle pin goes first";
+            EXPECT_GT(w.jointBreaks()[0].force, 4000.0);
+            EXPECT_NEAR(crateY, -4.0 + 0.7, 0.05) << mass << " kg: the crate is on the ground";
+        }
+    }
+}
