@@ -994,3 +994,27 @@ TEST(JointLevels, TheBreakingBridgeBreaksUnderAHeavyCrateAndHoldsALightOne) {
         }
     }
 }
+
+/// With no damping the spring still loses amplitude: the soft step is
+/// implicit, a factor 1 / (1 + (w h)^2) a substep, as docs/joints.md says.
+/// Measured from the peaks over two periods, across frequencies and
+/// substeps: the decay rate within 3% of (w h)^2 / (1 + (w h)^2).
+TEST(HingeSpring, UndampedAmplitudeDecaysByTheImplicitStepsFactor) {
+    for (const int substeps : {1, 4}) {
+        for (const double hz : {0.5, 1.0, 2.0}) {
+            World w = build(springScene(hz, 0.0, 0.5, 1.0, substeps, 0.3));
+            const int perPeriod = int(std::lround(60.0 / hz));
+            const std::vector<double> angle = springAngles(w, 3 * perPeriod);
+            std::vector<double> peaks;
+            for (std::size_t i = 1; i + 1 < angle.size(); ++i)
+                if (std::abs(angle[i]) >= std::abs(angle[i - 1]) && std::abs(angle[i]) >= std::abs(angle[i + 1]))
+                    peaks.push_back(std::abs(angle[i]));
+            ASSERT_GE(peaks.size(), 5u);
+            // Peaks 0 and 4 are two periods apart.
+            const double perSubstep = std::pow(peaks[4] / peaks[0], 1.0 / (2.0 * perPeriod * substeps));
+            const double wh = 2.0 * kPi * hz / 60.0 / substeps;
+            // The decay rate (1 - factor, about (w h)^2) within 3%.
+            EXPECT_NEAR(perSubstep, 1.0 / (1.0 + wh * wh), 0.03 * wh * wh) << hz << " Hz, " << substeps << " substeps";
+        }
+    }
+}
