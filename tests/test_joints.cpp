@@ -154,10 +154,10 @@ TEST(JointFormat, ZeroSliderAxisIsRefusedNamingTheJoint) {
 TEST(JointFormat, OtherMistakesAreRefusedWithWhereAndWhat) {
     const std::string bodies = std::string(R"({"entities": [)") + kTwoBodies + ", ";
     EXPECT_EQ(refusal(bodies + R"({"name": "j", "joint": {"type": "hing", "a": "arm"}}]})"),
-              "test.json: error: /entities/3/joint/type: expected one of hinge, slider, weld, distance, rope, got "
+              "test.json: error: /entities/3/joint/type: expected one of hinge, slider, weld, distance, rope, wheel, got "
               "\"hing\"; did you mean \"hinge\"?");
     EXPECT_EQ(refusal(bodies + R"({"name": "j", "joint": {"a": "arm"}}]})"),
-              "test.json: error: /entities/3/joint/type: expected one of hinge, slider, weld, distance, rope, got "
+              "test.json: error: /entities/3/joint/type: expected one of hinge, slider, weld, distance, rope, wheel, got "
               "nothing");
     EXPECT_EQ(refusal(bodies + R"({"name": "j", "joint": {"type": "rope"}}]})"),
               "test.json: error: /entities/3/joint/a: expected the name of a body, got nothing");
@@ -1017,4 +1017,167 @@ TEST(HingeSpring, UndampedAmplitudeDecaysByTheImplicitStepsFactor) {
             EXPECT_NEAR(perSubstep, 1.0 / (1.0 + wh * wh), 0.03 * wh * wh) << hz << " Hz, " << substeps << " substeps";
         }
     }
+}
+
+// ---------------------------------------------------------------- wheel
+
+namespace {
+
+/// A disc "hub" on a wheel joint to a static "frame": axis `axis` in the
+/// frame's frame, anchors at the hub's centre, gravity `gy`.
+Scene wheelOnFrame(const std::string& extra, double gy, int substeps, double hubMass = 2.0, double spin = 0.0,
+                   Vec2 hubOffset = {}) {
+    std::string w = world(substeps, gy);
+    w.insert(w.size() - 1, R"(, "sleep": false)");
+    return load("{" + w + R"(, "entities": [
+        {"name": "frame", "position": {"x": 0, "y": 0}, "static": true},
+        {"name": "hub", "position": {"x": )" + num(hubOffset.x) + R"(, "y": )" + num(hubOffset.y) +
+                R"(}, "mass": )" + num(hubMass) + R"(, "radius": 0.3, "angular_velocity": )" + num(spin) + R"(},
+        {"name": "axle", "joint": {"type": "wheel", "a": "frame", "b": "hub", "local_a": {"x": 0, "y": 0},
+                                   "local_b": {"x": 0, "y": 0})" + extra + "}}]}");
+}
+
+} // namespace
+
+TEST(WheelJoint, FormatRoundTripsAndRefusesAZeroAxisNamingTheJoint) {
+    const std::string text = R"({"entities": [{"name": "car", "position": {"x": 0, "y": 1}, "box": {"width": 2, "height": 0.5}},
+        {"name": "tyre", "position": {"x": 1, "y": 0.5}, "radius": 0.4},
+        {"name": "axle", "joint": {"type": "wheel", "a": "car", "b": "tyre", "anchor": {"x": 1, "y": 0.5},
+                                   "axis": {"x": 0, "y": 2}, "lower": -0.2, "upper": 0.1, "stiffness_hz": 4,
+                                   "damping_ratio": 0.6, "motor_speed": -5, "max_motor_torque": 30, "max_force": 900}}]})";
+    const Scene first = load(text);
+    const std::string saved = sceneToJsonText(first);
+    EXPECT_EQ(sceneToJsonText(load(saved)), saved);
+    const Joint* j = first.registry.tryGet<Joint>(named(first, "axle"));
+    ASSERT_NE(j, nullptr);
+    EXPECT_EQ(j->localA, (Vec2{1.0, -0.5}));
+    EXPECT_EQ(*j->stiffnessHz, 4.0);
+    EXPECT_EQ(refusal(R"({"entities": [{"name": "car", "position": {"x": 0, "y": 1}, "radius": 0.5},
+        {"name": "axle", "joint": {"type": "wheel", "a": "car", "axis": {"x": 0, "y": 0}}}]})"),
+              "test.json: error: /entities/1/joint/axis: joint on entity 1 (\"axle\"): a wheel axis needs a non-zero "
+              "length, got {\"x\": 0.0, \"y\": 0.0}");
+    EXPECT_EQ(refusal(R"({"entities": [{"name": "car", "position": {"x": 0, "y": 1}, "radius": 0.5},
+        {"name": "axle", "joint": {"type": "wheel", "a": "car", "spring_hz": 3}}]})"),
+              "test.json: error: /entities/1/joint/spring_hz: joint on entity 1 (\"axle\"): spring_hz belongs to a "
+              "hinge's rotational spring, not to a wheel joint (its own spring is stiffness_hz and damping_ratio)");
+}
+
+/// The suspension spring along the axis, undamped, gravity off: the hub
+/// released 0.1 m along the axis oscillates with period 1 / stiffness_hz
+/// (the frame is static, so the spring's mass is the hub's) within the
+/// soft step's 0.5 (w h)^2; it stays on the axis line (across it < 1 um)
+/// and keeps the spin it was given (free rotation). Swept over axes,
+/// frequencies, masses and substeps.
+TEST(WheelJoint, AxisSpringHasItsFrequencyAndTheHubStaysOnTheLineAndSpinsFreely) {
+    for (const int substeps : {1, 4}) {
+        for (const double hz : {1.0, 3.0}) {
+            for (const double mass : {0.5, 20.0}) {
+                for (const Vec2 axis : {Vec2{0.0, 1.0}, Vec2{0.6, 0.8}}) {
+                    const Vec2 start = 0.1 * axis;
+                    const Scene scene = wheelOnFrame(R"(, "axis": {"x": )" + num(axis.x) + R"(, "y": )" + num(axis.y) +
+                                                         R"(}, "stiffness_hz": )" + num(hz) + R"(, "damping_ratio": 0)",
+                                                     0.0, substeps, mass, 7.0, start);
+                    World w = build(scene);
+                    std::vector<double> along;
+                    double across = 0.0;
+                    for (int i = 0; i < int(std::ceil(4.5 / hz * 60.0)); ++i) {
+                        ASSERT_TRUE(w.step());
+                        const Vec2 p = w.bodyPosition(0);
+                        along.push_back(dot(p, axis));
+                        across = std::max(across, std::abs(cross(axis, p)));
+                    }
+                    const double period = periodOf(along, 1.0 / 60.0);
+                    const double wh = 2.0 * kPi * hz / 60.0 / substeps;
+                    const std::string what = std::to_string(hz) + " Hz, m " + std::to_string(mass) + ", " +
+                                             std::to_string(substeps) + " substeps, axis (" + std::to_string(axis.x) + ")";
+                    EXPECT_LT(std::abs(period * hz - 1.0), 1e-4 + 0.5 * wh * wh) << what << ": period " << period;
+                    EXPECT_LT(across, 1e-6) << what;
+                    const WorldState s = w.saveState();
+                    EXPECT_NEAR(s.colliderSpin.at(0), 7.0, 1e-9) << what << ": free rotation";
+                }
+            }
+        }
+    }
+}
+
+/// The motor drives the hub's spin to motor_speed, and pushes with at most
+/// max_motor_torque: a hub of inertia I spun up from rest gains
+/// max_motor_torque / I per second until it gets there.
+TEST(WheelJoint, MotorReachesItsSpeedAtItsTorqueLimit) {
+    for (const double torque : {0.5, 3.0}) {
+        const Scene scene = wheelOnFrame(R"(, "motor_speed": 10, "max_motor_torque": )" + num(torque), 0.0, 4, 2.0);
+        World w = build(scene);
+        const double inertia = 0.5 * 2.0 * 0.3 * 0.3;
+        ASSERT_TRUE(w.step());
+        const double expected = std::min(10.0, torque / inertia / 60.0);
+        EXPECT_NEAR(w.saveState().colliderSpin.at(0), expected, 1e-9) << torque << " N m";
+        for (int i = 0; i < 240; ++i) ASSERT_TRUE(w.step());
+        EXPECT_NEAR(w.saveState().colliderSpin.at(0), 10.0, 1e-9) << torque << " N m";
+    }
+}
+
+/// Under gravity with no spring the hub slides down its vertical axis to
+/// the lower limit and rests there (within 5 mm); with the spring it
+/// hangs at the static sag m g / k, k = m (2 pi f)^2 (within 2%).
+TEST(WheelJoint, LimitHoldsAndTheSpringSagsByItsStaticDeflection) {
+    {
+        World w = build(wheelOnFrame(R"(, "axis": {"x": 0, "y": 1}, "lower": -0.2, "upper": 0.2)", -9.81, 4));
+        for (int i = 0; i < 120; ++i) ASSERT_TRUE(w.step());
+        EXPECT_NEAR(w.bodyPosition(0).y, -0.2, 0.005);
+    }
+    for (const double hz : {2.0, 5.0}) {
+        World w = build(wheelOnFrame(R"(, "axis": {"x": 0, "y": 1}, "stiffness_hz": )" + num(hz) + R"(, "damping_ratio": 1)",
+                                     -9.81, 4));
+        for (int i = 0; i < 240; ++i) ASSERT_TRUE(w.step());
+        const double sag = 9.81 / std::pow(2.0 * kPi * hz, 2);
+        EXPECT_NEAR(-w.bodyPosition(0).y, sag, 0.02 * sag) << hz << " Hz";
+    }
+}
+
+/// levels/suspension_car.json: a 12 kg chassis on two wheel joints (4 Hz,
+/// damping ratio 0.7, travel +-0.15 m), the rear one driven, over a 0.3 m
+/// bump. The same car with its wheels on hinges (a rigid axle, as
+/// levels/car.json) crosses the same bump: the suspended chassis's largest
+/// vertical acceleration while the wheels cross it is less than half the
+/// rigid one's, and both cars get over.
+TEST(JointLevels, TheSuspensionAbsorbsTheBump) {
+    Result<Scene> loaded = loadSceneFile(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "suspension_car.json");
+    ASSERT_TRUE(loaded) << loaded.error();
+    const auto drive = [](const Scene& scene, double& peak, double& endX) {
+        World w = build(scene);
+        std::size_t chassis = 0;
+        for (std::size_t b = 0; b < w.bodyCount(); ++b)
+            if (w.bodyEntity(b) == named(scene, "chassis")) chassis = b;
+        double vy = w.bodyVelocity(chassis).y;
+        peak = 0.0;
+        for (int i = 0; i < 600; ++i) {
+            ASSERT_TRUE(w.step());
+            const double x = w.bodyPosition(chassis).x, v = w.bodyVelocity(chassis).y;
+            // While either wheel can touch the bump (x from 6 to 10 m).
+            if (x > 5.5 && x < 10.5) peak = std::max(peak, std::abs(v - vy) * 60.0);
+            vy = v;
+        }
+        endX = w.bodyPosition(chassis).x;
+    };
+    double suspended = 0.0, rigid = 0.0, endSuspended = 0.0, endRigid = 0.0;
+    drive(*loaded, suspended, endSuspended);
+    Scene hinged = *loaded;
+    for (const char* name : {"rear suspension", "front suspension"}) {
+        Joint* j = hinged.registry.tryGet<Joint>(named(hinged, name));
+        ASSERT_NE(j, nullptr);
+        j->type = "hinge";
+        j->axis.reset();
+        j->lower.reset();
+        j->upper.reset();
+        j->stiffnessHz.reset();
+        j->dampingRatio.reset();
+        j->referenceAngle = 0.0;
+    }
+    drive(hinged, rigid, endRigid);
+    std::printf("suspension car: chassis's largest vertical acceleration over the bump %.1f m/s^2 on wheel joints, "
+                "%.1f on hinges; at x = %.1f and %.1f m after 10 s\n",
+                suspended, rigid, endSuspended, endRigid);
+    EXPECT_LT(suspended, 0.5 * rigid);
+    EXPECT_GT(endSuspended, 12.0);
+    EXPECT_GT(endRigid, 12.0);
 }

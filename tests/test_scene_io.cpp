@@ -520,19 +520,24 @@ TEST(SceneJoints, BadSpringsAndMaxForcesAreRefusedNamingTheEntityAndField) {
     for (const auto& [joint, message] : cases) EXPECT_EQ(refusal(jointLevel(joint)), message) << joint;
 }
 
-TEST(SceneJoints, SpringImpulseInSolverStateRoundTripsAndIsChecked) {
+TEST(SceneJoints, HingeSpringImpulseInSolverStateRoundTripsAndReachesTheSolver) {
     const std::string level = R"({"entities": [{"name": "arm", "position": {"x": 1, "y": 0}, "radius": 0.2},
         {"name": "elbow", "joint": {"type": "hinge", "a": "arm", "anchor": {"x": 0, "y": 0}, "spring_hz": 2}}],
-        "solver_state": {"joints": [{"joint": "elbow", "spring_impulse": -0.125}]}})";
+        "solver_state": {"joints": [{"joint": "elbow", "angular_impulse": -0.125}]}})";
     Result<Scene> first = parseScene(level, "t.json");
     ASSERT_TRUE(first) << first.error();
     ASSERT_TRUE(first->solverState);
     ASSERT_EQ(first->solverState->joints.size(), 1u);
-    EXPECT_EQ(first->solverState->joints[0].spring, -0.125);
+    EXPECT_EQ(first->solverState->joints[0].angular, -0.125) << "a hinge's spring travels as angular_impulse";
     const std::string once = sceneToJsonText(*first);
-    EXPECT_NE(once.find(R"({"joint": "elbow", "spring_impulse": -0.125})"), std::string::npos) << once;
+    EXPECT_NE(once.find(R"({"joint": "elbow", "angular_impulse": -0.125})"), std::string::npos) << once;
+    // And reaches the solver: a world built from it starts the spring warm.
+    Result<World> w = World::build(*first);
+    ASSERT_TRUE(w) << w.error();
+    ASSERT_EQ(w->solverState().joints.size(), 1u);
+    EXPECT_EQ(w->solverState().joints[0].angular, -0.125);
     EXPECT_EQ(refusal(R"({"entities": [{"name": "arm", "position": {"x": 1, "y": 0}, "radius": 0.2},
         {"name": "elbow", "joint": {"type": "hinge", "a": "arm"}}],
-        "solver_state": {"joints": [{"joint": "elbow", "spring_impulse": "x"}]}})"),
-              "t.json: error: /solver_state/joints/0/spring_impulse: expected a finite number, got \"x\"");
+        "solver_state": {"joints": [{"joint": "elbow", "angular_impulse": "x"}]}})"),
+              "t.json: error: /solver_state/joints/0/angular_impulse: expected a finite number, got \"x\"");
 }

@@ -410,9 +410,8 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
     static constexpr std::array<std::string_view, 5> kContactKeys{"a", "b", "feature", "normal_impulse",
                                                                   "tangent_impulse"};
     // "joint" is required; an impulse left out is +0.
-    static constexpr std::array<std::string_view, 8> kJointKeys{"joint",         "linear_impulse", "angular_impulse",
-                                                                "axial_impulse", "motor_impulse",  "lower_impulse",
-                                                                "upper_impulse", "spring_impulse"};
+    static constexpr std::array<std::string_view, 7> kJointKeys{
+        "joint", "linear_impulse", "angular_impulse", "axial_impulse", "motor_impulse", "lower_impulse", "upper_impulse"};
     SolverState state;
     for (const auto& [key, value] : v.items()) {
         const std::string at = child(pointer, key);
@@ -513,7 +512,6 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
                           else if (field == "axial_impulse") j.axial = readNumber(fv, fa, NumberRange{});
                           else if (field == "motor_impulse") j.motor = readNumber(fv, fa, NumberRange{});
                           else if (field == "lower_impulse") j.lower = readNumber(fv, fa, oneSided);
-                          else if (field == "spring_impulse") j.spring = readNumber(fv, fa, NumberRange{});
                           else j.upper = readNumber(fv, fa, oneSided);
                       });
             state.joints.push_back(j);
@@ -681,12 +679,13 @@ std::string checkJoint(const Registry& registry, std::size_t index, const Joint&
                endLabel(registry, joint.b) + "); at least one end must be dynamic";
     if (joint.type != "hinge" && (joint.springHz || joint.springDampingRatio)) {
         const char* key = joint.springHz ? "spring_hz" : "spring_damping_ratio";
-        const bool softens = joint.type == "weld" || joint.type == "distance";
+        const bool softens = joint.type == "weld" || joint.type == "distance" || joint.type == "wheel";
         return at + "/" + key + ": " + who + ": " + key + " belongs to a hinge's rotational spring, not to a " +
                joint.type + (softens ? " joint (its own spring is stiffness_hz and damping_ratio)" : " joint");
     }
-    if (joint.type == "slider" && joint.axis && !(std::hypot(joint.axis->x, joint.axis->y) > 1e-12))
-        return at + "/axis: " + who + ": a slider axis needs a non-zero length, got {\"x\": " +
+    if ((joint.type == "slider" || joint.type == "wheel") && joint.axis &&
+        !(std::hypot(joint.axis->x, joint.axis->y) > 1e-12))
+        return at + "/axis: " + who + ": a " + joint.type + " axis needs a non-zero length, got {\"x\": " +
                describeFound(Json(joint.axis->x)) + ", \"y\": " + describeFound(Json(joint.axis->y)) + "}";
     return {};
 }
@@ -984,7 +983,7 @@ void appendSolverState(const SolverState& state, const Registry& registry, std::
                 out += ", \"linear_impulse\": {\"x\": " + number(j.linear.x) + ", \"y\": " + number(j.linear.y) + "}";
             const std::pair<const char*, double> scalars[] = {{"angular_impulse", j.angular}, {"axial_impulse", j.axial},
                                                               {"motor_impulse", j.motor},     {"lower_impulse", j.lower},
-                                                              {"upper_impulse", j.upper},     {"spring_impulse", j.spring}};
+                                                              {"upper_impulse", j.upper}};
             for (const auto& [key, value] : scalars)
                 if (!plusZero(value)) out += ", \"" + std::string(key) + "\": " + number(value);
             out += "}";

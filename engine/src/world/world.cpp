@@ -413,7 +413,7 @@ namespace {
 bool isPlusZero(double v) { return v == 0.0 && !std::signbit(v); }
 bool carriesNothing(const JointImpulse& j) {
     return isPlusZero(j.linear.x) && isPlusZero(j.linear.y) && isPlusZero(j.angular) && isPlusZero(j.axial) &&
-           isPlusZero(j.motor) && isPlusZero(j.lower) && isPlusZero(j.upper) && isPlusZero(j.spring);
+           isPlusZero(j.motor) && isPlusZero(j.lower) && isPlusZero(j.upper);
 }
 
 /// The bodies' sleep state, one array of each (WorldState's or the live one's).

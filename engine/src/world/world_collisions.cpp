@@ -27,6 +27,7 @@ joints::JointKind jointKindOf(const std::string& type) {
     if (type == "weld") return joints::JointKind::Weld;
     if (type == "distance") return joints::JointKind::Distance;
     if (type == "rope") return joints::JointKind::Rope;
+    if (type == "wheel") return joints::JointKind::Wheel;
     return joints::JointKind::Hinge;
 }
 
@@ -164,7 +165,8 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         j.upper = joint->upper.value_or(0.0);
         const std::optional<double>& maxMotor = j.kind == joints::JointKind::Slider ? joint->maxMotorForce
                                                                                     : joint->maxMotorTorque;
-        j.motor = maxMotor.has_value() && (j.kind == joints::JointKind::Hinge || j.kind == joints::JointKind::Slider);
+        j.motor = maxMotor.has_value() && (j.kind == joints::JointKind::Hinge || j.kind == joints::JointKind::Slider ||
+                                           j.kind == joints::JointKind::Wheel);
         j.maxMotor = maxMotor.value_or(0.0);
         j.motorSpeed = joint->motorSpeed.value_or(0.0);
         j.length = joint->length.value_or(0.0);
