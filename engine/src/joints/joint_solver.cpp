@@ -95,7 +95,7 @@ void solvePoint(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pa
 /// (axial rows).
 void solveHingeAxial(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
                      const Softness& soft, bool useBias) {
-    if (j.springHz > 0.0) {
+    if (j.spring) {
         // Box2D v3's revolute spring: a soft row toward the reference angle
         // on the axial mass, in both passes (it is a force, not an error to
         // correct, so the relax pass must not drop it). With the soft step's
@@ -274,7 +274,7 @@ void solveWheel(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pa
         p.wB += p.iB * impulse * a2;
     };
     const auto axialSpeed = [&] { return dot(axis, p.vB - p.vA) + a2 * p.wB - a1 * p.wA; };
-    if (j.stiffnessHz > 0.0) {
+    if (j.spring) {
         // A force in both passes, as the hinge's spring.
         const Softness spring = Softness::make(j.stiffnessHz, j.dampingRatio, h);
         const double impulse = -axialMass * spring.massScale * (axialSpeed() + spring.biasRate * translation) -
@@ -332,9 +332,9 @@ void setImpulses(JointConstraint& j, const JointImpulse& in) {
     j.motorImpulse = hingeLike && j.motor ? in.motor : 0.0;
     j.lowerImpulse = hingeLike && j.hasLower ? in.lower : 0.0;
     j.upperImpulse = (hingeLike && j.hasUpper) || j.kind == JointKind::Rope ? in.upper : 0.0;
-    j.springImpulse = j.kind == JointKind::Hinge && j.springHz > 0.0       ? in.angular
-                      : j.kind == JointKind::Wheel && j.stiffnessHz > 0.0 ? in.axial
-                                                                          : 0.0;
+    j.springImpulse = !j.spring                  ? 0.0
+                      : j.kind == JointKind::Hinge ? in.angular
+                                                   : in.axial;
     if (j.kind == JointKind::Wheel) {
         j.linearImpulse = {in.linear.x, 0.0};
         j.motorImpulse = j.motor ? in.motor : 0.0;
@@ -379,7 +379,7 @@ void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bo
                                                      : j.motorImpulse + j.lowerImpulse - j.upperImpulse;
             // Only a hinge with a spring adds it: 0 + x could turn a -0 into
             // +0 and change the bits of a level without springs.
-            if (j.springHz > 0.0) axial += j.springImpulse;
+            if (j.spring) axial += j.springImpulse;
             p.applyLinear(j.linearImpulse, rA, rB);
             p.applyAngular(axial);
             break;
@@ -518,7 +518,7 @@ double jointTorque(const JointConstraint& j, double h) {
     switch (j.kind) {
     case JointKind::Hinge: {
         double axial = j.motorImpulse + j.lowerImpulse - j.upperImpulse;
-        if (j.springHz > 0.0) axial += j.springImpulse;
+        if (j.spring) axial += j.springImpulse;
         return invH * axial;
     }
     case JointKind::Weld: return invH * j.angularImpulse;

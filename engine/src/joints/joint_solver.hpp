@@ -60,6 +60,10 @@ struct alignas(64) JointConstraint {
     bool direct = false;
     bool motor = false;
     bool hasLower = false, hasUpper = false;
+    /// A hinge with a spring (springHz > 0), or a wheel with an axis spring
+    /// (stiffnessHz > 0): read here, in the first cache line, so a hinge
+    /// without one never touches the spring's fields.
+    bool spring = false;
 
     // Prepared at step start.
     Vec2 anchorA, anchorB;         ///< anchors rotated to world orientation, relative to the centres, m

@@ -176,6 +176,8 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
             j.springHz = joint->springHz.value_or(0.0);
             j.springDampingRatio = joint->springDampingRatio.value_or(1.0);
         }
+        j.spring = (j.kind == joints::JointKind::Hinge && j.springHz > 0.0) ||
+                   (j.kind == joints::JointKind::Wheel && j.stiffnessHz > 0.0);
         j.maxForce = joint->maxForce.value_or(0.0);
         makeSystem();
         system->addJoint(j, filter[0], filter[1], joint->collideConnected);
