@@ -490,7 +490,7 @@ TEST(SceneJoints, SpringAndMaxForceRoundTripByteForByteAndAbsentStaysAbsent) {
     EXPECT_FALSE(j->springDampingRatio) << "absent: the engine's 1";
 }
 
-TEST(SceneJoints, BadSpringsAndMaxForcesAreRefusedNamingTheEntityAndField) {
+TEST(SceneJoints, BadSpringsMaxForcesAndWheelAxesAreRefusedAtTheirPointer) {
     const std::vector<std::pair<std::string, std::string>> cases = {
         {R"("type": "hinge", "a": "arm", "spring_hz": -1)",
          "t.json: error: /entities/2/joint/spring_hz: expected a number in [0, 1e+30], got -1"},
@@ -506,16 +506,9 @@ TEST(SceneJoints, BadSpringsAndMaxForcesAreRefusedNamingTheEntityAndField) {
          "t.json: error: /entities/2/joint/max_force: expected a number in (0, 1e+30], got 1e+31"},
         {R"("type": "hinge", "a": "arm", "max_force": null)",
          "t.json: error: /entities/2/joint/max_force: expected a number in (0, 1e+30], got null"},
-        {R"("type": "weld", "a": "arm", "spring_hz": 2)",
-         "t.json: error: /entities/2/joint/spring_hz: joint on entity 2 (\"elbow\"): spring_hz belongs to a hinge's "
-         "rotational spring, not to a weld joint (its own spring is stiffness_hz and damping_ratio)"},
-        {R"("type": "distance", "a": "arm", "spring_damping_ratio": 1)",
-         "t.json: error: /entities/2/joint/spring_damping_ratio: joint on entity 2 (\"elbow\"): spring_damping_ratio "
-         "belongs to a hinge's rotational spring, not to a distance joint (its own spring is stiffness_hz and "
-         "damping_ratio)"},
-        {R"("type": "slider", "a": "arm", "spring_hz": 2)",
-         "t.json: error: /entities/2/joint/spring_hz: joint on entity 2 (\"elbow\"): spring_hz belongs to a hinge's "
-         "rotational spring, not to a slider joint"},
+        {R"("type": "wheel", "a": "arm", "axis": {"x": 0, "y": 0})",
+         "t.json: error: /entities/2/joint/axis: joint on entity 2 (\"elbow\"): a wheel axis needs a non-zero length, "
+         "got {\"x\": 0.0, \"y\": 0.0}"},
     };
     for (const auto& [joint, message] : cases) EXPECT_EQ(refusal(jointLevel(joint)), message) << joint;
 }

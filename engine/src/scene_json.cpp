@@ -677,12 +677,6 @@ std::string checkJoint(const Registry& registry, std::size_t index, const Joint&
     if (isStatic[0] && isStatic[1])
         return at + ": " + who + ": joins two static bodies (" + endLabel(registry, joint.a) + " and " +
                endLabel(registry, joint.b) + "); at least one end must be dynamic";
-    if (joint.type != "hinge" && (joint.springHz || joint.springDampingRatio)) {
-        const char* key = joint.springHz ? "spring_hz" : "spring_damping_ratio";
-        const bool softens = joint.type == "weld" || joint.type == "distance" || joint.type == "wheel";
-        return at + "/" + key + ": " + who + ": " + key + " belongs to a hinge's rotational spring, not to a " +
-               joint.type + (softens ? " joint (its own spring is stiffness_hz and damping_ratio)" : " joint");
-    }
     if ((joint.type == "slider" || joint.type == "wheel") && joint.axis &&
         !(std::hypot(joint.axis->x, joint.axis->y) > 1e-12))
         return at + "/axis: " + who + ": a " + joint.type + " axis needs a non-zero length, got {\"x\": " +
