@@ -785,13 +785,13 @@ TEST(HingeSpring, StiffSpringOnAChainHingeHoldsTheLinksStraightAndTheChainClosed
 namespace {
 
 /// A ball of `mass` kg hanging 1 m under a world point on a joint of `type`
-/// with max_force `maxForce`, gravity 10 m/s^2 (slider: the axis is
-/// horizontal, so its sideways row carries the weight).
+/// with max_force `maxForce`, gravity 10 m/s^2 (slider and wheel: the
+/// axis is horizontal, so the row across it carries the weight).
 Scene hangingOn(const std::string& type, double mass, double maxForce, int substeps) {
     std::string anchor = R"("anchor": {"x": 0, "y": 0})";
     if (type == "distance" || type == "rope")
         anchor = R"("local_a": {"x": 0, "y": 0}, "local_b": {"x": 0, "y": 0}, "length": 1)";
-    if (type == "slider") anchor = R"("anchor": {"x": 0, "y": -1}, "axis": {"x": 1, "y": 0})";
+    if (type == "slider" || type == "wheel") anchor = R"("anchor": {"x": 0, "y": -1}, "axis": {"x": 1, "y": 0})";
     return load("{" + world(substeps, -10.0) + R"(, "entities": [
         {"name": "weight", "position": {"x": 0, "y": -1}, "mass": )" + num(mass) + R"(, "radius": 0.2},
         {"name": "hook", "joint": {"type": ")" + type + R"(", "a": "weight", )" + anchor +
@@ -808,7 +808,7 @@ Scene hangingOn(const std::string& type, double mass, double maxForce, int subst
 TEST(JointBreaking, AHangingWeightBreaksItsJointExactlyWhenItsWeightExceedsMaxForce) {
     const double F = 100.0, g = 10.0;
     double worstForceError = 0.0;
-    for (const std::string type : {"hinge", "weld", "slider", "distance", "rope"}) {
+    for (const std::string type : {"hinge", "weld", "slider", "distance", "rope", "wheel"}) {
         for (const int substeps : {1, 4}) {
             for (const double delta : {-0.5, -0.1, -0.01, -1e-3, -1e-4, 1e-4, 1e-3, 0.01, 0.1, 0.5}) {
                 const double m = F / g * (1.0 + delta);
