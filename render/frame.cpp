@@ -874,7 +874,7 @@ void Builder::joints() {
         segment(toPx(a.centre), pa, 0.7 * width, withAlpha(c, 0.45f));
         if (b.body) segment(toPx(b.centre), pb, 0.7 * width, withAlpha(c, 0.45f));
         if (j->type == "distance" || j->type == "rope") segment(pa, pb, j->type == "rope" ? 1.2 : 2.4, c);
-        if (j->type == "slider") {
+        if (j->type == "slider" || j->type == "wheel") {
             const Vec2 axis = j->axis ? *j->axis : Vec2{1.0, 0.0};
             const double len = length(axis);
             if (len > 0.0) {

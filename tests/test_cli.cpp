@@ -262,6 +262,55 @@ TEST_F(Cli, ContactsFileHasOneLinePerStepWithEveryContact) {
     EXPECT_NE(last.find("\"normal\": {\"x\": 0, \"y\": -1}"), std::string::npos) << last;
 }
 
+// Two weights on hinges with max_force 100 N under 10 m/s^2: the 15 kg one
+// breaks its hook after the first step, the 5 kg one holds. The contacts
+// trace gets one break line, stderr a note, the summary a count; the saved
+// file no longer holds the broken hook and resumes exactly, with a spring
+// on the hinge that holds.
+TEST_F(Cli, ABreakingJointIsReportedInTheTraceAndStderrAndLeavesTheSavedFile) {
+    const fs::path file = write("hooks.json", R"({"world": {"gravity": {"x": 0, "y": -10}, "substeps": 4},
+      "entities": [{"name": "heavy", "position": {"x": -2, "y": -1}, "mass": 15, "radius": 0.2},
+                   {"name": "light", "position": {"x": 2, "y": -1}, "angle": 0.2, "mass": 5, "radius": 0.2},
+                   {"name": "weak hook", "joint": {"type": "hinge", "a": "heavy", "anchor": {"x": -2, "y": 0},
+                                                   "max_force": 100}},
+                   {"name": "strong hook", "joint": {"type": "hinge", "a": "light", "anchor": {"x": 2, "y": 0},
+                                                     "reference_angle": 0, "spring_hz": 3, "spring_damping_ratio": 0.1,
+                                                     "max_force": 100}}]})");
+    const fs::path contacts = dir_ / "c.jsonl", whole = dir_ / "whole.json", half = dir_ / "half.json",
+                   resumed = dir_ / "resumed.json";
+    Outcome o = stepwise("run " + file.string() + " --steps 60 --contacts " + contacts.string() + " --out " +
+                         whole.string());
+    ASSERT_EQ(o.exitCode, 0) << o.err;
+    EXPECT_EQ(o.err, file.string() + ": note: step 1: joint \"weak hook\" broke: force 150 N past its max_force 100 N\n");
+    EXPECT_NE(o.out.find("; 1 joint broke; wrote "), std::string::npos) << o.out;
+    std::istringstream lines(readFile(contacts));
+    std::string line;
+    std::vector<std::string> breaks;
+    int steps = 0;
+    while (std::getline(lines, line)) {
+        if (line.rfind("{\"event\": \"break\"", 0) == 0) breaks.push_back(line);
+        else ++steps;
+    }
+    EXPECT_EQ(steps, 60);
+    ASSERT_EQ(breaks.size(), 1u);
+    EXPECT_EQ(breaks[0].rfind(R"({"event": "break", "step": 1, "time": 0.016666666666666666, "joint": "weak hook", )"
+                              R"("a": "heavy", "b": null, "force": 15)",
+                              0),
+              0u)
+        << breaks[0];
+    EXPECT_NE(breaks[0].find(R"("max_force": 100})"), std::string::npos) << breaks[0];
+    const std::string saved = readFile(whole);
+    EXPECT_EQ(saved.find("weak hook"), std::string::npos) << "the broken joint left the scene";
+    EXPECT_NE(saved.find("strong hook"), std::string::npos);
+    EXPECT_NE(saved.find(R"({"joint": "strong hook", "linear_impulse")"), std::string::npos) << saved;
+    EXPECT_NE(saved.find(R"("angular_impulse")"), std::string::npos) << "the spring's warm start is saved";
+    ASSERT_EQ(stepwise("run " + file.string() + " --steps 30 --out " + half.string()).exitCode, 0);
+    o = stepwise("run " + half.string() + " --steps 30 --out " + resumed.string());
+    ASSERT_EQ(o.exitCode, 0) << o.err;
+    EXPECT_EQ(o.err, "") << "nothing left to break";
+    EXPECT_EQ(readFile(whole), readFile(resumed));
+}
+
 TEST_F(Cli, SchemaCommandMatchesTheCommittedSchema) {
     Outcome o = stepwise("schema");
     ASSERT_EQ(o.exitCode, 0);

@@ -154,10 +154,10 @@ TEST(JointFormat, ZeroSliderAxisIsRefusedNamingTheJoint) {
 TEST(JointFormat, OtherMistakesAreRefusedWithWhereAndWhat) {
     const std::string bodies = std::string(R"({"entities": [)") + kTwoBodies + ", ";
     EXPECT_EQ(refusal(bodies + R"({"name": "j", "joint": {"type": "hing", "a": "arm"}}]})"),
-              "test.json: error: /entities/3/joint/type: expected one of hinge, slider, weld, distance, rope, got "
+              "test.json: error: /entities/3/joint/type: expected one of hinge, slider, weld, distance, rope, wheel, got "
               "\"hing\"; did you mean \"hinge\"?");
     EXPECT_EQ(refusal(bodies + R"({"name": "j", "joint": {"a": "arm"}}]})"),
-              "test.json: error: /entities/3/joint/type: expected one of hinge, slider, weld, distance, rope, got "
+              "test.json: error: /entities/3/joint/type: expected one of hinge, slider, weld, distance, rope, wheel, got "
               "nothing");
     EXPECT_EQ(refusal(bodies + R"({"name": "j", "joint": {"type": "rope"}}]})"),
               "test.json: error: /entities/3/joint/a: expected the name of a body, got nothing");
@@ -633,3 +633,552 @@ TEST(JointSweep, ChainsStayJoinedAtEverySoftnessAndSolverSetting) {
 }
 
 } // namespace
+
+// ---------------------------------------------------------------- hinge spring
+
+namespace {
+
+/// A hinge's rotational spring with gravity off: body "rotor" (a disc of
+/// `radius` and `mass`) pinned at its centre to the world, or to a second
+/// free disc "stator" (then the relative angle oscillates with the joint's
+/// axial mass 1 / (1/I_a + 1/I_b)), released at `theta0` from the reference
+/// angle 0 with no spin.
+Scene springScene(double hz, double ratio, double radius, double mass, int substeps, double theta0,
+                  bool twoBodies = false, double statorMass = 1.0) {
+    std::ostringstream s;
+    // Sleep off: an undamped spring still loses amplitude (the soft step is
+    // implicit), and a swing that has decayed under the sleep speed would
+    // stop the measurement.
+    std::string w = world(substeps, 0.0);
+    w.insert(w.size() - 1, R"(, "sleep": false)");
+    s << "{" << w << R"(, "entities": [)"
+      << R"({"name": "rotor", "position": {"x": 0, "y": 0}, "angle": )" << num(theta0) << R"(, "mass": )" << num(mass)
+      << R"(, "radius": )" << num(radius) << "}";
+    // The stator has no shape (it turns like a small disc, kShapelessRadius):
+    // two shapes on one spot would be a deep overlap, which the contact
+    // solver treats as a crowd whatever the joint says.
+    if (twoBodies) s << R"(, {"name": "stator", "position": {"x": 0, "y": 0}, "mass": )" << num(statorMass) << "}";
+    s << R"(, {"name": "pin", "joint": {"type": "hinge", "a": ")" << (twoBodies ? "stator" : "rotor") << "\"";
+    if (twoBodies) s << R"(, "b": "rotor")";
+    s << R"(, "anchor": {"x": 0, "y": 0}, "reference_angle": 0, "spring_hz": )" << num(hz)
+      << R"(, "spring_damping_ratio": )" << num(ratio) << "}}]}";
+    return load(s.str());
+}
+
+/// The joint's angle over `steps` steps (JointRecord::angle), signed so
+/// that it starts positive (with the world as b the angle is -rotor's).
+std::vector<double> springAngles(World& w, int steps) {
+    std::vector<double> out;
+    for (int i = 0; i < steps; ++i) {
+        const Result<void> stepped = w.step();
+        EXPECT_TRUE(stepped) << stepped.error();
+        if (!stepped) break;
+        out.push_back(w.joints()[0].angle);
+    }
+    if (!out.empty() && out[0] < 0.0)
+        for (double& a : out) a = -a;
+    return out;
+}
+
+/// Mean period from the downward zero crossings of the angle (interpolated).
+double periodOf(const std::vector<double>& angle, double dt) {
+    std::vector<double> crossings;
+    for (std::size_t i = 1; i < angle.size(); ++i)
+        if (angle[i - 1] > 0.0 && angle[i] <= 0.0)
+            crossings.push_back(dt * (double(i) + angle[i - 1] / (angle[i - 1] - angle[i])));
+    if (crossings.size() < 2) return std::numeric_limits<double>::quiet_NaN();
+    return (crossings.back() - crossings.front()) / double(crossings.size() - 1);
+}
+
+} // namespace
+
+/// Undamped, the spring's period is 1 / spring_hz for any inertia: the
+/// row works on the joint's axial mass, so k = I_eff (2 pi f)^2. The soft
+/// step is an implicit scheme, so its error grows with w h (w = 2 pi f,
+/// h the substep): measured 0.46 (w h)^2 at every inertia (0.126% at
+/// 0.5 Hz and 1 substep, 3.05% at 10 Hz and 4 substeps, 41.6% at 10 Hz
+/// and 1 substep, where w h = 1.05); the bound is 1e-4 + 0.5 (w h)^2. A
+/// spring on the wrong mass (a world pin's I for the two-body case) would
+/// be off by the square root of the inertia ratio.
+TEST(HingeSpring, PeriodIsOneOverSpringHzAcrossFrequenciesInertiasAndSubsteps) {
+    const double dt = 1.0 / 60.0;
+    double worst = 0.0, worstOmegaH = 0.0;
+    for (const int substeps : {1, 4}) {
+        for (const double hz : {0.5, 1.0, 2.0, 5.0, 10.0}) {
+            for (const auto& [radius, mass] : {std::pair{0.25, 0.5}, std::pair{1.0, 2.0}, std::pair{2.0, 50.0}}) {
+                for (const bool two : {false, true}) {
+                    const Scene scene = springScene(hz, 0.0, radius, mass, substeps, 0.3, two, 3.0);
+                    World w = build(scene);
+                    const int steps = int(std::ceil(6.5 / hz / dt));
+                    const double period = periodOf(springAngles(w, steps), dt);
+                    const double omegaH = 2.0 * kPi * hz * dt / substeps;
+                    const double error = std::abs(period * hz - 1.0);
+                    std::printf("  %4.1f Hz r %.2f m %4.1f %s %d substeps: period error %.3g%% (w h %.3f)\n", hz,
+                                radius, mass, two ? "two bodies" : "world pin ", substeps, 100.0 * error, omegaH);
+                    if (error > worst) {
+                        worst = error;
+                        worstOmegaH = omegaH;
+                    }
+                    EXPECT_LT(error, 1e-4 + 0.5 * omegaH * omegaH)
+                        << hz << " Hz, r " << radius << ", m " << mass << (two ? ", two bodies" : "") << ", "
+                        << substeps << " substeps: period " << period << " s";
+                }
+            }
+        }
+    }
+    std::printf("hinge spring: largest period error %.3g%% (at w h = %.3f)\n", 100.0 * worst, worstOmegaH);
+}
+
+/// Critically (ratio 1) and over-damped springs released from rest come
+/// back to the reference angle without crossing it; an under-damped one
+/// (ratio 0.1) crosses: the check can fail.
+TEST(HingeSpring, CriticalDampingDoesNotOvershootAndLightDampingDoes) {
+    for (const int substeps : {1, 4}) {
+        for (const double hz : {0.5, 2.0, 10.0}) {
+            for (const double mass : {0.5, 20.0}) {
+                for (const double ratio : {0.1, 1.0, 2.0}) {
+                    World w = build(springScene(hz, ratio, 0.5, mass, substeps, 0.4));
+                    const std::vector<double> angle = springAngles(w, int(std::ceil(4.0 / hz * 60.0)));
+                    const double lowest = *std::min_element(angle.begin(), angle.end());
+                    if (ratio >= 1.0) {
+                        EXPECT_GE(lowest, -1e-9) << hz << " Hz, ratio " << ratio << ", m " << mass << ", " << substeps;
+                        EXPECT_LT(std::abs(angle.back()), 0.4 * 0.05) << "it comes back: " << hz << " Hz ratio " << ratio;
+                    } else if (2.0 * kPi * hz / 60.0 / substeps < 0.6) {
+                        // Past w h = 0.6 the implicit step's own damping
+                        // (10 Hz at one substep) hides a ratio of 0.1.
+                        EXPECT_LT(lowest, -0.1) << hz << " Hz, ratio 0.1 overshoots, m " << mass << ", " << substeps;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A spring on a chain's hinge leaves the chain's exact solve intact (the
+/// spring is an axial row, like a motor): a two-link pendulum whose
+/// middle hinge is a stiff spring swings with its links at the reference
+/// angle to each other, and the joints stay closed.
+TEST(HingeSpring, StiffSpringOnAChainHingeHoldsTheLinksStraightAndTheChainClosed) {
+    Scene scene = load(chainLevel(2, 0.5, 1.0, 1.0, 4));
+    Joint* elbow = scene.registry.tryGet<Joint>(named(scene, "pin1"));
+    ASSERT_NE(elbow, nullptr);
+    for (const double hz : {2.0, 8.0}) {
+        elbow->springHz = hz;
+        elbow->springDampingRatio = 0.7;
+        World w = build(scene);
+        double worstAngle = 0.0, worstGap = 0.0;
+        for (int i = 0; i < 180; ++i) {
+            ASSERT_TRUE(w.step());
+            worstAngle = std::max(worstAngle, std::abs(w.joints()[1].angle));
+            worstGap = std::max(worstGap, largestSeparation(w));
+        }
+        std::printf("chain elbow spring %.0f Hz: largest bend %.4f rad, largest opening %.3f mm\n", hz, worstAngle,
+                    1e3 * worstGap);
+        EXPECT_LT(worstGap, 0.001);
+        // A stiffer spring bends less under the same swing.
+        EXPECT_LT(worstAngle, hz > 4.0 ? 0.12 : 0.6);
+    }
+}
+
+// ---------------------------------------------------------------- breaking
+
+namespace {
+
+/// A ball of `mass` kg hanging 1 m under a world point on a joint of `type`
+/// with max_force `maxForce`, gravity 10 m/s^2 (slider and wheel: the
+/// axis is horizontal, so the row across it carries the weight).
+Scene hangingOn(const std::string& type, double mass, double maxForce, int substeps) {
+    std::string anchor = R"("anchor": {"x": 0, "y": 0})";
+    if (type == "distance" || type == "rope")
+        anchor = R"("local_a": {"x": 0, "y": 0}, "local_b": {"x": 0, "y": 0}, "length": 1)";
+    if (type == "slider" || type == "wheel") anchor = R"("anchor": {"x": 0, "y": -1}, "axis": {"x": 1, "y": 0})";
+    return load("{" + world(substeps, -10.0) + R"(, "entities": [
+        {"name": "weight", "position": {"x": 0, "y": -1}, "mass": )" + num(mass) + R"(, "radius": 0.2},
+        {"name": "hook", "joint": {"type": ")" + type + R"(", "a": "weight", )" + anchor +
+                R"(, "max_force": )" + num(maxForce) + "}}]}");
+}
+
+} // namespace
+
+/// A weight m under a joint with max_force F breaks exactly when m g > F:
+/// a sweep of m from half to one and a half times F / g, as close as 1e-4
+/// on either side, for every joint type, at 1 and 4 substeps. A weight at
+/// rest under its joint pulls with m g from the first substep, so one that
+/// breaks does so after the first step, and the reported force is m g.
+TEST(JointBreaking, AHangingWeightBreaksItsJointExactlyWhenItsWeightExceedsMaxForce) {
+    const double F = 100.0, g = 10.0;
+    double worstForceError = 0.0;
+    for (const std::string type : {"hinge", "weld", "slider", "distance", "rope", "wheel"}) {
+        for (const int substeps : {1, 4}) {
+            for (const double delta : {-0.5, -0.1, -0.01, -1e-3, -1e-4, 1e-4, 1e-3, 0.01, 0.1, 0.5}) {
+                const double m = F / g * (1.0 + delta);
+                const Scene scene = hangingOn(type, m, F, substeps);
+                World w = build(scene);
+                double largest = 0.0;
+                for (int i = 0; i < 120; ++i) {
+                    ASSERT_TRUE(w.step());
+                    for (const JointRecord& r : w.joints()) largest = std::max(largest, length(r.force));
+                }
+                const std::string what = type + ", " + std::to_string(substeps) + " substeps, m g / F - 1 = " +
+                                         std::to_string(delta);
+                worstForceError = std::max(worstForceError, std::abs(largest / (m * g) - 1.0));
+                if (delta > 0.0) {
+                    ASSERT_EQ(w.jointBreaks().size(), 1u) << what;
+                    const JointBreak& b = w.jointBreaks()[0];
+                    EXPECT_EQ(b.joint, named(scene, "hook")) << what;
+                    EXPECT_EQ(b.a, named(scene, "weight")) << what;
+                    EXPECT_EQ(b.step, 1u) << what;
+                    EXPECT_NEAR(b.force, m * g, 1e-6 * m * g) << what;
+                    EXPECT_EQ(b.maxForce, F);
+                    EXPECT_TRUE(w.joints().empty()) << what << ": a broken joint has no record after its step";
+                    // Free fall from there: 119 steps of gravity alone.
+                    EXPECT_LT(w.bodyPosition(0).y, -1.0 - 0.5 * g * 1.9 * 1.9) << what;
+                } else {
+                    EXPECT_TRUE(w.jointBreaks().empty()) << what << ": broke at force " << w.jointBreaks()[0].force;
+                    EXPECT_NEAR(w.bodyPosition(0).y, -1.0, 0.01) << what;
+                }
+            }
+        }
+    }
+    std::printf("hanging weights: largest joint force within %.3g of m g\n", worstForceError);
+}
+
+namespace {
+
+/// A door on a sprung hinge knocked by a ball that swings down on a
+/// breakable rod and flies off at the bottom of its swing (the rod's
+/// tension passes its max_force, 1.5 m g, on the way down), onto a floor;
+/// an arm on a sprung hinge, released level, whose weld to a heavy bob
+/// breaks on the way down too.
+const char* kSpringsAndBreaks = R"({"world": {"gravity": {"x": 0, "y": -9.81}, "dt": 0.016666666666666666, "substeps": 4},
+  "entities": [
+    {"name": "floor", "position": {"x": 0, "y": -3}, "static": true, "box": {"width": 30, "height": 1}},
+    {"name": "door", "position": {"x": 2, "y": -1.5}, "mass": 3, "box": {"width": 0.2, "height": 1.5}},
+    {"name": "hinge", "joint": {"type": "hinge", "a": "door", "anchor": {"x": 2, "y": -0.75}, "spring_hz": 1.5,
+                                "spring_damping_ratio": 0.2}},
+    {"name": "ball", "position": {"x": -1.5, "y": 0}, "mass": 2, "radius": 0.25},
+    {"name": "rod", "joint": {"type": "distance", "a": "ball", "local_b": {"x": 0, "y": 0}, "max_force": 30}},
+    {"name": "arm", "position": {"x": -4.5, "y": -0.5}, "mass": 1, "box": {"width": 1, "height": 0.2}},
+    {"name": "shoulder", "joint": {"type": "hinge", "a": "arm", "anchor": {"x": -5, "y": -0.5}, "spring_hz": 3,
+                                   "spring_damping_ratio": 0.05}},
+    {"name": "bob", "position": {"x": -3.7, "y": -0.5}, "mass": 4, "radius": 0.3},
+    {"name": "wrist", "joint": {"type": "weld", "a": "arm", "b": "bob", "anchor": {"x": -4, "y": -0.5}, "max_force": 78}}
+  ]})";
+
+std::string savedWith(const World& w, Scene scene) {
+    w.writeBack(scene);
+    scene.solverState.reset();
+    if (SolverState s = w.solverState(); !s.empty()) scene.solverState = std::move(s);
+    return sceneToJsonText(scene);
+}
+
+} // namespace
+
+/// Save mid-run, load and go on equals running on, bit for bit, with
+/// hinge springs and before and after each break; so does a snapshot
+/// taken before the breaks and restored after them (the joints come back
+/// and break again at the same steps).
+TEST(JointBreaking, ResumeFromAFileOrASnapshotIsExactWithSpringsAndBreaks) {
+    const Scene scene = load(kSpringsAndBreaks);
+    World straight = build(scene);
+    ASSERT_TRUE(advance(straight, 240).ok());
+    ASSERT_EQ(straight.jointBreaks().size(), 2u);
+    std::vector<std::uint64_t> breakSteps;
+    for (const JointBreak& b : straight.jointBreaks()) breakSteps.push_back(b.step);
+    std::printf("breaks: \"%s\" at step %llu (%.2f N), \"%s\" at step %llu (%.2f N)\n",
+                straight.jointBreaks()[0].joint == named(scene, "rod") ? "rod" : "wrist",
+                (unsigned long long)breakSteps[0], straight.jointBreaks()[0].force,
+                straight.jointBreaks()[1].joint == named(scene, "rod") ? "rod" : "wrist",
+                (unsigned long long)breakSteps[1], straight.jointBreaks()[1].force);
+    const std::uint64_t first = std::min(breakSteps[0], breakSteps[1]), last = std::max(breakSteps[0], breakSteps[1]);
+    ASSERT_GT(first, 2u);
+    ASSERT_GT(last, first + 2);
+    const std::string once = savedWith(straight, scene);
+    EXPECT_EQ(once.find("\"rod\""), std::string::npos);
+    EXPECT_EQ(once.find("\"wrist\""), std::string::npos);
+    // Splits before both breaks, between them and after both.
+    for (const std::uint64_t split : {first - 1, first, (first + last) / 2, last, last + 30}) {
+        World w = build(scene);
+        ASSERT_TRUE(advance(w, split).ok());
+        Result<Scene> middle = parseScene(savedWith(w, scene), "middle.json");
+        ASSERT_TRUE(middle) << middle.error();
+        World resumed = build(*middle);
+        ASSERT_TRUE(advance(resumed, 240 - split).ok());
+        EXPECT_TRUE(savedWith(resumed, *middle) == once) << "saved at step " << split;
+    }
+    // A snapshot before the breaks, restored after them.
+    World w = build(scene);
+    ASSERT_TRUE(advance(w, first - 1).ok());
+    const WorldState before = w.saveState();
+    ASSERT_TRUE(advance(w, 240 - (first - 1)).ok());
+    ASSERT_EQ(w.jointBreaks().size(), 2u);
+    ASSERT_TRUE(w.restoreState(before).ok());
+    EXPECT_TRUE(w.jointBreaks().empty());
+    ASSERT_TRUE(advance(w, 240 - (first - 1)).ok());
+    EXPECT_TRUE(std::equal(w.jointBreaks().begin(), w.jointBreaks().end(), straight.jointBreaks().begin(),
+                           straight.jointBreaks().end()));
+    EXPECT_TRUE(savedWith(w, scene) == once) << "restore before the breaks and run on";
+    // A snapshot's writeBack leaves out the joints broken as of it.
+    Scene fromSnapshot = scene;
+    const WorldState after = w.saveState();
+    after.writeBack(fromSnapshot);
+    EXPECT_FALSE(fromSnapshot.registry.alive(named(scene, "rod")));
+    Scene fromBefore = scene;
+    before.writeBack(fromBefore);
+    EXPECT_TRUE(fromBefore.registry.alive(named(scene, "rod")));
+}
+
+/// After a break the two bodies collide again: a hinge kept them from it
+/// (collide_connected false), and once broken the ball falls through the
+/// plank it was pinned to no more.
+TEST(JointBreaking, BodiesOfABrokenJointCollideAgain) {
+    const Scene scene = load("{" + world(4) + R"(, "entities": [
+        {"name": "shelf", "position": {"x": 0, "y": 0}, "static": true, "box": {"width": 4, "height": 0.2}},
+        {"name": "ball", "position": {"x": 0, "y": -0.3}, "mass": 1, "radius": 0.25},
+        {"name": "pin", "joint": {"type": "hinge", "a": "ball", "b": "shelf", "anchor": {"x": 0, "y": -0.3}, "max_force": 5}},
+        {"name": "floor", "position": {"x": 0, "y": -3}, "static": true, "box": {"width": 4, "height": 1}}]})");
+    World w = build(scene);
+    ASSERT_TRUE(advance(w, 120).ok());
+    ASSERT_EQ(w.jointBreaks().size(), 1u);
+    EXPECT_EQ(w.jointBreaks()[0].step, 1u);
+    // Overlapping the shelf it was pinned inside, the freed ball is pushed
+    // out of it and lands on the floor (top at y = -2.5).
+    EXPECT_NEAR(w.bodyPosition(0).y, -2.25, 0.02);
+    bool touchedShelf = false;
+    World again = build(scene);
+    for (int i = 0; i < 5; ++i) {
+        ASSERT_TRUE(again.step());
+        for (const ContactRecord& c : again.contacts()) touchedShelf = touchedShelf || c.b == named(scene, "shelf");
+    }
+    EXPECT_TRUE(touchedShelf) << "the joint's no-collide pair left with it";
+}
+
+/// levels/breaking_bridge.json: 13 planks hinged in a sagging arc between
+/// two piers, every pin with a max_force (4 kN for the middle one, "pin 6",
+/// 12 kN for the others), and a crate dropped 0.14 m onto the middle. The
+/// shipped 150 kg crate breaks the middle pin and falls to the ground,
+/// the halves hanging from the piers; crates of up to 30 kg ride the bridge
+/// for 10 s without a break. The largest pin force of each run is printed.
+TEST(JointLevels, TheBreakingBridgeBreaksUnderAHeavyCrateAndHoldsALightOne) {
+    Result<Scene> loaded = loadSceneFile(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "breaking_bridge.json");
+    ASSERT_TRUE(loaded) << loaded.error();
+    const Scene& shipped = *loaded;
+    const Entity crate = named(shipped, "crate"), middle = named(shipped, "pin 6");
+    ASSERT_FALSE(crate.isNull());
+    ASSERT_FALSE(middle.isNull());
+    EXPECT_EQ(shipped.registry.tryGet<Mass>(crate)->value, 150.0);
+    for (const double mass : {5.0, 10.0, 20.0, 30.0, 80.0, 150.0, 300.0}) {
+        Scene scene = shipped;
+        scene.registry.emplace<Mass>(crate, Mass{mass});
+        World w = build(scene);
+        double largest = 0.0;
+        std::size_t crateBody = 0;
+        for (std::size_t b = 0; b < w.bodyCount(); ++b)
+            if (w.bodyEntity(b) == crate) crateBody = b;
+        for (int i = 0; i < 600; ++i) {
+            ASSERT_TRUE(w.step());
+            for (const JointRecord& r : w.joints()) largest = std::max(largest, length(r.force));
+        }
+        const double crateY = w.bodyPosition(crateBody).y;
+        std::printf("breaking bridge, %5.0f kg crate: largest pin force %6.0f N, %zu joints broke, crate at y = %.2f m\n",
+                    mass, largest, w.jointBreaks().size(), crateY);
+        if (mass <= 30.0) {
+            EXPECT_TRUE(w.jointBreaks().empty()) << mass << " kg";
+            EXPECT_GT(crateY, -2.0) << mass << " kg: the crate rides the bridge";
+            EXPECT_LT(largest, 4000.0);
+        } else {
+            ASSERT_FALSE(w.jointBreaks().empty()) << mass << " kg";
+            EXPECT_EQ(w.jointBreaks()[0].joint, middle) << mass << " kg: the weak middle pin goes first";
+            EXPECT_GT(w.jointBreaks()[0].force, 4000.0);
+            EXPECT_NEAR(crateY, -4.0 + 0.7, 0.05) << mass << " kg: the crate is on the ground";
+        }
+    }
+}
+
+/// With no damping the spring still loses amplitude: the soft step is
+/// implicit, a factor 1 / (1 + (w h)^2) a substep, as docs/joints.md says.
+/// Measured from the peaks over two periods, across frequencies and
+/// substeps: the decay rate within 3% of (w h)^2 / (1 + (w h)^2).
+TEST(HingeSpring, UndampedAmplitudeDecaysByTheImplicitStepsFactor) {
+    for (const int substeps : {1, 4}) {
+        for (const double hz : {0.5, 1.0, 2.0}) {
+            World w = build(springScene(hz, 0.0, 0.5, 1.0, substeps, 0.3));
+            const int perPeriod = int(std::lround(60.0 / hz));
+            const std::vector<double> angle = springAngles(w, 3 * perPeriod);
+            std::vector<double> peaks;
+            for (std::size_t i = 1; i + 1 < angle.size(); ++i)
+                if (std::abs(angle[i]) >= std::abs(angle[i - 1]) && std::abs(angle[i]) >= std::abs(angle[i + 1]))
+                    peaks.push_back(std::abs(angle[i]));
+            ASSERT_GE(peaks.size(), 5u);
+            // Peaks 0 and 4 are two periods apart.
+            const double perSubstep = std::pow(peaks[4] / peaks[0], 1.0 / (2.0 * perPeriod * substeps));
+            const double wh = 2.0 * kPi * hz / 60.0 / substeps;
+            // The decay rate (1 - factor, about (w h)^2) within 3%.
+            EXPECT_NEAR(perSubstep, 1.0 / (1.0 + wh * wh), 0.03 * wh * wh) << hz << " Hz, " << substeps << " substeps";
+        }
+    }
+}
+
+// ---------------------------------------------------------------- wheel
+
+namespace {
+
+/// A disc "hub" on a wheel joint to a static "frame": axis `axis` in the
+/// frame's frame, anchors at the hub's centre, gravity `gy`.
+Scene wheelOnFrame(const std::string& extra, double gy, int substeps, double hubMass = 2.0, double spin = 0.0,
+                   Vec2 hubOffset = {}) {
+    std::string w = world(substeps, gy);
+    w.insert(w.size() - 1, R"(, "sleep": false)");
+    return load("{" + w + R"(, "entities": [
+        {"name": "frame", "position": {"x": 0, "y": 0}, "static": true},
+        {"name": "hub", "position": {"x": )" + num(hubOffset.x) + R"(, "y": )" + num(hubOffset.y) +
+                R"(}, "mass": )" + num(hubMass) + R"(, "radius": 0.3, "angular_velocity": )" + num(spin) + R"(},
+        {"name": "axle", "joint": {"type": "wheel", "a": "frame", "b": "hub", "local_a": {"x": 0, "y": 0},
+                                   "local_b": {"x": 0, "y": 0})" + extra + "}}]}");
+}
+
+} // namespace
+
+TEST(WheelJoint, FormatRoundTripsAndRefusesAZeroAxisNamingTheJoint) {
+    const std::string text = R"({"entities": [{"name": "car", "position": {"x": 0, "y": 1}, "box": {"width": 2, "height": 0.5}},
+        {"name": "tyre", "position": {"x": 1, "y": 0.5}, "radius": 0.4},
+        {"name": "axle", "joint": {"type": "wheel", "a": "car", "b": "tyre", "anchor": {"x": 1, "y": 0.5},
+                                   "axis": {"x": 0, "y": 2}, "lower": -0.2, "upper": 0.1, "stiffness_hz": 4,
+                                   "damping_ratio": 0.6, "motor_speed": -5, "max_motor_torque": 30, "max_force": 900}}]})";
+    const Scene first = load(text);
+    const std::string saved = sceneToJsonText(first);
+    EXPECT_EQ(sceneToJsonText(load(saved)), saved);
+    const Joint* j = first.registry.tryGet<Joint>(named(first, "axle"));
+    ASSERT_NE(j, nullptr);
+    EXPECT_EQ(j->localA, (Vec2{1.0, -0.5}));
+    EXPECT_EQ(*j->stiffnessHz, 4.0);
+    EXPECT_EQ(refusal(R"({"entities": [{"name": "car", "position": {"x": 0, "y": 1}, "radius": 0.5},
+        {"name": "axle", "joint": {"type": "wheel", "a": "car", "axis": {"x": 0, "y": 0}}}]})"),
+              "test.json: error: /entities/1/joint/axis: joint on entity 1 (\"axle\"): a wheel axis needs a non-zero "
+              "length, got {\"x\": 0.0, \"y\": 0.0}");
+    // A field of another type is ignored, as everywhere in the joint
+    // table: spring_hz on a wheel loads and changes nothing.
+    const std::string withHingeSpring = R"({"entities": [{"name": "car", "position": {"x": 0, "y": 1}, "radius": 0.5},
+        {"name": "axle", "joint": {"type": "wheel", "a": "car", "spring_hz": 3}}]})";
+    EXPECT_EQ(refusal(withHingeSpring), "(loaded)");
+}
+
+/// The suspension spring along the axis, undamped, gravity off: the hub
+/// released 0.1 m along the axis oscillates with period 1 / stiffness_hz
+/// (the frame is static, so the spring's mass is the hub's) within the
+/// soft step's 0.5 (w h)^2; it stays on the axis line (across it < 1 um)
+/// and keeps the spin it was given (free rotation). Swept over axes,
+/// frequencies, masses and substeps.
+TEST(WheelJoint, AxisSpringHasItsFrequencyAndTheHubStaysOnTheLineAndSpinsFreely) {
+    for (const int substeps : {1, 4}) {
+        for (const double hz : {1.0, 3.0}) {
+            for (const double mass : {0.5, 20.0}) {
+                for (const Vec2 axis : {Vec2{0.0, 1.0}, Vec2{0.6, 0.8}}) {
+                    const Vec2 start = 0.1 * axis;
+                    const Scene scene = wheelOnFrame(R"(, "axis": {"x": )" + num(axis.x) + R"(, "y": )" + num(axis.y) +
+                                                         R"(}, "stiffness_hz": )" + num(hz) + R"(, "damping_ratio": 0)",
+                                                     0.0, substeps, mass, 7.0, start);
+                    World w = build(scene);
+                    std::vector<double> along;
+                    double across = 0.0;
+                    for (int i = 0; i < int(std::ceil(4.5 / hz * 60.0)); ++i) {
+                        ASSERT_TRUE(w.step());
+                        const Vec2 p = w.bodyPosition(0);
+                        along.push_back(dot(p, axis));
+                        across = std::max(across, std::abs(cross(axis, p)));
+                    }
+                    const double period = periodOf(along, 1.0 / 60.0);
+                    const double wh = 2.0 * kPi * hz / 60.0 / substeps;
+                    const std::string what = std::to_string(hz) + " Hz, m " + std::to_string(mass) + ", " +
+                                             std::to_string(substeps) + " substeps, axis (" + std::to_string(axis.x) + ")";
+                    EXPECT_LT(std::abs(period * hz - 1.0), 1e-4 + 0.5 * wh * wh) << what << ": period " << period;
+                    EXPECT_LT(across, 1e-6) << what;
+                    const WorldState s = w.saveState();
+                    EXPECT_NEAR(s.colliderSpin.at(0), 7.0, 1e-9) << what << ": free rotation";
+                }
+            }
+        }
+    }
+}
+
+/// The motor drives the hub's spin to motor_speed, and pushes with at most
+/// max_motor_torque: a hub of inertia I spun up from rest gains
+/// max_motor_torque / I per second until it gets there.
+TEST(WheelJoint, MotorReachesItsSpeedAtItsTorqueLimit) {
+    for (const double torque : {0.5, 3.0}) {
+        const Scene scene = wheelOnFrame(R"(, "motor_speed": 10, "max_motor_torque": )" + num(torque), 0.0, 4, 2.0);
+        World w = build(scene);
+        const double inertia = 0.5 * 2.0 * 0.3 * 0.3;
+        ASSERT_TRUE(w.step());
+        const double expected = std::min(10.0, torque / inertia / 60.0);
+        EXPECT_NEAR(w.saveState().colliderSpin.at(0), expected, 1e-9) << torque << " N m";
+        for (int i = 0; i < 240; ++i) ASSERT_TRUE(w.step());
+        EXPECT_NEAR(w.saveState().colliderSpin.at(0), 10.0, 1e-9) << torque << " N m";
+    }
+}
+
+/// Under gravity with no spring the hub slides down its vertical axis to
+/// the lower limit and rests there (within 5 mm); with the spring it
+/// hangs at the static sag m g / k, k = m (2 pi f)^2 (within 2%).
+TEST(WheelJoint, LimitHoldsAndTheSpringSagsByItsStaticDeflection) {
+    {
+        World w = build(wheelOnFrame(R"(, "axis": {"x": 0, "y": 1}, "lower": -0.2, "upper": 0.2)", -9.81, 4));
+        for (int i = 0; i < 120; ++i) ASSERT_TRUE(w.step());
+        EXPECT_NEAR(w.bodyPosition(0).y, -0.2, 0.005);
+    }
+    for (const double hz : {2.0, 5.0}) {
+        World w = build(wheelOnFrame(R"(, "axis": {"x": 0, "y": 1}, "stiffness_hz": )" + num(hz) + R"(, "damping_ratio": 1)",
+                                     -9.81, 4));
+        for (int i = 0; i < 240; ++i) ASSERT_TRUE(w.step());
+        const double sag = 9.81 / std::pow(2.0 * kPi * hz, 2);
+        EXPECT_NEAR(-w.bodyPosition(0).y, sag, 0.02 * sag) << hz << " Hz";
+    }
+}
+
+/// levels/suspension_car.json: a 12 kg chassis on two wheel joints (4 Hz,
+/// damping ratio 0.7, travel +-0.15 m), the rear one driven, over a 0.3 m
+/// bump. The same car with its wheels on hinges (a rigid axle, as
+/// levels/car.json) crosses the same bump: the suspended chassis's largest
+/// vertical acceleration while the wheels cross it is less than half the
+/// rigid one's, and both cars get over.
+TEST(JointLevels, TheSuspensionAbsorbsTheBump) {
+    Result<Scene> loaded = loadSceneFile(fs::path(STEPWISE_SOURCE_DIR) / "levels" / "suspension_car.json");
+    ASSERT_TRUE(loaded) << loaded.error();
+    const auto drive = [](const Scene& scene, double& peak, double& endX) {
+        World w = build(scene);
+        std::size_t chassis = 0;
+        for (std::size_t b = 0; b < w.bodyCount(); ++b)
+            if (w.bodyEntity(b) == named(scene, "chassis")) chassis = b;
+        double vy = w.bodyVelocity(chassis).y;
+        peak = 0.0;
+        for (int i = 0; i < 600; ++i) {
+            ASSERT_TRUE(w.step());
+            const double x = w.bodyPosition(chassis).x, v = w.bodyVelocity(chassis).y;
+            // While either wheel can touch the bump (x from 6 to 10 m).
+            if (x > 5.5 && x < 10.5) peak = std::max(peak, std::abs(v - vy) * 60.0);
+            vy = v;
+        }
+        endX = w.bodyPosition(chassis).x;
+    };
+    double suspended = 0.0, rigid = 0.0, endSuspended = 0.0, endRigid = 0.0;
+    drive(*loaded, suspended, endSuspended);
+    Scene hinged = *loaded;
+    for (const char* name : {"rear suspension", "front suspension"}) {
+        Joint* j = hinged.registry.tryGet<Joint>(named(hinged, name));
+        ASSERT_NE(j, nullptr);
+        j->type = "hinge";
+        j->axis.reset();
+        j->lower.reset();
+        j->upper.reset();
+        j->stiffnessHz.reset();
+        j->dampingRatio.reset();
+        j->referenceAngle = 0.0;
+    }
+    drive(hinged, rigid, endRigid);
+    std::printf("suspension car: chassis's largest vertical acceleration over the bump %.1f m/s^2 on wheel joints, "
+                "%.1f on hinges; at x = %.1f and %.1f m after 10 s\n",
+                suspended, rigid, endSuspended, endRigid);
+    EXPECT_LT(suspended, 0.5 * rigid);
+    EXPECT_GT(endSuspended, 12.0);
+    EXPECT_GT(endRigid, 12.0);
+}

@@ -449,3 +449,88 @@ TEST(WorldFields, SaveWritesGivenSettingsOnlyAndReadsThemBack) {
     ASSERT_TRUE(again) << again.error();
     EXPECT_EQ(again->world, scene->world);
 }
+
+// ---- hinge springs and breakable joints ---------------------------------
+
+namespace {
+/// Two bodies and one joint with the given members: the level the refusals
+/// below edit.
+std::string jointLevel(const std::string& joint) {
+    return R"({"entities": [{"name": "post", "position": {"x": 0, "y": 0}, "static": true, "radius": 0.2},
+        {"name": "arm", "position": {"x": 1, "y": 0}, "radius": 0.2},
+        {"name": "elbow", "joint": {)" + joint + "}}]}";
+}
+} // namespace
+
+TEST(SceneJoints, SpringAndMaxForceRoundTripByteForByteAndAbsentStaysAbsent) {
+    for (const std::string joint :
+         {std::string(R"("type": "hinge", "a": "arm", "b": "post", "spring_hz": 2.5, "spring_damping_ratio": 0.3, "max_force": 1250.75)"),
+          std::string(R"("type": "hinge", "a": "arm", "b": "post", "spring_hz": 0)"),
+          std::string(R"("type": "weld", "a": "arm", "b": "post", "stiffness_hz": 4, "max_force": 1e-3)"),
+          std::string(R"("type": "rope", "a": "arm", "b": "post", "max_force": 1e30)")}) {
+        Result<Scene> first = parseScene(jointLevel(joint), "t.json");
+        ASSERT_TRUE(first) << first.error();
+        const std::string once = sceneToJsonText(*first);
+        Result<Scene> second = parseScene(once, "t.json");
+        ASSERT_TRUE(second) << second.error();
+        EXPECT_EQ(sceneToJsonText(*second), once) << joint;
+        const Joint* j = second->registry.tryGet<Joint>(second->registry.entities()[2]);
+        ASSERT_NE(j, nullptr);
+        EXPECT_EQ(j->springHz.has_value(), joint.find("spring_hz") != std::string::npos) << joint;
+        EXPECT_EQ(j->maxForce.has_value(), joint.find("max_force") != std::string::npos) << joint;
+        EXPECT_EQ(once.find("spring_damping_ratio") != std::string::npos,
+                  joint.find("spring_damping_ratio") != std::string::npos)
+            << "absent stays absent: " << once;
+    }
+    Result<Scene> s = parseScene(jointLevel(R"("type": "hinge", "a": "arm", "spring_hz": 2.5, "max_force": 1250.75)"), "t.json");
+    ASSERT_TRUE(s) << s.error();
+    const Joint* j = s->registry.tryGet<Joint>(s->registry.entities()[2]);
+    EXPECT_EQ(*j->springHz, 2.5);
+    EXPECT_EQ(*j->maxForce, 1250.75);
+    EXPECT_FALSE(j->springDampingRatio) << "absent: the engine's 1";
+}
+
+TEST(SceneJoints, BadSpringsMaxForcesAndWheelAxesAreRefusedAtTheirPointer) {
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {R"("type": "hinge", "a": "arm", "spring_hz": -1)",
+         "t.json: error: /entities/2/joint/spring_hz: expected a number in [0, 1e+30], got -1"},
+        {R"("type": "hinge", "a": "arm", "spring_hz": "soft")",
+         "t.json: error: /entities/2/joint/spring_hz: expected a number in [0, 1e+30], got \"soft\""},
+        {R"("type": "hinge", "a": "arm", "spring_damping_ratio": -0.5)",
+         "t.json: error: /entities/2/joint/spring_damping_ratio: expected a number in [0, 1e+30], got -0.5"},
+        {R"("type": "hinge", "a": "arm", "max_force": 0)",
+         "t.json: error: /entities/2/joint/max_force: expected a number in (0, 1e+30], got 0"},
+        {R"("type": "rope", "a": "arm", "max_force": -5)",
+         "t.json: error: /entities/2/joint/max_force: expected a number in (0, 1e+30], got -5"},
+        {R"("type": "distance", "a": "arm", "max_force": 1e31)",
+         "t.json: error: /entities/2/joint/max_force: expected a number in (0, 1e+30], got 1e+31"},
+        {R"("type": "hinge", "a": "arm", "max_force": null)",
+         "t.json: error: /entities/2/joint/max_force: expected a number in (0, 1e+30], got null"},
+        {R"("type": "wheel", "a": "arm", "axis": {"x": 0, "y": 0})",
+         "t.json: error: /entities/2/joint/axis: joint on entity 2 (\"elbow\"): a wheel axis needs a non-zero length, "
+         "got {\"x\": 0.0, \"y\": 0.0}"},
+    };
+    for (const auto& [joint, message] : cases) EXPECT_EQ(refusal(jointLevel(joint)), message) << joint;
+}
+
+TEST(SceneJoints, HingeSpringImpulseInSolverStateRoundTripsAndReachesTheSolver) {
+    const std::string level = R"({"entities": [{"name": "arm", "position": {"x": 1, "y": 0}, "radius": 0.2},
+        {"name": "elbow", "joint": {"type": "hinge", "a": "arm", "anchor": {"x": 0, "y": 0}, "spring_hz": 2}}],
+        "solver_state": {"joints": [{"joint": "elbow", "angular_impulse": -0.125}]}})";
+    Result<Scene> first = parseScene(level, "t.json");
+    ASSERT_TRUE(first) << first.error();
+    ASSERT_TRUE(first->solverState);
+    ASSERT_EQ(first->solverState->joints.size(), 1u);
+    EXPECT_EQ(first->solverState->joints[0].angular, -0.125) << "a hinge's spring travels as angular_impulse";
+    const std::string once = sceneToJsonText(*first);
+    EXPECT_NE(once.find(R"({"joint": "elbow", "angular_impulse": -0.125})"), std::string::npos) << once;
+    // And reaches the solver: a world built from it starts the spring warm.
+    Result<World> w = World::build(*first);
+    ASSERT_TRUE(w) << w.error();
+    ASSERT_EQ(w->solverState().joints.size(), 1u);
+    EXPECT_EQ(w->solverState().joints[0].angular, -0.125);
+    EXPECT_EQ(refusal(R"({"entities": [{"name": "arm", "position": {"x": 1, "y": 0}, "radius": 0.2},
+        {"name": "elbow", "joint": {"type": "hinge", "a": "arm"}}],
+        "solver_state": {"joints": [{"joint": "elbow", "angular_impulse": "x"}]}})"),
+              "t.json: error: /solver_state/joints/0/angular_impulse: expected a finite number, got \"x\"");
+}

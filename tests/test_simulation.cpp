@@ -271,3 +271,25 @@ TEST(Simulation, StepCounterIsClearedByResetNewAndOpen) {
     ASSERT_TRUE(f.ed.open(kLevels / "default.json"));
     EXPECT_EQ(f.ed.sim.steps(), 0u);
 }
+
+// A joint that breaks (max_force) is named in the status line when the step
+// it broke in is taken, and leaves the running scene; stepping back before
+// the break brings it back.
+TEST(SimulationBreaks, AJointThatBreaksIsNamedInTheStatusAndLeavesTheScene) {
+    LevelOpen f("breaking_bridge.json");
+    Editor& ed = f.ed;
+    const auto pinAlive = [&] {
+        for (Entity e : ed.doc.scene.registry.entities())
+            if (const Name* n = ed.doc.scene.registry.tryGet<Name>(e); n && n->value == "pin 6") return true;
+        return false;
+    };
+    bool named = false;
+    for (int i = 0; i < 30; ++i) {
+        ed.stepForward();
+        named = named || ed.status.find("joint \"pin 6\" broke at t = ") != std::string::npos;
+    }
+    EXPECT_TRUE(named) << ed.status;
+    EXPECT_FALSE(pinAlive());
+    for (int i = 0; i < 25; ++i) ed.stepBack();
+    EXPECT_TRUE(pinAlive()) << "stepping back before the break brings the joint back";
+}

@@ -381,6 +381,7 @@ void Editor::stepForward() {
         trails = render::TrailRecorder(trails.capacity());
     }
     if (!sim.step(doc.scene) && !sim.message().empty()) note(sim.message());
+    for (std::string& line : sim.takeBreakNotes()) note(std::move(line));
     if (const World* w = sim.world()) trails.record(*w);
     ++revisionExtra_;
 }
@@ -412,6 +413,7 @@ void Editor::update(double frameSeconds) {
     const std::uint64_t before = sim.steps();
     const bool wasPlaying = sim.state() == SimState::Playing;
     sim.advance(doc.scene, frameSeconds);
+    for (std::string& line : sim.takeBreakNotes()) note(std::move(line));
     if (sim.steps() != before) {
         ++revisionExtra_;
         if (const World* w = sim.world()) trails.record(*w);

@@ -340,6 +340,15 @@ bool Simulation::prepareStep(Scene& scene) {
 
 bool Simulation::finishStep(Scene& scene) {
     contactsKept_ = false;  // the step made contacts of its own
+    // Named before writeBack, which removes a broken joint's entity.
+    if (!world_->jointBreaks().empty() && world_->jointBreaks().back().step == world_->lastStats().step)
+        for (const JointBreak& b : world_->jointBreaks()) {
+            if (b.step != world_->lastStats().step) continue;
+            char text[160];
+            std::snprintf(text, sizeof text, " broke at t = %.3f s: %.0f N past its max_force %.0f N", world_->time(),
+                          b.force, b.maxForce);
+            breakNotes_.push_back("joint \"" + displayName(scene.registry, b.joint) + "\"" + text);
+        }
     world_->writeBack(scene);
     ++steps_;
     record();

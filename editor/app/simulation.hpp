@@ -35,6 +35,7 @@
 #include <optional>
 #include <set>
 #include <span>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -144,6 +145,10 @@ public:
 
     /// Last message: divergence, break on contact, refusal. Empty when none.
     const std::string& message() const { return message_; }
+    /// One line per joint that broke (max_force) in the steps since the
+    /// last call ("joint \"pin 6\" broke at t = 0.267 s: 6683 N past its
+    /// max_force 4000 N"); the joint is already gone from the scene.
+    std::vector<std::string> takeBreakNotes() { return std::exchange(breakNotes_, {}); }
     bool diverged() const { return diverged_; }
     /// The contacts the panels and the overlay show: the last step's. An edit
     /// that leaves the contacts as they were (a mass, a colour, a name, a
@@ -237,6 +242,7 @@ private:
     std::uint64_t steps_ = 0;
     double frameStepMs_ = 0.0;
     std::string message_;
+    std::vector<std::string> breakNotes_;
     bool diverged_ = false;
     struct BeforeEdits {
         std::size_t cursor = 0;       ///< undo stack position before the first edit since a step

@@ -103,12 +103,31 @@ void appendContactLine(std::string& jsonl, std::uint64_t step, const World& worl
     }
     jsonl += "}\n";
     // A line of its own for each body entering or leaving a sensor, after
-    // the step's line: {"step", "time", "event": "begin" or "end",
-    // "sensor", "body"}.
+    // the step's line: {"event": "begin" or "end", "step", "time",
+    // "sensor", "body"} (the same shape as a joint's "break" line).
     for (const SensorEvent& e : world.sensorEvents())
-        jsonl += "{\"step\": " + std::to_string(step) + ", \"time\": " + number(world.time()) + ", \"event\": \"" +
-                 (e.begin ? "begin" : "end") + "\", \"sensor\": " + jsonString(entityRef(scene, e.sensor)) +
+        jsonl += std::string("{\"event\": \"") + (e.begin ? "begin" : "end") + "\", \"step\": " + std::to_string(step) +
+                 ", \"time\": " + number(world.time()) + ", \"sensor\": " + jsonString(entityRef(scene, e.sensor)) +
                  ", \"body\": " + jsonString(entityRef(scene, e.body)) + "}\n";
+}
+
+/// One JSON line per joint that broke in this step, after the step's line:
+/// which joint, its ends, the step and the force that broke it.
+void appendBreakLines(std::string& jsonl, std::uint64_t step, const World& world, const Scene& scene) {
+    for (const JointBreak& b : world.jointBreaks()) {
+        if (b.step != step) continue;
+        jsonl += "{\"event\": \"break\", \"step\": " + std::to_string(step) + ", \"time\": " + number(world.time()) +
+                 ", \"joint\": " + jsonString(entityRef(scene, b.joint)) + ", \"a\": " + jsonString(entityRef(scene, b.a)) +
+                 ", \"b\": " + (b.b.isNull() ? std::string("null") : jsonString(entityRef(scene, b.b))) +
+                 ", \"force\": " + number(b.force) + ", \"max_force\": " + number(b.maxForce) + "}\n";
+    }
+}
+
+/// "step 12: joint \"left rope\" broke: force 1250.3 N past its max_force 1000 N".
+std::string breakNote(const JointBreak& b, const Scene& scene) {
+    char forces[96];
+    std::snprintf(forces, sizeof forces, "force %.6g N past its max_force %.6g N", b.force, b.maxForce);
+    return "step " + std::to_string(b.step) + ": joint " + jsonString(entityRef(scene, b.joint)) + " broke: " + forces;
 }
 
 /// Ctrl-C (SIGINT) or SIGTERM during the steps: the loop stops, the
@@ -250,7 +269,15 @@ int run(const RunOptions& options) {
              }
              if (contacts) {
                  appendContactLine(row, step, world, *scene);
+                 appendBreakLines(row, step, world, *scene);
                  emit(contacts);
+             }
+             // A break is news whether or not a trace is written.
+             if (!world.jointBreaks().empty() && world.jointBreaks().back().step == step) {
+                 if (progressShown) std::fputc('\n', stderr);
+                 progressShown = false;
+                 for (const JointBreak& b : world.jointBreaks())
+                     if (b.step == step) std::cerr << options.level << ": note: " << breakNote(b, *scene) << "\n";
              }
              // A clock read every 256 steps: a progress line on a terminal twice
              // a second, and once, after a second, the estimate of the whole run
@@ -342,6 +369,8 @@ int run(const RunOptions& options) {
               << (world.kinematicCount() ? " and " + std::to_string(world.kinematicCount()) + " kinematic" : std::string())
               << "; total energy " << number(energy.total()) << " J; "
               << number(taken ? 1e3 * seconds / double(taken) : 0.0) << " ms/step";
+    if (const std::size_t broke = world.jointBreaks().size())
+        std::cout << "; " << broke << " joint" << (broke == 1 ? "" : "s") << " broke";
     if (options.out) std::cout << "; wrote " << *options.out;
     if (options.trace) std::cout << "; trace " << *options.trace;
     std::cout << "\n";
@@ -365,8 +394,9 @@ void addRunCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--contacts", options->contacts,
                     "Write one JSON line per step: the step, the time and every contact (entities, point, normal, "
                     "depth, normal and tangent impulse); with joints, every joint too (anchors, separation, "
-                    "reaction force and torque on b, angle); a line of its own for each body entering or leaving a "
-                    "sensor (\"event\": \"begin\" or \"end\", \"sensor\", \"body\")")
+                    "reaction force and torque on b, angle). After a step's line, a line of its own for each event "
+                    "of that step: a body entering or leaving a sensor ({\"event\": \"begin\" or \"end\", ..., "
+                    "\"sensor\", \"body\"}) and a joint breaking ({\"event\": \"break\", ...} with the force)")
         ->check(outputFileName());
     cmd->callback([options, &exitCode] { exitCode = run(*options); });
 }

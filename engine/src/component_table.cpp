@@ -100,14 +100,14 @@ std::optional<Error> finishSpring(void* component) {
     return {};
 }
 
-constexpr std::string_view kJointTypes[] = {"hinge", "slider", "weld", "distance", "rope"};
+constexpr std::string_view kJointTypes[] = {"hinge", "slider", "weld", "distance", "rope", "wheel"};
 
 std::optional<Error> finishJoint(void* component) {
     auto& joint = *static_cast<Joint*>(component);
     if (joint.type.empty())
-        return Error{"expected one of hinge, slider, weld, distance, rope, got nothing", "type"};
+        return Error{"expected one of hinge, slider, weld, distance, rope, wheel, got nothing", "type"};
     if (std::find(std::begin(kJointTypes), std::end(kJointTypes), joint.type) == std::end(kJointTypes)) {
-        std::string message = "expected one of hinge, slider, weld, distance, rope, got \"" + joint.type + "\"";
+        std::string message = "expected one of hinge, slider, weld, distance, rope, wheel, got \"" + joint.type + "\"";
         if (auto guess = closestName(joint.type, kJointTypes)) message += "; did you mean \"" + std::string(*guess) + "\"?";
         return Error{message, "type"};
     }
@@ -211,7 +211,7 @@ std::vector<ComponentInfo> buildTable() {
          field<&Boid::maxSpeed>("max_speed", NumberRange{0.0, kMaxSpeed, true}, "m/s", "speed limit of steering")},
         &finishBoid));
     {
-        FieldInfo type = field<&Joint::type>("type", kAny, "", "hinge, slider, weld, distance or rope");
+        FieldInfo type = field<&Joint::type>("type", kAny, "", "hinge, slider, weld, distance, rope or wheel");
         type.choices = kJointTypes;
         t.push_back(row<Joint>(
             "joint", "constraint between bodies a and b (b absent: the world); on its own entity", false, {},
@@ -221,17 +221,23 @@ std::vector<ComponentInfo> buildTable() {
              field<&Joint::localA>("local_a", kAny, "m", "anchor in a's frame"),
              field<&Joint::localB>("local_b", kAny, "m", "anchor in b's frame (a world point for the world)"),
              field<&Joint::anchor>("anchor", kAny, "m", "one world point that sets local_a and local_b on load"),
-             field<&Joint::axis>("axis", kAny, "", "slider: direction of travel in a's frame; absent {1, 0}"),
+             field<&Joint::axis>("axis", kAny, "", "slider, wheel: direction of travel in a's frame; absent {1, 0}"),
              field<&Joint::referenceAngle>("reference_angle", kAny, "rad",
                                            "angle of b relative to a that counts as zero; absent: as loaded"),
-             field<&Joint::lower>("lower", kAny, "rad or m", "hinge: lowest angle; slider: lowest travel"),
-             field<&Joint::upper>("upper", kAny, "rad or m", "hinge: highest angle; slider: highest travel"),
+             field<&Joint::lower>("lower", kAny, "rad or m", "hinge: lowest angle; slider, wheel: lowest travel"),
+             field<&Joint::upper>("upper", kAny, "rad or m", "hinge: highest angle; slider, wheel: highest travel"),
              field<&Joint::motorSpeed>("motor_speed", kAnySpeed, "rad/s or m/s", "motor target speed; absent 0"),
-             field<&Joint::maxMotorTorque>("max_motor_torque", kNonNegative, "N*m", "hinge motor: largest torque"),
+             field<&Joint::maxMotorTorque>("max_motor_torque", kNonNegative, "N*m", "hinge, wheel motor: largest torque"),
              field<&Joint::maxMotorForce>("max_motor_force", kNonNegative, "N", "slider motor: largest force"),
              field<&Joint::length>("length", kNonNegative, "m", "distance, rope: length; absent: as loaded"),
-             field<&Joint::stiffnessHz>("stiffness_hz", kNonNegative, "Hz", "weld, distance: softness; 0 rigid"),
-             field<&Joint::dampingRatio>("damping_ratio", kNonNegative, "", "weld, distance: damping; absent 1"),
+             field<&Joint::stiffnessHz>("stiffness_hz", kNonNegative, "Hz",
+                                        "weld, distance: softness, 0 rigid; wheel: axis spring, 0 none"),
+             field<&Joint::dampingRatio>("damping_ratio", kNonNegative, "", "weld, distance, wheel: damping; absent 1"),
+             field<&Joint::springHz>("spring_hz", kNonNegative, "Hz",
+                                     "hinge: rotational spring toward reference_angle; absent or 0 none"),
+             field<&Joint::springDampingRatio>("spring_damping_ratio", kNonNegative, "",
+                                               "hinge spring's damping ratio; absent 1"),
+             field<&Joint::maxForce>("max_force", kPositive, "N", "breaks past this force; absent never"),
              field<&Joint::collideConnected>("collide_connected", kAny, "", "a and b still collide")},
             &finishJoint));
     }

@@ -681,8 +681,9 @@ std::string checkJoint(const Registry& registry, std::size_t index, const Joint&
     if (isStatic[0] && isStatic[1])
         return at + ": " + who + ": joins two static bodies (" + endLabel(registry, joint.a) + " and " +
                endLabel(registry, joint.b) + "); at least one end must be dynamic";
-    if (joint.type == "slider" && joint.axis && !(std::hypot(joint.axis->x, joint.axis->y) > 1e-12))
-        return at + "/axis: " + who + ": a slider axis needs a non-zero length, got {\"x\": " +
+    if ((joint.type == "slider" || joint.type == "wheel") && joint.axis &&
+        !(std::hypot(joint.axis->x, joint.axis->y) > 1e-12))
+        return at + "/axis: " + who + ": a " + joint.type + " axis needs a non-zero length, got {\"x\": " +
                describeFound(Json(joint.axis->x)) + ", \"y\": " + describeFound(Json(joint.axis->y)) + "}";
     return {};
 }

@@ -164,12 +164,12 @@ std::string sceneJsonSchema() {
          Json{{"joint", entityRef},
               {"linear_impulse", Json{{"$ref", "#/$defs/vector"},
                                       {"description", "hinge, weld: the shared point, N*s; slider: (across the axis "
-                                                      "N*s, relative rotation N*m*s)"}}},
-              {"angular_impulse", impulse("weld: relative rotation, N*m*s")},
-              {"axial_impulse", impulse("distance: along the anchors' line, N*s")},
-              {"motor_impulse", impulse("hinge motor N*m*s, slider motor N*s")},
-              {"lower_impulse", oneSided("hinge, slider: lower limit")},
-              {"upper_impulse", oneSided("hinge, slider: upper limit; rope: its pull, N*s")}}}};
+                                                      "N*s, relative rotation N*m*s); wheel: (across the axis N*s, 0)"}}},
+              {"angular_impulse", impulse("weld: relative rotation; hinge: its spring (spring_hz), N*m*s")},
+              {"axial_impulse", impulse("distance: along the anchors' line; wheel: its axis spring, N*s")},
+              {"motor_impulse", impulse("hinge and wheel motor N*m*s, slider motor N*s")},
+              {"lower_impulse", oneSided("hinge, slider, wheel: lower limit")},
+              {"upper_impulse", oneSided("hinge, slider, wheel: upper limit; rope: its pull, N*s")}}}};
     Json bodySleep = Json{
         {"type", "object"},
         {"description", "one dynamic body's sleep state: seconds it has been still and, while it sleeps, its island "

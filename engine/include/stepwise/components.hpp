@@ -161,30 +161,40 @@ struct Boid {
 /// `reference_angle` / `length` hold their defaults, so a save writes what
 /// the simulation uses.
 struct Joint {
-    /// "hinge", "slider", "weld", "distance" or "rope" (jointTypeNames()).
+    /// "hinge", "slider", "weld", "distance", "rope" or "wheel" (jointTypeNames()).
     std::string type;
     Entity a;                       ///< first body; required
     Entity b;                       ///< second body; null = the world
     Vec2 localA;                    ///< anchor in a's frame (relative to its position), metres
     Vec2 localB;                    ///< anchor in b's frame; a world point when b is the world
     std::optional<Vec2> anchor;     ///< input only: one world point that sets both locals
-    std::optional<Vec2> axis;       ///< slider: direction of travel in a's frame; absent = {1, 0}
+    std::optional<Vec2> axis;       ///< slider, wheel: direction of travel in a's frame; absent = {1, 0}
     /// Angle of b relative to a that counts as zero (hinge limits, slider,
     /// weld), radians. Absent in a file: the relative angle at first load.
     std::optional<double> referenceAngle;
-    std::optional<double> lower;    ///< hinge: rad; slider: m. Absent: no lower limit
-    std::optional<double> upper;    ///< hinge: rad; slider: m. Absent: no upper limit
+    std::optional<double> lower;    ///< hinge: rad; slider, wheel: m. Absent: no lower limit
+    std::optional<double> upper;    ///< hinge: rad; slider, wheel: m. Absent: no upper limit
     std::optional<double> motorSpeed;     ///< hinge rad/s, slider m/s; absent = 0 (a brake)
-    std::optional<double> maxMotorTorque; ///< hinge motor, N*m; absent: no motor
+    std::optional<double> maxMotorTorque; ///< hinge and wheel motor, N*m; absent: no motor
     std::optional<double> maxMotorForce;  ///< slider motor, N; absent: no motor
     /// distance and rope: metres. Absent in a file: the anchors' distance at first load.
     std::optional<double> length;
-    std::optional<double> stiffnessHz;    ///< weld, distance: spring frequency, Hz; absent or 0 = rigid
-    std::optional<double> dampingRatio;   ///< weld, distance: with stiffness_hz; absent = 1 (critical)
+    /// weld, distance: spring frequency, Hz; absent or 0 = rigid. wheel: the
+    /// suspension spring along the axis (rest: anchors together); absent or
+    /// 0 = none, free travel.
+    std::optional<double> stiffnessHz;
+    std::optional<double> dampingRatio;   ///< weld, distance, wheel: with stiffness_hz; absent = 1 (critical)
+    /// hinge: a rotational spring toward reference_angle of this frequency,
+    /// Hz (Box2D's revolute spring); absent or 0 = no spring.
+    std::optional<double> springHz;
+    std::optional<double> springDampingRatio;  ///< hinge spring's damping ratio; absent = 1 (critical)
+    /// Any type: the joint breaks (is removed from the run) after a step
+    /// whose constraint force exceeds this, newtons (> 0); absent: never.
+    std::optional<double> maxForce;
     bool collideConnected = false;        ///< whether a and b still collide with each other
 };
 
-/// Joint type names in file order: hinge, slider, weld, distance, rope.
+/// Joint type names in file order: hinge, slider, weld, distance, rope, wheel.
 std::span<const std::string_view> jointTypeNames();
 
 } // namespace stepwise

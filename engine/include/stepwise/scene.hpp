@@ -100,8 +100,8 @@ struct JointImpulse {
     /// hinge and weld: the point constraint, N*s; slider: (across the axis
     /// N*s, relative rotation N*m*s)
     Vec2 linear;
-    double angular = 0.0;        ///< weld: relative rotation, N*m*s
-    double axial = 0.0;          ///< distance: along the anchors' line, N*s
+    double angular = 0.0;        ///< weld: relative rotation; hinge: its spring (spring_hz), N*m*s
+    double axial = 0.0;          ///< distance: along the anchors' line; wheel: its axis spring, N*s
     double motor = 0.0;          ///< hinge N*m*s, slider N*s
     double lower = 0.0;          ///< hinge, slider: lower limit (>= 0)
     double upper = 0.0;          ///< hinge, slider: upper limit; rope: its pull (>= 0)

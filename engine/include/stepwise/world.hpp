@@ -87,6 +87,17 @@ struct JointRecord {
     double angle = 0.0;        ///< b's angle relative to a minus the reference angle, rad
 };
 
+/// A joint that broke: after step `step` its constraint force exceeded its
+/// `max_force`, and it left the run (docs/joints.md, "Breaking").
+struct JointBreak {
+    Entity joint;              ///< the joint's entity
+    Entity a, b;               ///< its ends; b null = the world
+    std::uint64_t step = 0;    ///< StepStats::step of the step after which it broke
+    double force = 0.0;        ///< |constraint force| over that step's last substep, newtons
+    double maxForce = 0.0;     ///< its max_force, newtons
+    friend bool operator==(const JointBreak&, const JointBreak&) = default;
+};
+
 /// A stiffness warning: a spring whose dt*sqrt(k/m) is past the chosen
 /// integrator's stability limit.
 struct StiffnessHint {
@@ -141,6 +152,9 @@ struct WorldState {
     std::vector<double> colliderAngle, colliderSpin;  ///< colliders, rad and rad/s
     std::vector<CachedImpulse> contacts;       ///< the warm-start cache
     std::vector<JointImpulse> joints;          ///< every joint's accumulated impulses, in layout.joints order
+    /// Joints broken so far, in the order they broke; writeBack removes
+    /// their entities from the scene.
+    std::vector<JointBreak> breaks;
     std::vector<double> sleepTimer;            ///< bodies: seconds still (world.sleep_time)
     std::vector<std::int32_t> sleepIsland;     ///< bodies: -1 awake, else the sleeping island's first body
     std::vector<double> sleepAnchor;           ///< bodies: where the still window began (x, y m, angle rad, vx, vy m/s)
@@ -277,7 +291,8 @@ public:
     Result<void> step();
 
     /// Copies positions, velocities, angles and time into `scene`, whose
-    /// entities must be the ones the world was built from.
+    /// entities must be the ones the world was built from, and destroys the
+    /// entities of joints that broke (jointBreaks()).
     void writeBack(Scene& scene) const;
 
     /// The solver's carried state keyed by entities (what a file's
@@ -351,8 +366,15 @@ public:
     /// Every (sensor, body) pair overlapping at the end of the last step.
     std::vector<std::pair<Entity, Entity>> sensorOverlaps() const;
     /// Joints of the last step, in scene order: anchors, separation and
-    /// reaction force and torque (empty when the scene has no joints).
+    /// reaction force and torque (empty when the scene has no joints). A
+    /// joint that broke is listed for the step it broke in, not after.
     std::span<const JointRecord> joints() const;
+    /// Every joint that broke since the World was built (or, after
+    /// restoreState, as of that snapshot), in the order they broke; those
+    /// of the last step have `step == lastStats().step`. A broken joint is
+    /// out of the run, and writeBack removes its entity from the scene, so a
+    /// saved file no longer holds it and its resume is exact.
+    std::span<const JointBreak> jointBreaks() const;
 
     /// Springs past the integrator's stability limit at the current dt.
     std::vector<StiffnessHint> stiffnessHints() const;

@@ -136,7 +136,7 @@ void CollisionSystem::refreshSleeping(std::span<const Vec2> x) {
     for (std::size_t i = 0; i < n; ++i)
         if (solverIndex_[i] != 0 && !colliderAsleep_[i]) awakeSolverColliders_.push_back(std::uint32_t(i));
     for (joints::JointConstraint& j : joints_)
-        j.asleep = (j.a.collider >= 0 && colliderAsleep_[std::size_t(j.a.collider)]) ||
+        j.asleep = j.broken || (j.a.collider >= 0 && colliderAsleep_[std::size_t(j.a.collider)]) ||
                    (j.b.collider >= 0 && colliderAsleep_[std::size_t(j.b.collider)]);
     splitCache();
 
@@ -246,7 +246,7 @@ void CollisionSystem::bodyEdges(std::vector<std::pair<std::uint32_t, std::uint32
         if (a >= 0 && b >= 0) out.emplace_back(std::uint32_t(a), std::uint32_t(b));
     }
     for (const joints::JointConstraint& j : joints_) {
-        if (j.a.collider < 0 || j.b.collider < 0) continue;
+        if (j.broken || j.a.collider < 0 || j.b.collider < 0) continue;
         if (colliders_[std::size_t(j.a.collider)].kinematic || colliders_[std::size_t(j.b.collider)].kinematic) continue;
         const std::int32_t a = colliders_[std::size_t(j.a.collider)].body, b = colliders_[std::size_t(j.b.collider)].body;
         if (a >= 0 && b >= 0) out.emplace_back(std::uint32_t(a), std::uint32_t(b));
@@ -316,13 +316,59 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
 void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_t filterA, std::int32_t filterB,
                                bool collideConnected) {
     if (bodies_.empty()) bodies_.push_back(SolverBody{});
-    joints_.push_back(joint);
+    joints::JointConstraint& j = joints_.emplace_back(joint);
     directJoints_.reset();
+    if (j.maxForce > 0.0) breakable_.push_back(std::uint32_t(joints_.size() - 1));
     if (!collideConnected && filterA >= 0 && filterB >= 0) {
         const auto lo = std::uint64_t(std::min(filterA, filterB)), hi = std::uint64_t(std::max(filterA, filterB));
         const std::uint64_t key = (lo << 32) | hi;
+        j.noCollideKey = key;
         noCollide_.insert(std::lower_bound(noCollide_.begin(), noCollide_.end(), key), key);
     }
+}
+
+void CollisionSystem::breakJoints(std::vector<std::pair<std::uint32_t, double>>& out) {
+    bool any = false;
+    for (const std::uint32_t k : breakable_) {
+        joints::JointConstraint& j = joints_[k];
+        if (j.asleep) continue;  // broken already, or asleep: nothing pulls harder than before
+        const double force = length(joints::jointForce(j, lastH_));
+        // Not (force <= maxForce): a non-finite force breaks the joint too.
+        if (!(force > j.maxForce)) continue;
+        j.broken = true;
+        j.asleep = true;
+        // All +0: the joint carries nothing, so a save lists no entry for it
+        // and a restore of a later state has nothing to warm.
+        joints::setImpulses(j, JointImpulse{j.entity});
+        out.emplace_back(k, force);
+        any = true;
+    }
+    if (any) jointsBroke();
+}
+
+void CollisionSystem::setBrokenJoints(std::span<const Entity> broken) {
+    bool changed = false;
+    for (joints::JointConstraint& j : joints_) {
+        const bool b = std::find(broken.begin(), broken.end(), j.entity) != broken.end();
+        if (b == j.broken) continue;
+        changed = true;
+        j.broken = b;
+        // Whole again: awake until the sleep state (set after this) says otherwise.
+        j.asleep = b;
+    }
+    if (changed) jointsBroke();
+}
+
+void CollisionSystem::jointsBroke() {
+    // The no-collide list as the joints still whole would build it (a
+    // sorted multiset: two joints may keep the same pair apart), so the
+    // broken joint's bodies collide from the next step on, as in a world
+    // built from the scene without it.
+    noCollide_.clear();
+    for (const joints::JointConstraint& j : joints_)
+        if (!j.broken && j.noCollideKey != 0) noCollide_.push_back(j.noCollideKey);
+    std::sort(noCollide_.begin(), noCollide_.end());
+    directJoints_.reset();
 }
 
 void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m,
@@ -862,6 +908,7 @@ void CollisionSystem::endStep() {
     }
     jointRecords_.clear();
     for (const joints::JointConstraint& j : joints_) {
+        if (j.broken) continue;
         JointRecord r;
         r.joint = j.entity;
         r.a = j.entityA;

@@ -96,6 +96,17 @@ public:
     std::span<joints::JointConstraint> jointConstraints() { return joints_; }
     /// Joints of the last step, for the debugging views.
     std::span<const JointRecord> jointRecords() const { return jointRecords_; }
+    /// After a successful step: every unbroken, awake joint with a max_force
+    /// whose constraint force over the last substep (|jointForce|) exceeds
+    /// it breaks: it leaves the solver, its groups, its island edges and the
+    /// no-collide list, and its impulses go to zero (so a saved state lists
+    /// none for it). Appends (joint index, force in N) of each to `out`.
+    /// Only joints with a max_force are visited.
+    void breakJoints(std::vector<std::pair<std::uint32_t, double>>& out);
+    bool hasBreakableJoints() const { return !breakable_.empty(); }
+    /// Sets which joints are broken (a restored snapshot's): the others are
+    /// whole again. `broken` holds joint entities.
+    void setBrokenJoints(std::span<const Entity> broken);
     const SolverSettings& settings() const { return settings_; }
     /// Fixes the broad-phase strategy (tests, benchmarks); by default it is
     /// chosen per step from the number of shapes.
@@ -279,6 +290,10 @@ private:
         if (anyKinematic_ && invMass_[a] == 0.0 && invMass_[b] == 0.0) return false;
         return !filtered_ || shouldCollide(colliders_[a].filter, colliders_[b].filter);
     }
+    std::vector<std::uint32_t> breakable_;  // joints with a max_force, ascending
+    /// Drops broken joints' records and their no-collide entries, and
+    /// regroups the direct solve.
+    void jointsBroke();
     std::vector<JointRecord> jointRecords_;
     double lastH_ = 0.0;
     // Sleeping: see refreshSleeping(). With nothing asleep these are the

@@ -24,6 +24,7 @@ namespace {
 /// Rows a joint has here: a hinge's point (x, y); a rigid weld's point and
 /// angle (x, y, angle); 0: not solved here.
 std::uint32_t directRows(const JointConstraint& j) {
+    if (j.broken) return 0;  // out of the run: grouped as if absent
     if (j.kind == JointKind::Hinge) return 2;
     if (j.kind == JointKind::Weld && !(j.stiffnessHz > 0.0)) return 3;
     return 0;

@@ -91,9 +91,24 @@ void solvePoint(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pa
     p.applyLinear(impulse, rA, rB);
 }
 
-/// One-sided angular limits and the motor of a hinge (axial rows).
+/// The rotational spring, one-sided angular limits and the motor of a hinge
+/// (axial rows).
 void solveHingeAxial(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
                      const Softness& soft, bool useBias) {
+    if (j.spring) {
+        // Box2D v3's revolute spring: a soft row toward the reference angle
+        // on the axial mass, in both passes (it is a force, not an error to
+        // correct, so the relax pass must not drop it). With the soft step's
+        // mass and impulse scales this is the implicit spring-damper of
+        // frequency springHz on the joint's relative rotation.
+        const Softness spring = Softness::make(j.springHz, j.springDampingRatio, h);
+        const double angle = j.deltaAngle + angleOf(b.dq) - angleOf(a.dq);
+        const double cdot = p.wB - p.wA;
+        const double impulse = -j.axialMass * spring.massScale * (cdot + spring.biasRate * angle) -
+                               spring.impulseScale * j.springImpulse;
+        j.springImpulse += impulse;
+        p.applyAngular(impulse);
+    }
     if (j.motor) {
         const double cdot = p.wB - p.wA - j.motorSpeed;
         const double maxImpulse = j.maxMotor * h;
@@ -231,10 +246,82 @@ void solveSlider(JointConstraint& j, const SolverBody& a, const SolverBody& b, P
     p.wB += p.iB * (impulse.x * s2 + impulse.y);
 }
 
+/// Wheel (Box2D v3's wheel joint): b's anchor stays on the line through
+/// a's anchor along a's axis (one row, rigid and softly corrected like the
+/// other rigid rows), travels along it against a spring (stiffnessHz,
+/// dampingRatio, rest where the anchors coincide; none at 0 Hz) and within
+/// the travel limits, and turns freely but for the motor.
+void solveWheel(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
+                const Softness& soft, bool useBias) {
+    if (j.motor) {
+        const double cdot = p.wB - p.wA - j.motorSpeed;
+        const double maxImpulse = j.maxMotor * h;
+        const double old = j.motorImpulse;
+        j.motorImpulse = std::clamp(old - j.axialMass * cdot, -maxImpulse, maxImpulse);
+        p.applyAngular(j.motorImpulse - old);
+    }
+    const Vec2 rA = rotate(a.dq, j.anchorA), rB = rotate(b.dq, j.anchorB);
+    const Vec2 d = (b.dp - a.dp) + j.deltaCenter + (rB - rA);
+    const Vec2 axis = rotate(a.dq, j.axisA);
+    const double translation = dot(axis, d);
+    const double a1 = cross(d + rA, axis), a2 = cross(rB, axis);
+    const double k = p.mA + p.mB + p.iA * a1 * a1 + p.iB * a2 * a2;
+    const double axialMass = k > 0.0 ? 1.0 / k : 0.0;
+    const auto applyAxial = [&](double impulse) {
+        p.vA -= (p.mA * impulse) * axis;
+        p.wA -= p.iA * impulse * a1;
+        p.vB += (p.mB * impulse) * axis;
+        p.wB += p.iB * impulse * a2;
+    };
+    const auto axialSpeed = [&] { return dot(axis, p.vB - p.vA) + a2 * p.wB - a1 * p.wA; };
+    if (j.spring) {
+        // A force in both passes, as the hinge's spring.
+        const Softness spring = Softness::make(j.stiffnessHz, j.dampingRatio, h);
+        const double impulse = -axialMass * spring.massScale * (axialSpeed() + spring.biasRate * translation) -
+                               spring.impulseScale * j.springImpulse;
+        j.springImpulse += impulse;
+        applyAxial(impulse);
+    }
+    const double invH = 1.0 / h;
+    if (j.hasLower) {
+        const Row r = limitRow(translation - j.lower, invH, soft, useBias);
+        const double impulse = -axialMass * r.massScale * (axialSpeed() + r.bias) - r.impulseScale * j.lowerImpulse;
+        const double total = std::max(j.lowerImpulse + impulse, 0.0);
+        applyAxial(total - j.lowerImpulse);
+        j.lowerImpulse = total;
+    }
+    if (j.hasUpper) {
+        const Row r = limitRow(j.upper - translation, invH, soft, useBias);
+        const double impulse = -axialMass * r.massScale * (-axialSpeed() + r.bias) - r.impulseScale * j.upperImpulse;
+        const double total = std::max(j.upperImpulse + impulse, 0.0);
+        applyAxial(-(total - j.upperImpulse));
+        j.upperImpulse = total;
+    }
+    // The point stays on the line: no travel across the axis.
+    const Vec2 perp = leftPerp(axis);
+    const double s1 = cross(d + rA, perp), s2 = cross(rB, perp);
+    const double kp = p.mA + p.mB + p.iA * s1 * s1 + p.iB * s2 * s2;
+    const double perpMass = kp > 0.0 ? 1.0 / kp : 0.0;
+    const Row r = equalityRow(dot(perp, d), soft, useBias);
+    const double cdot = dot(perp, p.vB - p.vA) + s2 * p.wB - s1 * p.wA;
+    const double impulse = -perpMass * r.massScale * (cdot + r.bias) - r.impulseScale * j.linearImpulse.x;
+    j.linearImpulse.x += impulse;
+    p.vA -= (p.mA * impulse) * perp;
+    p.wA -= p.iA * impulse * s1;
+    p.vB += (p.mB * impulse) * perp;
+    p.wB += p.iB * impulse * s2;
+}
+
 } // namespace
 
 JointImpulse impulsesOf(const JointConstraint& j) {
-    return {j.entity, j.linearImpulse, j.angularImpulse, j.axialImpulse, j.motorImpulse, j.lowerImpulse, j.upperImpulse};
+    // The hinge's spring travels as `angular` and the wheel's as `axial`,
+    // rows those types do not otherwise have: files keep one set of keys.
+    JointImpulse out{j.entity,       j.linearImpulse, j.angularImpulse, j.axialImpulse, j.motorImpulse,
+                     j.lowerImpulse, j.upperImpulse};
+    if (j.kind == JointKind::Hinge) out.angular = j.springImpulse;
+    if (j.kind == JointKind::Wheel) out.axial = j.springImpulse;
+    return out;
 }
 
 void setImpulses(JointConstraint& j, const JointImpulse& in) {
@@ -245,6 +332,15 @@ void setImpulses(JointConstraint& j, const JointImpulse& in) {
     j.motorImpulse = hingeLike && j.motor ? in.motor : 0.0;
     j.lowerImpulse = hingeLike && j.hasLower ? in.lower : 0.0;
     j.upperImpulse = (hingeLike && j.hasUpper) || j.kind == JointKind::Rope ? in.upper : 0.0;
+    j.springImpulse = !j.spring                  ? 0.0
+                      : j.kind == JointKind::Hinge ? in.angular
+                                                   : in.axial;
+    if (j.kind == JointKind::Wheel) {
+        j.linearImpulse = {in.linear.x, 0.0};
+        j.motorImpulse = j.motor ? in.motor : 0.0;
+        j.lowerImpulse = j.hasLower ? in.lower : 0.0;
+        j.upperImpulse = j.hasUpper ? in.upper : 0.0;
+    }
 }
 
 void prepareJoints(std::span<JointConstraint> joints, std::span<const SolverBody> bodies,
@@ -279,8 +375,11 @@ void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bo
         switch (j.kind) {
         case JointKind::Hinge:
         case JointKind::Weld: {
-            const double axial = j.kind == JointKind::Weld ? j.angularImpulse
-                                                           : j.motorImpulse + j.lowerImpulse - j.upperImpulse;
+            double axial = j.kind == JointKind::Weld ? j.angularImpulse
+                                                     : j.motorImpulse + j.lowerImpulse - j.upperImpulse;
+            // Only a hinge with a spring adds it: 0 + x could turn a -0 into
+            // +0 and change the bits of a level without springs.
+            if (j.spring) axial += j.springImpulse;
             p.applyLinear(j.linearImpulse, rA, rB);
             p.applyAngular(axial);
             break;
@@ -294,6 +393,17 @@ void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bo
             p.wA -= p.iA * (axial * cross(d + rA, axis) + j.linearImpulse.x * cross(d + rA, perp) + j.linearImpulse.y);
             p.vB += p.mB * P;
             p.wB += p.iB * (axial * cross(rB, axis) + j.linearImpulse.x * cross(rB, perp) + j.linearImpulse.y);
+            break;
+        }
+        case JointKind::Wheel: {
+            const Vec2 d = (b.dp - a.dp) + j.deltaCenter + (rB - rA);
+            const Vec2 axis = rotate(a.dq, j.axisA), perp = leftPerp(axis);
+            const double axial = j.springImpulse + j.lowerImpulse - j.upperImpulse;
+            const Vec2 P = axial * axis + j.linearImpulse.x * perp;
+            p.vA -= p.mA * P;
+            p.wA -= p.iA * (axial * cross(d + rA, axis) + j.linearImpulse.x * cross(d + rA, perp) + j.motorImpulse);
+            p.vB += p.mB * P;
+            p.wB += p.iB * (axial * cross(rB, axis) + j.linearImpulse.x * cross(rB, perp) + j.motorImpulse);
             break;
         }
         case JointKind::Distance:
@@ -326,6 +436,7 @@ void solveJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies
             if (!j.direct) solveWeld(j, a, b, p, h, soft, useBias);
             break;
         case JointKind::Slider: solveSlider(j, a, b, p, h, soft, useBias); break;
+        case JointKind::Wheel: solveWheel(j, a, b, p, h, soft, useBias); break;
         case JointKind::Distance:
         case JointKind::Rope: solveDistance(j, a, b, p, h, soft, useBias); break;
         }
@@ -388,6 +499,10 @@ Vec2 jointForce(const JointConstraint& j, double h) {
         const double axial = j.motorImpulse + j.lowerImpulse - j.upperImpulse;
         return invH * (axial * j.axisA + j.linearImpulse.x * leftPerp(j.axisA));
     }
+    case JointKind::Wheel: {
+        const double axial = j.springImpulse + j.lowerImpulse - j.upperImpulse;
+        return invH * (axial * j.axisA + j.linearImpulse.x * leftPerp(j.axisA));
+    }
     case JointKind::Distance:
     case JointKind::Rope: {
         const Vec2 d = j.deltaCenter + (j.anchorB - j.anchorA);
@@ -401,9 +516,14 @@ Vec2 jointForce(const JointConstraint& j, double h) {
 double jointTorque(const JointConstraint& j, double h) {
     const double invH = h > 0.0 ? 1.0 / h : 0.0;
     switch (j.kind) {
-    case JointKind::Hinge: return invH * (j.motorImpulse + j.lowerImpulse - j.upperImpulse);
+    case JointKind::Hinge: {
+        double axial = j.motorImpulse + j.lowerImpulse - j.upperImpulse;
+        if (j.spring) axial += j.springImpulse;
+        return invH * axial;
+    }
     case JointKind::Weld: return invH * j.angularImpulse;
     case JointKind::Slider: return invH * j.linearImpulse.y;
+    case JointKind::Wheel: return invH * j.motorImpulse;
     default: return 0.0;
     }
 }

@@ -9,6 +9,8 @@
 //   weld      point (2x2) + angle; rigid, or a spring of stiffness_hz
 //   distance  anchors `length` apart along their line; rigid or a spring
 //   rope      anchors at most `length` apart (one-sided)
+//   wheel     b's anchor on a line along a's axis (1 row), a spring along
+//             the axis, free rotation with a motor, travel limits
 //
 // Anchors are taken at step start (rotated by each body's orientation then)
 // and turned by each body's rotation since, as the contact solver does, so
@@ -29,7 +31,7 @@
 
 namespace stepwise::joints {
 
-enum class JointKind : std::uint8_t { Hinge, Slider, Weld, Distance, Rope };
+enum class JointKind : std::uint8_t { Hinge, Slider, Weld, Distance, Rope, Wheel };
 
 /// A fixed end (a static body or the world) or a body in the solver.
 struct JointEnd {
@@ -58,12 +60,16 @@ struct alignas(64) JointConstraint {
     bool direct = false;
     bool motor = false;
     bool hasLower = false, hasUpper = false;
+    /// A hinge with a spring (springHz > 0), or a wheel with an axis spring
+    /// (stiffnessHz > 0): read here, in the first cache line, so a hinge
+    /// without one never touches the spring's fields.
+    bool spring = false;
 
     // Prepared at step start.
     Vec2 anchorA, anchorB;         ///< anchors rotated to world orientation, relative to the centres, m
     Vec2 deltaCenter;              ///< centre B - centre A, m
     // Accumulated impulses (warm started), N*s and N*m*s.
-    Vec2 linearImpulse;            ///< hinge/weld point; slider: (perpendicular, angular)
+    Vec2 linearImpulse;            ///< hinge/weld point; slider: (perpendicular, angular); wheel: (perpendicular, 0)
 
     JointEnd a, b;                 ///< solverBody first in each: still in the first two lines
 
@@ -78,14 +84,31 @@ struct alignas(64) JointConstraint {
     double motorSpeed = 0.0;       ///< rad/s or m/s
     double maxMotor = 0.0;         ///< N*m or N
     double length = 0.0;           ///< distance, rope: metres
-    double stiffnessHz = 0.0;      ///< weld, distance: 0 = rigid
+    double stiffnessHz = 0.0;      ///< weld, distance: 0 = rigid; wheel: the axis spring, 0 = none (free travel)
     double dampingRatio = 1.0;
+    /// Hinge: rotational spring toward referenceAngle, Hz (0: none), solved
+    /// in both passes as Box2D's revolute spring, on the axial mass.
+    double springHz = 0.0;
+    double springDampingRatio = 1.0;
+    double springImpulse = 0.0;    ///< accumulated, N*m*s (warm started); wheel: its axis spring's, N*s
+    /// Breaks after a step whose constraint force |jointForce| exceeds this,
+    /// newtons; 0: never (CollisionSystem only looks at joints listed as
+    /// breakable, so an unbreakable level pays nothing).
+    double maxForce = 0.0;
+    /// Broke: out of the run. It stays in the array (snapshots and the
+    /// layout keep their shape; a restore before the break brings it back)
+    /// with `asleep` set, so every pass skips it as it skips a sleeping one,
+    /// and no group, island edge or record includes it.
+    bool broken = false;
+    /// Its (min collider << 32 | max collider) entry in the no-collide list
+    /// (collide_connected false, both ends with a collider); 0: none.
+    std::uint64_t noCollideKey = 0;
     Entity entity;                 ///< the joint's own entity
     Entity entityA, entityB;       ///< its ends (entityB null: the world)
 
     Vec2 centreA, centreB;         ///< centres at step start, m
     double deltaAngle = 0.0;       ///< angle B - angle A - reference, rad
-    Vec2 axisA;                    ///< slider axis in world orientation at step start
+    Vec2 axisA;                    ///< slider and wheel axis in world orientation at step start
     double axialMass = 0.0;        ///< 1 / (iA + iB), kg m^2 (hinge motor/limits, weld angle)
 };
 

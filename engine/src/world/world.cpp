@@ -301,6 +301,17 @@ Result<void> World::step() {
     }
     w.settings.time += w.settings.dt;
     w.stepStartKnown = true;
+    // Breaks after the step is known good (a failed step breaks nothing)
+    // and before the islands are updated, which then no longer join the
+    // broken joint's bodies.
+    if (contacts && contacts->hasBreakableJoints()) {
+        w.breakScratch.clear();
+        contacts->breakJoints(w.breakScratch);
+        for (const auto& [k, force] : w.breakScratch) {
+            const joints::JointConstraint& j = contacts->jointConstraints()[k];
+            w.breaks.push_back({j.entity, j.entityA, j.entityB, w.stats.step + 1, force, j.maxForce});
+        }
+    }
     w.updateSleep(substeps > 1 ? w.backupX.data() : w.x[1 - w.current].data(),
                   substeps > 1 ? w.backupV.data() : w.v[1 - w.current].data());
     if (w.kind == detail::IntegratorKind::Dopri5) w.settings.adaptiveStep = w.integrator->proposedStep();
@@ -376,6 +387,13 @@ void writeStateBack(const WorldLayout& layout, const double* x, const double* v,
     scene.world.adaptiveStep = adaptiveStep;
 }
 
+/// A broken joint is out of the run: out of the scene too, so a save holds
+/// what the run simulates and a resume builds the same world.
+void removeBrokenJoints(std::span<const JointBreak> breaks, Scene& scene) {
+    for (const JointBreak& b : breaks)
+        if (scene.registry.has<Joint>(b.joint)) scene.registry.destroy(b.joint);
+}
+
 } // namespace
 
 void World::writeBack(Scene& scene) const {
@@ -386,10 +404,12 @@ void World::writeBack(Scene& scene) const {
         spins = w.collision->angularVelocities();
     }
     writeStateBack(*w.layout, w.xs(), w.vs(), w.angle, angles, spins, w.settings.time, w.settings.adaptiveStep, scene);
+    removeBrokenJoints(w.breaks, scene);
 }
 
 void WorldState::writeBack(Scene& scene) const {
     writeStateBack(*layout, x.data(), v.data(), spinAngle, colliderAngle, colliderSpin, time, adaptiveStep, scene);
+    removeBrokenJoints(breaks, scene);
 }
 
 namespace {
@@ -589,7 +609,8 @@ std::size_t WorldState::bytes() const {
     return sizeof(double) * (x.capacity() + v.capacity() + spinAngle.capacity() + colliderAngle.capacity() +
                              colliderSpin.capacity() + sleepTimer.capacity() + sleepAnchor.capacity()) +
            sizeof(std::int32_t) * sleepIsland.capacity() + sleepAnchored.capacity() +
-           sizeof(CachedImpulse) * contacts.capacity() + sizeof(JointImpulse) * joints.capacity();
+           sizeof(CachedImpulse) * contacts.capacity() + sizeof(JointImpulse) * joints.capacity() +
+           sizeof(JointBreak) * breaks.capacity();
 }
 
 WorldState World::saveState() const {
@@ -612,6 +633,7 @@ WorldState World::saveState() const {
         s.contacts = w.collision->warmStartCache();
         s.joints = jointImpulsesOf(*w.collision);
     }
+    s.breaks = w.breaks;
     return s;
 }
 
@@ -625,6 +647,14 @@ Result<void> World::restoreState(const WorldState& s) {
     std::copy(s.v.begin(), s.v.end(), w.v[w.current].begin());
     w.angle = s.spinAngle;
     if (w.collision) w.collision->restoreRotation(s.colliderAngle, s.colliderSpin);
+    // Joints broken as of the snapshot (before the sleep state, which sets
+    // the others' flags); one that broke later is whole again.
+    w.breaks = s.breaks;
+    if (w.collision && w.collision->hasBreakableJoints()) {
+        std::vector<Entity> broken;
+        for (const JointBreak& b : w.breaks) broken.push_back(b.joint);
+        w.collision->setBrokenJoints(broken);
+    }
     // Sleep after the rotations (the frozen shapes' boxes use them) and
     // before the cache (it is split by it).
     w.sleep.timer = s.sleepTimer;
@@ -822,6 +852,8 @@ std::vector<std::pair<Entity, Entity>> World::sensorOverlaps() const {
 std::span<const JointRecord> World::joints() const {
     return impl_->collision ? impl_->collision->jointRecords() : std::span<const JointRecord>{};
 }
+
+std::span<const JointBreak> World::jointBreaks() const { return impl_->breaks; }
 
 std::vector<StiffnessHint> World::stiffnessHints() const {
     const WorldImpl& w = *impl_;

@@ -27,6 +27,7 @@ joints::JointKind jointKindOf(const std::string& type) {
     if (type == "weld") return joints::JointKind::Weld;
     if (type == "distance") return joints::JointKind::Distance;
     if (type == "rope") return joints::JointKind::Rope;
+    if (type == "wheel") return joints::JointKind::Wheel;
     return joints::JointKind::Hinge;
 }
 
@@ -168,12 +169,20 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         j.upper = joint->upper.value_or(0.0);
         const std::optional<double>& maxMotor = j.kind == joints::JointKind::Slider ? joint->maxMotorForce
                                                                                     : joint->maxMotorTorque;
-        j.motor = maxMotor.has_value() && (j.kind == joints::JointKind::Hinge || j.kind == joints::JointKind::Slider);
+        j.motor = maxMotor.has_value() && (j.kind == joints::JointKind::Hinge || j.kind == joints::JointKind::Slider ||
+                                           j.kind == joints::JointKind::Wheel);
         j.maxMotor = maxMotor.value_or(0.0);
         j.motorSpeed = joint->motorSpeed.value_or(0.0);
         j.length = joint->length.value_or(0.0);
         j.stiffnessHz = joint->stiffnessHz.value_or(0.0);
         j.dampingRatio = joint->dampingRatio.value_or(1.0);
+        if (j.kind == joints::JointKind::Hinge) {
+            j.springHz = joint->springHz.value_or(0.0);
+            j.springDampingRatio = joint->springDampingRatio.value_or(1.0);
+        }
+        j.spring = (j.kind == joints::JointKind::Hinge && j.springHz > 0.0) ||
+                   (j.kind == joints::JointKind::Wheel && j.stiffnessHz > 0.0);
+        j.maxForce = joint->maxForce.value_or(0.0);
         makeSystem();
         system->addJoint(j, filter[0], filter[1], joint->collideConnected);
     }

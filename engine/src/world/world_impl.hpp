@@ -76,6 +76,8 @@ public:
     /// rotation of the bodies that have shapes: only contacts make torque.
     std::unique_ptr<collision::CollisionSystem> collision;
     std::optional<DroppedImpulses> dropped;  ///< by the last setSolverState
+    std::vector<JointBreak> breaks;          ///< joints broken so far (World::jointBreaks)
+    std::vector<std::pair<std::uint32_t, double>> breakScratch;  ///< CollisionSystem::breakJoints' output
     ContactSettingsChoice contactChoice;  ///< the scene's deepest pile (pileHint) and the engine's choice
     World::SettingsSource settingsSource = World::SettingsSource::Given;  ///< where substeps came from
     bool substepsGiven = false, iterationsGiven = false;  ///< by the level's world object

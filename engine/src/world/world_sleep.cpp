@@ -94,7 +94,8 @@ bool sameJoint(const joints::JointConstraint& a, const joints::JointConstraint& 
            a.hasLower == b.hasLower && a.hasUpper == b.hasUpper && sameBits(a.lower, b.lower) &&
            sameBits(a.upper, b.upper) && a.motor == b.motor && sameBits(a.motorSpeed, b.motorSpeed) &&
            sameBits(a.maxMotor, b.maxMotor) && sameBits(a.length, b.length) && sameBits(a.stiffnessHz, b.stiffnessHz) &&
-           sameBits(a.dampingRatio, b.dampingRatio);
+           sameBits(a.dampingRatio, b.dampingRatio) && sameBits(a.springHz, b.springHz) &&
+           sameBits(a.springDampingRatio, b.springDampingRatio) && sameBits(a.maxForce, b.maxForce);
 }
 
 /// The settings that change how bodies move (time and the dopri5 step are
