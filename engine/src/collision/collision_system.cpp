@@ -579,15 +579,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     for (const ProxyPair& pair : pairs_) {
         const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
         if (colliderAsleep_[a] || colliderAsleep_[b]) continue;  // no manifold: it would have woken them
-        if (anySensor_ && (colliders_[a].sensor || colliders_[b].sensor)) {
-            // Tested at the step's end (updateSensors); never a contact.
-            // Sensors do not sense each other (Box2D's rule).
-            if (colliders_[a].sensor != colliders_[b].sensor &&
-                (!filtered_ || shouldCollide(colliders_[a].filter, colliders_[b].filter)))
-                sensorCandidates_.push_back(colliders_[a].sensor ? (std::uint64_t(a) << 32) | b
-                                                                 : (std::uint64_t(b) << 32) | a);
-            continue;
-        }
+        if (anySensor_ && sensedInstead(a, b)) continue;
         if (!collides(a, b)) continue;
         if (!noCollide_.empty()) {
             // Bodies joined with collide_connected false do not collide.
@@ -620,13 +612,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
         for (std::size_t k = 0, count = anySleeping_ ? awakeProxies_.size() : finite_.size(); k < count; ++k) {
             const std::uint32_t b = finite_[anySleeping_ ? awakeProxies_[k] : k];
             if (colliders_[b].body < 0 || colliders_[b].kinematic) continue;
-            if (anySensor_ && (colliders_[p].sensor || colliders_[b].sensor)) {
-                if (colliders_[p].sensor != colliders_[b].sensor &&
-                    (!filtered_ || shouldCollide(colliders_[p].filter, colliders_[b].filter)))
-                    sensorCandidates_.push_back(colliders_[p].sensor ? (std::uint64_t(p) << 32) | b
-                                                                     : (std::uint64_t(b) << 32) | p);
-                continue;
-            }
+            if (anySensor_ && sensedInstead(p, b)) continue;
             if (!collides(p, b)) continue;
             const Manifold m = collide(colliders_[p].shape, {}, {}, colliders_[b].shape, centres_[b], rots[b],
                                        pairMargin(p, b));
@@ -925,6 +911,16 @@ void CollisionSystem::endStep() {
     // Usually already in order (constraints follow the sorted pairs); the
     // check is cheaper than sorting sorted data.
     if (!std::is_sorted(cache_.begin(), cache_.end())) std::sort(cache_.begin(), cache_.end());
+}
+
+bool CollisionSystem::sensedInstead(std::uint32_t a, std::uint32_t b) {
+    if (!colliders_[a].sensor && !colliders_[b].sensor) return false;
+    // Tested at the step's end (updateSensors), never a contact. Sensors do
+    // not sense each other (Box2D's rule); filters apply.
+    if (colliders_[a].sensor != colliders_[b].sensor &&
+        (!filtered_ || shouldCollide(colliders_[a].filter, colliders_[b].filter)))
+        sensorCandidates_.push_back(colliders_[a].sensor ? (std::uint64_t(a) << 32) | b : (std::uint64_t(b) << 32) | a);
+    return true;
 }
 
 bool CollisionSystem::sensorOverlap(std::uint32_t s, std::uint32_t o, std::span<const Vec2> x) const {

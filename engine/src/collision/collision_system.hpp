@@ -275,6 +275,9 @@ private:
     std::vector<std::uint64_t> sensorCandidates_;
     std::vector<std::uint64_t> sensorOverlaps_;
     std::vector<SensorEvent> sensorEvents_;
+    /// When a or b is a sensor: keeps the pair for the end-of-step test and
+    /// returns true (no manifold for it); otherwise false.
+    bool sensedInstead(std::uint32_t a, std::uint32_t b);
     /// Whether sensor collider s and collider o overlap at the centres and
     /// rotations given.
     bool sensorOverlap(std::uint32_t s, std::uint32_t o, std::span<const Vec2> x) const;

@@ -183,6 +183,28 @@ void solveDistance(JointConstraint& j, const SolverBody& a, const SolverBody& b,
     j.upperImpulse = total;
 }
 
+/// A slider's or wheel's travel limits along its axis: one-sided rows on
+/// the translation, lower then upper. `axialSpeed()` is the relative speed
+/// along the axis and `applyAxial(impulse)` applies an impulse along it.
+template <class Speed, class Apply>
+void solveTravelLimits(JointConstraint& j, double translation, double axialMass, double invH, const Softness& soft,
+                       bool useBias, const Speed& axialSpeed, const Apply& applyAxial) {
+    if (j.hasLower) {
+        const Row r = limitRow(translation - j.lower, invH, soft, useBias);
+        const double impulse = -axialMass * r.massScale * (axialSpeed() + r.bias) - r.impulseScale * j.lowerImpulse;
+        const double total = std::max(j.lowerImpulse + impulse, 0.0);
+        applyAxial(total - j.lowerImpulse);
+        j.lowerImpulse = total;
+    }
+    if (j.hasUpper) {
+        const Row r = limitRow(j.upper - translation, invH, soft, useBias);
+        const double impulse = -axialMass * r.massScale * (-axialSpeed() + r.bias) - r.impulseScale * j.upperImpulse;
+        const double total = std::max(j.upperImpulse + impulse, 0.0);
+        applyAxial(-(total - j.upperImpulse));
+        j.upperImpulse = total;
+    }
+}
+
 void solveSlider(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
                  const Softness& soft, bool useBias) {
     const Vec2 rA = rotate(a.dq, j.anchorA), rB = rotate(b.dq, j.anchorB);
@@ -206,21 +228,7 @@ void solveSlider(JointConstraint& j, const SolverBody& a, const SolverBody& b, P
         j.motorImpulse = std::clamp(old + axialMass * (j.motorSpeed - axialSpeed()), -maxImpulse, maxImpulse);
         applyAxial(j.motorImpulse - old);
     }
-    const double invH = 1.0 / h;
-    if (j.hasLower) {
-        const Row r = limitRow(translation - j.lower, invH, soft, useBias);
-        const double impulse = -axialMass * r.massScale * (axialSpeed() + r.bias) - r.impulseScale * j.lowerImpulse;
-        const double total = std::max(j.lowerImpulse + impulse, 0.0);
-        applyAxial(total - j.lowerImpulse);
-        j.lowerImpulse = total;
-    }
-    if (j.hasUpper) {
-        const Row r = limitRow(j.upper - translation, invH, soft, useBias);
-        const double impulse = -axialMass * r.massScale * (-axialSpeed() + r.bias) - r.impulseScale * j.upperImpulse;
-        const double total = std::max(j.upperImpulse + impulse, 0.0);
-        applyAxial(-(total - j.upperImpulse));
-        j.upperImpulse = total;
-    }
+    solveTravelLimits(j, translation, axialMass, 1.0 / h, soft, useBias, axialSpeed, applyAxial);
     // No sideways travel and no relative rotation, solved together.
     const Vec2 perp = leftPerp(axis);
     const double s1 = cross(d + rA, perp), s2 = cross(rB, perp);
@@ -282,21 +290,7 @@ void solveWheel(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pa
         j.springImpulse += impulse;
         applyAxial(impulse);
     }
-    const double invH = 1.0 / h;
-    if (j.hasLower) {
-        const Row r = limitRow(translation - j.lower, invH, soft, useBias);
-        const double impulse = -axialMass * r.massScale * (axialSpeed() + r.bias) - r.impulseScale * j.lowerImpulse;
-        const double total = std::max(j.lowerImpulse + impulse, 0.0);
-        applyAxial(total - j.lowerImpulse);
-        j.lowerImpulse = total;
-    }
-    if (j.hasUpper) {
-        const Row r = limitRow(j.upper - translation, invH, soft, useBias);
-        const double impulse = -axialMass * r.massScale * (-axialSpeed() + r.bias) - r.impulseScale * j.upperImpulse;
-        const double total = std::max(j.upperImpulse + impulse, 0.0);
-        applyAxial(-(total - j.upperImpulse));
-        j.upperImpulse = total;
-    }
+    solveTravelLimits(j, translation, axialMass, 1.0 / h, soft, useBias, axialSpeed, applyAxial);
     // The point stays on the line: no travel across the axis.
     const Vec2 perp = leftPerp(axis);
     const double s1 = cross(d + rA, perp), s2 = cross(rB, perp);
