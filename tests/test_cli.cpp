@@ -127,6 +127,19 @@ TEST_F(Cli, ValidateWarnsAboutComponentsThatHaveNoEffect) {
         << "a static attractor's mass sets its pull, so it gets no warning";
 }
 
+TEST_F(Cli, ValidateWarnsAboutWhatAKinematicBodyIgnores) {
+    const fs::path file = write("kinematic_notes.json", R"({"entities": [
+      {"name": "lift", "position": {"x": 0, "y": 0}, "kinematic": true, "mass": 3, "drag": 1, "boid": {}},
+      {"name": "moon", "position": {"x": 5, "y": 0}, "kinematic": true, "mass": 50, "attractor": {}}]})");
+    Outcome o = stepwise("validate " + file.string());
+    EXPECT_EQ(o.exitCode, 0);
+    const std::string head = file.string() + ": warning: entity 0 (\"lift\"): ";
+    EXPECT_EQ(o.err, head + "\"mass\" on a kinematic body has no effect (its mass is infinite)\n" + head +
+                         "\"drag\" on a kinematic body has no effect (only its velocity moves it)\n" + head +
+                         "\"boid\" on a kinematic body has no effect (only its velocity moves it)\n")
+        << "a kinematic attractor's mass sets its pull, so it gets no warning";
+}
+
 TEST_F(Cli, ValidateRefusesABadFileWithExitTwoAndTheLoaderMessage) {
     const fs::path file = write("bad.json", R"({"entities": [{"name": "ball", "position": {"x": 0, "y": 0}, "mass": -1}]})");
     Outcome o = stepwise("validate " + file.string());

@@ -42,7 +42,9 @@ std::vector<std::string> ineffectiveComponents(const Scene& scene) {
                 notes.push_back(label + ": \"mass\" on a static body has no effect (static mass is infinite)");
         }
         if (r.has<Kinematic>(e) && r.tryGet<Kinematic>(e)->value) {
-            if (r.has<Mass>(e)) notes.push_back(label + ": \"mass\" on a kinematic body has no effect (its mass is infinite)");
+            // As on a static body, an attractor's mass sets its pull.
+            if (r.has<Mass>(e) && !r.has<Attractor>(e))
+                notes.push_back(label + ": \"mass\" on a kinematic body has no effect (its mass is infinite)");
             if (r.has<Drag>(e))
                 notes.push_back(label + ": \"drag\" on a kinematic body has no effect (only its velocity moves it)");
             if (r.has<Boid>(e))
