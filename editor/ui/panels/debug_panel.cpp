@@ -35,7 +35,7 @@ void sensorRows(Editor& ed) {
     if (inside.empty() && log.empty()) return;
     const Registry& reg = ed.doc.scene.registry;
     if (!ImGui::CollapsingHeader(("sensors: " + std::to_string(inside.size()) + " inside, " + std::to_string(log.size()) +
-                                  " events###sensors")
+                                  (log.size() == 1 ? " event" : " events") + "###sensors")
                                      .c_str(),
                                  ImGuiTreeNodeFlags_DefaultOpen))
         return;

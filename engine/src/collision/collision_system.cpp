@@ -52,7 +52,7 @@ Vec2 CollisionSystem::centreOfMass(std::size_t i, std::span<const Vec2> x) const
     return p + rotate(Rot::fromAngle(angles_[i]), c.centreOfMass);
 }
 
-void CollisionSystem::add(const Collider& c, double angle, double angularVelocity) {
+void CollisionSystem::add(const Collider& c, double angle, double angularVelocity, const Filter& filter) {
     const std::uint32_t index = std::uint32_t(colliders_.size());
     colliders_.push_back(c);
     if (c.shape.kind == ShapeKind::Polygon) {
@@ -62,7 +62,8 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     // A kinematic body moves like a dynamic one (a solver body, turned by
     // its spin) with zero inverse mass and inertia.
     const bool dynamic = c.body >= 0 && (c.mass > 0.0 || c.kinematic);
-    filtered_ = filtered_ || !(c.filter == Filter{});
+    filtered_ = filtered_ || !(filter == Filter{});
+    filters_.push_back(filter);
     anyKinematic_ = anyKinematic_ || c.kinematic;
     anySensor_ = anySensor_ || c.sensor;
     colliderAsleep_.push_back(0);
@@ -918,7 +919,7 @@ bool CollisionSystem::sensedInstead(std::uint32_t a, std::uint32_t b) {
     // Tested at the step's end (updateSensors), never a contact. Sensors do
     // not sense each other (Box2D's rule); filters apply.
     if (colliders_[a].sensor != colliders_[b].sensor &&
-        (!filtered_ || shouldCollide(colliders_[a].filter, colliders_[b].filter)))
+        (!filtered_ || shouldCollide(filters_[a], filters_[b])))
         sensorCandidates_.push_back(colliders_[a].sensor ? (std::uint64_t(a) << 32) | b : (std::uint64_t(b) << 32) | a);
     return true;
 }
@@ -982,7 +983,7 @@ void CollisionSystem::initSensors(std::span<const Vec2> x) {
             } else if (colliders_[s].body < 0 && other.body < 0) {
                 continue;
             }
-            if (filtered_ && !shouldCollide(colliders_[s].filter, other.filter)) continue;
+            if (filtered_ && !shouldCollide(filters_[s], filters_[o])) continue;
             if (sensorOverlap(s, o, x)) sensorOverlaps_.push_back((std::uint64_t(s) << 32) | o);
         }
     }

@@ -36,16 +36,15 @@ struct Collider {
     double mass = 0.0;           ///< kg; 0 for static
     double restitution = 0.0;
     double friction = 0.2;
-    Filter filter;               ///< which other colliders it meets (shouldCollide)
+    Entity entity;
+    /// A body with no shape that is in the solver only because a joint
+    /// holds it: it turns and takes impulses but never collides.
+    bool solverOnly = false;
     /// A kinematic body: in the state vector (`body` >= 0) and moving, with
     /// zero inverse mass and inertia, so contacts push others but never it.
     bool kinematic = false;
     /// A sensor: overlaps are detected and reported, never solved.
     bool sensor = false;
-    Entity entity;
-    /// A body with no shape that is in the solver only because a joint
-    /// holds it: it turns and takes impulses but never collides.
-    bool solverOnly = false;
     /// Moment of inertia about the centre, kg m^2: given for solverOnly
     /// bodies, set by add() from the shape for the others.
     double inertia = 0.0;
@@ -68,8 +67,9 @@ struct CollisionTimings {
 
 class CollisionSystem {
 public:
-    /// Adds a collider with its initial orientation (rad) and spin (rad/s).
-    void add(const Collider& collider, double angle, double angularVelocity);
+    /// Adds a collider with its initial orientation (rad) and spin (rad/s),
+    /// and the filter of which colliders it meets (shouldCollide).
+    void add(const Collider& collider, double angle, double angularVelocity, const Filter& filter = {});
     bool empty() const { return colliders_.empty(); }
     std::size_t colliderCount() const { return colliders_.size(); }
     const Collider& collider(std::size_t i) const { return colliders_[i]; }
@@ -268,6 +268,9 @@ private:
     /// Whether any collider has a filter other than the default: without
     /// one every pair passes and the test is skipped.
     bool filtered_ = false;
+    /// Each collider's filter, kept apart from the colliders: only a level
+    /// with filters reads it.
+    std::vector<Filter> filters_;
     /// Sensors: whether there are any, the pairs the broad phase found for
     /// them this step (sensor collider << 32 | other), the overlapping ones
     /// at the end of the last step (sorted, same keys), and its events.
@@ -291,7 +294,7 @@ private:
     /// least one of them can be pushed.
     bool collides(std::uint32_t a, std::uint32_t b) const {
         if (anyKinematic_ && invMass_[a] == 0.0 && invMass_[b] == 0.0) return false;
-        return !filtered_ || shouldCollide(colliders_[a].filter, colliders_[b].filter);
+        return !filtered_ || shouldCollide(filters_[a], filters_[b]);
     }
     std::vector<std::uint32_t> breakable_;  // joints with a max_force, ascending
     /// Drops broken joints' records and their no-collide entries, and

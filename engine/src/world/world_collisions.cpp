@@ -79,14 +79,14 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         c.mass = c.body >= 0 && !c.kinematic ? (reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0) : 0.0;
         c.restitution = reg.has<Restitution>(e) ? reg.tryGet<Restitution>(e)->value : Restitution{}.value;
         c.friction = reg.has<Friction>(e) ? reg.tryGet<Friction>(e)->value : Friction{}.value;
-        if (const Filter* f = reg.tryGet<Filter>(e)) c.filter = *f;
         c.sensor = reg.has<Sensor>(e) && reg.tryGet<Sensor>(e)->value;
         c.entity = e;
         const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
         const double spin = reg.has<AngularVelocity>(e) ? reg.tryGet<AngularVelocity>(e)->value : 0.0;
         makeSystem();
         colliderOf.emplace(e.index, std::int32_t(system->colliderCount()));
-        system->add(c, angle, spin);
+        const Filter* filter = reg.tryGet<Filter>(e);
+        system->add(c, angle, spin, filter ? *filter : Filter{});
     }
 
     // Joints, in scene order.
