@@ -105,7 +105,7 @@ std::string label(const char* prefix, int a, int b) {
 
 // CreateJointGrid: 100 x 100 circles (r 0.4, density 1) 1 m apart, each
 // hinged to its neighbour above and to its left; seven bodies of the top
-// row (the middle ones) are static.
+// row (the middle ones) are static; a filter keeps the circles apart.
 Scene jointGrid() {
     Scene s = v3World();
     const int n = 100;
@@ -116,6 +116,9 @@ Scene jointGrid() {
             const bool isStatic = k >= n / 2 - 3 && k <= n / 2 + 3 && i == 0;
             const Entity e = dynamicCircle(s, label("node ", k, i), {double(k), -double(i)}, 0.4, 1.0, 0.6,
                                            isStatic ? kGrey : palette(k + i));
+            // Box2D's filter: category 2, mask ~2, so the circles never
+            // collide with one another (only their joints hold them).
+            s.registry.emplace<Filter>(e, Filter{2u, ~2u, 0});
             if (isStatic) {
                 s.registry.remove<Mass>(e);
                 s.registry.emplace<Static>(e, Static{true});
