@@ -289,6 +289,44 @@ TEST(CapsuleNarrowPhase, EveryPairInBothOrdersAgreesAndLyingFlatGivesTwoPoints) 
     }
 }
 
+TEST(CapsuleNarrowPhase, FeatureIdsStayTheSameAsTheCapsuleShiftsAndTilts) {
+    // Warm starting matches points by id: a capsule resting on a box, a
+    // polygon, a capsule and the plane keeps its two ids while it slides a
+    // little and tilts by a milliradian, and the two differ.
+    static const Vec2 square[4] = {{-1, -0.5}, {1, -0.5}, {1, 0.5}, {-1, 0.5}};
+    const ConvexPolygon poly = ConvexPolygon::fromVertices(square, 4);
+    Shape box;
+    box.kind = ShapeKind::Box;
+    box.halfExtents = {1.0, 0.5};
+    Shape polygon;
+    polygon.kind = ShapeKind::Polygon;
+    polygon.polygon = &poly;
+    Shape plane;
+    plane.kind = ShapeKind::Plane;
+    const Shape ground = capsuleShape({1.0, 0.0}, 0.5);
+    const Shape capsule = capsuleShape({0.4, 0.0}, 0.2);
+    for (const Shape* under : std::initializer_list<const Shape*>{&box, &polygon, &ground, &plane}) {
+        const double top = under->kind == ShapeKind::Plane ? 0.0 : 0.5;
+        std::uint32_t ids[2] = {0, 0};
+        bool first = true;
+        for (const double dx : {-0.1, 0.0, 0.07})
+            for (const double tilt : {-1e-3, 0.0, 1e-3}) {
+                const Manifold m = collide(*under, {0, 0}, Rot{}, capsule, {dx, top + 0.2 - 1e-3}, Rot::fromAngle(tilt), 0.02);
+                ASSERT_EQ(m.pointCount, 2) << int(under->kind) << " " << dx << " " << tilt;
+                const std::uint32_t lo = std::min(m.points[0].id, m.points[1].id), hi = std::max(m.points[0].id, m.points[1].id);
+                EXPECT_NE(lo, hi);
+                EXPECT_LT(hi, 0x10000u) << "a warm-start key keeps 16 bits";
+                if (first) {
+                    ids[0] = lo;
+                    ids[1] = hi;
+                    first = false;
+                }
+                EXPECT_EQ(lo, ids[0]) << int(under->kind) << " " << dx << " " << tilt;
+                EXPECT_EQ(hi, ids[1]) << int(under->kind) << " " << dx << " " << tilt;
+            }
+    }
+}
+
 TEST(CapsuleNarrowPhase, CapAgainstACornerIsOnePointAlongTheLineBetweenThem) {
     // A capsule end to the upper right of a box's corner: the exact
     // distance, the normal along the line from corner to cap centre.
