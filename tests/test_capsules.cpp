@@ -16,7 +16,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <sstream>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -171,6 +174,25 @@ TEST(CapsuleFormat, RoundTripsByteForByte) {
     EXPECT_EQ(c->a, (Vec2{-0.3333333333333333, 0.1}));
     EXPECT_EQ(c->b, (Vec2{0.7, 0.123456789012345678}));
     EXPECT_EQ(c->radius, 0.1);
+}
+
+TEST(CapsuleFormat, ValidateCountsACapsuleAsAShape) {
+    // Friction and restitution on a capsule act (it collides): validate
+    // notes nothing, where the same on a shapeless body is noted.
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "stepwise_capsule_validate";
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path file = dir / "pill.json", err = dir / "err.txt";
+    std::ofstream(file) << level("{\"name\": \"pill\", \"position\": {\"x\": 0, \"y\": 1}, \"friction\": 0.5, "
+                                 "\"restitution\": 0.3, " + capsuleJson({0, 0}, {1, 0}, 0.2) +
+                                 "}, {\"name\": \"dot\", \"position\": {\"x\": 3, \"y\": 1}, \"friction\": 0.5}");
+    const std::string command =
+        std::string(STEPWISE_BINARY) + " validate " + file.string() + " >/dev/null 2>" + err.string();
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    std::stringstream text;
+    text << std::ifstream(err).rdbuf();
+    EXPECT_EQ(text.str(), file.string() + ": warning: entity 1 (\"dot\"): \"friction\" has no effect: the entity has "
+                                          "no shape, so it never collides\n");
+    std::filesystem::remove_all(dir);
 }
 
 // ------------------------------------------------------------ mass properties

@@ -1,5 +1,6 @@
 // Polygon shapes: the one validity check (loader, world, editor) and the
-// mass properties the engine derives from the outline.
+// mass properties the engine derives from the outline; and the capsule's
+// mass properties, which the collision system and the tests share.
 
 #include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
