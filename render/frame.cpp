@@ -758,8 +758,8 @@ void Builder::springs() {
 }
 
 void Builder::bodies() {
-    // Polygons first (filled triangles, then their outlines), then boxes,
-    // then discs: each kind is one batch.
+    // Polygons first (filled triangles, then their outlines), then boxes
+    // and capsules, then discs: each kind is one batch.
     for (Entity e : scene_.registry.entities()) {
         const Polygon* poly = scene_.registry.tryGet<Polygon>(e);
         const Position* p = scene_.registry.tryGet<Position>(e);
@@ -780,9 +780,27 @@ void Builder::bodies() {
         box(toPx(p->value), {0.5 * b->width * ppm_, 0.5 * b->height * ppm_}, a ? a->value : 0.0,
             bodyColour(e), flags, 1.0);
     }
+    // Capsules in the box batch: a box as long as the capsule and as high
+    // as its diameter, rounded by its radius, is exactly the capsule (the
+    // same shading, rim and selection ring as boxes).
+    for (Entity e : scene_.registry.entities()) {
+        const Capsule* cap = scene_.registry.tryGet<Capsule>(e);
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!cap || !p) continue;
+        const Angle* a = scene_.registry.tryGet<Angle>(e);
+        const double angle = a ? a->value : 0.0, c = std::cos(angle), s = std::sin(angle);
+        const Vec2 mid = 0.5 * (cap->a + cap->b), axis = cap->b - cap->a;
+        const Vec2 centre = p->value + Vec2{c * mid.x - s * mid.y, s * mid.x + c * mid.y};
+        float flags = 0;
+        if (selected_.count(e)) flags += kSelected;
+        if (isStatic(scene_, e)) flags += kStatic;
+        const double r = cap->radius * ppm_;
+        box(toPx(centre), {0.5 * length(axis) * ppm_ + r, r}, angle + std::atan2(axis.y, axis.x), bodyColour(e), flags, r);
+    }
     for (Entity e : scene_.registry.entities()) {
         const Position* p = scene_.registry.tryGet<Position>(e);
-        if (!p || scene_.registry.has<Box>(e) || scene_.registry.has<Polygon>(e) || scene_.registry.has<Spring>(e))
+        if (!p || scene_.registry.has<Box>(e) || scene_.registry.has<Polygon>(e) || scene_.registry.has<Capsule>(e) ||
+            scene_.registry.has<Spring>(e))
             continue;
         const Radius* r = scene_.registry.tryGet<Radius>(e);
         const Angle* a = scene_.registry.tryGet<Angle>(e);

@@ -305,6 +305,7 @@ std::string_view entityKind(const Registry& registry, Entity e) {
     if (registry.has<Box>(e)) return "box";
     if (registry.has<Radius>(e)) return "circle";
     if (registry.has<Polygon>(e)) return "polygon";
+    if (registry.has<Capsule>(e)) return "capsule";
     if (registry.has<Attractor>(e)) return "attractor";
     if (registry.has<Boid>(e)) return "boid";
     return "point";
@@ -368,6 +369,11 @@ Entity pick(const Scene& scene, Vec2 world, double pickRadius) {
                 inside = cross(v1 - v0, local - v0) >= 0.0;
             }
             if (inside) return e;
+        } else if (const Capsule* cap = reg.tryGet<Capsule>(e)) {
+            const Angle* a = reg.tryGet<Angle>(e);
+            const double th = a ? a->value : 0.0;
+            const Vec2 local{std::cos(th) * d.x + std::sin(th) * d.y, -std::sin(th) * d.x + std::cos(th) * d.y};
+            if (distanceToSegment(local, cap->a, cap->b) <= cap->radius) return e;
         } else if (length(d) <= pickRadius) {
             return e;
         }
@@ -697,6 +703,8 @@ bool entityBounds(const Registry& registry, Entity e, Vec2& lo, Vec2& hi) {
     }
     if (const Polygon* poly = registry.tryGet<Polygon>(e))
         for (const Vec2 v : poly->vertices) rx = ry = std::max(rx, length(v));  // any angle
+    if (const Capsule* cap = registry.tryGet<Capsule>(e))
+        rx = ry = std::max(length(cap->a), length(cap->b)) + cap->radius;  // any angle
     lo = {p->value.x - rx, p->value.y - ry};
     hi = {p->value.x + rx, p->value.y + ry};
     return true;

@@ -89,6 +89,16 @@ std::optional<Error> finishPolygon(void* component) {
     return problem->within("vertices");
 }
 
+std::optional<Error> finishCapsule(void* component) {
+    const auto& capsule = *static_cast<Capsule*>(component);
+    if (capsule.a == capsule.b)
+        return Error{"a and b are the same point {\"x\": " + formatNumber(capsule.a.x) + ", \"y\": " +
+                         formatNumber(capsule.a.y) + "}; a capsule needs a segment of non-zero length (a circle is "
+                         "the shape without one)",
+                     "b"};
+    return {};
+}
+
 std::optional<Error> finishSpring(void* component) {
     auto& spring = *static_cast<Spring*>(component);
     if (spring.a.isNull()) return Error{"expected the name of an entity, got nothing", "a"};
@@ -159,6 +169,17 @@ std::vector<ComponentInfo> buildTable() {
             &finishPolygon);
         polygon.finishNamesEntity = true;
         t.push_back(std::move(polygon));
+    }
+    {
+        ComponentInfo capsule = row<Capsule>(
+            "capsule", "capsule shape: a segment swept by a radius, rotated by angle about position; the body collides",
+            false, needsPosition,
+            {field<&Capsule::a>("a", kAny, "m", "one end of the segment, relative to position"),
+             field<&Capsule::b>("b", kAny, "m", "the other end of the segment, relative to position"),
+             field<&Capsule::radius>("radius", kSize, "m", "radius swept around the segment")},
+            &finishCapsule);
+        capsule.finishNamesEntity = true;
+        t.push_back(std::move(capsule));
     }
     t.push_back(row<Angle>("angle", "orientation, counter-clockwise", true, needsPosition,
                            {field<&Angle::value>("", kAny, "rad", "orientation")}));

@@ -1,5 +1,6 @@
 // Polygon shapes: the one validity check (loader, world, editor) and the
-// mass properties the engine derives from the outline.
+// mass properties the engine derives from the outline; and the capsule's
+// mass properties, which the collision system and the tests share.
 
 #include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
@@ -110,6 +111,27 @@ PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& v) {
     out.centroid = v[0] + c;
     // Parallel axis theorem: J_v0 = J_centroid + A |c|^2.
     out.secondMoment = polarAboutV0 - out.area * lengthSquared(c);
+    return out;
+}
+
+} // namespace stepwise
+
+namespace stepwise {
+
+CapsuleMassProperties capsuleMassProperties(double length, double radius) {
+    // A rectangle 2r by L and two half discs, mass shared by area. A half
+    // disc's centroid is lc = 4r / (3 pi) beyond its flat side, which sits
+    // h = L/2 from the centre; about its centroid it has m (r^2/2 - lc^2),
+    // so by parallel axes m (r^2/2 + h^2 + 2 h lc) about the centre.
+    constexpr double kPi = 3.14159265358979323846;
+    const double r = radius, h = 0.5 * length;
+    const double rectangle = 2.0 * r * length, discs = kPi * r * r;
+    CapsuleMassProperties out;
+    out.area = rectangle + discs;
+    const double lc = 4.0 * r / (3.0 * kPi);
+    out.inertiaPerMass = (rectangle * (length * length + 4.0 * r * r) / 12.0 +
+                          discs * (0.5 * r * r + h * h + 2.0 * h * lc)) /
+                         out.area;
     return out;
 }
 

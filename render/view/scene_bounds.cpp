@@ -22,6 +22,12 @@ std::optional<ShapeBox> shapeBox(const Scene& scene, Entity e) {
         for (const Vec2 v : poly->vertices) bounds.add(p->value + Vec2{c * v.x - s * v.y, s * v.x + c * v.y});
         return ShapeBox{0.5 * (bounds.lo + bounds.hi), 0.5 * (bounds.hi - bounds.lo)};
     }
+    if (const Capsule* cap = scene.registry.tryGet<Capsule>(e)) {
+        const double c = std::cos(angle), s = std::sin(angle);
+        const Vec2 ea = p->value + Vec2{c * cap->a.x - s * cap->a.y, s * cap->a.x + c * cap->a.y};
+        const Vec2 eb = p->value + Vec2{c * cap->b.x - s * cap->b.y, s * cap->b.x + c * cap->b.y};
+        return ShapeBox{0.5 * (ea + eb), Vec2{0.5 * std::abs(eb.x - ea.x) + cap->radius, 0.5 * std::abs(eb.y - ea.y) + cap->radius}};
+    }
     return std::nullopt;
 }
 

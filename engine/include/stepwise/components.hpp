@@ -69,6 +69,28 @@ struct PolygonMassProperties {
 };
 PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& vertices);
 
+/// Capsule shape: the segment from `a` to `b` (metres, relative to
+/// `Position`, rotated by `Angle` about it) swept by `radius`: a stadium.
+/// Mass is spread evenly, so the centre of mass is the segment's midpoint,
+/// which need not be `Position`; `Velocity` is the centre of mass's. The
+/// loader refuses a == b (a circle is the shape for that).
+struct Capsule {
+    /// Default: a horizontal capsule 1.5 m long overall, centred on its
+    /// position (exact binary fractions, so it round-trips as written).
+    Vec2 a{-0.5, 0.0};
+    Vec2 b{0.5, 0.0};
+    double radius = 0.25;
+};
+
+/// Area (m^2) and moment of inertia per unit mass about the segment's
+/// midpoint (m^2) of a capsule with core length `length` and `radius`:
+/// a 2r by L rectangle plus two half discs.
+struct CapsuleMassProperties {
+    double area = 0.0;
+    double inertiaPerMass = 0.0;
+};
+CapsuleMassProperties capsuleMassProperties(double length, double radius);
+
 /// Orientation, radians, counter-clockwise.
 struct Angle { double value = 0.0; };
 /// Angular velocity, rad/s, counter-clockwise.

@@ -1,5 +1,7 @@
 #include "collision/collision_system.hpp"
 
+#include "stepwise/components.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,6 +27,8 @@ double momentOfInertia(const Shape& shape, double mass) {
         return mass * (w * w + h * h) / 12.0;
     }
     case ShapeKind::Plane: return 0.0;
+    case ShapeKind::Capsule:
+        return mass * capsuleMassProperties(2.0 * length(shape.halfExtents), shape.radius).inertiaPerMass;
     case ShapeKind::Polygon: {
         // Fan of triangles (0, vi, vi+1) about the centre of mass (the
         // origin of the outline): each has area cross(vi, vi+1)/2 and polar
@@ -79,6 +83,7 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     maxExtent_.push_back(c.solverOnly                          ? 0.0
                          : c.shape.kind == ShapeKind::Circle    ? c.shape.radius
                          : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius
+                         : c.shape.kind == ShapeKind::Capsule ? length(c.shape.halfExtents) + c.shape.radius
                                                               : length(c.shape.halfExtents));
     if (dynamic && (c.centreOfMass.x != 0.0 || c.centreOfMass.y != 0.0)) offsetBodies_.push_back(index);
     if (c.solverOnly) {

@@ -10,7 +10,7 @@
 
 namespace stepwise::collision {
 
-enum class ShapeKind : std::uint8_t { Circle, Box, Plane, Polygon };
+enum class ShapeKind : std::uint8_t { Circle, Box, Plane, Polygon, Capsule };
 
 /// Rotation as cosine/sine, so rotating a vector is 4 multiplies.
 struct Rot {
@@ -70,8 +70,11 @@ struct ConvexPolygon {
 /// Geometry of one collider in its body's frame.
 struct Shape {
     ShapeKind kind = ShapeKind::Circle;
-    double radius = 0.0;      ///< circles, metres
-    Vec2 halfExtents;         ///< boxes, metres
+    double radius = 0.0;      ///< circles and capsules, metres
+    /// Boxes: half extents, metres. Capsules: the half segment, from the
+    /// centre of mass (the segment's midpoint) to end b in the body frame;
+    /// end a is its negative. Shared, so a capsule costs a Shape no bytes.
+    Vec2 halfExtents;
     Vec2 normal{0.0, 1.0};    ///< planes: unit normal, world frame
     double offset = 0.0;      ///< planes: dot(normal, p) >= offset is outside
     /// Polygons: the outline about the centre of mass. Owned by whoever made

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <optional>
 
 namespace stepwise::collision {
 
@@ -255,6 +256,167 @@ Manifold collidePlaneWorldPolygon(Vec2 n, double offset, const WorldPolygon& b, 
     return m;
 }
 
+/// Closest points of segments p1-q1 and p2-q2: fractions s along the first
+/// and t along the second (Ericson, Real-Time Collision Detection 5.1.9).
+struct SegmentClosest {
+    double s = 0.0, t = 0.0;
+    Vec2 onFirst, onSecond;
+};
+
+SegmentClosest closestOnSegments(Vec2 p1, Vec2 q1, Vec2 p2, Vec2 q2) {
+    const Vec2 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
+    const double a = dot(d1, d1), e = dot(d2, d2), f = dot(d2, r);
+    constexpr double kTiny = 1e-300;
+    SegmentClosest out;
+    if (a <= kTiny && e <= kTiny) {
+        // both points
+    } else if (a <= kTiny) {
+        out.t = std::clamp(f / e, 0.0, 1.0);
+    } else {
+        const double c = dot(d1, r);
+        if (e <= kTiny) {
+            out.s = std::clamp(-c / a, 0.0, 1.0);
+        } else {
+            const double b = dot(d1, d2), denom = a * e - b * b;
+            // Parallel segments (denom 0) take s = 0: any point is as close.
+            out.s = denom > 0.0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+            out.t = (b * out.s + f) / e;
+            if (out.t < 0.0) {
+                out.t = 0.0;
+                out.s = std::clamp(-c / a, 0.0, 1.0);
+            } else if (out.t > 1.0) {
+                out.t = 1.0;
+                out.s = std::clamp((b - c) / a, 0.0, 1.0);
+            }
+        }
+    }
+    out.onFirst = p1 + out.s * d1;
+    out.onSecond = p2 + out.t * d2;
+    return out;
+}
+
+/// A capsule's core as a two-sided polygon: vertices a and b, and edge 0
+/// (a to b) and edge 1 (b to a) with opposite outward normals.
+WorldPolygon worldSegment(Vec2 a, Vec2 b) {
+    WorldPolygon out;
+    out.count = 2;
+    out.vertices[0] = a;
+    out.vertices[1] = b;
+    const Vec2 d = b - a;
+    const double len = length(d);
+    out.normals[0] = len > 0.0 ? Vec2{d.y, -d.x} / len : Vec2{0.0, -1.0};
+    out.normals[1] = -out.normals[0];
+    return out;
+}
+
+/// Feature ids of capsule manifolds, in bits 12-13 above the polygons'
+/// (reference edge << 8 | vertex or clip id < 32), all within the 16 bits a
+/// warm-start key keeps: a face of B is the reference, a face of the
+/// capsule A is, or one point between an end of A and a vertex of B.
+constexpr std::uint32_t kCapsuleFaceOfB = 0x1000, kCapsuleFaceOfA = 0x2000, kCapsuleCorner = 0x3000;
+
+/// Capsule A (core a1-a2, radius rA) against the convex polygon B swept by
+/// rB (a box or polygon with rB = 0, or another capsule's core as a
+/// two-sided polygon). The separating axis test over both cores' face
+/// normals picks a reference face; the other core's edge is clipped to that
+/// face's side planes, which gives two points when a capsule lies along a
+/// face. When the cores are apart and nearest at an end of A and a vertex of
+/// B (a cap against a corner) one point on the line between them, the
+/// distance measured exactly (Box2D v3's b2CollidePolygons does the same
+/// with its rounded polygons).
+Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPolygon& b, double rB, double margin) {
+    const double rSum = rA + rB;
+    const WorldPolygon a = worldSegment(a1, a2);
+    const auto [edgeB, separationB] = maxSeparation(b, a);
+    if (separationB - rSum > margin) return Manifold{};
+    const auto [edgeA, separationA] = maxSeparation(a, b);
+    if (separationA - rSum > margin) return Manifold{};
+    // B's face unless the capsule's is clearly better (the boxes' rule, so
+    // the reference does not flicker between steps).
+    const bool capsuleReference = separationA > 0.98 * separationB + 0.0005;
+    const Vec2 referenceNormal = capsuleReference ? a.normals[edgeA] : -b.normals[edgeB];  // from A to B
+
+    // One point from the exact closest points.
+    const auto cornerPoint = [&](const SegmentClosest& c, int vertexB) {
+        Manifold m;
+        const Vec2 d = c.onSecond - c.onFirst;
+        const double dist = length(d);
+        const double separation = dist - rSum;
+        if (separation > margin || !(dist > 0.0)) return m;
+        m.normal = d / dist;
+        m.pointCount = 1;
+        m.points[0].separation = separation;
+        m.points[0].point = 0.5 * ((c.onFirst + rA * m.normal) + (c.onSecond - rB * m.normal));
+        m.points[0].id = kCapsuleCorner | (std::uint32_t(c.s > 0.5) << 8) | std::uint32_t(vertexB);
+        return m;
+    };
+    std::optional<SegmentClosest> nearest;
+    int nearestVertex = 0;
+    if (std::max(separationA, separationB) > 0.0) {
+        // The cores are apart: their distance is the nearest pair of edges.
+        double best = std::numeric_limits<double>::infinity();
+        const int edges = b.count == 2 ? 1 : b.count;
+        for (int i = 0; i < edges; ++i) {
+            const int next = (i + 1) % b.count;
+            const SegmentClosest c = closestOnSegments(a1, a2, b.vertices[i], b.vertices[next]);
+            const double d2 = lengthSquared(c.onSecond - c.onFirst);
+            if (d2 < best) {
+                best = d2;
+                nearest = c;
+                nearestVertex = c.t > 0.5 ? next : i;
+            }
+        }
+        if (std::sqrt(best) - rSum > margin) return Manifold{};
+        const bool cornerToCorner = (nearest->s == 0.0 || nearest->s == 1.0) && (nearest->t == 0.0 || nearest->t == 1.0);
+        const double dist = std::sqrt(best);
+        // A cap against a corner, unless the line between them is (nearly)
+        // the reference face's normal: two parallel capsules stacked end
+        // to end are nearest at their ends too, and must rest on two points.
+        if (cornerToCorner && dist > 0.0 && dot(nearest->onSecond - nearest->onFirst, referenceNormal) < 0.999 * dist)
+            return cornerPoint(*nearest, nearestVertex);
+    }
+
+    Manifold m;
+    const WorldPolygon& ref = capsuleReference ? a : b;
+    const WorldPolygon& inc = capsuleReference ? b : a;
+    const int refEdge = capsuleReference ? edgeA : edgeB;
+    const Vec2 n = ref.normals[refEdge];  // out of the reference core, toward the other
+    int incEdge = 0;
+    double minDot = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < inc.count; ++i) {
+        const double d = dot(n, inc.normals[i]);
+        if (d < minDot) {
+            minDot = d;
+            incEdge = i;
+        }
+    }
+    const int incNext = (incEdge + 1) % inc.count;
+    const ClipVertex incident[2] = {{inc.vertices[incEdge], std::uint32_t(incEdge)},
+                                    {inc.vertices[incNext], std::uint32_t(incNext)}};
+    const Vec2 v1 = ref.vertices[refEdge], v2 = ref.vertices[(refEdge + 1) % ref.count];
+    const Vec2 t = (v2 - v1) / length(v2 - v1);
+    ClipVertex clipped1[2], clipped2[2];
+    const bool clipped = clipSegment(incident, clipped1, -t, -dot(t, v1), 16 + std::uint32_t(refEdge)) == 2 &&
+                         clipSegment(clipped1, clipped2, t, dot(t, v2), 24 + std::uint32_t(refEdge)) == 2;
+    if (!clipped) return nearest ? cornerPoint(*nearest, nearestVertex) : m;
+    // The reference side's radius and the incident side's.
+    const double rRef = capsuleReference ? rA : rB, rInc = capsuleReference ? rB : rA;
+    m.normal = capsuleReference ? n : -n;
+    for (const ClipVertex& cv : clipped2) {
+        const double depth = dot(n, cv.v - v1);  // core to core along n
+        const double separation = depth - rSum;
+        if (separation > margin) continue;
+        ManifoldPoint& p = m.points[m.pointCount++];
+        p.separation = separation;
+        // Midway between the reference surface (v1 plane + rRef) and the
+        // incident one (cv - rInc n).
+        p.point = cv.v - 0.5 * (depth - rRef + rInc) * n;
+        p.id = (capsuleReference ? kCapsuleFaceOfA : kCapsuleFaceOfB) | (std::uint32_t(refEdge) << 8) | cv.id;
+    }
+    if (m.pointCount == 0 && nearest) return cornerPoint(*nearest, nearestVertex);
+    return m;
+}
+
 } // namespace
 
 Manifold collidePolygons(const ConvexPolygon& a, Vec2 pA, Rot qA, const ConvexPolygon& b, Vec2 pB, Rot qB,
@@ -350,11 +512,79 @@ Manifold collidePlaneBox(Vec2 n, double offset, Vec2 h, Vec2 pB, Rot qB, double 
     return collidePlaneWorldPolygon(n, offset, worldPolygon(worldBox(h, pB, qB)), margin);
 }
 
+Manifold collideCapsuleCircle(Vec2 a1, Vec2 a2, double rA, double rB, Vec2 pB, double margin) {
+    const Vec2 d = a2 - a1;
+    const double len2 = lengthSquared(d);
+    const double u = len2 > 0.0 ? std::clamp(dot(pB - a1, d) / len2, 0.0, 1.0) : 0.0;
+    return collideCircles(rA, a1 + u * d, rB, pB, margin);
+}
+
+Manifold collidePlaneCapsule(Vec2 n, double offset, Vec2 b1, Vec2 b2, double rB, double margin) {
+    // Each end's cap against the plane: two points when the capsule lies on
+    // it, ids the ends' numbers.
+    Manifold m;
+    m.normal = n;
+    const Vec2 ends[2] = {b1, b2};
+    for (int i = 0; i < 2; ++i) {
+        const double separation = dot(n, ends[i]) - offset - rB;
+        if (separation > margin) continue;
+        ManifoldPoint& p = m.points[m.pointCount++];
+        p.separation = separation;
+        p.point = ends[i] - (rB + 0.5 * separation) * n;
+        p.id = std::uint32_t(i);
+    }
+    return m;
+}
+
+Manifold collideCapsules(Vec2 a1, Vec2 a2, double rA, Vec2 b1, Vec2 b2, double rB, double margin) {
+    return collideWorldCapsulePolygon(a1, a2, rA, worldSegment(b1, b2), rB, margin);
+}
+
+Manifold collideCapsuleBox(Vec2 a1, Vec2 a2, double rA, Vec2 hB, Vec2 pB, Rot qB, double margin) {
+    return collideWorldCapsulePolygon(a1, a2, rA, worldPolygon(worldBox(hB, pB, qB)), 0.0, margin);
+}
+
+Manifold collideCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const ConvexPolygon& b, Vec2 pB, Rot qB,
+                               double margin) {
+    return collideWorldCapsulePolygon(a1, a2, rA, worldPolygon(b, pB, qB), 0.0, margin);
+}
+
 Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot qB, double margin) {
     auto flipped = [](Manifold m) {
         m.normal = -m.normal;
         return m;
     };
+    if (a.kind == ShapeKind::Capsule || b.kind == ShapeKind::Capsule) {
+        // Capsule first: every pair with a capsule is written as capsule (or
+        // plane) A against B, then flipped back.
+        const auto ends = [](const Shape& s, Vec2 p, Rot q) {
+            const Vec2 h = rotate(q, s.halfExtents);
+            return std::pair<Vec2, Vec2>{p - h, p + h};
+        };
+        if (a.kind == ShapeKind::Capsule) {
+            const auto [a1, a2] = ends(a, pA, qA);
+            switch (b.kind) {
+            case ShapeKind::Circle: return collideCapsuleCircle(a1, a2, a.radius, b.radius, pB, margin);
+            case ShapeKind::Box: return collideCapsuleBox(a1, a2, a.radius, b.halfExtents, pB, qB, margin);
+            case ShapeKind::Polygon: return collideCapsulePolygon(a1, a2, a.radius, *b.polygon, pB, qB, margin);
+            case ShapeKind::Plane: return flipped(collidePlaneCapsule(b.normal, b.offset, a1, a2, a.radius, margin));
+            case ShapeKind::Capsule: {
+                const auto [b1, b2] = ends(b, pB, qB);
+                return collideCapsules(a1, a2, a.radius, b1, b2, b.radius, margin);
+            }
+            }
+            return Manifold{};
+        }
+        const auto [b1, b2] = ends(b, pB, qB);
+        switch (a.kind) {
+        case ShapeKind::Circle: return flipped(collideCapsuleCircle(b1, b2, b.radius, a.radius, pA, margin));
+        case ShapeKind::Box: return flipped(collideCapsuleBox(b1, b2, b.radius, a.halfExtents, pA, qA, margin));
+        case ShapeKind::Polygon: return flipped(collideCapsulePolygon(b1, b2, b.radius, *a.polygon, pA, qA, margin));
+        case ShapeKind::Plane: return collidePlaneCapsule(a.normal, a.offset, b1, b2, b.radius, margin);
+        case ShapeKind::Capsule: break;  // handled above
+        }
+        return Manifold{};
+    }
     if (a.kind == ShapeKind::Polygon || b.kind == ShapeKind::Polygon) {
         // Polygon first: every pair with a polygon is written as polygon (or
         // plane, or box) A against B, then flipped back.
@@ -364,6 +594,7 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
             case ShapeKind::Box: return flipped(collideBoxPolygon(b.halfExtents, pB, qB, *a.polygon, pA, qA, margin));
             case ShapeKind::Polygon: return collidePolygons(*a.polygon, pA, qA, *b.polygon, pB, qB, margin);
             case ShapeKind::Plane: return flipped(collidePlanePolygon(b.normal, b.offset, *a.polygon, pA, qA, margin));
+            case ShapeKind::Capsule: break;  // handled above
             }
             return Manifold{};
         }
@@ -371,7 +602,8 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
         case ShapeKind::Circle: return flipped(collidePolygonCircle(*b.polygon, pB, qB, a.radius, pA, margin));
         case ShapeKind::Box: return collideBoxPolygon(a.halfExtents, pA, qA, *b.polygon, pB, qB, margin);
         case ShapeKind::Plane: return collidePlanePolygon(a.normal, a.offset, *b.polygon, pB, qB, margin);
-        case ShapeKind::Polygon: break;
+        case ShapeKind::Polygon:
+        case ShapeKind::Capsule: break;
         }
         return Manifold{};
     }
@@ -388,7 +620,8 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
         if (b.kind == ShapeKind::Circle) return collidePlaneCircle(a.normal, a.offset, b.radius, pB, margin);
         if (b.kind == ShapeKind::Box) return collidePlaneBox(a.normal, a.offset, b.halfExtents, pB, qB, margin);
         return Manifold{};  // two infinite walls never collide
-    case ShapeKind::Polygon: break;  // handled above
+    case ShapeKind::Polygon:
+    case ShapeKind::Capsule: break;  // handled above
     }
     return Manifold{};
 }
@@ -403,6 +636,11 @@ Aabb computeAabb(const Shape& shape, Vec2 p, Rot q) {
             box.upper = {std::max(box.upper.x, v.x), std::max(box.upper.y, v.y)};
         }
         return box;
+    }
+    if (shape.kind == ShapeKind::Capsule) {
+        const Vec2 h = rotate(q, shape.halfExtents);
+        const Vec2 e{std::abs(h.x) + shape.radius, std::abs(h.y) + shape.radius};
+        return {p - e, p + e};
     }
     const Vec2 h = shape.halfExtents;
     const Vec2 e{std::abs(q.c) * h.x + std::abs(q.s) * h.y, std::abs(q.s) * h.x + std::abs(q.c) * h.y};

@@ -30,7 +30,17 @@ Manifold collideBoxPolygon(Vec2 hA, Vec2 pA, Rot qA, const ConvexPolygon& b, Vec
 Manifold collidePolygonCircle(const ConvexPolygon& a, Vec2 pA, Rot qA, double rB, Vec2 pB, double margin);
 Manifold collidePlanePolygon(Vec2 n, double offset, const ConvexPolygon& b, Vec2 pB, Rot qB, double margin);
 
-/// World-space bounding box of a circle, box or polygon (planes have none).
+/// Capsules: the segment from c1 to c2 (world points) swept by radius r.
+/// Capsule A against circle B, plane A against capsule B, capsule A against
+/// capsule B, and capsule A against box B / polygon B.
+Manifold collideCapsuleCircle(Vec2 a1, Vec2 a2, double rA, double rB, Vec2 pB, double margin);
+Manifold collidePlaneCapsule(Vec2 n, double offset, Vec2 b1, Vec2 b2, double rB, double margin);
+Manifold collideCapsules(Vec2 a1, Vec2 a2, double rA, Vec2 b1, Vec2 b2, double rB, double margin);
+Manifold collideCapsuleBox(Vec2 a1, Vec2 a2, double rA, Vec2 hB, Vec2 pB, Rot qB, double margin);
+Manifold collideCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const ConvexPolygon& b, Vec2 pB, Rot qB,
+                               double margin);
+
+/// World-space bounding box of a circle, box, polygon or capsule (planes have none).
 Aabb computeAabb(const Shape& shape, Vec2 p, Rot q);
 
 } // namespace stepwise::collision

@@ -214,11 +214,16 @@ void compileBoids(const Registry& reg, WorldImpl& w) {
     if (f.boidsOn) f.boids.prepare();
 }
 
-/// The loader refuses bad outlines, but a scene built in code or edited in
-/// the editor reaches here unchecked.
+/// The loader refuses bad outlines (and capsules without a segment), but a
+/// scene built in code or edited in the editor reaches here unchecked.
 std::optional<Error> checkPolygons(const Registry& reg) {
     const std::vector<Entity>& order = reg.entities();
     for (std::size_t i = 0; i < order.size(); ++i) {
+        if (const Capsule* capsule = reg.tryGet<Capsule>(order[i]); capsule && capsule->a == capsule->b) {
+            const Name* name = reg.tryGet<Name>(order[i]);
+            return Error{"a and b are the same point; a capsule needs a segment of non-zero length",
+                         entityLabel(i, name ? &name->value : nullptr) + ": capsule.b"};
+        }
         const Polygon* poly = reg.tryGet<Polygon>(order[i]);
         if (!poly) continue;
         if (std::optional<Error> problem = polygonProblem(poly->vertices)) {

@@ -65,6 +65,15 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
             c.shape.kind = collision::ShapeKind::Polygon;
             c.shape.polygon = &polygon;
             c.centreOfMass = props.centroid;
+        } else if (const Capsule* cap = reg.tryGet<Capsule>(e)) {
+            // About the centre of mass, like polygons: the segment's
+            // midpoint, kept as the offset (exactly zero for a capsule
+            // centred on its position, which then takes the plain path).
+            const Vec2 mid = 0.5 * (cap->a + cap->b);
+            c.shape.kind = collision::ShapeKind::Capsule;
+            c.shape.radius = cap->radius;
+            c.shape.halfExtents = 0.5 * (cap->b - cap->a);
+            c.centreOfMass = mid;
         } else if (const Plane* p = reg.tryGet<Plane>(e)) {
             c.shape.kind = collision::ShapeKind::Plane;
             c.shape.normal = p->normal;
@@ -224,17 +233,20 @@ double halfExtentAlong(const Registry& reg, Entity e, Vec2 dir) {
         }
         return 0.5 * (hi - lo);
     }
+    if (const Capsule* cap = reg.tryGet<Capsule>(e)) return 0.5 * std::abs(dot(cap->b - cap->a, local)) + cap->radius;
     return 0.0;
 }
 
-/// A shape's centre offset along `dir` from its position (polygons are
-/// not centred on it), metres.
+/// A shape's centre offset along `dir` from its position (polygons and
+/// capsules need not be centred on it), metres.
 double centreAlong(const Registry& reg, Entity e, Vec2 dir) {
     const Polygon* p = reg.tryGet<Polygon>(e);
-    if (!p || p->vertices.empty()) return 0.0;
+    const Capsule* cap = p ? nullptr : reg.tryGet<Capsule>(e);
+    if ((!p || p->vertices.empty()) && !cap) return 0.0;
     const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
     const double c = std::cos(angle), s = std::sin(angle);
     const Vec2 local{c * dir.x + s * dir.y, -s * dir.x + c * dir.y};
+    if (cap) return 0.5 * dot(cap->a + cap->b, local);
     double lo = dot(p->vertices[0], local), hi = lo;
     for (const Vec2& v : p->vertices) {
         lo = std::min(lo, dot(v, local));
@@ -359,7 +371,7 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     };
     // With contacts switched off no shape takes part.
     const auto hasShape = [&](Entity e) {
-        return switches.collisions && (reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e));
+        return switches.collisions && (reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) || reg.has<Capsule>(e));
     };
     const auto dynamic = [&](Entity e) { return reg.alive(e) && reg.has<Position>(e) && !isStatic(e); };
     const auto massOf = [&](Entity e) { return reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0; };
