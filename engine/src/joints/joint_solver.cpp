@@ -183,6 +183,32 @@ void solveDistance(JointConstraint& j, const SolverBody& a, const SolverBody& b,
     j.upperImpulse = total;
 }
 
+/// What a slider's and a wheel's rows share: the arms rA, rB and the
+/// anchors' offset d (metres), a's axis, the travel along it, and the
+/// effective mass along it (kg).
+struct AxisFrame {
+    Vec2 rA, rB, d, axis;
+    double translation = 0.0, a1 = 0.0, a2 = 0.0, axialMass = 0.0;
+    AxisFrame(const JointConstraint& j, const SolverBody& a, const SolverBody& b, const Pair& p)
+        : rA(rotate(a.dq, j.anchorA)), rB(rotate(b.dq, j.anchorB)),
+          d((b.dp - a.dp) + j.deltaCenter + (rB - rA)), axis(rotate(a.dq, j.axisA)) {
+        translation = dot(axis, d);
+        a1 = cross(d + rA, axis);
+        a2 = cross(rB, axis);
+        const double k = p.mA + p.mB + p.iA * a1 * a1 + p.iB * a2 * a2;
+        axialMass = k > 0.0 ? 1.0 / k : 0.0;
+    }
+    /// Relative speed along the axis, m/s.
+    double speed(const Pair& p) const { return dot(axis, p.vB - p.vA) + a2 * p.wB - a1 * p.wA; }
+    /// An impulse along the axis (N s): -on A, +on B.
+    void apply(Pair& p, double impulse) const {
+        p.vA -= (p.mA * impulse) * axis;
+        p.wA -= p.iA * impulse * a1;
+        p.vB += (p.mB * impulse) * axis;
+        p.wB += p.iB * impulse * a2;
+    }
+};
+
 /// A slider's or wheel's travel limits along its axis: one-sided rows on
 /// the translation, lower then upper. `axialSpeed()` is the relative speed
 /// along the axis and `applyAxial(impulse)` applies an impulse along it.
@@ -207,21 +233,11 @@ void solveTravelLimits(JointConstraint& j, double translation, double axialMass,
 
 void solveSlider(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
                  const Softness& soft, bool useBias) {
-    const Vec2 rA = rotate(a.dq, j.anchorA), rB = rotate(b.dq, j.anchorB);
-    const Vec2 d = (b.dp - a.dp) + j.deltaCenter + (rB - rA);
-    const Vec2 axis = rotate(a.dq, j.axisA);
-    const double translation = dot(axis, d);
-    const double a1 = cross(d + rA, axis), a2 = cross(rB, axis);
-    const double k = p.mA + p.mB + p.iA * a1 * a1 + p.iB * a2 * a2;
-    const double axialMass = k > 0.0 ? 1.0 / k : 0.0;
-    // Impulse `impulse` along the axis: -on A, +on B.
-    const auto applyAxial = [&](double impulse) {
-        p.vA -= (p.mA * impulse) * axis;
-        p.wA -= p.iA * impulse * a1;
-        p.vB += (p.mB * impulse) * axis;
-        p.wB += p.iB * impulse * a2;
-    };
-    const auto axialSpeed = [&] { return dot(axis, p.vB - p.vA) + a2 * p.wB - a1 * p.wA; };
+    const AxisFrame f(j, a, b, p);
+    const Vec2 rA = f.rA, rB = f.rB, d = f.d, axis = f.axis;
+    const double translation = f.translation, axialMass = f.axialMass;
+    const auto applyAxial = [&](double impulse) { f.apply(p, impulse); };
+    const auto axialSpeed = [&] { return f.speed(p); };
     if (j.motor) {
         const double maxImpulse = j.maxMotor * h;
         const double old = j.motorImpulse;
@@ -268,20 +284,11 @@ void solveWheel(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pa
         j.motorImpulse = std::clamp(old - j.axialMass * cdot, -maxImpulse, maxImpulse);
         p.applyAngular(j.motorImpulse - old);
     }
-    const Vec2 rA = rotate(a.dq, j.anchorA), rB = rotate(b.dq, j.anchorB);
-    const Vec2 d = (b.dp - a.dp) + j.deltaCenter + (rB - rA);
-    const Vec2 axis = rotate(a.dq, j.axisA);
-    const double translation = dot(axis, d);
-    const double a1 = cross(d + rA, axis), a2 = cross(rB, axis);
-    const double k = p.mA + p.mB + p.iA * a1 * a1 + p.iB * a2 * a2;
-    const double axialMass = k > 0.0 ? 1.0 / k : 0.0;
-    const auto applyAxial = [&](double impulse) {
-        p.vA -= (p.mA * impulse) * axis;
-        p.wA -= p.iA * impulse * a1;
-        p.vB += (p.mB * impulse) * axis;
-        p.wB += p.iB * impulse * a2;
-    };
-    const auto axialSpeed = [&] { return dot(axis, p.vB - p.vA) + a2 * p.wB - a1 * p.wA; };
+    const AxisFrame f(j, a, b, p);
+    const Vec2 rA = f.rA, rB = f.rB, d = f.d, axis = f.axis;
+    const double translation = f.translation, axialMass = f.axialMass;
+    const auto applyAxial = [&](double impulse) { f.apply(p, impulse); };
+    const auto axialSpeed = [&] { return f.speed(p); };
     if (j.spring) {
         // A force in both passes, as the hinge's spring.
         const Softness spring = Softness::make(j.stiffnessHz, j.dampingRatio, h);
