@@ -247,13 +247,15 @@ void CollisionSystem::bodyEdges(std::vector<std::pair<std::uint32_t, std::uint32
         if (!touching) continue;
         // A kinematic body joins no island (as in Box2D): a platform would
         // otherwise tie every pile it touches into one.
-        if (colliders_[d.colliderA].kinematic || colliders_[d.colliderB].kinematic) continue;
+        if (anyKinematic_ && (colliders_[d.colliderA].kinematic || colliders_[d.colliderB].kinematic)) continue;
         const std::int32_t a = colliders_[d.colliderA].body, b = colliders_[d.colliderB].body;
         if (a >= 0 && b >= 0) out.emplace_back(std::uint32_t(a), std::uint32_t(b));
     }
     for (const joints::JointConstraint& j : joints_) {
         if (j.broken || j.a.collider < 0 || j.b.collider < 0) continue;
-        if (colliders_[std::size_t(j.a.collider)].kinematic || colliders_[std::size_t(j.b.collider)].kinematic) continue;
+        if (anyKinematic_ &&
+            (colliders_[std::size_t(j.a.collider)].kinematic || colliders_[std::size_t(j.b.collider)].kinematic))
+            continue;
         const std::int32_t a = colliders_[std::size_t(j.a.collider)].body, b = colliders_[std::size_t(j.b.collider)].body;
         if (a >= 0 && b >= 0) out.emplace_back(std::uint32_t(a), std::uint32_t(b));
     }
@@ -390,7 +392,9 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
     c.bodyA = solverIndex_[a];
     c.bodyB = solverIndex_[b];
     // A kinematic side counts as static (Box2D's rule: zero inverse mass).
-    c.touchesStatic = c.bodyA == 0 || c.bodyB == 0 || colliders_[a].kinematic || colliders_[b].kinematic;
+    // (The flag is read first: a collider's kinematic bit is on another
+    // cache line than what the narrow phase has read of it.)
+    c.touchesStatic = c.bodyA == 0 || c.bodyB == 0 || (anyKinematic_ && (colliders_[a].kinematic || colliders_[b].kinematic));
     c.roundA = colliders_[a].shape.kind == ShapeKind::Circle;
     c.roundB = colliders_[b].shape.kind == ShapeKind::Circle;
     c.normal = m.normal;
@@ -617,7 +621,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     for (const std::uint32_t p : planes_) {
         for (std::size_t k = 0, count = anySleeping_ ? awakeProxies_.size() : finite_.size(); k < count; ++k) {
             const std::uint32_t b = finite_[anySleeping_ ? awakeProxies_[k] : k];
-            if (colliders_[b].body < 0 || colliders_[b].kinematic) continue;
+            if (colliders_[b].body < 0 || (anyKinematic_ && colliders_[b].kinematic)) continue;
             if (anySensor_ && sensedInstead(p, b)) continue;
             if (!collides(p, b)) continue;
             const Manifold m = collide(colliders_[p].shape, {}, {}, colliders_[b].shape, centres_[b], rots[b],
