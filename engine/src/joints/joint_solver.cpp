@@ -210,23 +210,21 @@ struct AxisFrame {
 };
 
 /// A slider's or wheel's travel limits along its axis: one-sided rows on
-/// the translation, lower then upper. `axialSpeed()` is the relative speed
-/// along the axis and `applyAxial(impulse)` applies an impulse along it.
-template <class Speed, class Apply>
-void solveTravelLimits(JointConstraint& j, double translation, double axialMass, double invH, const Softness& soft,
-                       bool useBias, const Speed& axialSpeed, const Apply& applyAxial) {
+/// the translation, lower then upper.
+void solveTravelLimits(JointConstraint& j, const AxisFrame& f, Pair& p, double invH, const Softness& soft,
+                       bool useBias) {
     if (j.hasLower) {
-        const Row r = limitRow(translation - j.lower, invH, soft, useBias);
-        const double impulse = -axialMass * r.massScale * (axialSpeed() + r.bias) - r.impulseScale * j.lowerImpulse;
+        const Row r = limitRow(f.translation - j.lower, invH, soft, useBias);
+        const double impulse = -f.axialMass * r.massScale * (f.speed(p) + r.bias) - r.impulseScale * j.lowerImpulse;
         const double total = std::max(j.lowerImpulse + impulse, 0.0);
-        applyAxial(total - j.lowerImpulse);
+        f.apply(p, total - j.lowerImpulse);
         j.lowerImpulse = total;
     }
     if (j.hasUpper) {
-        const Row r = limitRow(j.upper - translation, invH, soft, useBias);
-        const double impulse = -axialMass * r.massScale * (-axialSpeed() + r.bias) - r.impulseScale * j.upperImpulse;
+        const Row r = limitRow(j.upper - f.translation, invH, soft, useBias);
+        const double impulse = -f.axialMass * r.massScale * (-f.speed(p) + r.bias) - r.impulseScale * j.upperImpulse;
         const double total = std::max(j.upperImpulse + impulse, 0.0);
-        applyAxial(-(total - j.upperImpulse));
+        f.apply(p, -(total - j.upperImpulse));
         j.upperImpulse = total;
     }
 }
@@ -234,25 +232,21 @@ void solveTravelLimits(JointConstraint& j, double translation, double axialMass,
 void solveSlider(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
                  const Softness& soft, bool useBias) {
     const AxisFrame f(j, a, b, p);
-    const Vec2 rA = f.rA, rB = f.rB, d = f.d, axis = f.axis;
-    const double translation = f.translation, axialMass = f.axialMass;
-    const auto applyAxial = [&](double impulse) { f.apply(p, impulse); };
-    const auto axialSpeed = [&] { return f.speed(p); };
     if (j.motor) {
         const double maxImpulse = j.maxMotor * h;
         const double old = j.motorImpulse;
-        j.motorImpulse = std::clamp(old + axialMass * (j.motorSpeed - axialSpeed()), -maxImpulse, maxImpulse);
-        applyAxial(j.motorImpulse - old);
+        j.motorImpulse = std::clamp(old + f.axialMass * (j.motorSpeed - f.speed(p)), -maxImpulse, maxImpulse);
+        f.apply(p, j.motorImpulse - old);
     }
-    solveTravelLimits(j, translation, axialMass, 1.0 / h, soft, useBias, axialSpeed, applyAxial);
+    solveTravelLimits(j, f, p, 1.0 / h, soft, useBias);
     // No sideways travel and no relative rotation, solved together.
-    const Vec2 perp = leftPerp(axis);
-    const double s1 = cross(d + rA, perp), s2 = cross(rB, perp);
+    const Vec2 perp = leftPerp(f.axis);
+    const double s1 = cross(f.d + f.rA, perp), s2 = cross(f.rB, perp);
     const Vec2 cdot{dot(perp, p.vB - p.vA) + s2 * p.wB - s1 * p.wA, p.wB - p.wA};
     Vec2 bias;
     Row r;
     if (useBias) {
-        const Vec2 C{dot(perp, d), j.deltaAngle + angleOf(b.dq) - angleOf(a.dq)};
+        const Vec2 C{dot(perp, f.d), j.deltaAngle + angleOf(b.dq) - angleOf(a.dq)};
         bias = soft.biasRate * C;
         r = {0.0, soft.massScale, soft.impulseScale};
     }
@@ -285,25 +279,21 @@ void solveWheel(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pa
         p.applyAngular(j.motorImpulse - old);
     }
     const AxisFrame f(j, a, b, p);
-    const Vec2 rA = f.rA, rB = f.rB, d = f.d, axis = f.axis;
-    const double translation = f.translation, axialMass = f.axialMass;
-    const auto applyAxial = [&](double impulse) { f.apply(p, impulse); };
-    const auto axialSpeed = [&] { return f.speed(p); };
     if (j.spring) {
         // A force in both passes, as the hinge's spring.
         const Softness spring = Softness::make(j.stiffnessHz, j.dampingRatio, h);
-        const double impulse = -axialMass * spring.massScale * (axialSpeed() + spring.biasRate * translation) -
+        const double impulse = -f.axialMass * spring.massScale * (f.speed(p) + spring.biasRate * f.translation) -
                                spring.impulseScale * j.springImpulse;
         j.springImpulse += impulse;
-        applyAxial(impulse);
+        f.apply(p, impulse);
     }
-    solveTravelLimits(j, translation, axialMass, 1.0 / h, soft, useBias, axialSpeed, applyAxial);
+    solveTravelLimits(j, f, p, 1.0 / h, soft, useBias);
     // The point stays on the line: no travel across the axis.
-    const Vec2 perp = leftPerp(axis);
-    const double s1 = cross(d + rA, perp), s2 = cross(rB, perp);
+    const Vec2 perp = leftPerp(f.axis);
+    const double s1 = cross(f.d + f.rA, perp), s2 = cross(f.rB, perp);
     const double kp = p.mA + p.mB + p.iA * s1 * s1 + p.iB * s2 * s2;
     const double perpMass = kp > 0.0 ? 1.0 / kp : 0.0;
-    const Row r = equalityRow(dot(perp, d), soft, useBias);
+    const Row r = equalityRow(dot(perp, f.d), soft, useBias);
     const double cdot = dot(perp, p.vB - p.vA) + s2 * p.wB - s1 * p.wA;
     const double impulse = -perpMass * r.massScale * (cdot + r.bias) - r.impulseScale * j.linearImpulse.x;
     j.linearImpulse.x += impulse;
