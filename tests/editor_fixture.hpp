@@ -79,11 +79,12 @@ struct Fixture : LevelOpen {
 };
 
 
-/// Renames `e` through the inspector's path (setFieldOnAll on "name").
-inline bool rename(Fixture& f, Entity e, const std::string& to, std::string* problem = nullptr) {
+/// Renames `e` through the inspector's path (setFieldOnAll on "name"):
+/// whether it changed the name, or why it was refused.
+inline Result<bool> rename(Fixture& f, Entity e, const std::string& to) {
     const ComponentInfo* name = findComponent("name");
-    return f.ed.applyEdit("rename", [&](Scene& s) {
-        return setFieldOnAll(s, *name, name->fields[0], std::string(to), {e}, problem) > 0;
+    return f.ed.tryEdit("rename", [&](Scene& s) {
+        return changedAny(setFieldOnAll(s, *name, name->fields[0], std::string(to), {e}));
     });
 }
 

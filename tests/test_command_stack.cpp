@@ -141,7 +141,7 @@ TEST(CommandStack, UndoOfADeletedPolygonRestoresItsVertices) {
     Fixture f("default.json");
     Entity polygon;
     ASSERT_TRUE(f.ed.applyEdit("add", [&](Scene& s) {
-        polygon = addPolygon(s, {{0.0, 0.0}, {1.0, 0.0}, {1.25, 0.75}, {0.5, 1.5}});
+        polygon = addPolygon(s, {{0.0, 0.0}, {1.0, 0.0}, {1.25, 0.75}, {0.5, 1.5}}).value();
         return !polygon.isNull();
     }));
     const std::string before = textOf(f.ed.doc.scene);

@@ -299,20 +299,22 @@ TEST(PolygonTool, TheInspectorRefusesADentAndKeepsTheOldOutline) {
     Fixture f("orbit.json");
     Entity e;
     ASSERT_TRUE(f.ed.applyEdit("add", [&](Scene& s) {
-        e = addPolygon(s, {{0, 0}, {2, 0}, {2, 2}, {0, 2}});
+        e = addPolygon(s, {{0, 0}, {2, 0}, {2, 2}, {0, 2}}).value();
         return !e.isNull();
     }));
     const ComponentInfo* info = findComponent("polygon");
     const std::vector<Vec2> before = f.ed.doc.scene.registry.tryGet<Polygon>(e)->vertices;
-    std::string problem;
     const std::vector<Vec2> dent{{-1, -1}, {1, -1}, {-0.25, -0.25}, {-1, 1}};
-    EXPECT_EQ(setFieldOnAll(f.ed.doc.scene, *info, info->fields[0], dent, {e}, &problem), 0u);
-    EXPECT_EQ(problem, "\"polygon\" polygon.vertices/2: not convex: the outline turns clockwise at vertex 2 {\"x\": -0.25, \"y\": "
+    const Result<std::size_t> refused = setFieldOnAll(f.ed.doc.scene, *info, info->fields[0], dent, {e});
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error(), "\"polygon\" polygon.vertices/2: not convex: the outline turns clockwise at vertex 2 {\"x\": -0.25, \"y\": "
                        "-0.25}; "
                        "a polygon shape must be convex (split the shape into convex pieces)");
     EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Polygon>(e)->vertices, before);
     const std::vector<Vec2> kite{{-1, -1}, {1, -1}, {1.5, 0.5}, {-1, 1}};
-    EXPECT_EQ(setFieldOnAll(f.ed.doc.scene, *info, info->fields[0], kite, {e}, &problem), 1u);
+    const Result<std::size_t> changed = setFieldOnAll(f.ed.doc.scene, *info, info->fields[0], kite, {e});
+    ASSERT_TRUE(changed) << changed.error();
+    EXPECT_EQ(*changed, 1u);
     EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Polygon>(e)->vertices, kite);
 }
 
@@ -322,7 +324,7 @@ TEST(Springs, RenamingABodyKeepsItsSpringPlaysAndSavesTheNewName) {
     const Entity bob = f.named("bob");
     ASSERT_FALSE(bob.isNull());
     ASSERT_EQ(springsAttachedTo(f.ed.doc.scene.registry, bob).size(), 1u);
-    ASSERT_TRUE(rename(f, bob, "pendulum"));
+    ASSERT_TRUE(rename(f, bob, "pendulum").value());
     EXPECT_EQ(f.named("bob"), Entity{});
     EXPECT_EQ(springsAttachedTo(f.ed.doc.scene.registry, bob).size(), 1u) << "the spring follows the body, not its old name";
     EXPECT_EQ(checkSceneRelations(f.ed.doc.scene), std::nullopt);
@@ -551,7 +553,7 @@ TEST(Recovery, UndoingBackToTheFilesStateDeletesTheCopy) {
     std::filesystem::copy_file(kLevels / "default.json", file);
     ASSERT_TRUE(f.ed.open(file));
     EXPECT_FALSE(f.ed.tickAutosave(0.0));
-    ASSERT_TRUE(rename(f, f.named("bob"), "robert"));
+    ASSERT_TRUE(rename(f, f.named("bob"), "robert").value());
     ASSERT_TRUE(f.ed.tickAutosave(31.0));
     const std::filesystem::path copy = f.ed.doc.recoveryPath(f.ed.configDir);
     ASSERT_TRUE(std::filesystem::exists(copy));
@@ -671,13 +673,15 @@ TEST(NumberFields, ARefusalOfUpperBelowLowerNamesUpper) {
         return static_cast<const FieldInfo*>(nullptr);
     };
     const std::string before = textOf(ed.doc.scene);
-    std::string problem;
-    EXPECT_EQ(setFieldOnAll(ed.doc.scene, *joint, *fieldNamed("upper"), std::optional<double>(-1.0), {hinge}, &problem), 0u);
-    EXPECT_EQ(problem, "\"hinge\" joint.upper: conflicts with joint.lower: expected at most upper (-1), got -0.5");
+    Result<std::size_t> refused =
+        setFieldOnAll(ed.doc.scene, *joint, *fieldNamed("upper"), std::optional<double>(-1.0), {hinge});
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error(), "\"hinge\" joint.upper: conflicts with joint.lower: expected at most upper (-1), got -0.5");
     EXPECT_EQ(textOf(ed.doc.scene), before);
     // Editing lower above upper names lower, as before.
-    EXPECT_EQ(setFieldOnAll(ed.doc.scene, *joint, *fieldNamed("lower"), std::optional<double>(1.0), {hinge}, &problem), 0u);
-    EXPECT_EQ(problem, "\"hinge\" joint.lower: expected at most upper (0.5), got 1");
+    refused = setFieldOnAll(ed.doc.scene, *joint, *fieldNamed("lower"), std::optional<double>(1.0), {hinge});
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error(), "\"hinge\" joint.lower: expected at most upper (0.5), got 1");
     EXPECT_EQ(textOf(ed.doc.scene), before);
 }
 
@@ -702,7 +706,7 @@ TEST(RunningEdits, TheModeSaysWhereEditsGoAndResetSaysWhatItDiscards) {
     f.ed.stepForward();
     EXPECT_EQ(f.ed.runningEditsNote(),
               "editing the running state: Reset discards any edit; Save writes the level as it was at Play");
-    ASSERT_TRUE(rename(f, f.named("crate 1"), "heavy"));
+    ASSERT_TRUE(rename(f, f.named("crate 1"), "heavy").value());
     EXPECT_EQ(f.ed.editsSincePlay(), 1u);
     EXPECT_EQ(f.ed.runningEditsNote(),
               "editing the running state: Reset discards 1 edit; Save writes the level as it was at Play");
@@ -726,11 +730,10 @@ TEST(RunningEdits, AnEditThatLeavesTheContactsKeepsTheTable) {
     const std::vector<ContactRecord> before(f.ed.sim.contacts().begin(), f.ed.sim.contacts().end());
     ASSERT_EQ(before.size(), 33u);
     const ComponentInfo* mass = findComponent("mass");
-    std::string problem;
-    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
-        return setFieldOnAll(s, *mass, mass->fields[0], 3.0, {f.named("crate 1")}, &problem) > 0;
-    }));
-    ASSERT_TRUE(rename(f, f.named("crate 2"), "heavy"));
+    ASSERT_TRUE(f.ed.tryEdit("mass", [&](Scene& s) {
+        return changedAny(setFieldOnAll(s, *mass, mass->fields[0], 3.0, {f.named("crate 1")}));
+    }).value());
+    ASSERT_TRUE(rename(f, f.named("crate 2"), "heavy").value());
     ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
     EXPECT_EQ(f.ed.sim.world()->contacts().size(), 0u) << "the recompiled World has none of its own";
     ASSERT_EQ(f.ed.sim.contacts().size(), before.size());
@@ -763,10 +766,9 @@ TEST(RunningEdits, UndoingAnEditBeforeAnyStepPutsTheIslandsItWokeBackToSleep) {
     const std::size_t contacts = f.ed.sim.contacts().size();
     const std::string before = textOf(f.ed.doc.scene);
     const ComponentInfo* mass = findComponent("mass");
-    std::string problem;
-    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
-        return setFieldOnAll(s, *mass, mass->fields[0], 3.0, {f.named("crate 1")}, &problem) > 0;
-    }));
+    ASSERT_TRUE(f.ed.tryEdit("mass", [&](Scene& s) {
+        return changedAny(setFieldOnAll(s, *mass, mass->fields[0], 3.0, {f.named("crate 1")}));
+    }).value());
     ASSERT_TRUE(f.ed.sim.ensureWorld(f.ed.doc.scene));
     EXPECT_EQ(f.ed.sim.world()->sleepingBodyCount(), 0u) << "the edit wakes the crate's island";
     ASSERT_TRUE(f.ed.undo());

@@ -24,24 +24,25 @@ TEST(Inspector, MultiSelectionEditAppliesToAllAndIsOneUndoStep) {
     const std::uint64_t key = f.ed.newMergeKey();
     // A slider drag: three values, one command.
     for (double v : {0.5, 0.7, 2.5})
-        ASSERT_TRUE(f.ed.applyEdit("edit mass", [&](Scene& s) {
-            return setFieldOnAll(s, *mass, mass->fields[0], v, f.ed.selection) > 0;
-        }, key));
+        ASSERT_TRUE(f.ed.tryEdit("edit mass", [&](Scene& s) {
+            return changedAny(setFieldOnAll(s, *mass, mass->fields[0], v, f.ed.selection));
+        }, key).value());
     f.ed.endEdit();
     for (Entity e : sel) EXPECT_EQ(f.ed.doc.scene.registry.tryGet<Mass>(e)->value, 2.5);
     EXPECT_NE(f.ed.doc.scene.registry.tryGet<Mass>(f.named("link2"))->value, 2.5);
     ASSERT_TRUE(f.ed.undo());
     EXPECT_EQ(textOf(f.ed.doc.scene), before);
     // Out of range: refused, nothing changes.
-    std::string problem;
-    EXPECT_EQ(setFieldOnAll(f.ed.doc.scene, *mass, mass->fields[0], -1.0, sel, &problem), 0u);
-    EXPECT_NE(problem.find("mass"), std::string::npos) << problem;
+    const Result<std::size_t> refused = setFieldOnAll(f.ed.doc.scene, *mass, mass->fields[0], -1.0, sel);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().find("mass"), std::string::npos) << refused.error();
     // Add and remove a component on the whole selection.
     const ComponentInfo* drag = findComponent("restitution");
     ASSERT_NE(drag, nullptr);
-    ASSERT_TRUE(f.ed.applyEdit("add", [&](Scene& s) { return addComponentToAll(s, *drag, sel) > 0; }));
+    ASSERT_TRUE(f.ed.tryEdit("add", [&](Scene& s) { return changedAny(addComponentToAll(s, *drag, sel)); }).value());
     for (Entity e : sel) EXPECT_TRUE(drag->has(f.ed.doc.scene.registry, e));
-    ASSERT_TRUE(f.ed.applyEdit("remove", [&](Scene& s) { return removeComponentFromAll(s, *drag, sel) > 0; }));
+    ASSERT_TRUE(
+        f.ed.tryEdit("remove", [&](Scene& s) { return changedAny(removeComponentFromAll(s, *drag, sel)); }).value());
     for (Entity e : sel) EXPECT_FALSE(drag->has(f.ed.doc.scene.registry, e));
 }
 
@@ -69,31 +70,36 @@ TEST(Inspector, RefusesAtEditTimeWhatTheLoaderRefusesNamingEntityAndField) {
     const std::string before = textOf(f.ed.doc.scene);
     const Entity bob = f.named("bob");
     ASSERT_TRUE(f.ed.doc.scene.registry.has<Radius>(bob));
-    std::string problem;
     // A second shape.
-    EXPECT_FALSE(f.ed.applyEdit("add box", [&](Scene& s) { return addComponentToAll(s, *findComponent("box"), {bob}, &problem) > 0; }));
-    EXPECT_EQ(problem, "\"bob\" box: an entity has at most one shape (radius, box, polygon, capsule or plane), got 2");
+    Result<bool> refused =
+        f.ed.tryEdit("add box", [&](Scene& s) { return changedAny(addComponentToAll(s, *findComponent("box"), {bob})); });
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error(), "\"bob\" box: an entity has at most one shape (radius, box, polygon, capsule or plane), got 2");
     // A speed past the fastest a level holds.
     const ComponentInfo* velocity = findComponent("velocity");
-    EXPECT_FALSE(f.ed.applyEdit("v", [&](Scene& s) {
-        return setFieldOnAll(s, *velocity, velocity->fields[0], Vec2{1e308, 0.0}, {bob}, &problem) > 0;
-    }));
-    EXPECT_EQ(problem, "\"bob\" velocity: expected each axis in [-1e+09, 1e+09], got {\"x\": 1e+308, \"y\": 0}");
+    refused = f.ed.tryEdit("v", [&](Scene& s) {
+        return changedAny(setFieldOnAll(s, *velocity, velocity->fields[0], Vec2{1e308, 0.0}, {bob}));
+    });
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error(), "\"bob\" velocity: expected each axis in [-1e+09, 1e+09], got {\"x\": 1e+308, \"y\": 0}");
     // The same numbers are refused by the loader.
     EXPECT_FALSE(parseScene(R"({"entities": [{"position": {"x": 0, "y": 0}, "velocity": {"x": 1e308, "y": 0}}]})", "t.json"));
     // A duplicate name.
-    EXPECT_FALSE(rename(f, bob, "floor", &problem));
-    EXPECT_NE(problem.find("duplicate name \"floor\""), std::string::npos) << problem;
+    refused = rename(f, bob, "floor");
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().find("duplicate name \"floor\""), std::string::npos) << refused.error();
     // Removing the position of a body that has a velocity.
-    EXPECT_FALSE(f.ed.applyEdit("rm", [&](Scene& s) {
-        return removeComponentFromAll(s, *findComponent("position"), {bob}, &problem) > 0;
-    }));
-    EXPECT_EQ(problem.rfind("\"bob\"", 0), 0u) << problem;
-    EXPECT_NE(problem.find("needs \"position\""), std::string::npos) << problem;
+    refused = f.ed.tryEdit("rm", [&](Scene& s) {
+        return changedAny(removeComponentFromAll(s, *findComponent("position"), {bob}));
+    });
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().rfind("\"bob\"", 0), 0u) << refused.error();
+    EXPECT_NE(refused.error().find("needs \"position\""), std::string::npos) << refused.error();
     // Mass out of range names the entity and the field.
     const ComponentInfo* mass = findComponent("mass");
-    EXPECT_FALSE(f.ed.applyEdit("m", [&](Scene& s) { return setFieldOnAll(s, *mass, mass->fields[0], -1.0, {bob}, &problem) > 0; }));
-    EXPECT_EQ(problem, "\"bob\" mass: expected a number in [1e-30, 1e+30], got -1");  // the loader's words
+    refused = f.ed.tryEdit("m", [&](Scene& s) { return changedAny(setFieldOnAll(s, *mass, mass->fields[0], -1.0, {bob})); });
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error(), "\"bob\" mass: expected a number in [1e-30, 1e+30], got -1");  // the loader's words
     // Nothing of it reached the scene.
     EXPECT_EQ(textOf(f.ed.doc.scene), before);
 }

@@ -178,6 +178,18 @@ bool Editor::applyEdit(const std::string& label, const std::function<bool(Scene&
     return true;
 }
 
+Result<bool> Editor::tryEdit(const std::string& label, const std::function<Result<bool>(Scene&)>& edit,
+                             std::uint64_t mergeKey) {
+    std::optional<Error> refused;
+    const bool applied = applyEdit(label, [&](Scene& s) {
+        Result<bool> changed = edit(s);
+        if (!changed) refused = changed.failure();
+        return changed && *changed;
+    }, mergeKey);
+    if (refused) return *refused;
+    return applied;
+}
+
 bool Editor::undo() {
     if (sim.running() && commands.cursor() <= playMark_) {
         note("nothing to undo since Play (R resets to the edited level)");
@@ -229,12 +241,12 @@ bool Editor::finishReferencePick(Entity target) {
         note("pick cancelled: " + displayName(doc.scene.registry, target) + " is not a body");
         return false;
     }
-    std::string problem;
     const std::string what = "set " + std::string(p.component->name) + "." + std::string(p.field->key) + " to " +
                              displayName(doc.scene.registry, target);
-    if (applyEdit(what, [&](Scene& s) { return setFieldOnAll(s, *p.component, *p.field, target, p.entities, &problem) > 0; }))
-        return true;
-    status = problem.empty() ? "nothing changed" : "refused: " + problem;
+    const Result<bool> edited =
+        tryEdit(what, [&](Scene& s) { return changedAny(setFieldOnAll(s, *p.component, *p.field, target, p.entities)); });
+    if (edited && *edited) return true;
+    status = edited ? "nothing changed" : "refused: " + edited.error();
     return false;
 }
 

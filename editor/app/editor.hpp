@@ -75,6 +75,11 @@ public:
     /// Runs an edit through the undo stack (see CommandStack::apply) and
     /// tells the simulation. `mergeKey` != 0 coalesces (use newMergeKey()).
     bool applyEdit(const std::string& label, const std::function<bool(Scene&)>& edit, std::uint64_t mergeKey = 0);
+    /// applyEdit for an edit that can be refused: true when it changed the
+    /// scene, false when it changed nothing, the edit's error when refused
+    /// (the scene is then as it was).
+    Result<bool> tryEdit(const std::string& label, const std::function<Result<bool>(Scene&)>& edit,
+                         std::uint64_t mergeKey = 0);
     void endEdit() { commands.closeMerge(); }
     std::uint64_t newMergeKey() { return ++mergeCounter_; }
     bool undo();

@@ -177,8 +177,8 @@ std::optional<Error> checkEdited(Scene& scene, const std::vector<Entity>& entiti
     return std::nullopt;
 }
 
-std::size_t setFieldOnAll(Scene& scene, const ComponentInfo& component, const FieldInfo& field,
-                          const FieldValue& value, const std::vector<Entity>& entities, std::string* problem) {
+Result<std::size_t> setFieldOnAll(Scene& scene, const ComponentInfo& component, const FieldInfo& field,
+                                  const FieldValue& value, const std::vector<Entity>& entities) {
     // Write, check the way the loader would, and put the old values back
     // on a refusal: the scene is never left in a state a file could not hold.
     std::vector<std::pair<Entity, FieldValue>> old;
@@ -208,14 +208,13 @@ std::size_t setFieldOnAll(Scene& scene, const ComponentInfo& component, const Fi
                     break;
                 }
         for (const auto& [e, v] : old) writeField(field, component.get(scene.registry, e), v);
-        if (problem) *problem = message;
-        return 0;
+        return Error{message};
     }
     return old.size();
 }
 
-std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities,
-                              std::string* problem) {
+Result<std::size_t> addComponentToAll(Scene& scene, const ComponentInfo& component,
+                                      const std::vector<Entity>& entities) {
     std::vector<Entity> added;
     for (Entity e : entities)
         if (scene.registry.alive(e) && !component.has(scene.registry, e)) {
@@ -224,14 +223,13 @@ std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, cons
         }
     if (std::optional<Error> why = checkEdited(scene, added, std::string(component.name))) {
         for (Entity e : added) component.remove(scene.registry, e);
-        if (problem) *problem = why->message;
-        return 0;
+        return *why;
     }
     return added.size();
 }
 
-std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities,
-                                   std::string* problem) {
+Result<std::size_t> removeComponentFromAll(Scene& scene, const ComponentInfo& component,
+                                           const std::vector<Entity>& entities) {
     // Removal is checked on a copy of what goes: a body that loses its
     // position while it keeps a velocity would not load.
     std::vector<Entity> from;
@@ -242,10 +240,7 @@ std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component,
     for (Entity e : from) component.remove(trial.registry, e);
     std::vector<Entity> touched = from;
     for (Entity s : attachedTo(trial.registry, from)) touched.push_back(s);
-    if (std::optional<Error> why = checkEdited(trial, touched, std::string(component.name))) {
-        if (problem) *problem = why->message;
-        return 0;
-    }
+    if (std::optional<Error> why = checkEdited(trial, touched, std::string(component.name))) return *why;
     std::size_t n = 0;
     for (Entity e : from) n += component.remove(scene.registry, e) ? 1 : 0;
     return n;
@@ -535,21 +530,16 @@ std::vector<Vec2> regularPolygon(int sides, double radius, double angle) {
     return v;
 }
 
-Entity addPolygon(Scene& scene, const std::vector<Vec2>& worldVertices, std::string* problem) {
+Result<Entity> addPolygon(Scene& scene, const std::vector<Vec2>& worldVertices) {
     // The position is the centroid, so the centre of mass is the position
     // and the outline is stored about it.
-    if (std::optional<Error> why = polygonProblem(worldVertices)) {
-        if (problem) *problem = "polygon: " + why->message;
-        return {};
-    }
+    if (std::optional<Error> why = polygonProblem(worldVertices)) return Error{"polygon: " + why->message};
     const Vec2 centroid = polygonMassProperties(worldVertices).centroid;
     Polygon poly;
     poly.vertices.clear();
     for (const Vec2 v : worldVertices) poly.vertices.push_back(v - centroid);
-    if (std::optional<Error> why = polygonProblem(poly.vertices)) {  // rounding can merge tiny edges
-        if (problem) *problem = "polygon: " + why->message;
-        return {};
-    }
+    if (std::optional<Error> why = polygonProblem(poly.vertices))  // rounding can merge tiny edges
+        return Error{"polygon: " + why->message};
     const Entity e = newBody(scene, "polygon", centroid, Rgb{0.62, 0.55, 0.95});
     scene.registry.emplace(e, std::move(poly));
     scene.registry.emplace(e, Angle{0.0});
@@ -632,17 +622,14 @@ Entity addAnchoredSpring(Scene& scene, Entity a, Vec2 anchor) {
     return addPaletteSpring(scene.registry, a, std::move(s), anchor);
 }
 
-Entity addJoint(Scene& scene, const std::string& type, Entity a, Entity b, Vec2 anchor, std::string* problem) {
+Result<Entity> addJoint(Scene& scene, const std::string& type, Entity a, Entity b, Vec2 anchor) {
     Registry& reg = scene.registry;
     const auto isFixed = [&](Entity e) {
         if (e.isNull()) return true;
         const Static* st = reg.tryGet<Static>(e);
         return st && st->value;
     };
-    if (isFixed(a) && isFixed(b)) {
-        if (problem) *problem = "a joint needs at least one dynamic body";
-        return {};
-    }
+    if (isFixed(a) && isFixed(b)) return Error{"a joint needs at least one dynamic body"};
     nameForSpring(reg, a);
     if (!b.isNull()) nameForSpring(reg, b);
     Joint j;
@@ -663,10 +650,7 @@ Entity addJoint(Scene& scene, const std::string& type, Entity a, Entity b, Vec2 
     } else {
         j.anchor = anchor;
     }
-    if (std::string why = completeJoint(reg, j); !why.empty()) {
-        if (problem) *problem = why;
-        return {};
-    }
+    if (std::optional<Error> why = completeJoint(reg, j)) return Error{why->text()};
     const Entity e = reg.create();
     reg.emplace(e, Name{uniqueName(reg, "joint")});
     reg.emplace(e, std::move(j));

@@ -64,16 +64,27 @@ std::string describeRefusal(const Scene& scene, const std::string& problem, cons
 
 /// Sets one field on every entity of `entities` that has the component, then
 /// runs checkEdited. Returns how many were changed; on a refusal nothing is
-/// changed, 0 is returned and `problem` says why (entity and field named).
-std::size_t setFieldOnAll(Scene& scene, const ComponentInfo& component, const FieldInfo& field,
-                          const FieldValue& value, const std::vector<Entity>& entities, std::string* problem = nullptr);
+/// changed and the error says why (entity and field named).
+Result<std::size_t> setFieldOnAll(Scene& scene, const ComponentInfo& component, const FieldInfo& field,
+                                  const FieldValue& value, const std::vector<Entity>& entities);
 /// Adds the component (default value) to each entity that lacks it; refused
 /// like setFieldOnAll (e.g. a box on a circle: one shape per body).
-std::size_t addComponentToAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities,
-                              std::string* problem = nullptr);
+Result<std::size_t> addComponentToAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities);
 /// Removes it from each that has it; refused like setFieldOnAll.
-std::size_t removeComponentFromAll(Scene& scene, const ComponentInfo& component, const std::vector<Entity>& entities,
-                                   std::string* problem = nullptr);
+Result<std::size_t> removeComponentFromAll(Scene& scene, const ComponentInfo& component,
+                                           const std::vector<Entity>& entities);
+/// An edit's answer for Editor::tryEdit: whether it changed anything, or
+/// why it was refused.
+inline Result<bool> changedAny(const Result<std::size_t>& count) {
+    if (!count) return count.failure();
+    return count.value() > 0;
+}
+/// The same for an edit that creates an entity, which lands in `out`.
+inline Result<bool> createdInto(const Result<Entity>& made, Entity& out) {
+    if (!made) return made.failure();
+    out = made.value();
+    return true;
+}
 
 /// Unique entity names for a burst of creations (paste, generated levels):
 /// the names in use are gathered once, O(n), and each take() is O(1)
@@ -146,9 +157,9 @@ std::vector<Vec2> convexHull(std::vector<Vec2> points);
 /// `radius` metres from the centre.
 std::vector<Vec2> regularPolygon(int sides, double radius, double angle);
 /// A dynamic polygon body from world-space vertices (convex,
-/// counter-clockwise), positioned at their centroid. Null, with `problem`
-/// set, when polygonProblem() refuses them.
-Entity addPolygon(Scene& scene, const std::vector<Vec2>& worldVertices, std::string* problem = nullptr);
+/// counter-clockwise), positioned at their centroid. Refused when
+/// polygonProblem() refuses them.
+Result<Entity> addPolygon(Scene& scene, const std::vector<Vec2>& worldVertices);
 Entity addBox(Scene& scene, Vec2 at, double width = 1.0, double height = 1.0);
 /// A wall through `through` with the given normal (normalised here).
 Entity addPlane(Scene& scene, Vec2 through, Vec2 normal);
@@ -165,10 +176,9 @@ Entity addSpring(Scene& scene, Entity a, Entity b);
 Entity addAnchoredSpring(Scene& scene, Entity a, Vec2 anchor);
 /// A joint of `type` from body `a` to body `b` (null: the world) at world
 /// point `anchor` (for distance and rope: from a's centre to `anchor`).
-/// Unnamed ends get names (files name them). Returns the null entity, with
-/// `problem` set, when the joint would be refused (two static ends).
-Entity addJoint(Scene& scene, const std::string& type, Entity a, Entity b, Vec2 anchor,
-                std::string* problem = nullptr);
+/// Unnamed ends get names (files name them). Refused when the file would
+/// refuse the joint (two static ends).
+Result<Entity> addJoint(Scene& scene, const std::string& type, Entity a, Entity b, Vec2 anchor);
 /// A static attractor of `mass` kg.
 Entity addAttractor(Scene& scene, Vec2 at, double mass = 100.0);
 /// A boid at `at` with velocity `velocity`.

@@ -360,18 +360,16 @@ void drawInspector(UiState& ui, Editor& ed) {
                         ui.activeWidget = id;
                         ui.activeKey = ed.newMergeKey();
                     }
-                    std::string problem;
                     std::string what = "edit ";
                     what += info.name;
                     if (!f.key.empty()) {
                         what += '.';
                         what += f.key;
                     }
-                    if (!ed.applyEdit(what, [&](Scene& s) {
-                            return editor::setFieldOnAll(s, info, f, value, selection, &problem) > 0;
-                        }, ui.activeKey) &&
-                        !problem.empty())
-                        ed.status = "refused: " + problem;
+                    const Result<bool> edited = ed.tryEdit(what, [&](Scene& s) {
+                        return editor::changedAny(editor::setFieldOnAll(s, info, f, value, selection));
+                    }, ui.activeKey);
+                    if (!edited) ed.status = "refused: " + edited.error();
                 }
                 if (ImGui::IsItemDeactivated()) ed.endEdit();
                 ImGui::PopID();
@@ -383,11 +381,10 @@ void drawInspector(UiState& ui, Editor& ed) {
     if (selection.size() == 1) drawExcludedPartners(ed.doc.scene, primary);
     if (toRemove) {
         const ComponentInfo& info = *toRemove;
-        std::string problem;
-        if (!ed.applyEdit("remove " + std::string(info.name),
-                          [&](Scene& s) { return editor::removeComponentFromAll(s, info, selection, &problem) > 0; }) &&
-            !problem.empty())
-            ed.status = "refused: " + problem;
+        const Result<bool> edited = ed.tryEdit("remove " + std::string(info.name), [&](Scene& s) {
+            return editor::changedAny(editor::removeComponentFromAll(s, info, selection));
+        });
+        if (!edited) ed.status = "refused: " + edited.error();
     }
 
     ImGui::Separator();
@@ -397,11 +394,10 @@ void drawInspector(UiState& ui, Editor& ed) {
             const bool all = std::all_of(selection.begin(), selection.end(), [&](Entity e) { return info.has(reg, e); });
             if (all) continue;
             if (ImGui::Selectable(std::string(info.name).c_str())) {
-                std::string problem;
-                if (!ed.applyEdit("add " + std::string(info.name),
-                                  [&](Scene& s) { return editor::addComponentToAll(s, info, selection, &problem) > 0; }) &&
-                    !problem.empty())
-                    ed.status = "refused: " + problem;
+                const Result<bool> edited = ed.tryEdit("add " + std::string(info.name), [&](Scene& s) {
+                    return editor::changedAny(editor::addComponentToAll(s, info, selection));
+                });
+                if (!edited) ed.status = "refused: " + edited.error();
             }
             if (ImGui::IsItemHovered() && !info.description.empty())
                 ImGui::SetTooltip("%.*s", int(info.description.size()), info.description.data());

@@ -859,18 +859,16 @@ Result<Scene> parseSceneUnchecked(std::string_view text, std::string_view source
     for (std::size_t i = 0; i < entities.size(); ++i) {
         Joint* joint = scene.registry.tryGet<Joint>(entities[i]);
         if (!joint) continue;
-        if (std::string problem = completeJoint(scene.registry, *joint); !problem.empty()) {
-            const auto colon = problem.find(':');
-            return Error{prefix + child("/entities", i) + "/joint/" + problem.substr(0, colon) + ": joint on " +
-                         entityLabelOf(scene.registry, i) + ": " + problem.substr(colon + 2)};
-        }
+        if (std::optional<Error> problem = completeJoint(scene.registry, *joint))
+            return Error{prefix + child("/entities", i) + "/joint/" + problem->where + ": joint on " +
+                         entityLabelOf(scene.registry, i) + ": " + problem->message};
     }
     return scene;
 }
 
 } // namespace
 
-std::string completeJoint(const Registry& registry, Joint& joint) {
+std::optional<Error> completeJoint(const Registry& registry, Joint& joint) {
     // Pose of an end: position and angle of a body, the identity for the world.
     struct Pose {
         Vec2 position;
@@ -899,8 +897,9 @@ std::string completeJoint(const Registry& registry, Joint& joint) {
         // Derived values are saved, so they must be what a level may hold.
         const auto inRange = [](Vec2 v) { return std::abs(v.x) <= kMaxMagnitude && std::abs(v.y) <= kMaxMagnitude; };
         if (!inRange(localA) || !inRange(localB))
-            return "anchor: too far from the bodies to express in their frames (past " + formatNumber(kMaxMagnitude) +
-                   " m on an axis)";
+            return Error{"too far from the bodies to express in their frames (past " + formatNumber(kMaxMagnitude) +
+                             " m on an axis)",
+                         "anchor"};
         joint.localA = localA;
         joint.localB = localB;
         joint.anchor.reset();
@@ -909,8 +908,9 @@ std::string completeJoint(const Registry& registry, Joint& joint) {
     if (angular && !joint.referenceAngle) {
         const double reference = b.angle - a.angle;
         if (!(std::abs(reference) <= kMaxMagnitude))
-            return "reference_angle: the bodies' angles differ by more than " + formatNumber(kMaxMagnitude) +
-                   " rad; give \"reference_angle\"";
+            return Error{"the bodies' angles differ by more than " + formatNumber(kMaxMagnitude) +
+                             " rad; give \"reference_angle\"",
+                         "reference_angle"};
         joint.referenceAngle = reference;
     }
     const bool hasLength = joint.type == "distance" || joint.type == "rope";
@@ -918,11 +918,12 @@ std::string completeJoint(const Registry& registry, Joint& joint) {
         const double d = length(toWorld(b, joint.localB) - toWorld(a, joint.localA));
         // As a spring's rest length: the saved length must load again.
         if (!(d <= kMaxMagnitude))
-            return "length: the anchors are " + formatNumber(d) + " m apart, past the " + formatNumber(kMaxMagnitude) +
-                   " m a length may be; give \"length\"";
+            return Error{"the anchors are " + formatNumber(d) + " m apart, past the " + formatNumber(kMaxMagnitude) +
+                             " m a length may be; give \"length\"",
+                         "length"};
         joint.length = d;
     }
-    return {};
+    return std::nullopt;
 }
 
 Result<Scene> parseScene(std::string_view text, std::string_view sourceName, const LoadLimits& limits) {

@@ -50,14 +50,11 @@ void Editor::pressJoint(const ToolPress& press) {
     springStart_ = {};
     const Entity b = !hit.isNull() && hit != a && isBody(reg, hit) ? hit : Entity{};
     Entity created;
-    std::string problem;
-    if (applyEdit("place " + jointType + " joint", [&](Scene& s) {
-            created = addJoint(s, jointType, a, b, snapped(world), &problem);
-            return !created.isNull();
-        }))
-        selection = {created};
-    else if (!problem.empty())
-        note("joint refused: " + problem);
+    const Result<bool> placed = tryEdit("place " + jointType + " joint", [&](Scene& s) {
+        return createdInto(addJoint(s, jointType, a, b, snapped(world)), created);
+    });
+    if (placed && *placed) selection = {created};
+    else if (!placed) note("joint refused: " + placed.error());
 }
 
 } // namespace stepwise::editor

@@ -43,14 +43,10 @@ void Editor::releaseRegularPolygon() {
         return;
     }
     Entity created;
-    std::string problem;
-    if (applyEdit("place polygon", [&](Scene& s) {
-            created = addPolygon(s, outline, &problem);
-            return !created.isNull();
-        }))
-        selection = {created};
-    else if (!problem.empty())
-        note("refused: " + problem);
+    const Result<bool> placed =
+        tryEdit("place polygon", [&](Scene& s) { return createdInto(addPolygon(s, outline), created); });
+    if (placed && *placed) selection = {created};
+    else if (!placed) note("refused: " + placed.error());
 }
 
 std::vector<Vec2> Editor::polygonPreview() const {
@@ -78,17 +74,15 @@ std::vector<Vec2> Editor::regularOutline() const {
 bool Editor::finishPolygon() {
     const std::vector<Vec2> hull = convexHull(polygonClicks_);
     polygonClicks_.clear();
-    std::string problem;
     Entity created;
     if (hull.size() < 3) {
         note("polygon: needs 3 vertices that are not on one line");
         return false;
     }
-    if (!applyEdit("place polygon", [&](Scene& s) {
-            created = addPolygon(s, hull, &problem);
-            return !created.isNull();
-        })) {
-        note("refused: " + problem);
+    const Result<bool> placed =
+        tryEdit("place polygon", [&](Scene& s) { return createdInto(addPolygon(s, hull), created); });
+    if (!placed || !*placed) {
+        note(placed ? "nothing changed" : "refused: " + placed.error());
         return false;
     }
     selection = {created};

@@ -54,7 +54,9 @@ public:
     T& value() { assert(ok()); return std::get<0>(data_); }
     const T& value() const { assert(ok()); return std::get<0>(data_); }
     T& operator*() { return value(); }
+    const T& operator*() const { return value(); }
     T* operator->() { return &value(); }
+    const T* operator->() const { return &value(); }
     /// The whole message, place included ("WHERE: MESSAGE").
     std::string error() const { return failure().text(); }
     const Error& failure() const { assert(!ok()); return std::get<1>(data_); }

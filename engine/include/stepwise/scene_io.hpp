@@ -129,8 +129,8 @@ struct Joint;
 /// becomes `local_a` / `local_b` (and is cleared), a missing
 /// `reference_angle` becomes b's angle minus a's (hinge, slider, weld), a
 /// missing `length` the anchors' distance (distance, rope). The ends must
-/// pass checkSceneRelations. Returns "" or "FIELD: message".
-std::string completeJoint(const Registry& registry, Joint& joint);
+/// pass checkSceneRelations. A refusal's `where` is the joint's field.
+std::optional<Error> completeJoint(const Registry& registry, Joint& joint);
 
 } // namespace stepwise
 

@@ -104,9 +104,11 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         const Joint* stored = reg.tryGet<Joint>(order[i]);
         if (!stored) continue;
         // A scene built in code may leave anchor, reference_angle or length
-        // to their defaults; the loader has already filled them for files.
+        // to their defaults; the loader has already filled them for files
+        // and refused what cannot be filled, so a refusal here leaves the
+        // defaults.
         Joint completed = *stored;
-        completeJoint(reg, completed);
+        (void)completeJoint(reg, completed);
         const Joint* joint = &completed;
         joints::JointConstraint j;
         j.kind = jointKindOf(joint->type);
