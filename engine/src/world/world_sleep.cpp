@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <unordered_map>
+#include <span>
+#include <utility>
+#include <vector>
 
 namespace stepwise {
 
@@ -100,6 +102,26 @@ bool sameJoint(const joints::JointConstraint& a, const joints::JointConstraint& 
 
 /// The settings that change how bodies move (time and the dopri5 step are
 /// state, not settings).
+/// A value per live entity, looked up through the handle: a table indexed
+/// by the entity's slot that checks the generation, so a lookup is one
+/// array read (no hashing) and a handle to a destroyed entity finds nothing.
+class EntitySlots {
+public:
+    static constexpr std::uint32_t kNone = ~std::uint32_t(0);
+    void set(Entity e, std::uint32_t value) {
+        if (e.isNull()) return;
+        if (e.index >= slots_.size()) slots_.resize(std::size_t(e.index) + 1, {0, kNone});
+        slots_[e.index] = {e.generation, value};
+    }
+    std::uint32_t find(Entity e) const {
+        if (e.isNull() || e.index >= slots_.size() || slots_[e.index].first != e.generation) return kNone;
+        return slots_[e.index].second;
+    }
+
+private:
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> slots_;  // (generation, value)
+};
+
 bool sameMotionSettings(WorldSettings a, WorldSettings b) {
     a.time = b.time;
     a.adaptiveStep = b.adaptiveStep;
@@ -120,22 +142,21 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
     // Settings: judged at the next step (wakeForChangedSettings).
     sleptUnder = before.sleptUnder;
     if (!sleep.anyAsleep()) return;
-    std::unordered_map<Entity, std::uint32_t> bodyOf, oldBodyOf;
-    for (std::size_t b = 0; b < bodyEntity.size(); ++b) bodyOf.emplace(bodyEntity[b], std::uint32_t(b));
-    for (std::size_t b = 0; b < before.bodyEntity.size(); ++b) oldBodyOf.emplace(before.bodyEntity[b], std::uint32_t(b));
+    EntitySlots bodyOf, oldBodyOf;
+    for (std::size_t b = 0; b < bodyEntity.size(); ++b) bodyOf.set(bodyEntity[b], std::uint32_t(b));
+    for (std::size_t b = 0; b < before.bodyEntity.size(); ++b) oldBodyOf.set(before.bodyEntity[b], std::uint32_t(b));
     const auto wakeEntity = [&](Entity e) {
-        if (const auto it = bodyOf.find(e); it != bodyOf.end()) sleep.wake(it->second);
+        if (const std::uint32_t b = bodyOf.find(e); b != EntitySlots::kNone) sleep.wake(b);
     };
     // Bodies: state and parameters, bit for bit (an untouched body was
     // written back from the old World and reads back the same).
     const double *px = xs(), *pv = vs(), *ox = before.xs(), *ov = before.vs();
     for (std::size_t b = 0; b < bodyEntity.size(); ++b) {
         if (sleep.island[b] < 0) continue;
-        const auto it = oldBodyOf.find(bodyEntity[b]);
-        const std::size_t o = it == oldBodyOf.end() ? 0 : it->second;
-        const bool same = it != oldBodyOf.end() && sameBits(px[2 * b], ox[2 * o]) && sameBits(px[2 * b + 1], ox[2 * o + 1]) &&
-                          sameBits(pv[2 * b], ov[2 * o]) && sameBits(pv[2 * b + 1], ov[2 * o + 1]) &&
-                          sameBits(model.mass[b], before.model.mass[o]) &&
+        const std::uint32_t o = oldBodyOf.find(bodyEntity[b]);
+        const bool same = o != EntitySlots::kNone && sameBits(px[2 * b], ox[2 * o]) &&
+                          sameBits(px[2 * b + 1], ox[2 * o + 1]) && sameBits(pv[2 * b], ov[2 * o]) &&
+                          sameBits(pv[2 * b + 1], ov[2 * o + 1]) && sameBits(model.mass[b], before.model.mass[o]) &&
                           sameBits(model.dragOn ? model.dragB[b] : 0.0, before.model.dragOn ? before.model.dragB[o] : 0.0);
         if (!same) sleep.wake(std::uint32_t(b));
     }
@@ -143,22 +164,22 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
     // may hold up any island); a changed body's shape, angle or spin wakes
     // its island; a removed shape wakes what it touched (its cached contacts).
     if (collision || before.collision) {
-        std::unordered_map<Entity, std::size_t> oldCollider;
-        if (before.collision)
-            for (std::size_t c = 0; c < before.collision->colliderCount(); ++c)
-                oldCollider.emplace(before.collision->collider(c).entity, c);
+        EntitySlots oldCollider, newCollider;
         std::size_t staticCount = 0, oldStaticCount = 0;
         if (before.collision)
-            for (std::size_t c = 0; c < before.collision->colliderCount(); ++c)
+            for (std::size_t c = 0; c < before.collision->colliderCount(); ++c) {
+                oldCollider.set(before.collision->collider(c).entity, std::uint32_t(c));
                 oldStaticCount += before.collision->collider(c).body < 0 ? 1 : 0;
+            }
         bool staticEdited = false;
         if (collision)
             for (std::size_t c = 0; c < collision->colliderCount(); ++c) {
                 const collision::Collider& col = collision->collider(c);
-                const auto it = oldCollider.find(col.entity);
-                const bool same = it != oldCollider.end() && sameCollider(col, before.collision->collider(it->second)) &&
-                                  sameBits(collision->angle(c), before.collision->angle(it->second)) &&
-                                  sameBits(collision->angularVelocity(c), before.collision->angularVelocity(it->second));
+                newCollider.set(col.entity, std::uint32_t(c));
+                const std::uint32_t o = oldCollider.find(col.entity);
+                const bool same = o != EntitySlots::kNone && sameCollider(col, before.collision->collider(o)) &&
+                                  sameBits(collision->angle(c), before.collision->angle(o)) &&
+                                  sameBits(collision->angularVelocity(c), before.collision->angularVelocity(o));
                 if (col.body < 0) {
                     ++staticCount;
                     staticEdited = staticEdited || !same;
@@ -168,49 +189,46 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
             }
         if (staticEdited || staticCount != oldStaticCount) sleep.wakeAll();
         if (before.collision) {
-            std::unordered_map<Entity, bool> present;
-            if (collision)
-                for (std::size_t c = 0; c < collision->colliderCount(); ++c) present.emplace(collision->collider(c).entity, true);
             const std::vector<Entity>& oldColliders = before.layout->colliders;
             for (const CachedImpulse& e : before.collision->warmStartCache()) {
                 const Entity a = oldColliders[e.colliderA()], b = oldColliders[e.colliderB()];
-                if (!present.count(a)) wakeEntity(b);
-                if (!present.count(b)) wakeEntity(a);
+                if (newCollider.find(a) == EntitySlots::kNone) wakeEntity(b);
+                if (newCollider.find(b) == EntitySlots::kNone) wakeEntity(a);
             }
         }
         // Joints: changed, added or removed ones wake both ends.
-        std::unordered_map<Entity, const joints::JointConstraint*> oldJoints;
-        if (before.collision)
-            for (const joints::JointConstraint& j : before.collision->jointConstraints()) oldJoints.emplace(j.entity, &j);
-        std::unordered_map<Entity, bool> jointKept;
+        EntitySlots oldJoint, kept;
+        const std::span<const joints::JointConstraint> oldJoints =
+            before.collision ? before.collision->jointConstraints() : std::span<const joints::JointConstraint>{};
+        for (std::size_t j = 0; j < oldJoints.size(); ++j) oldJoint.set(oldJoints[j].entity, std::uint32_t(j));
         if (collision)
             for (const joints::JointConstraint& j : collision->jointConstraints()) {
-                const auto it = oldJoints.find(j.entity);
-                if (it != oldJoints.end()) jointKept.emplace(j.entity, true);
-                if (it == oldJoints.end() || !sameJoint(j, *it->second)) {
+                const std::uint32_t o = oldJoint.find(j.entity);
+                if (o != EntitySlots::kNone) kept.set(j.entity, 1);
+                if (o == EntitySlots::kNone || !sameJoint(j, oldJoints[o])) {
                     wakeEntity(j.entityA);
                     wakeEntity(j.entityB);
                 }
             }
-        for (const auto& [entity, j] : oldJoints)
-            if (!jointKept.count(entity)) {
-                wakeEntity(j->entityA);
-                wakeEntity(j->entityB);
+        for (const joints::JointConstraint& j : oldJoints)
+            if (kept.find(j.entity) == EntitySlots::kNone) {
+                wakeEntity(j.entityA);
+                wakeEntity(j.entityB);
             }
     }
     // Springs: the same, by entity.
-    std::unordered_map<Entity, const detail::SpringData*> oldSprings;
-    for (const detail::SpringData& s : before.model.springs) oldSprings.emplace(s.entity, &s);
+    EntitySlots oldSpring, springKept;
+    for (std::size_t i = 0; i < before.model.springs.size(); ++i)
+        oldSpring.set(before.model.springs[i].entity, std::uint32_t(i));
     const auto endEntity = [](const WorldImpl& w, std::uint32_t body) {
         return body == detail::kNoBody ? Entity{} : w.bodyEntity[body];
     };
-    std::unordered_map<Entity, bool> springKept;
     for (const detail::SpringData& s : model.springs) {
-        const auto it = oldSprings.find(s.entity);
-        bool same = it != oldSprings.end();
+        const std::uint32_t i = oldSpring.find(s.entity);
+        bool same = i != EntitySlots::kNone;
         if (same) {
-            const detail::SpringData& o = *it->second;
-            springKept.emplace(s.entity, true);
+            const detail::SpringData& o = before.model.springs[i];
+            springKept.set(s.entity, 1);
             same = endEntity(*this, s.a) == endEntity(before, o.a) && endEntity(*this, s.b) == endEntity(before, o.b) &&
                    sameBits(s.k, o.k) && sameBits(s.c, o.c) && sameBits(s.rest, o.rest) && sameBits(s.fx, o.fx) &&
                    sameBits(s.fy, o.fy);
@@ -220,10 +238,10 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
             if (s.b != detail::kNoBody) sleep.wake(s.b);
         }
     }
-    for (const auto& [entity, o] : oldSprings)
-        if (!springKept.count(entity)) {
-            wakeEntity(endEntity(before, o->a));
-            wakeEntity(endEntity(before, o->b));
+    for (const detail::SpringData& o : before.model.springs)
+        if (springKept.find(o.entity) == EntitySlots::kNone) {
+            wakeEntity(endEntity(before, o.a));
+            wakeEntity(endEntity(before, o.b));
         }
     sleepChanged();
 }
