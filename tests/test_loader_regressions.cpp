@@ -12,6 +12,7 @@
 
 #include "test_support.hpp"
 
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -153,9 +154,14 @@ TEST(LoaderRegressions, RefusingTooManyEntitiesTakesLinearTime) {
         }
         return seconds;
     };
+    // The fastest of three runs of each: on a shared machine a single run
+    // can be descheduled for longer than the whole measurement.
+    const auto fastest = [&](std::size_t limit) {
+        return std::min({timeToRefuse(limit), timeToRefuse(limit), timeToRefuse(limit)});
+    };
     timeToRefuse(20'000);  // warm up the allocator
-    const double small = timeToRefuse(100'000);
-    const double large = timeToRefuse(1'000'000);
+    const double small = fastest(100'000);
+    const double large = fastest(1'000'000);
     EXPECT_LT(large, 30.0 * small) << "100,001 entities: " << small << " s; 1,000,001: " << large << " s";
 }
 
