@@ -74,13 +74,15 @@ Bodies bodiesOf(const Scene& scene) {
     const Registry& r = scene.registry;
     for (Entity e : r.entities()) {
         if (!r.has<Position>(e) || isStatic(r, e) || !hasShape(r, e)) continue;
-        const Shapes* shapes = r.tryGet<Shapes>(e);
-        const std::optional<CompoundMassProperties> compound =
-            shapes ? std::optional(compoundMassProperties(
-                         *shapes, r.has<Mass>(e) ? std::optional(r.tryGet<Mass>(e)->value) : std::nullopt))
-                   : std::nullopt;
-        const double m = compound ? compound->mass : r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
-        double inertia = compound ? compound->inertia : 0.0, radius = 0.0;
+        double m = r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
+        double inertia = 0.0, radius = 0.0;
+        if (const Shapes* shapes = r.tryGet<Shapes>(e)) {
+            const Mass* given = r.tryGet<Mass>(e);
+            const CompoundMassProperties props =
+                compoundMassProperties(*shapes, given ? std::optional<double>(given->value) : std::nullopt);
+            m = props.mass;
+            inertia = props.inertia;
+        }
         if (const Radius* c = r.tryGet<Radius>(e)) {
             inertia = 0.5 * m * c->value * c->value;
             radius = c->value;
