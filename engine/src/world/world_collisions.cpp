@@ -344,6 +344,18 @@ double halfExtentAlong(const Registry& reg, Entity e, Vec2 dir) {
         return 0.5 * (hi - lo);
     }
     if (const Capsule* cap = reg.tryGet<Capsule>(e)) return 0.5 * std::abs(dot(cap->b - cap->a, local)) + cap->radius;
+    if (const Shapes* shapes = reg.tryGet<Shapes>(e)) {
+        // The whole body's extent: over every shape's outline.
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (const CompoundShape& s : shapes->items) {
+            const ShapeOutline outline = compoundShapeOutline(s);
+            for (const Vec2 v : outline.points) {
+                lo = std::min(lo, dot(v, local) - outline.radius);
+                hi = std::max(hi, dot(v, local) + outline.radius);
+            }
+        }
+        return hi >= lo ? 0.5 * (hi - lo) : 0.0;
+    }
     return 0.0;
 }
 
@@ -352,11 +364,23 @@ double halfExtentAlong(const Registry& reg, Entity e, Vec2 dir) {
 double centreAlong(const Registry& reg, Entity e, Vec2 dir) {
     const Polygon* p = reg.tryGet<Polygon>(e);
     const Capsule* cap = p ? nullptr : reg.tryGet<Capsule>(e);
-    if ((!p || p->vertices.empty()) && !cap) return 0.0;
+    const Shapes* shapes = p || cap ? nullptr : reg.tryGet<Shapes>(e);
+    if ((!p || p->vertices.empty()) && !cap && !shapes) return 0.0;
     const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
     const double c = std::cos(angle), s = std::sin(angle);
     const Vec2 local{c * dir.x + s * dir.y, -s * dir.x + c * dir.y};
     if (cap) return 0.5 * dot(cap->a + cap->b, local);
+    if (shapes) {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (const CompoundShape& item : shapes->items) {
+            const ShapeOutline outline = compoundShapeOutline(item);
+            for (const Vec2 v : outline.points) {
+                lo = std::min(lo, dot(v, local) - outline.radius);
+                hi = std::max(hi, dot(v, local) + outline.radius);
+            }
+        }
+        return hi >= lo ? 0.5 * (lo + hi) : 0.0;
+    }
     double lo = dot(p->vertices[0], local), hi = lo;
     for (const Vec2& v : p->vertices) {
         lo = std::min(lo, dot(v, local));
@@ -404,7 +428,9 @@ double springRate(const Scene& scene, const SystemSwitches& switches) {
         if (e.isNull() || !reg.alive(e) || !reg.has<Position>(e)) return 0.0;
         if (const Static* st = reg.tryGet<Static>(e); st && st->value) return 0.0;
         if (const Kinematic* k = reg.tryGet<Kinematic>(e); k && k->value) return 0.0;
-        return reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0;
+        if (reg.has<Mass>(e)) return reg.tryGet<Mass>(e)->value;
+        const Shapes* shapes = reg.tryGet<Shapes>(e);
+        return shapes ? compoundMassProperties(*shapes, std::nullopt).mass : 1.0;
     };
     std::unordered_map<std::uint32_t, std::pair<double, double>> rows;  // entity index -> (stiffness, damping)
     for (const Entity e : reg.entities()) {
@@ -481,10 +507,15 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     };
     // With contacts switched off no shape takes part.
     const auto hasShape = [&](Entity e) {
-        return switches.collisions && (reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) || reg.has<Capsule>(e));
+        return switches.collisions && (reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) ||
+                                       reg.has<Capsule>(e) || reg.has<Shapes>(e));
     };
     const auto dynamic = [&](Entity e) { return reg.alive(e) && reg.has<Position>(e) && !isStatic(e); };
-    const auto massOf = [&](Entity e) { return reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0; };
+    const auto massOf = [&](Entity e) {
+        if (reg.has<Mass>(e)) return reg.tryGet<Mass>(e)->value;
+        const Shapes* shapes = reg.tryGet<Shapes>(e);
+        return shapes ? compoundMassProperties(*shapes, std::nullopt).mass : 1.0;
+    };
     const auto sizeOf = [&](Entity e) {
         return hasShape(e) ? 2.0 * std::max(halfExtentAlong(reg, e, across), halfExtentAlong(reg, e, down))
                            : 2.0 * detail::kShapelessRadius;

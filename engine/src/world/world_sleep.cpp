@@ -143,10 +143,15 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
     // may hold up any island); a changed body's shape, angle or spin wakes
     // its island; a removed shape wakes what it touched (its cached contacts).
     if (collision || before.collision) {
-        std::unordered_map<Entity, std::size_t> oldCollider;
+        // Keyed by entity and shape: a compound body has a hub and a
+        // collider per shape.
+        const auto keyOf = [](const collision::Collider& c) {
+            return (std::uint64_t(c.entity.index) << 32) | std::uint64_t(std::uint32_t(c.part + 1));
+        };
+        std::unordered_map<std::uint64_t, std::size_t> oldCollider;
         if (before.collision)
             for (std::size_t c = 0; c < before.collision->colliderCount(); ++c)
-                oldCollider.emplace(before.collision->collider(c).entity, c);
+                oldCollider.emplace(keyOf(before.collision->collider(c)), c);
         std::size_t staticCount = 0, oldStaticCount = 0;
         if (before.collision)
             for (std::size_t c = 0; c < before.collision->colliderCount(); ++c)
@@ -155,8 +160,10 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
         if (collision)
             for (std::size_t c = 0; c < collision->colliderCount(); ++c) {
                 const collision::Collider& col = collision->collider(c);
-                const auto it = oldCollider.find(col.entity);
-                const bool same = it != oldCollider.end() && sameCollider(col, before.collision->collider(it->second)) &&
+                const auto it = oldCollider.find(keyOf(col));
+                const bool same = it != oldCollider.end() &&
+                                  before.collision->collider(it->second).entity == col.entity &&
+                                  sameCollider(col, before.collision->collider(it->second)) &&
                                   sameBits(collision->angle(c), before.collision->angle(it->second)) &&
                                   sameBits(collision->angularVelocity(c), before.collision->angularVelocity(it->second));
                 if (col.body < 0) {
