@@ -16,6 +16,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -164,6 +169,28 @@ TEST(CompoundFormat, RoundTripsByteForByte) {
     EXPECT_EQ(shapes->items[1].sensor, true);
     EXPECT_EQ(shapes->items[2].filter->group, -3);
     EXPECT_EQ(shapes->items[2].filter->mask, 4294967293u);
+}
+
+TEST(CompoundFormat, ValidateCountsTheShapesAndTheirMaterialActs) {
+    // Friction on a compound body acts (it collides): validate notes
+    // nothing, and its summary counts the bodies and their shapes.
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "stepwise_compound_validate";
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path file = dir / "ell.json", out = dir / "out.txt", err = dir / "err.txt";
+    std::ofstream(file) << level("{\"name\": \"ell\", \"position\": {\"x\": 0, \"y\": 1}, \"friction\": 0.5, "
+                                 "\"shapes\": [" + boxItem(0, 0, 2, 0.5) + ", " + boxItem(0.75, 1, 0.5, 1.5) +
+                                 "]}, {\"name\": \"bell\", \"position\": {\"x\": 3, \"y\": 1}, \"shapes\": [" +
+                                 circleItem(-1, 0, 0.3) + ", " + circleItem(1, 0, 0.3) + ", " +
+                                 capsuleItem({-1, 0}, {1, 0}, 0.1) + "]}");
+    const std::string command = std::string(STEPWISE_BINARY) + " validate " + file.string() + " >" + out.string() +
+                                " 2>" + err.string();
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    std::stringstream text, warnings;
+    text << std::ifstream(out).rdbuf();
+    warnings << std::ifstream(err).rdbuf();
+    EXPECT_NE(text.str().find("shapes x2 (5 shapes)"), std::string::npos) << text.str();
+    EXPECT_EQ(warnings.str(), "");
+    std::filesystem::remove_all(dir);
 }
 
 // ------------------------------------------------------------ mass
