@@ -161,7 +161,9 @@ struct CompoundShape {
 /// A compound body: several shapes on one rigid body. Exclusive with the
 /// single-shape components (radius, box, polygon, capsule, plane).
 struct Shapes {
-    std::vector<CompoundShape> items;
+    /// Default: one circle of 0.5 m on the position, so adding the
+    /// component (the editor's Add) gives a body that collides.
+    std::vector<CompoundShape> items{CompoundShape{}};
 };
 
 /// Nothing when `shape` is a valid compound-body shape, else why not (the
