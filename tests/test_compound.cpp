@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -483,6 +484,29 @@ TEST(CompoundWorld, AHingeHoldsACompoundBodyByItsFrame) {
     // The pin stays at the origin: the body's position is its frame's origin.
     EXPECT_LT(length(sim.position("pend")), 1e-3);
     EXPECT_LT(sim.angle("pend"), -0.1);
+}
+
+TEST(CompoundWorld, ARestingCompoundBodySleepsAndABallWakesIt) {
+    // The L rests and falls asleep as one body; a ball dropped on its post
+    // (not on the shape that touches the floor) wakes it, and it settles
+    // again with the ball on top.
+    const std::string text = level(kFloor + ", {\"name\": \"ell\", \"position\": " + vec(0, 0.25) +
+                                       ", \"shapes\": [" + boxItem(0, 0, 2, 0.5) + ", " + boxItem(0.75, 1.0, 0.5, 1.5) +
+                                       "]}, {\"name\": \"ball\", \"position\": {\"x\": 0.75, \"y\": 30}, \"radius\": 0.2}",
+                                   ", \"sleep\": true");
+    Sim sim(text);
+    ASSERT_TRUE(sim.step(90));
+    const Entity ell = named(sim.scene, "ell");
+    const auto sleeping = [&] {
+        const std::vector<Entity> asleep = sim.world->sleepingBodies();
+        return std::find(asleep.begin(), asleep.end(), ell) != asleep.end();
+    };
+    EXPECT_TRUE(sleeping()) << "the L rests and sleeps while the ball falls";
+    bool woke = false;
+    ASSERT_TRUE(sim.step(240, [&] { woke = woke || !sleeping(); }));
+    EXPECT_TRUE(woke);
+    EXPECT_NEAR(sim.position("ball").y, 0.25 + 1.75 + 0.2, 0.01);  // on the post's top
+    EXPECT_NEAR(sim.angle("ell"), 0.0, 1e-3);
 }
 
 // ------------------------------------------------------------ resume
