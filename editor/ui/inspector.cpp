@@ -233,6 +233,23 @@ bool fieldWidget(UiState& ui, const FieldInfo& f, FieldValue& value, const char*
             }
             ImGui::PopID();
         }
+        // Shapes are added at the body's position and removed from the end;
+        // the list's check refuses removing the last one.
+        for (int k = 0; k < 4; ++k) {
+            if (k > 0) ImGui::SameLine();
+            const std::string add = std::string("+ ") + kKinds[k];
+            if (!ImGui::SmallButton(add.c_str())) continue;
+            CompoundShape s;
+            s.kind = CompoundShape::Kind(k);
+            if (s.kind == CompoundShape::Kind::Polygon) s.vertices = Polygon{}.vertices;
+            list.push_back(s);
+            changed = true;
+        }
+        ImGui::SameLine();
+        if (ImGui::SmallButton("- last") && !list.empty()) {
+            list.pop_back();
+            changed = true;
+        }
         ImGui::EndGroup();
         return changed;
     }
