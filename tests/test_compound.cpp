@@ -130,6 +130,10 @@ TEST(CompoundFormat, ShapesWithASingleShapeAreRefusedNamingTheEntity) {
 TEST(CompoundFormat, BadItemsAreRefusedWithTheirPlace) {
     EXPECT_EQ(loadError(level("{\"name\": \"c\", \"position\": {\"x\": 0, \"y\": 0}, \"shapes\": []}")),
               "t.json: error: /entities/0/shapes: entity 0 (\"c\"): expected at least one shape, got none");
+    std::string many;
+    for (int i = 0; i < 257; ++i) many += (i ? ", " : "") + circleItem(i, 0, 0.4);
+    EXPECT_EQ(loadError(level("{\"name\": \"c\", \"position\": {\"x\": 0, \"y\": 0}, \"shapes\": [" + many + "]}")),
+              "t.json: error: /entities/0/shapes: entity 0 (\"c\"): expected at most 256 shapes, got 257");
     EXPECT_EQ(loadError(level("{\"name\": \"c\", \"position\": {\"x\": 0, \"y\": 0}, \"shapes\": [" + circleItem(0, 0, 1) +
                               ", " + capsuleItem({1, 1}, {1, 1}, 0.2) + "]}")),
               "t.json: error: /entities/0/shapes/1/capsule/b: entity 0 (\"c\"): a and b are the same point {\"x\": 1, "
@@ -148,6 +152,27 @@ TEST(CompoundFormat, BadItemsAreRefusedWithTheirPlace) {
                                                 polygon + "]}"));
     EXPECT_EQ(refused.rfind("t.json: error: /entities/0/shapes/0/polygon/vertices", 0), 0u) << refused;
     EXPECT_NE(refused.find("entity 0 (\"c\")"), std::string::npos) << refused;
+}
+
+TEST(CompoundFormat, TheWorldRefusesBadShapesMadeInCode) {
+    Scene s;
+    const Entity e = s.registry.create();
+    s.registry.emplace<Name>(e, {"c"});
+    s.registry.emplace<Position>(e, {{0.0, 0.0}});
+    Shapes shapes;
+    CompoundShape capsule;
+    capsule.kind = CompoundShape::Kind::Capsule;
+    capsule.a = capsule.b = {1.0, 1.0};
+    shapes.items = {capsule};
+    s.registry.emplace<Shapes>(e, shapes);
+    Result<World> w = World::build(s);
+    ASSERT_FALSE(w);
+    EXPECT_EQ(w.error(), "entity 0 (\"c\"): shapes/0/capsule/b: a and b are the same point {\"x\": 1, \"y\": 1}; a "
+                         "capsule needs a segment of non-zero length (a circle is the shape without one)");
+    s.registry.tryGet<Shapes>(e)->items.clear();
+    Result<World> empty = World::build(s);
+    ASSERT_FALSE(empty);
+    EXPECT_EQ(empty.error(), "entity 0 (\"c\"): shapes: expected 1 to 256 shapes, got 0");
 }
 
 TEST(CompoundFormat, RoundTripsByteForByte) {

@@ -102,6 +102,9 @@ std::optional<Error> finishCapsule(void* component) {
 std::optional<Error> finishShapes(void* component) {
     const auto& shapes = *static_cast<Shapes*>(component);
     if (shapes.items.empty()) return Error{"expected at least one shape, got none"};
+    // A saved contact names its shape by a one-byte index (shape_a, shape_b).
+    if (shapes.items.size() > 256)
+        return Error{"expected at most 256 shapes, got " + std::to_string(shapes.items.size())};
     for (std::size_t i = 0; i < shapes.items.size(); ++i)
         if (std::optional<Error> problem = compoundShapeProblem(shapes.items[i]))
             return problem->within(std::to_string(i));

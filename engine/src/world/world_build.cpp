@@ -52,7 +52,9 @@ std::optional<Error> compileBodies(const Registry& reg, WorldImpl& w, BodyIndex&
         const Mass* m = reg.tryGet<Mass>(e);
         // A compound body without a mass weighs what its shapes' densities
         // and areas give (with one, that sum is scaled to it).
+        // (An empty list is refused by checkPolygons, naming the shapes.)
         const Shapes* compound = m ? nullptr : reg.tryGet<Shapes>(e);
+        if (compound && compound->items.empty()) compound = nullptr;
         const double mv = m ? m->value : compound ? compoundMassProperties(*compound, std::nullopt).mass : 1.0;
         if (const Kinematic* k = reg.tryGet<Kinematic>(e); k && k->value) {
             w.isKinematic.resize(w.bodyEntity.size() + 1, 0);
@@ -229,9 +231,10 @@ std::optional<Error> checkPolygons(const Registry& reg) {
                     return Error{problem->message, entityLabel(i, name ? &name->value : nullptr) + ": shapes/" +
                                                        std::to_string(k) + "/" + problem->where};
                 }
-            if (compound->items.empty()) {
+            if (compound->items.empty() || compound->items.size() > 256) {
                 const Name* name = reg.tryGet<Name>(order[i]);
-                return Error{"expected at least one shape, got none", entityLabel(i, name ? &name->value : nullptr) + ": shapes"};
+                return Error{"expected 1 to 256 shapes, got " + std::to_string(compound->items.size()),
+                             entityLabel(i, name ? &name->value : nullptr) + ": shapes"};
             }
         }
         if (const Capsule* capsule = reg.tryGet<Capsule>(order[i]); capsule && capsule->a == capsule->b) {
