@@ -259,7 +259,7 @@ private:
     std::vector<double> offsetAngleBefore_;    // their angles at the start of the substep, rad
     std::vector<double> angles_, angularVelocities_;
     /// Shapes of moving compound bodies (hub >= 0), ascending; empty in a
-    /// world without one, which then runs exactly as before they existed.
+    /// world without one, which then takes only the single-shape paths.
     std::vector<std::uint32_t> shapesOfHubs_;
     std::vector<std::uint32_t> awakeShapesOfHubs_;  // those whose body is awake
     std::vector<double> invMass_, invInertia_, maxExtent_;
