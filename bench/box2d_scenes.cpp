@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <optional>
+#include <tuple>
 
 namespace stepwise::bench {
 
@@ -352,25 +353,23 @@ Scene tumbler() {
     Scene s = v3World();
     const Vec2 pivot{0.0, 10.0};
     const double speed = 25.0 * kPi / 180.0;
-    // One compound body in Box2D; here four bodies, each on its own motor
-    // about the same pivot. The top and bottom walls end at the side walls'
-    // inner faces so that the walls do not overlap one another; each keeps
-    // the mass of Box2D's wall (1 x 20 m at density 50).
-    struct Wall {
-        const char* name;
-        Vec2 offset;
-        double w, h;
-    };
-    const Wall walls[] = {{"wall right", {10.0, 0.0}, 1.0, 20.0},
-                          {"wall left", {-10.0, 0.0}, 1.0, 20.0},
-                          {"wall top", {0.0, 10.0}, 19.0, 1.0},
-                          {"wall bottom", {0.0, -10.0}, 19.0, 1.0}};
-    for (const Wall& w : walls) {
-        const Entity e = body(s, w.name, pivot + w.offset, 0.6, kGrey);
-        s.registry.emplace<Box>(e, Box{w.w, w.h});
-        s.registry.emplace<Mass>(e, Mass{50.0 * 20.0});
-        motorToWorld(s, std::string(w.name) + " motor", e, pivot + w.offset, pivot, speed, 1e8);
+    // One compound body as in Box2D: four 1 x 20 m walls at density 50
+    // (4,000 kg), overlapping at the corners (shapes of one body never
+    // collide), on one motor about its centre.
+    const Entity drum = body(s, "walls", pivot, 0.6, kGrey);
+    Shapes walls;
+    for (const auto& [offset, w, h] : {std::tuple{Vec2{10.0, 0.0}, 1.0, 20.0}, std::tuple{Vec2{-10.0, 0.0}, 1.0, 20.0},
+                                       std::tuple{Vec2{0.0, 10.0}, 20.0, 1.0}, std::tuple{Vec2{0.0, -10.0}, 20.0, 1.0}}) {
+        CompoundShape wall;
+        wall.kind = CompoundShape::Kind::Box;
+        wall.center = offset;
+        wall.width = w;
+        wall.height = h;
+        wall.density = 50.0;
+        walls.items.push_back(wall);
     }
+    s.registry.emplace<Shapes>(drum, walls);
+    motorToWorld(s, "walls motor", drum, pivot, pivot, speed, 1e8);
     const int grid = 45;
     double y = -0.2 * grid + 10.0;
     int index = 0;

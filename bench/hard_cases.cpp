@@ -65,15 +65,24 @@ struct Bodies {
 
 bool isStatic(const Registry& r, Entity e) { return r.has<Static>(e) && r.tryGet<Static>(e)->value; }
 
-bool hasShape(const Registry& r, Entity e) { return r.has<Radius>(e) || r.has<Box>(e) || r.has<Polygon>(e); }
+bool hasShape(const Registry& r, Entity e) {
+    return r.has<Radius>(e) || r.has<Box>(e) || r.has<Polygon>(e) || r.has<Shapes>(e);
+}
 
 Bodies bodiesOf(const Scene& scene) {
     Bodies b;
     const Registry& r = scene.registry;
     for (Entity e : r.entities()) {
         if (!r.has<Position>(e) || isStatic(r, e) || !hasShape(r, e)) continue;
-        const double m = r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
+        double m = r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
         double inertia = 0.0, radius = 0.0;
+        if (const Shapes* shapes = r.tryGet<Shapes>(e)) {
+            const Mass* given = r.tryGet<Mass>(e);
+            const CompoundMassProperties props =
+                compoundMassProperties(*shapes, given ? std::optional<double>(given->value) : std::nullopt);
+            m = props.mass;
+            inertia = props.inertia;
+        }
         if (const Radius* c = r.tryGet<Radius>(e)) {
             inertia = 0.5 * m * c->value * c->value;
             radius = c->value;

@@ -780,6 +780,43 @@ void Builder::bodies() {
         box(toPx(p->value), {0.5 * b->width * ppm_, 0.5 * b->height * ppm_}, a ? a->value : 0.0,
             bodyColour(e), flags, 1.0);
     }
+    // Compound bodies: each shape as the single shape of its kind would be
+    // drawn, placed in the body frame, in the same batches.
+    for (Entity e : scene_.registry.entities()) {
+        const Shapes* shapes = scene_.registry.tryGet<Shapes>(e);
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!shapes || !p) continue;
+        const Angle* a = scene_.registry.tryGet<Angle>(e);
+        const double angle = a ? a->value : 0.0, c = std::cos(angle), s = std::sin(angle);
+        const auto place = [&](Vec2 v) { return p->value + Vec2{c * v.x - s * v.y, s * v.x + c * v.y}; };
+        float flags = 0;
+        if (selected_.count(e)) flags += kSelected;
+        if (isStatic(scene_, e)) flags += kStatic;
+        const Rgba colour = bodyColour(e);
+        for (const CompoundShape& shape : shapes->items) {
+            switch (shape.kind) {
+            case CompoundShape::Kind::Polygon:
+                if (shape.vertices.size() >= 3)
+                    polygon(Polygon{shape.vertices}, p->value, angle, colour, selected_.count(e) != 0,
+                            isStatic(scene_, e));
+                break;
+            case CompoundShape::Kind::Box:
+                box(toPx(place(shape.center)), {0.5 * shape.width * ppm_, 0.5 * shape.height * ppm_},
+                    angle + shape.angle, colour, flags, 1.0);
+                break;
+            case CompoundShape::Kind::Capsule: {
+                const Vec2 axis = shape.b - shape.a;
+                const double r = shape.radius * ppm_;
+                box(toPx(place(0.5 * (shape.a + shape.b))), {0.5 * length(axis) * ppm_ + r, r},
+                    angle + std::atan2(axis.y, axis.x), colour, flags, r);
+                break;
+            }
+            case CompoundShape::Kind::Circle:
+                disc(toPx(place(shape.center)), shape.radius * ppm_, angle, colour, flags + kTick);
+                break;
+            }
+        }
+    }
     // Capsules in the box batch: a box as long as the capsule and as high
     // as its diameter, rounded by its radius, is exactly the capsule (the
     // same shading, rim and selection ring as boxes).
@@ -800,7 +837,7 @@ void Builder::bodies() {
     for (Entity e : scene_.registry.entities()) {
         const Position* p = scene_.registry.tryGet<Position>(e);
         if (!p || scene_.registry.has<Box>(e) || scene_.registry.has<Polygon>(e) || scene_.registry.has<Capsule>(e) ||
-            scene_.registry.has<Spring>(e))
+            scene_.registry.has<Shapes>(e) || scene_.registry.has<Spring>(e))
             continue;
         const Radius* r = scene_.registry.tryGet<Radius>(e);
         const Angle* a = scene_.registry.tryGet<Angle>(e);

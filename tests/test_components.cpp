@@ -33,6 +33,29 @@ void setDistinct(const FieldInfo& field, void* component, int salt, Entity targe
     case FieldKind::VectorList:  // a convex, counter-clockwise quadrilateral off its origin
         *static_cast<std::vector<Vec2>*>(m) = {{0.1 * salt + 1.0 / 3.0, -2.0 / 7.0}, {2.0, -0.5}, {2.5, 1e-3}, {0.2, 1.0}};
         break;
+    case FieldKind::ShapeList: {  // one of each kind, with every optional field set somewhere
+        CompoundShape circle;
+        circle.center = {0.1 * salt + 1.0 / 3.0, -2.0 / 7.0};
+        circle.radius = 0.3;
+        circle.density = 2.5;
+        circle.sensor = true;
+        CompoundShape box;
+        box.kind = CompoundShape::Kind::Box;
+        box.center = {1.0, 1.0 / 3.0};
+        box.angle = 0.1;
+        box.friction = 0.7;
+        box.filter = Filter{2, 0x80000001u, -4};
+        CompoundShape polygon;
+        polygon.kind = CompoundShape::Kind::Polygon;
+        polygon.vertices = {{0.1, -2.0 / 7.0}, {2.0, -0.5}, {2.5, 1e-3}, {0.2, 1.0}};
+        polygon.restitution = 0.25;
+        CompoundShape capsule;
+        capsule.kind = CompoundShape::Kind::Capsule;
+        capsule.a = {-1.0 / 3.0, 0.0};
+        capsule.b = {0.5, 1e-3};
+        *static_cast<std::vector<CompoundShape>*>(m) = {circle, box, polygon, capsule};
+        break;
+    }
     case FieldKind::String:
         // A field with a fixed set of values (a joint's type) gets one of them.
         *static_cast<std::string*>(m) = field.choices.empty()
@@ -61,6 +84,8 @@ bool fieldEquals(const FieldInfo& field, const void* a, const void* b, const Reg
     case FieldKind::Bool: return *static_cast<const bool*>(ma) == *static_cast<const bool*>(mb);
     case FieldKind::VectorList:
         return *static_cast<const std::vector<Vec2>*>(ma) == *static_cast<const std::vector<Vec2>*>(mb);
+    case FieldKind::ShapeList:
+        return *static_cast<const std::vector<CompoundShape>*>(ma) == *static_cast<const std::vector<CompoundShape>*>(mb);
     case FieldKind::String: return *static_cast<const std::string*>(ma) == *static_cast<const std::string*>(mb);
     case FieldKind::EntityRef: {
         const Entity ea = *static_cast<const Entity*>(ma), eb = *static_cast<const Entity*>(mb);

@@ -26,7 +26,10 @@ inline b2Body* createBox2dBody(b2World& world, const Registry& r, Entity e) {
     if (const Velocity* v = r.tryGet<Velocity>(e)) def.linearVelocity.Set(float(v->value.x), float(v->value.y));
     if (const Angle* a = r.tryGet<Angle>(e)) def.angle = float(a->value);
     if (const AngularVelocity* w = r.tryGet<AngularVelocity>(e)) def.angularVelocity = float(w->value);
-    const double mass = r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
+    const Shapes* shapes = r.tryGet<Shapes>(e);
+    const double mass = r.has<Mass>(e)  ? r.tryGet<Mass>(e)->value
+                        : shapes ? compoundMassProperties(*shapes, std::nullopt).mass
+                                 : 1.0;
     if (const Drag* d = r.tryGet<Drag>(e)) def.linearDamping = float(d->value / mass);
     b2Body* body = world.CreateBody(&def);
     b2FixtureDef fd;
@@ -51,6 +54,37 @@ inline b2Body* createBox2dBody(b2World& world, const Registry& r, Entity e) {
         fd.density = float(mass / polygonMassProperties(poly->vertices).area);
     }
     if (fd.shape) body->CreateFixture(&fd);
+    if (shapes) {
+        // A fixture per shape; densities scaled as Stepwise scales them to `mass`.
+        const double scale = mass / compoundMassProperties(*shapes, std::nullopt).mass;
+        for (const CompoundShape& s : shapes->items) {
+            b2FixtureDef part = fd;
+            part.friction = float(s.friction.value_or(fd.friction));
+            part.restitution = float(s.restitution.value_or(fd.restitution));
+            part.isSensor = s.sensor.value_or(false);
+            part.density = float(s.density.value_or(1.0) * scale);
+            b2CircleShape c;
+            b2PolygonShape p;
+            if (s.kind == CompoundShape::Kind::Circle) {
+                c.m_radius = float(s.radius);
+                c.m_p.Set(float(s.center.x), float(s.center.y));
+                part.shape = &c;
+            } else if (s.kind == CompoundShape::Kind::Box) {
+                p.SetAsBox(float(s.width / 2), float(s.height / 2), b2Vec2(float(s.center.x), float(s.center.y)),
+                           float(s.angle));
+                part.shape = &p;
+            } else if (s.kind == CompoundShape::Kind::Polygon) {
+                b2Vec2 v[b2_maxPolygonVertices];
+                for (std::size_t k = 0; k < s.vertices.size(); ++k)
+                    v[k].Set(float(s.vertices[k].x), float(s.vertices[k].y));
+                p.Set(v, int(s.vertices.size()));
+                part.shape = &p;
+            } else {
+                continue;  // Box2D 2.4.1 has no capsule
+            }
+            body->CreateFixture(&part);
+        }
+    }
     return body;
 }
 

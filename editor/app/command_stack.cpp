@@ -1,6 +1,7 @@
 #include "app/command_stack.hpp"
 
 #include "stepwise/component_table.hpp"
+#include "stepwise/components.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -41,6 +42,50 @@ void takeOptional(const std::string& in, std::size_t& at, void* field) {
     if (take<std::uint8_t>(in, at)) o = take<T>(in, at);
 }
 
+void putShapes(std::string& out, const void* field) {
+    const auto& list = *static_cast<const std::vector<CompoundShape>*>(field);
+    put(out, std::uint32_t(list.size()));
+    for (const CompoundShape& s : list) {
+        put(out, s.kind);
+        put(out, s.center);
+        put(out, s.radius);
+        put(out, s.width);
+        put(out, s.height);
+        put(out, s.angle);
+        put(out, std::uint32_t(s.vertices.size()));
+        for (const Vec2 p : s.vertices) put(out, p);
+        put(out, s.a);
+        put(out, s.b);
+        putOptional<double>(out, &s.density);
+        putOptional<double>(out, &s.friction);
+        putOptional<double>(out, &s.restitution);
+        putOptional<bool>(out, &s.sensor);
+        putOptional<Filter>(out, &s.filter);
+    }
+}
+
+void takeShapes(const std::string& in, std::size_t& at, void* field) {
+    auto& list = *static_cast<std::vector<CompoundShape>*>(field);
+    list.resize(take<std::uint32_t>(in, at));
+    for (CompoundShape& s : list) {
+        s.kind = take<CompoundShape::Kind>(in, at);
+        s.center = take<Vec2>(in, at);
+        s.radius = take<double>(in, at);
+        s.width = take<double>(in, at);
+        s.height = take<double>(in, at);
+        s.angle = take<double>(in, at);
+        s.vertices.resize(take<std::uint32_t>(in, at));
+        for (Vec2& p : s.vertices) p = take<Vec2>(in, at);
+        s.a = take<Vec2>(in, at);
+        s.b = take<Vec2>(in, at);
+        takeOptional<double>(in, at, &s.density);
+        takeOptional<double>(in, at, &s.friction);
+        takeOptional<double>(in, at, &s.restitution);
+        takeOptional<bool>(in, at, &s.sensor);
+        takeOptional<Filter>(in, at, &s.filter);
+    }
+}
+
 /// Appends component `c` of the table (at `component`) to `out`.
 void encodeComponent(std::string& out, std::size_t c, const void* component) {
     const std::span<const ComponentInfo> table = componentTable();
@@ -57,6 +102,7 @@ void encodeComponent(std::string& out, std::size_t c, const void* component) {
             for (const Vec2 p : list) put(out, p);
             break;
         }
+        case FieldKind::ShapeList: putShapes(out, field); break;
         case FieldKind::OptionalNumber: putOptional<double>(out, field); break;
         case FieldKind::Vector: put(out, *static_cast<const Vec2*>(field)); break;
         case FieldKind::OptionalVector: putOptional<Vec2>(out, field); break;
@@ -136,6 +182,7 @@ void decodeEntity(const std::string& in, Registry& reg, Entity e) {
                 for (Vec2& p : list) p = take<Vec2>(in, at);
                 break;
             }
+            case FieldKind::ShapeList: takeShapes(in, at, field); break;
             case FieldKind::OptionalNumber: takeOptional<double>(in, at, field); break;
             case FieldKind::Vector: *static_cast<Vec2*>(field) = take<Vec2>(in, at); break;
             case FieldKind::OptionalVector: takeOptional<Vec2>(in, at, field); break;

@@ -34,6 +34,9 @@ void copyField(const FieldInfo& field, const void* src, void* dst) {
     case FieldKind::VectorList:
         *static_cast<std::vector<Vec2>*>(to) = *static_cast<const std::vector<Vec2>*>(from);
         break;
+    case FieldKind::ShapeList:
+        *static_cast<std::vector<CompoundShape>*>(to) = *static_cast<const std::vector<CompoundShape>*>(from);
+        break;
     case FieldKind::String: *static_cast<std::string*>(to) = *static_cast<const std::string*>(from); break;
     case FieldKind::EntityRef: *static_cast<Entity*>(to) = *static_cast<const Entity*>(from); break;
     }
@@ -51,6 +54,7 @@ FieldValue readField(const FieldInfo& field, const void* component) {
     case FieldKind::Color: return *static_cast<const Rgb*>(at);
     case FieldKind::Bool: return *static_cast<const bool*>(at);
     case FieldKind::VectorList: return *static_cast<const std::vector<Vec2>*>(at);
+    case FieldKind::ShapeList: return *static_cast<const std::vector<CompoundShape>*>(at);
     case FieldKind::String: return *static_cast<const std::string*>(at);
     case FieldKind::EntityRef: return *static_cast<const Entity*>(at);
     }
@@ -74,6 +78,7 @@ void writeField(const FieldInfo& field, void* component, const FieldValue& value
                 (std::is_same_v<V, Rgb> && field.kind == FieldKind::Color) ||
                 (std::is_same_v<V, bool> && field.kind == FieldKind::Bool) ||
                 (std::is_same_v<V, std::vector<Vec2>> && field.kind == FieldKind::VectorList) ||
+                (std::is_same_v<V, std::vector<CompoundShape>> && field.kind == FieldKind::ShapeList) ||
                 (std::is_same_v<V, std::string> && field.kind == FieldKind::String) ||
                 (std::is_same_v<V, Entity> && field.kind == FieldKind::EntityRef);
             if (matches) *static_cast<V*>(at) = v;
@@ -95,6 +100,7 @@ bool valueFitsKind(const FieldInfo& field, const FieldValue& value) {
             case FieldKind::Color: return std::is_same_v<V, Rgb>;
             case FieldKind::Bool: return std::is_same_v<V, bool>;
             case FieldKind::VectorList: return std::is_same_v<V, std::vector<Vec2>>;
+            case FieldKind::ShapeList: return std::is_same_v<V, std::vector<CompoundShape>>;
             case FieldKind::String: return std::is_same_v<V, std::string>;
             case FieldKind::EntityRef: return std::is_same_v<V, Entity>;
             }
@@ -301,6 +307,7 @@ std::string_view entityKind(const Registry& registry, Entity e) {
     if (registry.has<Radius>(e)) return "circle";
     if (registry.has<Polygon>(e)) return "polygon";
     if (registry.has<Capsule>(e)) return "capsule";
+    if (registry.has<Shapes>(e)) return "compound";
     if (registry.has<Attractor>(e)) return "attractor";
     if (registry.has<Boid>(e)) return "boid";
     return "point";
@@ -369,6 +376,13 @@ Entity pick(const Scene& scene, Vec2 world, double pickRadius) {
             const double th = a ? a->value : 0.0;
             const Vec2 local{std::cos(th) * d.x + std::sin(th) * d.y, -std::sin(th) * d.x + std::cos(th) * d.y};
             if (distanceToSegment(local, cap->a, cap->b) <= cap->radius) return e;
+        } else if (const Shapes* shapes = reg.tryGet<Shapes>(e)) {
+            // A compound body is picked by any of its shapes.
+            const Angle* a = reg.tryGet<Angle>(e);
+            const double th = a ? a->value : 0.0;
+            const Vec2 local{std::cos(th) * d.x + std::sin(th) * d.y, -std::sin(th) * d.x + std::cos(th) * d.y};
+            for (const CompoundShape& s : shapes->items)
+                if (compoundShapeContains(s, local)) return e;
         } else if (length(d) <= pickRadius) {
             return e;
         }
@@ -689,6 +703,11 @@ bool entityBounds(const Registry& registry, Entity e, Vec2& lo, Vec2& hi) {
         for (const Vec2 v : poly->vertices) rx = ry = std::max(rx, length(v));  // any angle
     if (const Capsule* cap = registry.tryGet<Capsule>(e))
         rx = ry = std::max(length(cap->a), length(cap->b)) + cap->radius;  // any angle
+    if (const Shapes* shapes = registry.tryGet<Shapes>(e))
+        for (const CompoundShape& s : shapes->items) {
+            const ShapeOutline outline = compoundShapeOutline(s);
+            for (const Vec2 v : outline.points) rx = ry = std::max(rx, length(v) + outline.radius);  // any angle
+        }
     lo = {p->value.x - rx, p->value.y - ry};
     hi = {p->value.x + rx, p->value.y + ry};
     return true;

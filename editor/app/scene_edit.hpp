@@ -31,7 +31,7 @@ void copyEntity(const Registry& src, Entity from, Registry& dst, Entity to);
 
 /// A field's value, by kind (FieldKind -> alternative).
 using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string, Entity,
-                                std::vector<Vec2>, int, std::uint32_t>;
+                                std::vector<Vec2>, int, std::uint32_t, std::vector<CompoundShape>>;
 FieldValue readField(const FieldInfo& field, const void* component);
 void writeField(const FieldInfo& field, void* component, const FieldValue& value);
 /// True when `value` holds the C++ type of `field`'s kind.

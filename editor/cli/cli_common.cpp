@@ -1,6 +1,7 @@
 #include "cli/cli_common.hpp"
 
 #include "stepwise/component_table.hpp"
+#include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
 
@@ -37,6 +38,13 @@ std::string sceneSummary(const Scene& scene) {
         if (!count) continue;
         if (!components.empty()) components += ", ";
         components += std::string(info.name) + " x" + std::to_string(count);
+        // Compound bodies: how many shapes they hold between them.
+        if (info.name == "shapes") {
+            std::size_t shapes = 0;
+            for (Entity e : registry.entities())
+                if (const Shapes* s = registry.tryGet<Shapes>(e)) shapes += s->items.size();
+            components += " (" + std::to_string(shapes) + " shapes)";
+        }
     }
     std::string line = std::to_string(registry.size()) + " entities; components: " +
                        (components.empty() ? "none" : components);

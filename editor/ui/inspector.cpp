@@ -169,6 +169,90 @@ bool fieldWidget(UiState& ui, const FieldInfo& f, FieldValue& value, const char*
         ImGui::EndGroup();
         return changed;
     }
+    case FieldKind::ShapeList: {
+        // One tree node per shape with its geometry and material; the whole
+        // list is one value, so a drag is one undo step and the component's
+        // check refuses an edit that breaks a shape.
+        auto& list = std::get<std::vector<CompoundShape>>(value);
+        bool changed = false;
+        ImGui::BeginGroup();
+        ImGui::TextUnformatted(label);
+        static constexpr const char* kKinds[] = {"circle", "box", "polygon", "capsule"};
+        const auto drag2 = [&](const char* name, Vec2& v) {
+            double xy[2] = {v.x, v.y};
+            if (!ImGui::DragScalarN(name, ImGuiDataType_Double, xy, 2, 0.01f, nullptr, nullptr, "%.5g")) return;
+            v = {xy[0], xy[1]};
+            changed = true;
+        };
+        const auto drag1 = [&](const char* name, double& d, double min) {
+            if (ImGui::DragScalar(name, ImGuiDataType_Double, &d, 0.01f, &min, nullptr, "%.5g")) changed = true;
+        };
+        const auto optional1 = [&](const char* name, std::optional<double>& o, double fallback) {
+            double d = o.value_or(fallback);
+            const double min = 0.0;
+            if (ImGui::DragScalar(name, ImGuiDataType_Double, &d, 0.01f, &min, nullptr, "%.5g")) {
+                o = d;
+                changed = true;
+            }
+        };
+        for (std::size_t i = 0; i < list.size(); ++i) {
+            CompoundShape& s = list[i];
+            ImGui::PushID(int(i));
+            const std::string title = std::to_string(i) + ": " + kKinds[int(s.kind)];
+            if (ImGui::TreeNode(title.c_str())) {
+                const double tiny = 1e-6;
+                switch (s.kind) {
+                case CompoundShape::Kind::Circle:
+                    drag2("center", s.center);
+                    drag1("radius", s.radius, tiny);
+                    break;
+                case CompoundShape::Kind::Box:
+                    drag2("center", s.center);
+                    drag1("width", s.width, tiny);
+                    drag1("height", s.height, tiny);
+                    drag1("angle", s.angle, -1e9);
+                    break;
+                case CompoundShape::Kind::Polygon:
+                    for (std::size_t k = 0; k < s.vertices.size(); ++k) drag2(std::to_string(k).c_str(), s.vertices[k]);
+                    break;
+                case CompoundShape::Kind::Capsule:
+                    drag2("a", s.a);
+                    drag2("b", s.b);
+                    drag1("radius", s.radius, tiny);
+                    break;
+                }
+                optional1("density", s.density, 1.0);
+                optional1("friction", s.friction, Friction{}.value);
+                optional1("restitution", s.restitution, Restitution{}.value);
+                bool sensor = s.sensor.value_or(false);
+                if (ImGui::Checkbox("sensor", &sensor)) {
+                    s.sensor = sensor;
+                    changed = true;
+                }
+                ImGui::TreePop();
+            }
+            ImGui::PopID();
+        }
+        // Shapes are added at the body's position and removed from the end;
+        // the list's check refuses removing the last one.
+        for (int k = 0; k < 4; ++k) {
+            if (k > 0) ImGui::SameLine();
+            const std::string add = std::string("+ ") + kKinds[k];
+            if (!ImGui::SmallButton(add.c_str())) continue;
+            CompoundShape s;
+            s.kind = CompoundShape::Kind(k);
+            if (s.kind == CompoundShape::Kind::Polygon) s.vertices = Polygon{}.vertices;
+            list.push_back(s);
+            changed = true;
+        }
+        ImGui::SameLine();
+        if (ImGui::SmallButton("- last") && !list.empty()) {
+            list.pop_back();
+            changed = true;
+        }
+        ImGui::EndGroup();
+        return changed;
+    }
     case FieldKind::String:
         if (!f.choices.empty()) {
             // A fixed set of names (a joint's type): a combo, never a typo.

@@ -99,6 +99,18 @@ std::optional<Error> finishCapsule(void* component) {
     return {};
 }
 
+std::optional<Error> finishShapes(void* component) {
+    const auto& shapes = *static_cast<Shapes*>(component);
+    if (shapes.items.empty()) return Error{"expected at least one shape, got none"};
+    // A saved contact names its shape by a one-byte index (shape_a, shape_b).
+    if (shapes.items.size() > 256)
+        return Error{"expected at most 256 shapes, got " + std::to_string(shapes.items.size())};
+    for (std::size_t i = 0; i < shapes.items.size(); ++i)
+        if (std::optional<Error> problem = compoundShapeProblem(shapes.items[i]))
+            return problem->within(std::to_string(i));
+    return {};
+}
+
 std::optional<Error> finishSpring(void* component) {
     auto& spring = *static_cast<Spring*>(component);
     if (spring.a.isNull()) return Error{"expected the name of an entity, got nothing", "a"};
@@ -180,6 +192,18 @@ std::vector<ComponentInfo> buildTable() {
             &finishCapsule);
         capsule.finishNamesEntity = true;
         t.push_back(std::move(capsule));
+    }
+    {
+        ComponentInfo shapes = row<Shapes>(
+            "shapes",
+            "compound body: several shapes (circle, box, polygon, capsule) on one body, each with its own material, "
+            "filter, sensor and density; the body collides",
+            true, needsPosition,
+            {field<&Shapes::items>("", NumberRange{1.0, 256.0}, "m",
+                                   "the body's shapes in its frame; mass and inertia are their sum")},
+            &finishShapes);
+        shapes.finishNamesEntity = true;
+        t.push_back(std::move(shapes));
     }
     t.push_back(row<Angle>("angle", "orientation, counter-clockwise", true, needsPosition,
                            {field<&Angle::value>("", kAny, "rad", "orientation")}));
@@ -337,6 +361,14 @@ std::optional<Error> fieldValueProblem(const FieldInfo& field, const void* membe
     case FieldKind::VectorList:
         for (const Vec2 p : *static_cast<const std::vector<Vec2>*>(member))
             if (auto problem = vector(p, kAnyMagnitude)) return problem;
+        return std::nullopt;
+    case FieldKind::ShapeList:
+        for (const CompoundShape& s : *static_cast<const std::vector<CompoundShape>*>(member)) {
+            for (const Vec2 p : {s.center, s.a, s.b})
+                if (auto problem = vector(p, kAnyMagnitude)) return problem;
+            for (const Vec2 p : s.vertices)
+                if (auto problem = vector(p, kAnyMagnitude)) return problem;
+        }
         return std::nullopt;
     case FieldKind::Color: {
         const Rgb c = *static_cast<const Rgb*>(member);

@@ -136,3 +136,127 @@ CapsuleMassProperties capsuleMassProperties(double length, double radius) {
 }
 
 } // namespace stepwise
+
+namespace stepwise {
+
+std::optional<Error> compoundShapeProblem(const CompoundShape& shape) {
+    using Kind = CompoundShape::Kind;
+    if (shape.kind == Kind::Polygon) {
+        if (std::optional<Error> problem = polygonProblem(shape.vertices)) return problem->within("polygon/vertices");
+    } else if (shape.kind == Kind::Capsule && shape.a == shape.b) {
+        return Error{"a and b are the same point {\"x\": " + formatNumber(shape.a.x) + ", \"y\": " +
+                         formatNumber(shape.a.y) + "}; a capsule needs a segment of non-zero length (a circle is "
+                         "the shape without one)",
+                     "capsule/b"};
+    }
+    return {};
+}
+
+ShapeAreaProperties compoundShapeArea(const CompoundShape& shape) {
+    constexpr double kPi = 3.14159265358979323846;
+    ShapeAreaProperties out;
+    switch (shape.kind) {
+    case CompoundShape::Kind::Circle:
+        out.area = kPi * shape.radius * shape.radius;
+        out.centroid = shape.center;
+        out.secondMoment = 0.5 * out.area * shape.radius * shape.radius;
+        break;
+    case CompoundShape::Kind::Box:
+        out.area = shape.width * shape.height;
+        out.centroid = shape.center;
+        out.secondMoment = out.area * (shape.width * shape.width + shape.height * shape.height) / 12.0;
+        break;
+    case CompoundShape::Kind::Polygon: {
+        const PolygonMassProperties p = polygonMassProperties(shape.vertices);
+        out.area = p.area;
+        out.centroid = p.centroid;
+        out.secondMoment = p.secondMoment;
+        break;
+    }
+    case CompoundShape::Kind::Capsule: {
+        const CapsuleMassProperties c = capsuleMassProperties(length(shape.b - shape.a), shape.radius);
+        out.area = c.area;
+        out.centroid = 0.5 * (shape.a + shape.b);
+        out.secondMoment = c.area * c.inertiaPerMass;
+        break;
+    }
+    }
+    return out;
+}
+
+CompoundMassProperties compoundMassProperties(const Shapes& shapes, std::optional<double> mass) {
+    CompoundMassProperties out;
+    std::vector<ShapeAreaProperties> parts;
+    Vec2 moment;
+    for (const CompoundShape& s : shapes.items) {
+        parts.push_back(compoundShapeArea(s));
+        const double m = s.density.value_or(1.0) * parts.back().area;
+        out.shapeMass.push_back(m);
+        out.mass += m;
+        moment += m * parts.back().centroid;
+    }
+    if (!(out.mass > 0.0)) return out;
+    out.centre = moment / out.mass;
+    // Parallel axes: each shape's own inertia (m J / A) plus m d^2 to the
+    // common centre.
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        const double m = out.shapeMass[i];
+        out.inertia += m * parts[i].secondMoment / parts[i].area + m * lengthSquared(parts[i].centroid - out.centre);
+    }
+    if (mass) {
+        const double scale = *mass / out.mass;
+        for (double& m : out.shapeMass) m *= scale;
+        out.inertia *= scale;
+        out.mass = *mass;
+    }
+    return out;
+}
+
+} // namespace stepwise
+
+namespace stepwise {
+
+ShapeOutline compoundShapeOutline(const CompoundShape& s) {
+    ShapeOutline out;
+    switch (s.kind) {
+    case CompoundShape::Kind::Circle:
+        out.points = {s.center};
+        out.radius = s.radius;
+        break;
+    case CompoundShape::Kind::Box: {
+        const double c = std::cos(s.angle), sn = std::sin(s.angle), hx = 0.5 * s.width, hy = 0.5 * s.height;
+        for (const Vec2 k : {Vec2{-hx, -hy}, Vec2{hx, -hy}, Vec2{hx, hy}, Vec2{-hx, hy}})
+            out.points.push_back(s.center + Vec2{c * k.x - sn * k.y, sn * k.x + c * k.y});
+        break;
+    }
+    case CompoundShape::Kind::Polygon: out.points = s.vertices; break;
+    case CompoundShape::Kind::Capsule:
+        out.points = {s.a, s.b};
+        out.radius = s.radius;
+        break;
+    }
+    return out;
+}
+
+bool compoundShapeContains(const CompoundShape& s, Vec2 local) {
+    switch (s.kind) {
+    case CompoundShape::Kind::Circle: return length(local - s.center) <= s.radius;
+    case CompoundShape::Kind::Capsule: {
+        const Vec2 ab = s.b - s.a;
+        const double t = std::clamp(dot(local - s.a, ab) / dot(ab, ab), 0.0, 1.0);
+        return length(local - (s.a + t * ab)) <= s.radius;
+    }
+    case CompoundShape::Kind::Box:
+    case CompoundShape::Kind::Polygon: {
+        // Inside a counter-clockwise convex outline: left of every edge.
+        const std::vector<Vec2> v = compoundShapeOutline(s).points;
+        if (v.size() < 3) return false;
+        for (std::size_t i = 0; i < v.size(); ++i)
+            if (cross(v[(i + 1) % v.size()] - v[i], local - v[i]) < 0.0) return false;
+        return true;
+    }
+    }
+    return false;
+}
+
+} // namespace stepwise

@@ -159,6 +159,114 @@ struct EntityNames {
     mutable std::vector<std::string> unresolved;
 };
 
+/// The keys of one compound shape's object ("circle": {...} and the rest).
+constexpr std::array<std::string_view, 4> kShapeKinds{"circle", "box", "polygon", "capsule"};
+constexpr std::array<std::string_view, 9> kShapeItemKeys{"circle",      "box",    "polygon", "capsule", "density",
+                                                         "friction",    "restitution", "sensor", "filter"};
+
+/// Reads an object's keys, refusing any not in `known` (what: "a box").
+template <std::size_t N, typename Fn>
+void readKeys(const Json& v, const std::string& pointer, const std::array<std::string_view, N>& known,
+              const std::string& what, Fn&& fn) {
+    if (!v.is_object()) refuse(pointer, "expected " + what + " object, got " + describeFound(v));
+    for (const auto& [key, value] : v.items()) {
+        if (std::find(known.begin(), known.end(), key) == known.end())
+            refuse(child(pointer, key), unknownNameMessage("unknown key \"" + key + "\" in " + what, key,
+                                                           std::span<const std::string_view>(known), "keys"));
+        fn(key, value, child(pointer, key));
+    }
+}
+
+CompoundShape readCompoundShape(const Json& v, const std::string& pointer) {
+    constexpr NumberRange size{kMinSize, kMaxMagnitude, false};
+    CompoundShape s;
+    int kinds = 0;
+    readKeys(v, pointer, kShapeItemKeys, "a compound shape", [&](const std::string& key, const Json& value,
+                                                                   const std::string& at) {
+        if (key == "circle") {
+            ++kinds;
+            s.kind = CompoundShape::Kind::Circle;
+            readKeys(value, at, std::array<std::string_view, 2>{"center", "radius"}, "a circle",
+                     [&](const std::string& k, const Json& fv, const std::string& fa) {
+                         if (k == "center") s.center = readVector(fv, fa);
+                         else s.radius = readNumber(fv, fa, size);
+                     });
+        } else if (key == "box") {
+            ++kinds;
+            s.kind = CompoundShape::Kind::Box;
+            readKeys(value, at, std::array<std::string_view, 4>{"center", "width", "height", "angle"}, "a box",
+                     [&](const std::string& k, const Json& fv, const std::string& fa) {
+                         if (k == "center") s.center = readVector(fv, fa);
+                         else if (k == "width") s.width = readNumber(fv, fa, size);
+                         else if (k == "height") s.height = readNumber(fv, fa, size);
+                         else s.angle = readNumber(fv, fa, kAnyMagnitude);
+                     });
+        } else if (key == "polygon") {
+            ++kinds;
+            s.kind = CompoundShape::Kind::Polygon;
+            readKeys(value, at, std::array<std::string_view, 1>{"vertices"}, "a polygon",
+                     [&](const std::string&, const Json& fv, const std::string& fa) {
+                         if (!fv.is_array()) refuse(fa, "expected an array of vectors, got " + describeFound(fv));
+                         for (std::size_t i = 0; i < fv.size(); ++i) s.vertices.push_back(readVector(fv[i], child(fa, i)));
+                     });
+        } else if (key == "capsule") {
+            ++kinds;
+            s.kind = CompoundShape::Kind::Capsule;
+            readKeys(value, at, std::array<std::string_view, 3>{"a", "b", "radius"}, "a capsule",
+                     [&](const std::string& k, const Json& fv, const std::string& fa) {
+                         if (k == "a") s.a = readVector(fv, fa);
+                         else if (k == "b") s.b = readVector(fv, fa);
+                         else s.radius = readNumber(fv, fa, size);
+                     });
+        } else if (key == "density") {
+            s.density = readNumber(value, at, size);
+        } else if (key == "friction") {
+            s.friction = readNumber(value, at, NumberRange{0.0, kMaxMagnitude, false});
+        } else if (key == "restitution") {
+            s.restitution = readNumber(value, at, NumberRange{0.0, 1.0, false});
+        } else if (key == "sensor") {
+            s.sensor = readBool(value, at);
+        } else {
+            Filter f;
+            readKeys(value, at, std::array<std::string_view, 3>{"category", "mask", "group"}, "a filter",
+                     [&](const std::string& k, const Json& fv, const std::string& fa) {
+                         if (k == "category") f.category = std::uint32_t(readInteger(fv, fa, 0, 0xFFFFFFFFL));
+                         else if (k == "mask") f.mask = std::uint32_t(readInteger(fv, fa, 0, 0xFFFFFFFFL));
+                         else f.group = int(readInteger(fv, fa, -2147483647L, 2147483647L));
+                     });
+            s.filter = f;
+        }
+    });
+    if (kinds != 1)
+        refuse(pointer, "expected exactly one of circle, box, polygon, capsule in a compound shape, got " +
+                            std::to_string(kinds));
+    return s;
+}
+
+Json compoundShapeJson(const CompoundShape& s) {
+    const auto vec = [](Vec2 p) { return Json{{"x", p.x}, {"y", p.y}}; };
+    Json j = Json::object();
+    switch (s.kind) {
+    case CompoundShape::Kind::Circle: j["circle"] = Json{{"center", vec(s.center)}, {"radius", s.radius}}; break;
+    case CompoundShape::Kind::Box:
+        j["box"] = Json{{"center", vec(s.center)}, {"width", s.width}, {"height", s.height}, {"angle", s.angle}};
+        break;
+    case CompoundShape::Kind::Polygon: {
+        Json list = Json::array();
+        for (const Vec2 p : s.vertices) list.push_back(vec(p));
+        j["polygon"] = Json{{"vertices", list}};
+        break;
+    }
+    case CompoundShape::Kind::Capsule: j["capsule"] = Json{{"a", vec(s.a)}, {"b", vec(s.b)}, {"radius", s.radius}}; break;
+    }
+    if (s.density) j["density"] = *s.density;
+    if (s.friction) j["friction"] = *s.friction;
+    if (s.restitution) j["restitution"] = *s.restitution;
+    if (s.sensor) j["sensor"] = *s.sensor;
+    if (s.filter) j["filter"] = Json{{"category", s.filter->category}, {"mask", s.filter->mask}, {"group", s.filter->group}};
+    return j;
+}
+
 void readField(const FieldInfo& field, const Json& v, void* component, const std::string& pointer,
                const EntityNames& names) {
     void* member = field.address(component);
@@ -194,6 +302,13 @@ void readField(const FieldInfo& field, const Json& v, void* component, const std
         auto& list = *static_cast<std::vector<Vec2>*>(member);
         list.clear();
         for (std::size_t i = 0; i < v.size(); ++i) list.push_back(readVector(v[i], child(pointer, i)));
+        break;
+    }
+    case FieldKind::ShapeList: {
+        if (!v.is_array()) refuse(pointer, "expected an array of shapes, got " + describeFound(v));
+        auto& list = *static_cast<std::vector<CompoundShape>*>(member);
+        list.clear();
+        for (std::size_t i = 0; i < v.size(); ++i) list.push_back(readCompoundShape(v[i], child(pointer, i)));
         break;
     }
     case FieldKind::String: *static_cast<std::string*>(member) = readString(v, pointer); break;
@@ -252,6 +367,12 @@ Json fieldJson(const FieldInfo& field, const void* component, const Registry& re
     case FieldKind::VectorList: {
         Json list = Json::array();
         for (const Vec2 p : *static_cast<const std::vector<Vec2>*>(member)) list.push_back(vectorJson(p));
+        return list;
+    }
+    case FieldKind::ShapeList: {
+        Json list = Json::array();
+        for (const CompoundShape& s : *static_cast<const std::vector<CompoundShape>*>(member))
+            list.push_back(compoundShapeJson(s));
         return list;
     }
     case FieldKind::String: return *static_cast<const std::string*>(member);
@@ -363,7 +484,7 @@ void readWorld(const Json& v, WorldSettings& world) {
 /// name it.
 bool collides(const Registry& registry, Entity e) {
     return registry.has<Radius>(e) || registry.has<Box>(e) || registry.has<Polygon>(e) || registry.has<Capsule>(e) ||
-           registry.has<Plane>(e);
+           registry.has<Plane>(e) || registry.has<Shapes>(e);
 }
 
 /// Reads one `solver_state` entry: an object with the given keys, each read
@@ -412,8 +533,9 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
             refuse(at, "entity " + ref.dump() + " has no shape (radius, box, polygon, capsule or plane), so it has no contacts");
         return e;
     };
-    static constexpr std::array<std::string_view, 5> kContactKeys{"a", "b", "feature", "normal_impulse",
-                                                                  "tangent_impulse"};
+    // shape_a and shape_b (a compound body's shape index) are optional: 0.
+    static constexpr std::array<std::string_view, 7> kContactKeys{"a", "b", "feature", "normal_impulse",
+                                                                  "tangent_impulse", "shape_a", "shape_b"};
     // "joint" is required; an impulse left out is +0.
     static constexpr std::array<std::string_view, 7> kJointKeys{
         "joint", "linear_impulse", "angular_impulse", "axial_impulse", "motor_impulse", "lower_impulse", "upper_impulse"};
@@ -441,21 +563,26 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
             state.contacts.reserve(value.size());
             // What a run writes: one entry per (pair, feature), between two
             // entities, with a normal impulse that only ever pushes.
-            std::map<std::tuple<std::uint64_t, std::uint64_t, std::uint32_t>, std::size_t> seenContacts;
+            using Side = std::pair<std::uint64_t, std::uint32_t>;
+            std::map<std::tuple<Side, Side, std::uint32_t>, std::size_t> seenContacts;
             const NumberRange pushes{0.0, std::numeric_limits<double>::infinity(), false};
             for (std::size_t i = 0; i < value.size(); ++i) {
                 ContactImpulse c;
-                readEntry(value[i], child(at, i), "a contact", kContactKeys, kContactKeys.size(),
+                readEntry(value[i], child(at, i), "a contact", kContactKeys, 5,
                           [&](const std::string& field, const Json& fv, const std::string& fa) {
                               if (field == "a") c.a = shapeAt(fv, fa);
                               else if (field == "b") c.b = shapeAt(fv, fa);
                               else if (field == "feature") c.feature = std::uint32_t(readInteger(fv, fa, 0, 0xFFFF));
                               else if (field == "normal_impulse") c.normalImpulse = readNumber(fv, fa, pushes, NumberRange{});
+                              else if (field == "shape_a") c.shapeA = std::uint32_t(readInteger(fv, fa, 0, 255));
+                              else if (field == "shape_b") c.shapeB = std::uint32_t(readInteger(fv, fa, 0, 255));
                               else c.tangentImpulse = readNumber(fv, fa, NumberRange{});
                           });
                 if (c.a == c.b) refuse(child(child(at, i), "b"), "a contact joins an entity to itself");
-                const std::uint64_t ka = (std::uint64_t(c.a.index) << 32) | c.a.generation;
-                const std::uint64_t kb = (std::uint64_t(c.b.index) << 32) | c.b.generation;
+                // Pairs of shapes of the same two compound bodies are
+                // different contacts.
+                const auto ka = std::make_pair((std::uint64_t(c.a.index) << 32) | c.a.generation, c.shapeA);
+                const auto kb = std::make_pair((std::uint64_t(c.b.index) << 32) | c.b.generation, c.shapeB);
                 const auto [it, fresh] = seenContacts.emplace(std::make_tuple(std::min(ka, kb), std::max(ka, kb), c.feature), i);
                 if (!fresh)
                     refuse(child(at, i), "this pair and feature have an entry already (" + child(at, it->second) + ")");
@@ -712,6 +839,13 @@ std::string relationsProblem(const Scene& scene) {
         const Entity e = entities[i];
         const int shapes = int(registry.has<Radius>(e)) + int(registry.has<Box>(e)) + int(registry.has<Polygon>(e)) +
                            int(registry.has<Capsule>(e)) + int(registry.has<Plane>(e));
+        if (registry.has<Shapes>(e) && shapes > 0) {
+            const Name* name = registry.tryGet<Name>(e);
+            return child("/entities", i) + ": entity " + std::to_string(i) +
+                   (name && !name->value.empty() ? " (\"" + name->value + "\")" : std::string()) +
+                   " has both shapes and a single shape (radius, box, polygon, capsule or plane); a compound body "
+                   "lists every shape in shapes";
+        }
         if (shapes > 1)
             return child("/entities", i) +
                    ": an entity has at most one shape (radius, box, polygon, capsule or plane), got " +
@@ -969,8 +1103,10 @@ void appendSolverState(const SolverState& state, const Registry& registry, std::
         out += first ? "\n      " : ",\n      ";
         first = false;
         out += "{\"a\": " + *a + ", \"b\": " + *b + ", \"feature\": " + std::to_string(c.feature) +
-               ", \"normal_impulse\": " + number(c.normalImpulse) + ", \"tangent_impulse\": " + number(c.tangentImpulse) +
-               "}";
+               ", \"normal_impulse\": " + number(c.normalImpulse) + ", \"tangent_impulse\": " + number(c.tangentImpulse);
+        if (c.shapeA != 0) out += ", \"shape_a\": " + std::to_string(c.shapeA);
+        if (c.shapeB != 0) out += ", \"shape_b\": " + std::to_string(c.shapeB);
+        out += "}";
     }
     out += first ? "]" : "\n    ]";
     if (!state.joints.empty()) {

@@ -53,6 +53,37 @@ Json fieldSchema(const FieldInfo& f) {
         }
         break;
     case FieldKind::EntityRef: j = Json{{"type", "string"}, {"minLength", 1}}; break;
+    case FieldKind::ShapeList: {
+        const auto object = [](Json properties, const char* description) {
+            return Json{{"type", "object"}, {"description", description}, {"properties", std::move(properties)},
+                        {"additionalProperties", false}};
+        };
+        const Json size{{"type", "number"}, {"exclusiveMinimum", 0}};
+        const Json number{{"type", "number"}};
+        Json item = object(
+            Json{{"circle", object(Json{{"center", ref("vector")}, {"radius", size}}, "circle: centre in the body frame, m")},
+                 {"box", object(Json{{"center", ref("vector")}, {"width", size}, {"height", size}, {"angle", number}},
+                                "box: centre in the body frame, full sizes (m), turn in the body frame (rad)")},
+                 {"polygon", object(Json{{"vertices", Json{{"type", "array"}, {"items", ref("vector")}, {"minItems", 3},
+                                                           {"maxItems", 8}}}},
+                                    "convex polygon: 3 to 8 vertices in the body frame, counter-clockwise")},
+                 {"capsule", object(Json{{"a", ref("vector")}, {"b", ref("vector")}, {"radius", size}},
+                                    "capsule: a segment in the body frame swept by a radius")},
+                 {"density", Json{{"type", "number"}, {"exclusiveMinimum", 0}, {"description", "kg/m^2; absent: 1"}}},
+                 {"friction", Json{{"type", "number"}, {"minimum", 0}}},
+                 {"restitution", Json{{"type", "number"}, {"minimum", 0}, {"maximum", 1}}},
+                 {"sensor", Json{{"type", "boolean"}}},
+                 {"filter", object(Json{{"category", Json{{"type", "integer"}, {"minimum", 0}, {"maximum", 4294967295u}}},
+                                        {"mask", Json{{"type", "integer"}, {"minimum", 0}, {"maximum", 4294967295u}}},
+                                        {"group", Json{{"type", "integer"}}}},
+                                   "this shape's collision filter")}},
+            "one shape: exactly one of circle, box, polygon, capsule, with its own material");
+        item["oneOf"] = Json::array({Json{{"required", Json::array({"circle"})}}, Json{{"required", Json::array({"box"})}},
+                                     Json{{"required", Json::array({"polygon"})}},
+                                     Json{{"required", Json::array({"capsule"})}}});
+        j = Json{{"type", "array"}, {"items", item}, {"minItems", int(f.range.min)}, {"maxItems", int(f.range.max)}};
+        break;
+    }
     case FieldKind::VectorList:
         j = Json{{"type", "array"}, {"items", ref("vector")}};
         if (std::isfinite(f.range.min)) j["minItems"] = int(f.range.min);
@@ -147,7 +178,11 @@ std::string sceneJsonSchema() {
                             {"b", entityRef},
                             {"feature", Json{{"type", "integer"}, {"minimum", 0}, {"maximum", 65535}}},
                             {"normal_impulse", Json{{"type", "number"}, {"minimum", 0}, {"description", "N*s; a contact only pushes"}}},
-                            {"tangent_impulse", Json{{"type", "number"}, {"description", "N*s"}}}}}};
+                            {"tangent_impulse", Json{{"type", "number"}, {"description", "N*s"}}},
+                            {"shape_a", Json{{"type", "integer"}, {"minimum", 0}, {"maximum", 255},
+                                             {"description", "a's shape in its shapes list (compound bodies); absent: 0"}}},
+                            {"shape_b", Json{{"type", "integer"}, {"minimum", 0}, {"maximum", 255},
+                                             {"description", "b's shape in its shapes list (compound bodies); absent: 0"}}}}}};
     const auto impulse = [](const char* description) {
         return Json{{"type", "number"}, {"description", description}};
     };

@@ -41,6 +41,10 @@ enum class FieldKind {
     /// std::uint32_t bit field, a JSON integer in [0, 2^32 - 1] (collision
     /// categories and masks); every value is valid
     Bits,
+    /// std::vector<CompoundShape> (the `shapes` component), JSON
+    /// [{"circle"|"box"|"polygon"|"capsule": {...}, ...}, ...]; `range`
+    /// bounds the count
+    ShapeList,
 };
 
 /// Inclusive/exclusive bounds for Number fields. Every number must also be

@@ -139,6 +139,69 @@ struct Plane {
     double offset = 0.0; ///< metres along the normal
 };
 
+/// One shape of a compound body (`Shapes`), in the body's frame: relative
+/// to `Position`, turned with the body by `Angle`. The material, filter and
+/// sensor fields, when given, replace the body's own for this shape.
+struct CompoundShape {
+    enum class Kind : std::uint8_t { Circle, Box, Polygon, Capsule };
+    Kind kind = Kind::Circle;
+    Vec2 center;                    ///< circle and box: the shape's centre, metres
+    double radius = 0.5;            ///< circle and capsule, metres
+    double width = 1.0, height = 1.0;  ///< box, metres
+    double angle = 0.0;             ///< box: its turn in the body frame, rad
+    std::vector<Vec2> vertices;     ///< polygon: 3 to 8, counter-clockwise, convex
+    Vec2 a{-0.5, 0.0}, b{0.5, 0.0}; ///< capsule: the segment's ends
+    std::optional<double> density;  ///< kg/m^2; absent = 1
+    std::optional<double> friction, restitution;
+    std::optional<bool> sensor;
+    std::optional<Filter> filter;
+    friend bool operator==(const CompoundShape&, const CompoundShape&) = default;
+};
+
+/// A compound body: several shapes on one rigid body. Exclusive with the
+/// single-shape components (radius, box, polygon, capsule, plane).
+struct Shapes {
+    /// Default: one circle of 0.5 m on the position, so adding the
+    /// component (the editor's Add) gives a body that collides.
+    std::vector<CompoundShape> items{CompoundShape{}};
+};
+
+/// Nothing when `shape` is a valid compound-body shape, else why not (the
+/// error's `where` is the field inside the item).
+std::optional<Error> compoundShapeProblem(const CompoundShape& shape);
+
+/// Area (m^2) of one compound shape, its centroid in the body frame (m),
+/// and its polar second moment of area about that centroid (m^4).
+struct ShapeAreaProperties {
+    double area = 0.0;
+    Vec2 centroid;
+    double secondMoment = 0.0;
+};
+ShapeAreaProperties compoundShapeArea(const CompoundShape& shape);
+
+/// Mass properties of a compound body: each shape weighs density times
+/// area; `mass`, when given, scales them all so they sum to it. Centre of
+/// mass in the body frame (m); inertia about it (kg m^2, parallel axes);
+/// each shape's mass (kg) in list order.
+struct CompoundMassProperties {
+    double mass = 0.0;
+    Vec2 centre;
+    double inertia = 0.0;
+    std::vector<double> shapeMass;
+};
+CompoundMassProperties compoundMassProperties(const Shapes& shapes, std::optional<double> mass);
+
+/// Whether the body-frame point `local` is inside compound shape `shape`
+/// (picking).
+bool compoundShapeContains(const CompoundShape& shape, Vec2 local);
+/// The shape's outline as points in the body frame, and the radius swept
+/// around them (circles and capsules): its extent at any turn of the body.
+struct ShapeOutline {
+    std::vector<Vec2> points;
+    double radius = 0.0;
+};
+ShapeOutline compoundShapeOutline(const CompoundShape& shape);
+
 /// Newtonian attractor: every other dynamic body i feels
 /// G*m_i*m_a*r/(|r|^2+eps^2)^(3/2) towards it.
 struct Attractor {

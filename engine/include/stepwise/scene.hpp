@@ -87,6 +87,9 @@ struct ContactImpulse {
     std::uint32_t feature = 0;   ///< the manifold point's feature id (which vertex/edge pair touches)
     double normalImpulse = 0.0;  ///< accumulated along the normal, N*s
     double tangentImpulse = 0.0; ///< accumulated along the tangent, N*s
+    /// Which shape of a compound body (`shapes`) each side is, by its index
+    /// in the list; 0 for a single-shape body.
+    std::uint32_t shapeA = 0, shapeB = 0;
 
     friend bool operator==(const ContactImpulse&, const ContactImpulse&) = default;
 };

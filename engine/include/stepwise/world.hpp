@@ -132,6 +132,9 @@ struct WorldLayout {
     std::vector<Entity> bodies;      ///< dynamic bodies, in state-vector order
     std::vector<Entity> spinBodies;  ///< dynamic bodies without a shape that turn
     std::vector<Entity> colliders;   ///< every shape, in collider order
+    /// per collider: which shape of its entity's `shapes` it is (0 for a
+    /// single shape; 0xFFFFFFFF for a compound body's hub, which has none)
+    std::vector<std::uint32_t> colliderParts;
     std::vector<std::uint8_t> colliderMoves;  ///< per collider: 1 when it is a dynamic body's
     std::vector<Entity> joints;      ///< every joint's entity, in solver (scene) order
     friend bool operator==(const WorldLayout&, const WorldLayout&) = default;

@@ -63,6 +63,33 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
         polygons_.push_back(*c.shape.polygon);
         colliders_.back().shape.polygon = &polygons_.back();
     }
+    if (c.hub >= 0) {
+        // A shape of a compound body: everything that moves is its hub's.
+        const std::size_t hub = std::size_t(c.hub);
+        filtered_ = filtered_ || !(filter == Filter{});
+        filters_.push_back(filter);
+        anyKinematic_ = anyKinematic_ || c.kinematic;
+        anySensor_ = anySensor_ || c.sensor;
+        colliderAsleep_.push_back(0);
+        shapesOfHubs_.push_back(index);
+        awakeShapesOfHubs_.push_back(index);
+        angles_.push_back(angles_[hub]);
+        angularVelocities_.push_back(angularVelocities_[hub]);
+        invMass_.push_back(invMass_[hub]);
+        colliders_.back().inertia = 0.0;
+        colliders_.back().mass = 0.0;
+        invInertia_.push_back(0.0);
+        // Reach about the body's centre of mass: the shape's own plus how
+        // far its centre sits from the body's.
+        const double own = c.shape.kind == ShapeKind::Circle    ? c.shape.radius
+                           : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius
+                           : c.shape.kind == ShapeKind::Capsule ? length(c.shape.halfExtents) + c.shape.radius
+                                                                : length(c.shape.halfExtents);
+        maxExtent_.push_back(own + length(c.centreOfMass - colliders_[hub].centreOfMass));
+        finite_.push_back(index);
+        solverIndex_.push_back(solverIndex_[hub]);
+        return;
+    }
     // A kinematic body moves like a dynamic one (a solver body, turned by
     // its spin) with zero inverse mass and inertia.
     const bool dynamic = c.body >= 0 && (c.mass > 0.0 || c.kinematic);
@@ -138,9 +165,14 @@ void CollisionSystem::refreshSleeping(std::span<const Vec2> x) {
         colliderAsleep_[i] = bodyAsleep_ && body >= 0 && (*bodyAsleep_)[std::size_t(body)] ? 1 : 0;
         anySleeping_ = anySleeping_ || colliderAsleep_[i];
     }
+    syncShapes();
     awakeSolverColliders_.clear();
     for (std::size_t i = 0; i < n; ++i)
-        if (solverIndex_[i] != 0 && !colliderAsleep_[i]) awakeSolverColliders_.push_back(std::uint32_t(i));
+        if (solverIndex_[i] != 0 && !colliderAsleep_[i] && colliders_[i].hub < 0)
+            awakeSolverColliders_.push_back(std::uint32_t(i));
+    awakeShapesOfHubs_.clear();
+    for (const std::uint32_t i : shapesOfHubs_)
+        if (!colliderAsleep_[i]) awakeShapesOfHubs_.push_back(i);
     for (joints::JointConstraint& j : joints_)
         j.asleep = j.broken || (j.a.collider >= 0 && colliderAsleep_[std::size_t(j.a.collider)]) ||
                    (j.b.collider >= 0 && colliderAsleep_[std::size_t(j.b.collider)]);
@@ -303,7 +335,8 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
         if (colliders_[a].sensor || colliders_[b].sensor) continue;  // a sensor wakes nothing
         if (!collides(a, b)) continue;
         if (!noCollide_.empty()) {
-            const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+            const std::uint32_t oa = ownerOf(a), ob = ownerOf(b);
+            const std::uint64_t key = (std::uint64_t(std::min(oa, ob)) << 32) | std::max(oa, ob);
             if (std::binary_search(noCollide_.begin(), noCollide_.end(), key)) continue;
         }
         const double closing = std::max(length(startV_[a] - startV_[b]), length(endV_[a] - endV_[b]));
@@ -395,8 +428,13 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
     // (The flag is read first: a collider's kinematic bit is on another
     // cache line than what the narrow phase has read of it.)
     c.touchesStatic = c.bodyA == 0 || c.bodyB == 0 || (anyKinematic_ && (colliders_[a].kinematic || colliders_[b].kinematic));
-    c.roundA = colliders_[a].shape.kind == ShapeKind::Circle;
-    c.roundB = colliders_[b].shape.kind == ShapeKind::Circle;
+    // A circle turns under its contact point only about its own centre: not
+    // a compound body's circle, which turns about the body's.
+    c.roundA = colliders_[a].shape.kind == ShapeKind::Circle && colliders_[a].hub < 0;
+    c.roundB = colliders_[b].shape.kind == ShapeKind::Circle && colliders_[b].hub < 0;
+    // Lever arms from the body's centre of mass: a compound shape's hub's.
+    const Vec2 centreA = colliders_[a].hub >= 0 ? centres[std::size_t(colliders_[a].hub)] : centres[a];
+    const Vec2 centreB = colliders_[b].hub >= 0 ? centres[std::size_t(colliders_[b].hub)] : centres[b];
     c.normal = m.normal;
     c.friction = std::sqrt(colliders_[a].friction * colliders_[b].friction);
     c.pointCount = m.pointCount;
@@ -407,8 +445,8 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
         detail.id[i] = m.points[i].id;
         // Planes have no centre: their anchor is the point itself, which is
         // fine because a plane never moves or turns.
-        const Vec2 anchorA = colliders_[a].shape.kind == ShapeKind::Plane ? Vec2{} : detail.point[i] - centres[a];
-        const Vec2 anchorB = colliders_[b].shape.kind == ShapeKind::Plane ? Vec2{} : detail.point[i] - centres[b];
+        const Vec2 anchorA = colliders_[a].shape.kind == ShapeKind::Plane ? Vec2{} : detail.point[i] - centreA;
+        const Vec2 anchorB = colliders_[b].shape.kind == ShapeKind::Plane ? Vec2{} : detail.point[i] - centreB;
         p.rnA = cross(anchorA, m.normal);
         p.rnB = cross(anchorB, m.normal);
         p.dnA = dot(anchorA, m.normal);
@@ -447,6 +485,7 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
     detected_ = false;
     stepStartX_ = x;
     timings_ = {};
+    syncShapes();
     const std::size_t n = colliders_.size();
     centres_.resize(n);
     stepStart_.resize(n);
@@ -477,10 +516,12 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     // ones' motion, margins and rotations were set by refreshSleeping. With
     // none asleep every collider is visited, in the same order.
     const auto forEachActive = [&](auto&& visit) {
-        if (anySleeping_)
+        if (anySleeping_) {
             for (const std::uint32_t i : awakeSolverColliders_) visit(std::size_t(i));
-        else
+            for (const std::uint32_t i : awakeShapesOfHubs_) visit(std::size_t(i));
+        } else {
             for (std::size_t i = 0; i < n; ++i) visit(i);
+        }
     };
   for (;;) {  // once, or again after an awake shape woke a sleeping island
     // The motion within the step, not only at its start: the velocity after
@@ -589,11 +630,14 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     for (const ProxyPair& pair : pairs_) {
         const std::uint32_t a = finite_[pair.a], b = finite_[pair.b];
         if (colliderAsleep_[a] || colliderAsleep_[b]) continue;  // no manifold: it would have woken them
+        // Shapes of one body never touch each other (nor sense each other).
+        if (!shapesOfHubs_.empty() && sameBody(a, b)) continue;
         if (anySensor_ && sensedInstead(a, b)) continue;
         if (!collides(a, b)) continue;
         if (!noCollide_.empty()) {
             // Bodies joined with collide_connected false do not collide.
-            const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+            const std::uint32_t oa = ownerOf(a), ob = ownerOf(b);
+            const std::uint64_t key = (std::uint64_t(std::min(oa, ob)) << 32) | std::max(oa, ob);
             if (std::binary_search(noCollide_.begin(), noCollide_.end(), key)) continue;
         }
         const Shape& shapeA = colliders_[a].shape;
@@ -833,6 +877,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     }
     if (++substepsDone_ == substeps_) {
         correctStepPositions(x);
+        syncShapes();
         if (anySensor_) updateSensors(x);
     }
     timings_.solveMs += msSince(start);
@@ -974,6 +1019,7 @@ void CollisionSystem::initSensors(std::span<const Vec2> x) {
     sensorOverlaps_.clear();
     sensorEvents_.clear();
     if (!anySensor_) return;
+    syncShapes();
     // Every sensor against every shape that could be inside it: sensors are
     // few, and this runs once per build or restore.
     const std::size_t n = colliders_.size();
@@ -981,7 +1027,7 @@ void CollisionSystem::initSensors(std::span<const Vec2> x) {
         if (!colliders_[s].sensor || colliders_[s].solverOnly) continue;
         for (std::uint32_t o = 0; o < n; ++o) {
             const Collider& other = colliders_[o];
-            if (o == s || other.sensor || other.solverOnly) continue;
+            if (o == s || other.sensor || other.solverOnly || sameBody(s, o)) continue;
             // The pairs a step looks at: a plane meets only dynamic shapes,
             // and two shapes meet when at least one moves.
             const bool planeS = colliders_[s].shape.kind == ShapeKind::Plane, planeO = other.shape.kind == ShapeKind::Plane;

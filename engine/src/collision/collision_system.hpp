@@ -32,13 +32,23 @@ namespace stepwise::collision {
 struct Collider {
     Shape shape;
     std::int32_t body = -1;      ///< index in the World's state vector; -1 = static or plane
+    /// A shape of a moving compound body: the collider that holds the
+    /// body's rotation, spin, mass and solver body (its hub); -1 otherwise.
+    /// Such a shape has no mass of its own and shares everything but its
+    /// geometry, material, filter and sensor flag with the hub.
+    std::int32_t hub = -1;
+    /// Which shape of its entity's `shapes` list this is (0 for a
+    /// single-shape body); kHubPart for a hub.
+    std::uint32_t part = 0;
+    static constexpr std::uint32_t kHubPart = 0xFFFFFFFFu;
     Vec2 staticPosition;         ///< centre of a static shape, metres
     double mass = 0.0;           ///< kg; 0 for static
     double restitution = 0.0;
     double friction = 0.2;
     Entity entity;
     /// A body with no shape that is in the solver only because a joint
-    /// holds it: it turns and takes impulses but never collides.
+    /// holds it, or the hub of a compound body: it turns and takes impulses
+    /// but never collides itself.
     bool solverOnly = false;
     /// A kinematic body: in the state vector (`body` >= 0) and moving, with
     /// zero inverse mass and inertia, so contacts push others but never it.
@@ -50,6 +60,7 @@ struct Collider {
     double inertia = 0.0;
     /// Centre of mass relative to the body's position, in the body frame,
     /// metres: non-zero for a polygon whose centroid is not its position.
+    /// A compound body's shape: its own centre (of its outline) there.
     /// The state vector then holds the position (the file's value, so saves
     /// round-trip exactly) and the velocity of the centre of mass; contacts
     /// work about the centre of mass and turning the body moves its position.
@@ -71,6 +82,11 @@ public:
     /// and the filter of which colliders it meets (shouldCollide).
     void add(const Collider& collider, double angle, double angularVelocity, const Filter& filter = {});
     bool empty() const { return colliders_.empty(); }
+    /// Sets the farthest reach of a compound body's hub from its centre of
+    /// mass (its shapes' reach), metres: what sleeping and margins use.
+    void setMaxExtent(std::size_t i, double extent) { maxExtent_[i] = extent; }
+    /// Whether collider i is a compound body's hub.
+    bool isHub(std::size_t i) const { return colliders_[i].part == Collider::kHubPart; }
     std::size_t colliderCount() const { return colliders_.size(); }
     const Collider& collider(std::size_t i) const { return colliders_[i]; }
     double angle(std::size_t i) const { return angles_[i]; }
@@ -161,6 +177,7 @@ public:
     void restoreRotation(std::span<const double> angles, std::span<const double> angularVelocities) {
         angles_.assign(angles.begin(), angles.end());
         angularVelocities_.assign(angularVelocities.begin(), angularVelocities.end());
+        syncShapes();
     }
     /// Undoes what the last beginStep..endStep did to the carried solver
     /// state (after a divergence): the warm-start cache and the joints'
@@ -198,6 +215,23 @@ public:
     double maxExtent(std::size_t i) const { return maxExtent_[i]; }
 
 private:
+    /// Copies each compound body's rotation and spin from its hub to its
+    /// shapes, so every per-collider reader sees the body's.
+    void syncShapes() {
+        for (const std::uint32_t i : shapesOfHubs_) {
+            const std::size_t hub = std::size_t(colliders_[i].hub);
+            angles_[i] = angles_[hub];
+            angularVelocities_[i] = angularVelocities_[hub];
+        }
+    }
+    /// The collider whose pair a joint names: a compound shape's hub.
+    std::uint32_t ownerOf(std::uint32_t i) const {
+        return colliders_[i].hub >= 0 ? std::uint32_t(colliders_[i].hub) : i;
+    }
+    /// Whether two colliders are shapes of the same moving body.
+    bool sameBody(std::uint32_t a, std::uint32_t b) const {
+        return colliders_[a].body >= 0 && colliders_[a].body == colliders_[b].body;
+    }
     /// After the step's last substep: positions out of overlap beyond the
     /// slop (position_correction.hpp), written back to `x` and the angles.
     void correctStepPositions(std::span<Vec2> x);
@@ -224,6 +258,10 @@ private:
     std::vector<std::uint32_t> offsetBodies_;  // dynamic colliders whose centre of mass is off their position
     std::vector<double> offsetAngleBefore_;    // their angles at the start of the substep, rad
     std::vector<double> angles_, angularVelocities_;
+    /// Shapes of moving compound bodies (hub >= 0), ascending; empty in a
+    /// world without one, which then takes only the single-shape paths.
+    std::vector<std::uint32_t> shapesOfHubs_;
+    std::vector<std::uint32_t> awakeShapesOfHubs_;  // those whose body is awake
     std::vector<double> invMass_, invInertia_, maxExtent_;
     std::vector<std::uint32_t> finite_;  // colliders that are not planes (broad-phase proxies)
     std::vector<std::uint32_t> planes_;

@@ -446,8 +446,9 @@ SolverState entityKeyed(const WorldLayout& layout, std::span<const CachedImpulse
     }
     state.contacts.reserve(cache.size());
     for (const CachedImpulse& c : cache)
-        state.contacts.push_back(
-            {layout.colliders[c.colliderA()], layout.colliders[c.colliderB()], c.feature(), c.normal, c.tangent});
+        state.contacts.push_back({layout.colliders[c.colliderA()], layout.colliders[c.colliderB()], c.feature(),
+                                  c.normal, c.tangent, layout.colliderParts[c.colliderA()],
+                                  layout.colliderParts[c.colliderB()]});
     // A joint that carries nothing is left out: absent means all +0.
     for (const JointImpulse& j : jointImpulses)
         if (!carriesNothing(j)) state.joints.push_back(j);
@@ -559,9 +560,23 @@ void World::setSolverState(const SolverState& state) {
     }
     w.dropped.reset();
     if (!w.collision) return;
-    std::unordered_map<Entity, std::uint32_t> colliderOf;
+    // Keyed by entity and shape: a compound body has a collider per shape.
+    std::unordered_map<Entity, std::uint32_t> colliderOf;  // an entity's first collider
     const std::vector<Entity>& colliders = w.layout->colliders;
+    const std::vector<std::uint32_t>& parts = w.layout->colliderParts;
     for (std::size_t c = 0; c < colliders.size(); ++c) colliderOf.emplace(colliders[c], std::uint32_t(c));
+    // A compound body's colliders follow each other: its hub, then shape k at k + 1.
+    const auto colliderFor = [&](Entity e, std::uint32_t shape) -> std::optional<std::uint32_t> {
+        const auto it = colliderOf.find(e);
+        if (it == colliderOf.end()) return std::nullopt;
+        std::uint32_t c = it->second;
+        if (parts[c] == collision::Collider::kHubPart) ++c;
+        if (shape != 0) {
+            if (parts[c] != 0 || std::size_t(c) + shape >= colliders.size() || colliders[c + shape] != e) return std::nullopt;
+            c += shape;
+        }
+        return parts[c] == shape ? std::optional<std::uint32_t>(c) : std::nullopt;
+    };
     // The most impulse a run can leave on one contact, when contacts,
     // gravity and drag are all that act (springs, attractors, boids and
     // joints can press with any force, so no bound is claimed for them). A
@@ -580,8 +595,8 @@ void World::setSolverState(const SolverState& state) {
     std::vector<CachedImpulse> cache;
     cache.reserve(state.contacts.size());
     for (const ContactImpulse& c : state.contacts) {
-        const auto a = colliderOf.find(c.a), b = colliderOf.find(c.b);
-        if (a == colliderOf.end() || b == colliderOf.end()) continue;  // no longer collides: nothing to warm
+        const std::optional<std::uint32_t> a = colliderFor(c.a, c.shapeA), b = colliderFor(c.b, c.shapeB);
+        if (!a || !b) continue;  // no longer collides: nothing to warm
         const double largest = std::max(std::abs(c.normalImpulse), std::abs(c.tangentImpulse));
         if (bounded && !(largest <= bound)) {
             if (!w.dropped) w.dropped = DroppedImpulses{.bound = bound};
@@ -589,7 +604,7 @@ void World::setSolverState(const SolverState& state) {
             w.dropped->largest = std::max(w.dropped->largest, largest);
             continue;
         }
-        cache.push_back({CachedImpulse::makeKey(a->second, b->second, c.feature), c.normalImpulse, c.tangentImpulse});
+        cache.push_back({CachedImpulse::makeKey(*a, *b, c.feature), c.normalImpulse, c.tangentImpulse});
     }
     // Kept in the given order when it is sorted (always, for a state this
     // engine wrote): entries with equal keys then stay in the order the

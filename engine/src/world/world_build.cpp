@@ -50,7 +50,12 @@ std::optional<Error> compileBodies(const Registry& reg, WorldImpl& w, BodyIndex&
         if (st && st->value) continue;
         const Velocity* vel = reg.tryGet<Velocity>(e);
         const Mass* m = reg.tryGet<Mass>(e);
-        const double mv = m ? m->value : 1.0;
+        // A compound body without a mass weighs what its shapes' densities
+        // and areas give (with one, that sum is scaled to it).
+        // (An empty list is refused by checkPolygons, naming the shapes.)
+        const Shapes* compound = m ? nullptr : reg.tryGet<Shapes>(e);
+        if (compound && compound->items.empty()) compound = nullptr;
+        const double mv = m ? m->value : compound ? compoundMassProperties(*compound, std::nullopt).mass : 1.0;
         if (const Kinematic* k = reg.tryGet<Kinematic>(e); k && k->value) {
             w.isKinematic.resize(w.bodyEntity.size() + 1, 0);
             w.isKinematic.back() = 1;
@@ -219,6 +224,19 @@ void compileBoids(const Registry& reg, WorldImpl& w) {
 std::optional<Error> checkPolygons(const Registry& reg) {
     const std::vector<Entity>& order = reg.entities();
     for (std::size_t i = 0; i < order.size(); ++i) {
+        if (const Shapes* compound = reg.tryGet<Shapes>(order[i])) {
+            for (std::size_t k = 0; k < compound->items.size(); ++k)
+                if (std::optional<Error> problem = compoundShapeProblem(compound->items[k])) {
+                    const Name* name = reg.tryGet<Name>(order[i]);
+                    return Error{problem->message, entityLabel(i, name ? &name->value : nullptr) + ": shapes/" +
+                                                       std::to_string(k) + "/" + problem->where};
+                }
+            if (compound->items.empty() || compound->items.size() > 256) {
+                const Name* name = reg.tryGet<Name>(order[i]);
+                return Error{"expected 1 to 256 shapes, got " + std::to_string(compound->items.size()),
+                             entityLabel(i, name ? &name->value : nullptr) + ": shapes"};
+            }
+        }
         if (const Capsule* capsule = reg.tryGet<Capsule>(order[i]); capsule && capsule->a == capsule->b) {
             const Name* name = reg.tryGet<Name>(order[i]);
             return Error{"a and b are the same point; a capsule needs a segment of non-zero length",
@@ -321,10 +339,14 @@ void compileSleep(const WorldSettings& ws, WorldImpl& w) {
     if (w.collision)
         for (std::size_t c = 0; c < w.collision->colliderCount(); ++c)
             if (const std::int32_t body = w.collision->collider(c).body; body >= 0) {
+                // A compound body's hub stands for the body (its shapes
+                // share its rotation).
+                if (w.collision->collider(c).hub >= 0) continue;
                 w.colliderOfBody[std::size_t(body)] = std::int32_t(c);
                 // A shapeless jointed body turns like a disc of kShapelessRadius.
-                w.sleep.extent[std::size_t(body)] = w.collision->collider(c).solverOnly ? detail::kShapelessRadius
-                                                                                          : w.collision->maxExtent(c);
+                w.sleep.extent[std::size_t(body)] =
+                    w.collision->collider(c).solverOnly && !w.collision->isHub(c) ? detail::kShapelessRadius
+                                                                                  : w.collision->maxExtent(c);
             }
     // Boids steer by their neighbours and never rest; a shapeless body that
     // turns (its spin is constant: nothing applies torque) would stop turning.
@@ -374,6 +396,7 @@ std::shared_ptr<const WorldLayout> makeLayout(const WorldImpl& w) {
     if (w.collision) {
         for (std::size_t c = 0; c < w.collision->colliderCount(); ++c) {
             layout->colliders.push_back(w.collision->collider(c).entity);
+            layout->colliderParts.push_back(w.collision->collider(c).part);
             layout->colliderMoves.push_back(w.collision->collider(c).body >= 0 ? 1 : 0);
         }
         for (const joints::JointConstraint& j : w.collision->jointConstraints()) layout->joints.push_back(j.entity);

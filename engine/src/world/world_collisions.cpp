@@ -31,6 +31,111 @@ joints::JointKind jointKindOf(const std::string& type) {
     return joints::JointKind::Hinge;
 }
 
+/// One shape of a compound body as the engine holds it: the geometry about
+/// its own centre, and that centre in the body frame (Collider::centreOfMass).
+/// A turned box becomes the polygon of its corners, so every shape of a body
+/// turns with the body's one angle.
+void compoundGeometry(const CompoundShape& s, collision::Collider& c, collision::ConvexPolygon& polygon) {
+    switch (s.kind) {
+    case CompoundShape::Kind::Circle:
+        c.shape.kind = collision::ShapeKind::Circle;
+        c.shape.radius = s.radius;
+        c.centreOfMass = s.center;
+        return;
+    case CompoundShape::Kind::Box:
+        c.centreOfMass = s.center;
+        if (s.angle == 0.0) {
+            c.shape.kind = collision::ShapeKind::Box;
+            c.shape.halfExtents = {0.5 * s.width, 0.5 * s.height};
+            return;
+        } else {
+            const collision::Rot q = collision::Rot::fromAngle(s.angle);
+            const double hx = 0.5 * s.width, hy = 0.5 * s.height;
+            const Vec2 corners[4] = {collision::rotate(q, {-hx, -hy}), collision::rotate(q, {hx, -hy}),
+                                     collision::rotate(q, {hx, hy}), collision::rotate(q, {-hx, hy})};
+            polygon = collision::ConvexPolygon::fromVertices(corners, 4);
+            c.shape.kind = collision::ShapeKind::Polygon;
+            c.shape.polygon = &polygon;
+            return;
+        }
+    case CompoundShape::Kind::Polygon: {
+        const PolygonMassProperties props = polygonMassProperties(s.vertices);
+        Vec2 local[collision::kMaxPolygonVertices];
+        const int count = int(s.vertices.size());
+        for (int i = 0; i < count; ++i) local[i] = s.vertices[std::size_t(i)] - props.centroid;
+        polygon = collision::ConvexPolygon::fromVertices(local, count);
+        c.shape.kind = collision::ShapeKind::Polygon;
+        c.shape.polygon = &polygon;
+        c.centreOfMass = props.centroid;
+        return;
+    }
+    case CompoundShape::Kind::Capsule:
+        c.shape.kind = collision::ShapeKind::Capsule;
+        c.shape.radius = s.radius;
+        c.shape.halfExtents = 0.5 * (s.b - s.a);
+        c.centreOfMass = 0.5 * (s.a + s.b);
+        return;
+    }
+}
+
+/// A compound body: for a moving one, a hub (the rigid body: summed mass,
+/// inertia about the common centre of mass, the one angle and spin, the
+/// solver body) and then each shape pointing at it; for a static one, each
+/// shape as a static collider at its place in the body frame.
+void addCompoundBody(const Registry& reg, Entity e, const Shapes& compound,
+                     const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody,
+                     collision::CollisionSystem& system, std::unordered_map<std::uint32_t, std::int32_t>& colliderOf) {
+    const std::uint32_t body = bodyOf(e);
+    const bool moving = body != noBody;
+    const bool kinematic = moving && reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value;
+    const Vec2 position = reg.tryGet<Position>(e)->value;
+    const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
+    const double spin = reg.has<AngularVelocity>(e) ? reg.tryGet<AngularVelocity>(e)->value : 0.0;
+    const Mass* given = reg.tryGet<Mass>(e);
+    const CompoundMassProperties props =
+        compoundMassProperties(compound, given ? std::optional<double>(given->value) : std::nullopt);
+    const double restitution = reg.has<Restitution>(e) ? reg.tryGet<Restitution>(e)->value : Restitution{}.value;
+    const double friction = reg.has<Friction>(e) ? reg.tryGet<Friction>(e)->value : Friction{}.value;
+    const bool sensor = reg.has<Sensor>(e) && reg.tryGet<Sensor>(e)->value;
+    const Filter* filter = reg.tryGet<Filter>(e);
+    std::int32_t hub = -1;
+    if (moving) {
+        collision::Collider h;
+        h.body = std::int32_t(body);
+        h.part = collision::Collider::kHubPart;
+        h.kinematic = kinematic;
+        h.mass = kinematic ? 0.0 : props.mass;
+        h.inertia = props.inertia;
+        h.centreOfMass = props.centre;
+        h.entity = e;
+        h.solverOnly = true;
+        hub = std::int32_t(system.colliderCount());
+        colliderOf.emplace(e.index, hub);
+        system.add(h, angle, spin);
+    }
+    collision::ConvexPolygon polygon;
+    double reach = 0.0;
+    for (std::size_t k = 0; k < compound.items.size(); ++k) {
+        const CompoundShape& s = compound.items[k];
+        collision::Collider c;
+        compoundGeometry(s, c, polygon);
+        c.body = moving ? std::int32_t(body) : -1;
+        c.hub = hub;
+        c.part = std::uint32_t(k);
+        c.staticPosition = position;
+        c.kinematic = kinematic;
+        c.restitution = s.restitution.value_or(restitution);
+        c.friction = s.friction.value_or(friction);
+        c.sensor = s.sensor.value_or(sensor);
+        c.entity = e;
+        if (!moving) colliderOf.emplace(e.index, std::int32_t(system.colliderCount()));
+        const std::size_t index = system.colliderCount();
+        system.add(c, angle, 0.0, s.filter ? *s.filter : filter ? *filter : Filter{});
+        if (moving) reach = std::max(reach, system.maxExtent(index));
+    }
+    if (moving) system.setMaxExtent(std::size_t(hub), reach);
+}
+
 } // namespace
 
 std::unique_ptr<collision::CollisionSystem> buildCollisions(
@@ -47,6 +152,11 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
     collision::ConvexPolygon polygon;  // copied by add()
     static const std::vector<Entity> kNoEntities;
     for (const Entity e : shapes ? reg.entities() : kNoEntities) {
+        if (const Shapes* compound = reg.tryGet<Shapes>(e)) {
+            makeSystem();
+            addCompoundBody(reg, e, *compound, bodyOf, noBody, *system, colliderOf);
+            continue;
+        }
         collision::Collider c;
         if (const Radius* r = reg.tryGet<Radius>(e)) {
             c.shape.kind = collision::ShapeKind::Circle;
@@ -236,6 +346,18 @@ double halfExtentAlong(const Registry& reg, Entity e, Vec2 dir) {
         return 0.5 * (hi - lo);
     }
     if (const Capsule* cap = reg.tryGet<Capsule>(e)) return 0.5 * std::abs(dot(cap->b - cap->a, local)) + cap->radius;
+    if (const Shapes* shapes = reg.tryGet<Shapes>(e)) {
+        // The whole body's extent: over every shape's outline.
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (const CompoundShape& s : shapes->items) {
+            const ShapeOutline outline = compoundShapeOutline(s);
+            for (const Vec2 v : outline.points) {
+                lo = std::min(lo, dot(v, local) - outline.radius);
+                hi = std::max(hi, dot(v, local) + outline.radius);
+            }
+        }
+        return hi >= lo ? 0.5 * (hi - lo) : 0.0;
+    }
     return 0.0;
 }
 
@@ -244,11 +366,23 @@ double halfExtentAlong(const Registry& reg, Entity e, Vec2 dir) {
 double centreAlong(const Registry& reg, Entity e, Vec2 dir) {
     const Polygon* p = reg.tryGet<Polygon>(e);
     const Capsule* cap = p ? nullptr : reg.tryGet<Capsule>(e);
-    if ((!p || p->vertices.empty()) && !cap) return 0.0;
+    const Shapes* shapes = p || cap ? nullptr : reg.tryGet<Shapes>(e);
+    if ((!p || p->vertices.empty()) && !cap && !shapes) return 0.0;
     const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
     const double c = std::cos(angle), s = std::sin(angle);
     const Vec2 local{c * dir.x + s * dir.y, -s * dir.x + c * dir.y};
     if (cap) return 0.5 * dot(cap->a + cap->b, local);
+    if (shapes) {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (const CompoundShape& item : shapes->items) {
+            const ShapeOutline outline = compoundShapeOutline(item);
+            for (const Vec2 v : outline.points) {
+                lo = std::min(lo, dot(v, local) - outline.radius);
+                hi = std::max(hi, dot(v, local) + outline.radius);
+            }
+        }
+        return hi >= lo ? 0.5 * (lo + hi) : 0.0;
+    }
     double lo = dot(p->vertices[0], local), hi = lo;
     for (const Vec2& v : p->vertices) {
         lo = std::min(lo, dot(v, local));
@@ -296,7 +430,9 @@ double springRate(const Scene& scene, const SystemSwitches& switches) {
         if (e.isNull() || !reg.alive(e) || !reg.has<Position>(e)) return 0.0;
         if (const Static* st = reg.tryGet<Static>(e); st && st->value) return 0.0;
         if (const Kinematic* k = reg.tryGet<Kinematic>(e); k && k->value) return 0.0;
-        return reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0;
+        if (reg.has<Mass>(e)) return reg.tryGet<Mass>(e)->value;
+        const Shapes* shapes = reg.tryGet<Shapes>(e);
+        return shapes ? compoundMassProperties(*shapes, std::nullopt).mass : 1.0;
     };
     std::unordered_map<std::uint32_t, std::pair<double, double>> rows;  // entity index -> (stiffness, damping)
     for (const Entity e : reg.entities()) {
@@ -373,10 +509,15 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     };
     // With contacts switched off no shape takes part.
     const auto hasShape = [&](Entity e) {
-        return switches.collisions && (reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) || reg.has<Capsule>(e));
+        return switches.collisions && (reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) ||
+                                       reg.has<Capsule>(e) || reg.has<Shapes>(e));
     };
     const auto dynamic = [&](Entity e) { return reg.alive(e) && reg.has<Position>(e) && !isStatic(e); };
-    const auto massOf = [&](Entity e) { return reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0; };
+    const auto massOf = [&](Entity e) {
+        if (reg.has<Mass>(e)) return reg.tryGet<Mass>(e)->value;
+        const Shapes* shapes = reg.tryGet<Shapes>(e);
+        return shapes ? compoundMassProperties(*shapes, std::nullopt).mass : 1.0;
+    };
     const auto sizeOf = [&](Entity e) {
         return hasShape(e) ? 2.0 * std::max(halfExtentAlong(reg, e, across), halfExtentAlong(reg, e, down))
                            : 2.0 * detail::kShapelessRadius;

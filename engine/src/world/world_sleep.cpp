@@ -164,11 +164,22 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
     // may hold up any island); a changed body's shape, angle or spin wakes
     // its island; a removed shape wakes what it touched (its cached contacts).
     if (collision || before.collision) {
-        EntitySlots oldCollider, newCollider;
+        // An entity's colliders are consecutive (a compound body's hub, then
+        // its shapes): the slots hold each entity's first, and a shape is
+        // found by its part among them.
+        EntitySlots oldFirst, newCollider;
+        const auto oldColliderOf = [&](const collision::Collider& col) {
+            std::uint32_t o = oldFirst.find(col.entity);
+            if (o == EntitySlots::kNone) return o;
+            for (; o < before.collision->colliderCount() && before.collision->collider(o).entity == col.entity; ++o)
+                if (before.collision->collider(o).part == col.part) return o;
+            return EntitySlots::kNone;
+        };
         std::size_t staticCount = 0, oldStaticCount = 0;
         if (before.collision)
             for (std::size_t c = 0; c < before.collision->colliderCount(); ++c) {
-                oldCollider.set(before.collision->collider(c).entity, std::uint32_t(c));
+                if (oldFirst.find(before.collision->collider(c).entity) == EntitySlots::kNone)
+                    oldFirst.set(before.collision->collider(c).entity, std::uint32_t(c));
                 oldStaticCount += before.collision->collider(c).body < 0 ? 1 : 0;
             }
         bool staticEdited = false;
@@ -176,7 +187,7 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
             for (std::size_t c = 0; c < collision->colliderCount(); ++c) {
                 const collision::Collider& col = collision->collider(c);
                 newCollider.set(col.entity, std::uint32_t(c));
-                const std::uint32_t o = oldCollider.find(col.entity);
+                const std::uint32_t o = oldColliderOf(col);
                 const bool same = o != EntitySlots::kNone && sameCollider(col, before.collision->collider(o)) &&
                                   sameBits(collision->angle(c), before.collision->angle(o)) &&
                                   sameBits(collision->angularVelocity(c), before.collision->angularVelocity(o));
