@@ -72,7 +72,7 @@ TEST(Inspector, RefusesAtEditTimeWhatTheLoaderRefusesNamingEntityAndField) {
     std::string problem;
     // A second shape.
     EXPECT_FALSE(f.ed.applyEdit("add box", [&](Scene& s) { return addComponentToAll(s, *findComponent("box"), {bob}, &problem) > 0; }));
-    EXPECT_EQ(problem, "\"bob\" box: an entity has at most one shape (radius, box, polygon, capsule or plane), got 2");
+    EXPECT_EQ(problem, "\"bob\" box: an entity has at most one shape (radius, box, polygon, capsule, chain or plane), got 2");
     // A speed past the fastest a level holds.
     const ComponentInfo* velocity = findComponent("velocity");
     EXPECT_FALSE(f.ed.applyEdit("v", [&](Scene& s) {

@@ -99,6 +99,13 @@ std::optional<Error> finishCapsule(void* component) {
     return {};
 }
 
+std::optional<Error> finishChain(void* component) {
+    const auto& chain = *static_cast<Chain*>(component);
+    std::optional<Error> problem = chainProblem(chain.points, chain.loop);
+    if (!problem) return {};
+    return problem->within("points");
+}
+
 std::optional<Error> finishSpring(void* component) {
     auto& spring = *static_cast<Spring*>(component);
     if (spring.a.isNull()) return Error{"expected the name of an entity, got nothing", "a"};
@@ -180,6 +187,20 @@ std::vector<ComponentInfo> buildTable() {
             &finishCapsule);
         capsule.finishNamesEntity = true;
         t.push_back(std::move(capsule));
+    }
+    {
+        ComponentInfo chain = row<Chain>(
+            "chain",
+            "chain shape on a static body: a smooth one-sided polyline, solid on the right of each segment's "
+            "direction; rotated by angle about position",
+            false, needsPosition,
+            {field<&Chain::points>("points", NumberRange{2.0, double(kMaxChainPoints)}, "m",
+                                   "2 to 1024 points relative to position (3 or more with loop); bodies collide on "
+                                   "the right of each segment"),
+             field<&Chain::loop>("loop", kAny, "", "closes the chain from the last point back to the first")},
+            &finishChain);
+        chain.finishNamesEntity = true;
+        t.push_back(std::move(chain));
     }
     t.push_back(row<Angle>("angle", "orientation, counter-clockwise", true, needsPosition,
                            {field<&Angle::value>("", kAny, "rad", "orientation")}));

@@ -136,3 +136,38 @@ CapsuleMassProperties capsuleMassProperties(double length, double radius) {
 }
 
 } // namespace stepwise
+
+namespace stepwise {
+
+std::optional<Error> chainProblem(const std::vector<Vec2>& p, bool loop) {
+    const std::size_t n = p.size();
+    const std::size_t least = loop ? 3 : 2;
+    if (n < least || n > kMaxChainPoints)
+        return Error{"expected " + std::to_string(least) + " to " + std::to_string(kMaxChainPoints) + " points" +
+                     (loop ? " in a loop" : "") + ", got " + std::to_string(n)};
+    for (std::size_t i = 0; i < n; ++i)
+        if (!(std::abs(p[i].x) <= kMaxMagnitude && std::abs(p[i].y) <= kMaxMagnitude))
+            return Error{"point " + std::to_string(i) + " " + pointText(p[i]) + " is not within " +
+                             formatNumber(kMaxMagnitude) + " m of the body's position on each axis",
+                         std::to_string(i)};
+    // A segment needs a direction: its normal decides which side is solid.
+    // Relative to the chain's size, like a polygon's vertices.
+    Vec2 lo = p[0], hi = p[0];
+    for (const Vec2& q : p) {
+        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+    }
+    const double samePoint = 1e-9 * std::max(hi.x - lo.x, hi.y - lo.y);
+    const std::size_t segments = loop ? n : n - 1;
+    for (std::size_t i = 0; i < segments; ++i) {
+        const std::size_t j = (i + 1) % n;
+        if (length(p[j] - p[i]) <= samePoint || p[j] == p[i])
+            return Error{"point " + std::to_string(j) + " " + pointText(p[j]) + " is the same point as point " +
+                             std::to_string(i) + (j == 0 ? " (the loop closes from the last point to the first)" : "") +
+                             "; each segment of a chain needs a length",
+                         std::to_string(j)};
+    }
+    return {};
+}
+
+} // namespace stepwise

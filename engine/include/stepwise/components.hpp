@@ -91,6 +91,27 @@ struct CapsuleMassProperties {
 };
 CapsuleMassProperties capsuleMassProperties(double length, double radius);
 
+/// Chain shape: a polyline of segments in metres relative to `Position`
+/// (rotated by `Angle` about it), closed from the last point back to the
+/// first when `loop`. Smooth (a body sliding across a joint between two
+/// segments feels no bump) and one-sided: it collides with bodies on the
+/// right of each segment's direction, so a counter-clockwise loop keeps
+/// bodies outside and a clockwise one inside. Only on a static body.
+struct Chain {
+    /// Default: a floor 4 m wide, drawn right to left so its solid side is up.
+    std::vector<Vec2> points{{2.0, 0.0}, {-2.0, 0.0}};
+    bool loop = false;
+};
+
+/// Most points a chain may have: a contact's feature id keeps the segment's
+/// number in 10 bits (collisions.md).
+inline constexpr std::size_t kMaxChainPoints = 1024;
+
+/// Nothing when `points` (with `loop`) is a valid chain, else why not; the
+/// error's `where` is the offending point's index, or empty for the whole
+/// list. The loader, the world and the editor all ask this one function.
+std::optional<Error> chainProblem(const std::vector<Vec2>& points, bool loop);
+
 /// Orientation, radians, counter-clockwise.
 struct Angle { double value = 0.0; };
 /// Angular velocity, rad/s, counter-clockwise.

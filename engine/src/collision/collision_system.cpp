@@ -26,7 +26,8 @@ double momentOfInertia(const Shape& shape, double mass) {
         const double w = 2.0 * shape.halfExtents.x, h = 2.0 * shape.halfExtents.y;
         return mass * (w * w + h * h) / 12.0;
     }
-    case ShapeKind::Plane: return 0.0;
+    case ShapeKind::Plane:
+    case ShapeKind::ChainSegment: return 0.0;  // only on static bodies
     case ShapeKind::Capsule:
         return mass * capsuleMassProperties(2.0 * length(shape.halfExtents), shape.radius).inertiaPerMass;
     case ShapeKind::Polygon: {
@@ -63,6 +64,10 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
         polygons_.push_back(*c.shape.polygon);
         colliders_.back().shape.polygon = &polygons_.back();
     }
+    if (c.shape.kind == ShapeKind::ChainSegment) {
+        segments_.push_back(*c.shape.segment);
+        colliders_.back().shape.segment = &segments_.back();
+    }
     // A kinematic body moves like a dynamic one (a solver body, turned by
     // its spin) with zero inverse mass and inertia.
     const bool dynamic = c.body >= 0 && (c.mass > 0.0 || c.kinematic);
@@ -84,6 +89,8 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
                          : c.shape.kind == ShapeKind::Circle    ? c.shape.radius
                          : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius
                          : c.shape.kind == ShapeKind::Capsule ? length(c.shape.halfExtents) + c.shape.radius
+                         : c.shape.kind == ShapeKind::ChainSegment
+                             ? std::max(length(c.shape.segment->p1), length(c.shape.segment->p2))
                                                               : length(c.shape.halfExtents));
     if (dynamic && (c.centreOfMass.x != 0.0 || c.centreOfMass.y != 0.0)) offsetBodies_.push_back(index);
     if (c.solverOnly) {

@@ -221,6 +221,7 @@ private:
 
     std::vector<Collider> colliders_;
     std::deque<ConvexPolygon> polygons_;  // the polygon shapes' outlines (addresses stay fixed)
+    std::deque<ChainSegment> segments_;   // the chain segments (addresses stay fixed)
     std::vector<std::uint32_t> offsetBodies_;  // dynamic colliders whose centre of mass is off their position
     std::vector<double> offsetAngleBefore_;    // their angles at the start of the substep, rad
     std::vector<double> angles_, angularVelocities_;

@@ -82,6 +82,13 @@ bool sameCollider(const collision::Collider& a, const collision::Collider& b) {
         for (int i = 0; i < p.count; ++i)
             if (!sameBits(p.vertices[i], q.vertices[i])) return false;
     }
+    if ((a.shape.segment == nullptr) != (b.shape.segment == nullptr)) return false;
+    if (a.shape.segment) {
+        const collision::ChainSegment &p = *a.shape.segment, &q = *b.shape.segment;
+        if (!sameBits(p.p1, q.p1) || !sameBits(p.p2, q.p2) || !sameBits(p.ghost1, q.ghost1) ||
+            !sameBits(p.ghost2, q.ghost2) || p.open1 != q.open1 || p.open2 != q.open2 || p.index != q.index)
+            return false;
+    }
     return true;
 }
 
@@ -156,9 +163,14 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
             for (std::size_t c = 0; c < collision->colliderCount(); ++c) {
                 const collision::Collider& col = collision->collider(c);
                 const auto it = oldCollider.find(col.entity);
-                const bool same = it != oldCollider.end() && sameCollider(col, before.collision->collider(it->second)) &&
-                                  sameBits(collision->angle(c), before.collision->angle(it->second)) &&
-                                  sameBits(collision->angularVelocity(c), before.collision->angularVelocity(it->second));
+                // A chain's segments follow its first collider in order.
+                const std::size_t old = it == oldCollider.end() ? 0
+                                        : it->second + (col.shape.segment ? col.shape.segment->index : 0);
+                const bool same = it != oldCollider.end() && old < before.collision->colliderCount() &&
+                                  before.collision->collider(old).entity == col.entity &&
+                                  sameCollider(col, before.collision->collider(old)) &&
+                                  sameBits(collision->angle(c), before.collision->angle(old)) &&
+                                  sameBits(collision->angularVelocity(c), before.collision->angularVelocity(old));
                 if (col.body < 0) {
                     ++staticCount;
                     staticEdited = staticEdited || !same;
