@@ -758,8 +758,33 @@ void Builder::springs() {
 }
 
 void Builder::bodies() {
-    // Polygons first (filled triangles, then their outlines), then boxes
-    // and capsules, then discs: each kind is one batch.
+    // Chains first (lines under everything that rests on them), polygons
+    // (filled triangles, then their outlines), then boxes and capsules, then
+    // discs: each kind is one batch.
+    for (Entity e : scene_.registry.entities()) {
+        const Chain* chain = scene_.registry.tryGet<Chain>(e);
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!chain || !p || chain->points.size() < 2) continue;
+        const Angle* a = scene_.registry.tryGet<Angle>(e);
+        const double angle = a ? a->value : 0.0, c = std::cos(angle), s = std::sin(angle);
+        const auto world = [&](Vec2 v) { return p->value + Vec2{c * v.x - s * v.y, s * v.x + c * v.y}; };
+        const bool sel = selected_.count(e) != 0;
+        const Rgba colour = sel ? rgb(0xffd166) : bodyColour(e);
+        const double width = sel ? 3.5 : 2.5;
+        const std::size_t n = chain->points.size(), segments = chain->loop ? n : n - 1;
+        for (std::size_t k = 0; k < segments; ++k) {
+            const Vec2 a0 = toPx(world(chain->points[k])), a1 = toPx(world(chain->points[(k + 1) % n]));
+            segment(a0, a1, width, colour);
+            // A tick at the middle on the solid side (the right of the
+            // segment's direction; pixels keep the world's handedness).
+            const Vec2 d = a1 - a0;
+            const double len = length(d);
+            if (len < 12.0) continue;
+            const Vec2 mid = 0.5 * (a0 + a1);
+            const Vec2 right = Vec2{d.y, -d.x} / len;
+            segment(mid, mid + 6.0 * right, 1.5, colour);
+        }
+    }
     for (Entity e : scene_.registry.entities()) {
         const Polygon* poly = scene_.registry.tryGet<Polygon>(e);
         const Position* p = scene_.registry.tryGet<Position>(e);
@@ -800,7 +825,7 @@ void Builder::bodies() {
     for (Entity e : scene_.registry.entities()) {
         const Position* p = scene_.registry.tryGet<Position>(e);
         if (!p || scene_.registry.has<Box>(e) || scene_.registry.has<Polygon>(e) || scene_.registry.has<Capsule>(e) ||
-            scene_.registry.has<Spring>(e))
+            scene_.registry.has<Chain>(e) || scene_.registry.has<Spring>(e))
             continue;
         const Radius* r = scene_.registry.tryGet<Radius>(e);
         const Angle* a = scene_.registry.tryGet<Angle>(e);

@@ -306,6 +306,7 @@ std::string_view entityKind(const Registry& registry, Entity e) {
     if (registry.has<Radius>(e)) return "circle";
     if (registry.has<Polygon>(e)) return "polygon";
     if (registry.has<Capsule>(e)) return "capsule";
+    if (registry.has<Chain>(e)) return "chain";
     if (registry.has<Attractor>(e)) return "attractor";
     if (registry.has<Boid>(e)) return "boid";
     return "point";
@@ -347,7 +348,7 @@ Entity pick(const Scene& scene, Vec2 world, double pickRadius) {
     for (auto it = order.rbegin(); it != order.rend(); ++it) {
         const Entity e = *it;
         const Position* p = reg.tryGet<Position>(e);
-        if (!p || reg.has<Spring>(e)) continue;
+        if (!p || reg.has<Spring>(e) || reg.has<Chain>(e)) continue;
         const Vec2 d = world - p->value;
         if (const Radius* r = reg.tryGet<Radius>(e)) {
             if (length(d) <= r->value) return e;
@@ -377,6 +378,20 @@ Entity pick(const Scene& scene, Vec2 world, double pickRadius) {
         } else if (length(d) <= pickRadius) {
             return e;
         }
+    }
+    // Chains by distance to their polyline: they are lines, and bodies
+    // resting on them take the clicks inside themselves first.
+    for (auto it = order.rbegin(); it != order.rend(); ++it) {
+        const Chain* chain = reg.tryGet<Chain>(*it);
+        const Position* p = reg.tryGet<Position>(*it);
+        if (!chain || !p || chain->points.size() < 2) continue;
+        const Angle* a = reg.tryGet<Angle>(*it);
+        const double th = a ? a->value : 0.0;
+        const Vec2 d = world - p->value;
+        const Vec2 local{std::cos(th) * d.x + std::sin(th) * d.y, -std::sin(th) * d.x + std::cos(th) * d.y};
+        const std::size_t n = chain->points.size(), segments = chain->loop ? n : n - 1;
+        for (std::size_t k = 0; k < segments; ++k)
+            if (distanceToSegment(local, chain->points[k], chain->points[(k + 1) % n]) <= pickRadius) return *it;
     }
     for (auto it = order.rbegin(); it != order.rend(); ++it)
         if (const Spring* s = reg.tryGet<Spring>(*it)) {
@@ -705,6 +720,8 @@ bool entityBounds(const Registry& registry, Entity e, Vec2& lo, Vec2& hi) {
         for (const Vec2 v : poly->vertices) rx = ry = std::max(rx, length(v));  // any angle
     if (const Capsule* cap = registry.tryGet<Capsule>(e))
         rx = ry = std::max(length(cap->a), length(cap->b)) + cap->radius;  // any angle
+    if (const Chain* chain = registry.tryGet<Chain>(e))
+        for (const Vec2 v : chain->points) rx = ry = std::max(rx, length(v));  // any angle
     lo = {p->value.x - rx, p->value.y - ry};
     hi = {p->value.x + rx, p->value.y + ry};
     return true;

@@ -28,6 +28,12 @@ std::optional<ShapeBox> shapeBox(const Scene& scene, Entity e) {
         const Vec2 eb = p->value + Vec2{c * cap->b.x - s * cap->b.y, s * cap->b.x + c * cap->b.y};
         return ShapeBox{0.5 * (ea + eb), Vec2{0.5 * std::abs(eb.x - ea.x) + cap->radius, 0.5 * std::abs(eb.y - ea.y) + cap->radius}};
     }
+    if (const Chain* chain = scene.registry.tryGet<Chain>(e); chain && !chain->points.empty()) {
+        const double c = std::cos(angle), s = std::sin(angle);
+        Bounds bounds;
+        for (const Vec2 v : chain->points) bounds.add(p->value + Vec2{c * v.x - s * v.y, s * v.x + c * v.y});
+        return ShapeBox{0.5 * (bounds.lo + bounds.hi), 0.5 * (bounds.hi - bounds.lo)};
+    }
     return std::nullopt;
 }
 
