@@ -172,7 +172,9 @@ std::vector<ComponentInfo> buildTable() {
             "polygon", "convex polygon shape, rotated by angle about position; the body collides", false,
             needsPosition,
             {field<&Polygon::vertices>("vertices", NumberRange{3.0, 8.0}, "m",
-                                       "3 to 8 vertices relative to position, counter-clockwise, convex")},
+                                       "3 to 8 vertices relative to position, counter-clockwise, convex"),
+             field<&Polygon::radius>("radius", kNonNegative, "m",
+                                     "rounds the corners by this radius; the mass includes the rounding")},
             &finishPolygon);
         polygon.finishNamesEntity = true;
         t.push_back(std::move(polygon));

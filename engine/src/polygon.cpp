@@ -114,6 +114,48 @@ PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& v) {
     return out;
 }
 
+PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& v, double r) {
+    PolygonMassProperties core = polygonMassProperties(v);
+    if (!(r > 0.0) || v.size() < 3) return core;
+    // Moments about the core's centroid c (so large coordinates lose no
+    // digits): area, first moment and polar second moment of each piece.
+    const Vec2 c = core.centroid;
+    double area = core.area, polar = core.secondMoment;
+    Vec2 first;
+    const std::size_t n = v.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec2 a = v[i] - c, b = v[(i + 1) % n] - c, e = b - a;
+        const double len = length(e);
+        const Vec2 normal{e.y / len, -e.x / len};  // outward (counter-clockwise outline)
+        // The rectangle on edge i: len by r, centred at the edge's middle
+        // pushed out by r/2; about its centre len r (len^2 + r^2) / 12.
+        const double rect = len * r;
+        const Vec2 centre = 0.5 * (a + b) + (0.5 * r) * normal;
+        area += rect;
+        first += rect * centre;
+        polar += rect * (len * len + r * r) / 12.0 + rect * lengthSquared(centre);
+        // The sector at vertex b, between edge i's normal and edge i+1's:
+        // angle theta, area theta r^2 / 2, polar moment about its apex
+        // theta r^4 / 4, first moment about the apex (2/3) r^3 sin(theta/2)
+        // along the bisector.
+        const Vec2 f = v[(i + 2) % n] - v[(i + 1) % n];
+        const Vec2 nextNormal = Vec2{f.y, -f.x} / length(f);
+        const double theta = std::atan2(cross(normal, nextNormal), dot(normal, nextNormal));
+        const Vec2 bisector = (normal + nextNormal) / length(normal + nextNormal);
+        const double sector = 0.5 * theta * r * r;
+        const Vec2 apexMoment = (2.0 / 3.0) * r * r * r * std::sin(0.5 * theta) * bisector;
+        area += sector;
+        first += sector * b + apexMoment;
+        polar += 0.25 * theta * r * r * r * r + 2.0 * dot(b, apexMoment) + sector * lengthSquared(b);
+    }
+    PolygonMassProperties out;
+    out.area = area;
+    const Vec2 shift = first / area;  // centroid relative to the core's
+    out.centroid = c + shift;
+    out.secondMoment = polar - area * lengthSquared(shift);
+    return out;
+}
+
 } // namespace stepwise
 
 namespace stepwise {

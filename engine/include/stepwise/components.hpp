@@ -52,6 +52,10 @@ struct Polygon {
     /// Default: a triangle whose centroid is its position (exact binary
     /// fractions, so it round-trips as written).
     std::vector<Vec2> vertices{{-0.5, -0.25}, {0.5, -0.25}, {0.0, 0.5}};
+    /// Rounds the corners by this radius (metres, >= 0): the shape is the
+    /// outline grown by a disc (Box2D's rounded polygons), and its mass
+    /// includes the rounding. Absent is 0 and is not written on save.
+    std::optional<double> radius;
 };
 
 /// Nothing when `vertices` is a valid polygon shape, else why not; the
@@ -68,6 +72,11 @@ struct PolygonMassProperties {
     double secondMoment = 0.0;
 };
 PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& vertices);
+/// The same for the outline rounded by `radius` (the polygon grown by a
+/// disc): the polygon, a rectangle r wide along each edge and a sector at
+/// each corner; area A + P r + pi r^2. radius 0 gives polygonMassProperties
+/// bit for bit.
+PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& vertices, double radius);
 
 /// Capsule shape: the segment from `a` to `b` (metres, relative to
 /// `Position`, rotated by `Angle` about it) swept by `radius`: a stadium.

@@ -35,6 +35,12 @@ double momentOfInertia(const Shape& shape, double mass) {
         // origin of the outline): each has area cross(vi, vi+1)/2 and polar
         // second moment area/6 (vi.vi + vi.vi+1 + vi+1.vi+1); I = m J / A.
         const ConvexPolygon& p = *shape.polygon;
+        if (p.cornerRadius > 0.0) {
+            // Rounded: the polygon, its edge strips and corner sectors.
+            const std::vector<Vec2> outline(p.vertices, p.vertices + p.count);
+            const PolygonMassProperties props = polygonMassProperties(outline, p.cornerRadius);
+            return mass * props.secondMoment / props.area;
+        }
         double area = 0.0, polar = 0.0;
         for (int i = 0; i < p.count; ++i) {
             const Vec2 a = p.vertices[i], b = p.vertices[(i + 1) % p.count];
@@ -87,7 +93,7 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     invInertia_.push_back(inertia > 0.0 ? 1.0 / inertia : 0.0);
     maxExtent_.push_back(c.solverOnly                          ? 0.0
                          : c.shape.kind == ShapeKind::Circle    ? c.shape.radius
-                         : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius
+                         : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius + c.shape.polygon->cornerRadius
                          : c.shape.kind == ShapeKind::Capsule ? length(c.shape.halfExtents) + c.shape.radius
                          : c.shape.kind == ShapeKind::ChainSegment
                              ? std::max(length(c.shape.segment->p1), length(c.shape.segment->p2))

@@ -52,6 +52,9 @@ struct ConvexPolygon {
     Vec2 vertices[kMaxPolygonVertices];
     Vec2 normals[kMaxPolygonVertices];
     double radius = 0.0;  ///< farthest vertex from the centre of mass, metres
+    /// The corners rounded by this radius (the outline grown by a disc),
+    /// metres; 0 for a sharp polygon.
+    double cornerRadius = 0.0;
     /// Builds from vertices already relative to the centre of mass (valid:
     /// convex, counter-clockwise, 3..8).
     static ConvexPolygon fromVertices(const Vec2* v, int n) {

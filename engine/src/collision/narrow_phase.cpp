@@ -315,29 +315,29 @@ WorldPolygon worldSegment(Vec2 a, Vec2 b) {
 /// capsule A is, or one point between an end of A and a vertex of B.
 constexpr std::uint32_t kCapsuleFaceOfB = 0x1000, kCapsuleFaceOfA = 0x2000, kCapsuleCorner = 0x3000;
 
-/// Capsule A (core a1-a2, radius rA) against the convex polygon B swept by
-/// rB (a box or polygon with rB = 0, or another capsule's core as a
-/// two-sided polygon). The separating axis test over both cores' face
-/// normals picks a reference face; the other core's edge is clipped to that
-/// face's side planes, which gives two points when a capsule lies along a
-/// face. When the cores are apart and nearest at an end of A and a vertex of
-/// B (a cap against a corner) one point on the line between them, the
-/// distance measured exactly (Box2D v3's b2CollidePolygons does the same
-/// with its rounded polygons).
-Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPolygon& b, double rB, double margin) {
+/// Convex polygon A swept by rA against convex polygon B swept by rB:
+/// rounded polygons, and capsules (a capsule is its core as a two-sided
+/// polygon with its radius; boxes and sharp polygons have radius 0). The
+/// separating axis test over both cores' face normals picks a reference
+/// face; the other core's edge is clipped to that face's side planes, which
+/// gives two points when a shape lies along a face. When the cores are apart
+/// and nearest at a vertex of each (a rounded corner against a corner) one
+/// point on the line between them, the distance measured exactly (Box2D
+/// v3's b2CollidePolygons does the same with its rounded polygons).
+Manifold collideWorldRoundedPolygons(const WorldPolygon& a, double rA, const WorldPolygon& b, double rB,
+                                     double margin) {
     const double rSum = rA + rB;
-    const WorldPolygon a = worldSegment(a1, a2);
     const auto [edgeB, separationB] = maxSeparation(b, a);
     if (separationB - rSum > margin) return Manifold{};
     const auto [edgeA, separationA] = maxSeparation(a, b);
     if (separationA - rSum > margin) return Manifold{};
-    // B's face unless the capsule's is clearly better (the boxes' rule, so
-    // the reference does not flicker between steps).
+    // B's face unless A's is clearly better (the boxes' rule, so the
+    // reference does not flicker between steps).
     const bool capsuleReference = separationA > 0.98 * separationB + 0.0005;
     const Vec2 referenceNormal = capsuleReference ? a.normals[edgeA] : -b.normals[edgeB];  // from A to B
 
     // One point from the exact closest points.
-    const auto cornerPoint = [&](const SegmentClosest& c, int vertexB) {
+    const auto cornerPoint = [&](const SegmentClosest& c, int vertexA, int vertexB) {
         Manifold m;
         const Vec2 d = c.onSecond - c.onFirst;
         const double dist = length(d);
@@ -347,33 +347,39 @@ Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPoly
         m.pointCount = 1;
         m.points[0].separation = separation;
         m.points[0].point = 0.5 * ((c.onFirst + rA * m.normal) + (c.onSecond - rB * m.normal));
-        m.points[0].id = kCapsuleCorner | (std::uint32_t(c.s > 0.5) << 8) | std::uint32_t(vertexB);
+        m.points[0].id = kCapsuleCorner | (std::uint32_t(vertexA) << 8) | std::uint32_t(vertexB);
         return m;
     };
     std::optional<SegmentClosest> nearest;
-    int nearestVertex = 0;
+    int nearestVertex = 0, nearestVertexA = 0;
     if (std::max(separationA, separationB) > 0.0) {
         // The cores are apart: their distance is the nearest pair of edges.
         double best = std::numeric_limits<double>::infinity();
         const int edges = b.count == 2 ? 1 : b.count;
-        for (int i = 0; i < edges; ++i) {
-            const int next = (i + 1) % b.count;
-            const SegmentClosest c = closestOnSegments(a1, a2, b.vertices[i], b.vertices[next]);
-            const double d2 = lengthSquared(c.onSecond - c.onFirst);
-            if (d2 < best) {
-                best = d2;
-                nearest = c;
-                nearestVertex = c.t > 0.5 ? next : i;
+        const int edgesA = a.count == 2 ? 1 : a.count;
+        for (int j = 0; j < edgesA; ++j) {
+            const int nextA = (j + 1) % a.count;
+            for (int i = 0; i < edges; ++i) {
+                const int next = (i + 1) % b.count;
+                const SegmentClosest c = closestOnSegments(a.vertices[j], a.vertices[nextA], b.vertices[i], b.vertices[next]);
+                const double d2 = lengthSquared(c.onSecond - c.onFirst);
+                if (d2 < best) {
+                    best = d2;
+                    nearest = c;
+                    nearestVertex = c.t > 0.5 ? next : i;
+                    nearestVertexA = c.s > 0.5 ? nextA : j;
+                }
             }
         }
         if (std::sqrt(best) - rSum > margin) return Manifold{};
         const bool cornerToCorner = (nearest->s == 0.0 || nearest->s == 1.0) && (nearest->t == 0.0 || nearest->t == 1.0);
         const double dist = std::sqrt(best);
-        // A cap against a corner, unless the line between them is (nearly)
-        // the reference face's normal: two parallel capsules stacked end
-        // to end are nearest at their ends too, and must rest on two points.
+        // A rounded corner against a corner, unless the line between them is
+        // (nearly) the reference face's normal: two parallel capsules
+        // stacked end to end are nearest at their ends too, and must rest
+        // on two points.
         if (cornerToCorner && dist > 0.0 && dot(nearest->onSecond - nearest->onFirst, referenceNormal) < 0.999 * dist)
-            return cornerPoint(*nearest, nearestVertex);
+            return cornerPoint(*nearest, nearestVertexA, nearestVertex);
     }
 
     Manifold m;
@@ -398,7 +404,7 @@ Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPoly
     ClipVertex clipped1[2], clipped2[2];
     const bool clipped = clipSegment(incident, clipped1, -t, -dot(t, v1), 16 + std::uint32_t(refEdge)) == 2 &&
                          clipSegment(clipped1, clipped2, t, dot(t, v2), 24 + std::uint32_t(refEdge)) == 2;
-    if (!clipped) return nearest ? cornerPoint(*nearest, nearestVertex) : m;
+    if (!clipped) return nearest ? cornerPoint(*nearest, nearestVertexA, nearestVertex) : m;
     // The reference side's radius and the incident side's.
     const double rRef = capsuleReference ? rA : rB, rInc = capsuleReference ? rB : rA;
     m.normal = capsuleReference ? n : -n;
@@ -413,8 +419,12 @@ Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPoly
         p.point = cv.v - 0.5 * (depth - rRef + rInc) * n;
         p.id = (capsuleReference ? kCapsuleFaceOfA : kCapsuleFaceOfB) | (std::uint32_t(refEdge) << 8) | cv.id;
     }
-    if (m.pointCount == 0 && nearest) return cornerPoint(*nearest, nearestVertex);
+    if (m.pointCount == 0 && nearest) return cornerPoint(*nearest, nearestVertexA, nearestVertex);
     return m;
+}
+
+Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPolygon& b, double rB, double margin) {
+    return collideWorldRoundedPolygons(worldSegment(a1, a2), rA, b, rB, margin);
 }
 
 
@@ -742,20 +752,43 @@ Manifold collideWorldChainCircle(const WorldChainSegment& s, double r, Vec2 pB, 
 }
 } // namespace
 
+// A rounded polygon (cornerRadius > 0) takes the rounded routines; a sharp
+// one the plain ones, as before rounding existed.
+
 Manifold collidePolygons(const ConvexPolygon& a, Vec2 pA, Rot qA, const ConvexPolygon& b, Vec2 pB, Rot qB,
                          double margin) {
+    if (a.cornerRadius > 0.0 || b.cornerRadius > 0.0)
+        return collideWorldRoundedPolygons(worldPolygon(a, pA, qA), a.cornerRadius, worldPolygon(b, pB, qB),
+                                           b.cornerRadius, margin);
     return collideWorldPolygons(worldPolygon(a, pA, qA), worldPolygon(b, pB, qB), margin);
 }
 
 Manifold collideBoxPolygon(Vec2 hA, Vec2 pA, Rot qA, const ConvexPolygon& b, Vec2 pB, Rot qB, double margin) {
+    if (b.cornerRadius > 0.0)
+        return collideWorldRoundedPolygons(worldPolygon(worldBox(hA, pA, qA)), 0.0, worldPolygon(b, pB, qB),
+                                           b.cornerRadius, margin);
     return collideWorldPolygons(worldPolygon(worldBox(hA, pA, qA)), worldPolygon(b, pB, qB), margin);
 }
 
 Manifold collidePolygonCircle(const ConvexPolygon& a, Vec2 pA, Rot qA, double rB, Vec2 pB, double margin) {
+    if (a.cornerRadius > 0.0) {
+        // The core against a circle as large as both radii; the point then
+        // moves out by the rounding to sit midway between the surfaces.
+        Manifold m = collideWorldPolygonCircle(worldPolygon(a, pA, qA), rB + a.cornerRadius, pB, margin);
+        for (int i = 0; i < m.pointCount; ++i) m.points[i].point += a.cornerRadius * m.normal;
+        return m;
+    }
     return collideWorldPolygonCircle(worldPolygon(a, pA, qA), rB, pB, margin);
 }
 
 Manifold collidePlanePolygon(Vec2 n, double offset, const ConvexPolygon& b, Vec2 pB, Rot qB, double margin) {
+    if (b.cornerRadius > 0.0) {
+        // The core against the plane moved out by the rounding; the point
+        // then moves back to sit midway between the surfaces.
+        Manifold m = collidePlaneWorldPolygon(n, offset + b.cornerRadius, worldPolygon(b, pB, qB), margin);
+        for (int i = 0; i < m.pointCount; ++i) m.points[i].point -= b.cornerRadius * n;
+        return m;
+    }
     return collidePlaneWorldPolygon(n, offset, worldPolygon(b, pB, qB), margin);
 }
 
@@ -869,7 +902,7 @@ Manifold collideCapsuleBox(Vec2 a1, Vec2 a2, double rA, Vec2 hB, Vec2 pB, Rot qB
 
 Manifold collideCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const ConvexPolygon& b, Vec2 pB, Rot qB,
                                double margin) {
-    return collideWorldCapsulePolygon(a1, a2, rA, worldPolygon(b, pB, qB), 0.0, margin);
+    return collideWorldCapsulePolygon(a1, a2, rA, worldPolygon(b, pB, qB), b.cornerRadius, margin);
 }
 
 Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot qB, double margin) {
@@ -894,7 +927,8 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
             m = collideWorldChainPolygon(s, worldPolygon(worldBox(other.halfExtents, pO, qO)), pO, 0.0, margin);
             break;
         case ShapeKind::Polygon:
-            m = collideWorldChainPolygon(s, worldPolygon(*other.polygon, pO, qO), pO, 0.0, margin);
+            m = collideWorldChainPolygon(s, worldPolygon(*other.polygon, pO, qO), pO, other.polygon->cornerRadius,
+                                         margin);
             break;
         case ShapeKind::Capsule: {
             const Vec2 h = rotate(qO, other.halfExtents);
@@ -991,6 +1025,10 @@ Aabb computeAabb(const Shape& shape, Vec2 p, Rot q) {
             const Vec2 v = p + rotate(q, shape.polygon->vertices[i]);
             box.lower = {std::min(box.lower.x, v.x), std::min(box.lower.y, v.y)};
             box.upper = {std::max(box.upper.x, v.x), std::max(box.upper.y, v.y)};
+        }
+        if (const double r = shape.polygon->cornerRadius; r > 0.0) {
+            box.lower -= Vec2{r, r};
+            box.upper += Vec2{r, r};
         }
         return box;
     }

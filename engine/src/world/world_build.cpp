@@ -238,6 +238,12 @@ std::optional<Error> checkPolygons(const Registry& reg) {
         }
         const Polygon* poly = reg.tryGet<Polygon>(order[i]);
         if (!poly) continue;
+        if (poly->radius && !(*poly->radius >= 0.0 && *poly->radius <= kMaxMagnitude)) {
+            const Name* name = reg.tryGet<Name>(order[i]);
+            return Error{"expected a number in [0, " + formatNumber(kMaxMagnitude) + "], got " +
+                             formatNumber(*poly->radius),
+                         entityLabel(i, name ? &name->value : nullptr) + ": polygon.radius"};
+        }
         if (std::optional<Error> problem = polygonProblem(poly->vertices)) {
             // Vertex 3 is named "polygon.vertices[3]".
             const Name* name = reg.tryGet<Name>(order[i]);

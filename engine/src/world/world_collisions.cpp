@@ -57,11 +57,14 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         } else if (const Polygon* poly = reg.tryGet<Polygon>(e)) {
             // The engine works about the centre of mass: the outline is
             // shifted so the centroid is its origin, and the offset kept.
-            const PolygonMassProperties props = polygonMassProperties(poly->vertices);
+            const double rounding = poly->radius.value_or(0.0);
+            const PolygonMassProperties props = rounding > 0.0 ? polygonMassProperties(poly->vertices, rounding)
+                                                               : polygonMassProperties(poly->vertices);
             Vec2 local[collision::kMaxPolygonVertices];
             const int count = int(poly->vertices.size());
             for (int i = 0; i < count; ++i) local[i] = poly->vertices[std::size_t(i)] - props.centroid;
             polygon = collision::ConvexPolygon::fromVertices(local, count);
+            polygon.cornerRadius = rounding;
             c.shape.kind = collision::ShapeKind::Polygon;
             c.shape.polygon = &polygon;
             c.centreOfMass = props.centroid;
@@ -258,7 +261,7 @@ double halfExtentAlong(const Registry& reg, Entity e, Vec2 dir) {
             hi = first ? d : std::max(hi, d);
             first = false;
         }
-        return 0.5 * (hi - lo);
+        return 0.5 * (hi - lo) + p->radius.value_or(0.0);
     }
     if (const Capsule* cap = reg.tryGet<Capsule>(e)) return 0.5 * std::abs(dot(cap->b - cap->a, local)) + cap->radius;
     return 0.0;

@@ -78,7 +78,7 @@ bool sameCollider(const collision::Collider& a, const collision::Collider& b) {
         return false;
     if (a.shape.polygon && b.shape.polygon) {
         const collision::ConvexPolygon &p = *a.shape.polygon, &q = *b.shape.polygon;
-        if (p.count != q.count) return false;
+        if (p.count != q.count || !sameBits(p.cornerRadius, q.cornerRadius)) return false;
         for (int i = 0; i < p.count; ++i)
             if (!sameBits(p.vertices[i], q.vertices[i])) return false;
     }
