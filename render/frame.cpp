@@ -772,17 +772,23 @@ void Builder::bodies() {
         const Rgba colour = sel ? rgb(0xffd166) : bodyColour(e);
         const double width = sel ? 3.5 : 2.5;
         const std::size_t n = chain->points.size(), segments = chain->loop ? n : n - 1;
+        // Ticks on the solid side (the right of each segment's direction;
+        // pixels keep the world's handedness), at a segment's middle once
+        // 24 px of line have passed since the last, so short segments share
+        // them and the spacing stays even at any zoom.
+        double sinceTick = 24.0;
         for (std::size_t k = 0; k < segments; ++k) {
             const Vec2 a0 = toPx(world(chain->points[k])), a1 = toPx(world(chain->points[(k + 1) % n]));
             segment(a0, a1, width, colour);
-            // A tick at the middle on the solid side (the right of the
-            // segment's direction; pixels keep the world's handedness).
             const Vec2 d = a1 - a0;
             const double len = length(d);
-            if (len < 12.0) continue;
-            const Vec2 mid = 0.5 * (a0 + a1);
-            const Vec2 right = Vec2{d.y, -d.x} / len;
-            segment(mid, mid + 6.0 * right, 1.5, colour);
+            sinceTick += 0.5 * len;
+            if (len > 0.0 && sinceTick >= 24.0) {
+                const Vec2 mid = 0.5 * (a0 + a1);
+                segment(mid, mid + (6.0 / len) * Vec2{d.y, -d.x}, 1.5, colour);
+                sinceTick = 0.0;
+            }
+            sinceTick += 0.5 * len;
         }
     }
     for (Entity e : scene_.registry.entities()) {
@@ -790,7 +796,25 @@ void Builder::bodies() {
         const Position* p = scene_.registry.tryGet<Position>(e);
         if (!poly || !p || poly->vertices.size() < 3) continue;
         const Angle* a = scene_.registry.tryGet<Angle>(e);
-        polygon(*poly, p->value, a ? a->value : 0.0, bodyColour(e), selected_.count(e) != 0,
+        // A rounded polygon is drawn as its outline: each corner an arc of
+        // the rounding radius between its two edges' normals.
+        Polygon rounded;
+        if (const double r = poly->radius.value_or(0.0); r > 0.0) {
+            rounded.vertices.clear();
+            const std::size_t n = poly->vertices.size();
+            for (std::size_t i = 0; i < n; ++i) {
+                const Vec2 v = poly->vertices[i], before = v - poly->vertices[(i + n - 1) % n],
+                           after = poly->vertices[(i + 1) % n] - v;
+                const double a0 = std::atan2(-before.x, before.y), turn = std::atan2(cross(before, after), dot(before, after));
+                const int pieces = std::max(2, int(std::ceil(turn / 0.2)));
+                for (int k = 0; k <= pieces; ++k) {
+                    const double th = a0 + turn * k / pieces;
+                    rounded.vertices.push_back(v + r * Vec2{std::cos(th), std::sin(th)});
+                }
+            }
+        }
+        polygon(rounded.vertices.size() > poly->vertices.size() ? rounded : *poly, p->value, a ? a->value : 0.0,
+                bodyColour(e), selected_.count(e) != 0,
                 isStatic(scene_, e));
     }
     for (Entity e : scene_.registry.entities()) {

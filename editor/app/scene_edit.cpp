@@ -369,6 +369,11 @@ Entity pick(const Scene& scene, Vec2 world, double pickRadius) {
                 const Vec2 v0 = poly->vertices[i], v1 = poly->vertices[(i + 1) % poly->vertices.size()];
                 inside = cross(v1 - v0, local - v0) >= 0.0;
             }
+            // A rounded polygon reaches its radius beyond the outline.
+            if (const double r = poly->radius.value_or(0.0); !inside && r > 0.0)
+                for (std::size_t i = 0; !inside && i < poly->vertices.size(); ++i)
+                    inside = distanceToSegment(local, poly->vertices[i],
+                                               poly->vertices[(i + 1) % poly->vertices.size()]) <= r;
             if (inside) return e;
         } else if (const Capsule* cap = reg.tryGet<Capsule>(e)) {
             const Angle* a = reg.tryGet<Angle>(e);
@@ -717,7 +722,7 @@ bool entityBounds(const Registry& registry, Entity e, Vec2& lo, Vec2& hi) {
         rx = ry = 0.5 * std::hypot(b->width, b->height);
     }
     if (const Polygon* poly = registry.tryGet<Polygon>(e))
-        for (const Vec2 v : poly->vertices) rx = ry = std::max(rx, length(v));  // any angle
+        for (const Vec2 v : poly->vertices) rx = ry = std::max(rx, length(v) + poly->radius.value_or(0.0));  // any angle
     if (const Capsule* cap = registry.tryGet<Capsule>(e))
         rx = ry = std::max(length(cap->a), length(cap->b)) + cap->radius;  // any angle
     if (const Chain* chain = registry.tryGet<Chain>(e))
