@@ -591,3 +591,20 @@ TEST(ChainWorld, ResumesBitForBitFromAMidRunSave) {
     EXPECT_EQ(sceneToJsonText(second.scene), sceneToJsonText(whole.scene));
     EXPECT_FALSE(whole.world->contacts().empty());
 }
+
+TEST(ChainWorld, AJointToAChainLeavesOutEverySegmentUnlessCollideConnected) {
+    // A ball tied to the chain's body by a slack rope, above the chain's
+    // second segment: with collide_connected false it meets no segment of
+    // the chain (not only the first) and falls through; with true it rests.
+    for (const bool connected : {false, true}) {
+        Sim sim(level(chainEntity("ground", flatFloor(4.0, -4.0, 1.0), false) +
+                      ", {\"name\": \"ball\", \"position\": {\"x\": 2.5, \"y\": 0.5}, \"radius\": 0.25}, "
+                      "{\"name\": \"tether\", \"joint\": {\"type\": \"rope\", \"a\": \"ball\", \"b\": \"ground\", "
+                      "\"length\": 5, \"collide_connected\": " +
+                      std::string(connected ? "true" : "false") + "}}"));
+        ASSERT_TRUE(sim.world);
+        ASSERT_TRUE(sim.step(40));
+        if (connected) EXPECT_NEAR(sim.position("ball").y, 0.25, 2e-3);
+        else EXPECT_LT(sim.position("ball").y, -0.5);
+    }
+}

@@ -315,10 +315,7 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
         if (!colliderAsleep_[a] && !colliderAsleep_[b]) continue;
         if (colliders_[a].sensor || colliders_[b].sensor) continue;  // a sensor wakes nothing
         if (!collides(a, b)) continue;
-        if (!noCollide_.empty()) {
-            const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
-            if (std::binary_search(noCollide_.begin(), noCollide_.end(), key)) continue;
-        }
+        if (!noCollide_.empty() && joinedNotColliding(a, b)) continue;
         const double closing = std::max(length(startV_[a] - startV_[b]), length(endV_[a] - endV_[b]));
         // Within reach this step: the gap the two can close in dt (the
         // speeds at both ends of the step, forces included, and the spin)
@@ -332,6 +329,18 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
     if (woken.empty()) return true;
     for (const std::uint32_t body : woken) wakeBody_(body);
     return false;
+}
+
+bool CollisionSystem::joinedNotColliding(std::uint32_t a, std::uint32_t b) const {
+    // A chain's segments stand for the chain's first collider, which joints
+    // name.
+    const auto first = [&](std::uint32_t c) {
+        const Shape& s = colliders_[c].shape;
+        return s.kind == ShapeKind::ChainSegment ? c - s.segment->index : c;
+    };
+    const std::uint32_t fa = first(a), fb = first(b);
+    const std::uint64_t key = (std::uint64_t(std::min(fa, fb)) << 32) | std::max(fa, fb);
+    return std::binary_search(noCollide_.begin(), noCollide_.end(), key);
 }
 
 void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_t filterA, std::int32_t filterB,
@@ -604,11 +613,8 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
         if (colliderAsleep_[a] || colliderAsleep_[b]) continue;  // no manifold: it would have woken them
         if (anySensor_ && sensedInstead(a, b)) continue;
         if (!collides(a, b)) continue;
-        if (!noCollide_.empty()) {
-            // Bodies joined with collide_connected false do not collide.
-            const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
-            if (std::binary_search(noCollide_.begin(), noCollide_.end(), key)) continue;
-        }
+        // Bodies joined with collide_connected false do not collide.
+        if (!noCollide_.empty() && joinedNotColliding(a, b)) continue;
         const Shape& shapeA = colliders_[a].shape;
         const Shape& shapeB = colliders_[b].shape;
         if (shapeA.kind == ShapeKind::Circle && shapeB.kind == ShapeKind::Circle) {
