@@ -1,16 +1,22 @@
-// Chains and rounded polygons in the editor and the renderer's bounds:
-// picking a chain by distance to its polyline (after the bodies resting on
-// it), a rounded polygon within its radius of the outline, the selection and
-// framing boxes, and the kind the editor names a chain by.
+// Chains and rounded polygons in the editor and the renderer: picking a
+// chain by distance to its polyline (after the bodies resting on it), a
+// rounded polygon within its radius of the outline, the selection and
+// framing boxes, the kind the editor names a chain by, and what a frame
+// draws of them (the segments with ticks on the solid side; the rounded
+// outline).
 
 #include "app/scene_edit.hpp"
+#include "frame.hpp"
 #include "scene_bounds.hpp"
 
 #include "stepwise/components.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <vector>
 
 using namespace stepwise;
 
@@ -95,4 +101,83 @@ TEST(ChainEditor, RoundedPolygonsArePickedWithinTheirRadiusAndBoundedByIt) {
     ASSERT_TRUE(editor::entityBounds(s.registry, e, lo, hi));
     EXPECT_LE(hi.x, 0.5 * std::sqrt(2.0) + 0.2 + 1e-12);
     EXPECT_GE(hi.x, 0.7);
+}
+
+namespace {
+
+std::vector<std::array<float, 4>> segmentsOf(const render::DrawData& data) {
+    std::vector<std::array<float, 4>> out;
+    for (const render::Batch& b : data.batches)
+        if (b.kind == render::BatchKind::Segment)
+            for (std::size_t i = 0; i < b.count(); ++i) {
+                const float* s = b.data.data() + i * render::floatsPerInstance(render::BatchKind::Segment);
+                out.push_back({s[0], s[1], s[2], s[3]});
+            }
+    return out;
+}
+
+} // namespace
+
+TEST(ChainRender, SegmentsWithTicksOnTheSolidSideAndNoDot) {
+    // A floor drawn right to left (solid side up) and the same points left
+    // to right (solid side down): every segment is drawn, and every tick
+    // (a short line from a segment's middle) points to the solid side.
+    for (const bool up : {true, false}) {
+        Scene scene;
+        const Entity e = scene.registry.create();
+        scene.registry.emplace<Position>(e, {{0.0, 0.0}});
+        scene.registry.emplace<Static>(e, {true});
+        std::vector<Vec2> points{{3.0, 0.0}, {1.0, 0.0}, {-1.0, 0.0}, {-3.0, 0.0}};
+        if (!up) std::reverse(points.begin(), points.end());
+        scene.registry.emplace<Chain>(e, {points, false});
+        render::FrameInput input;
+        input.scene = &scene;
+        input.camera = render::Camera{{0.0, 0.0}, 120.0};  // 100 px per metre at 600 px
+        input.hud = false;
+        const std::vector<std::array<float, 4>> segs = segmentsOf(render::buildDrawData(input, 800, 600));
+        int lines = 0, ticks = 0;
+        for (const auto& s : segs) {
+            if (std::abs(s[1] - s[3]) < 1e-3) {
+                ++lines;  // along the floor (pixel y = 300)
+                EXPECT_NEAR(s[1], 300.0, 1e-3);
+                EXPECT_NEAR(std::abs(s[2] - s[0]), 200.0, 1e-3);
+            } else {
+                ++ticks;
+                EXPECT_NEAR(s[1], 300.0, 1e-3);
+                EXPECT_NEAR(s[3] - s[1], up ? 6.0 : -6.0, 1e-3) << "the tick points to the solid side";
+            }
+        }
+        EXPECT_EQ(lines, 3);
+        EXPECT_EQ(ticks, 3);  // 200 px segments: one tick each
+        int discs = 0;
+        for (const render::Batch& b : render::buildDrawData(input, 800, 600).batches)
+            if (b.kind == render::BatchKind::Disc) discs += int(b.count());
+        EXPECT_EQ(discs, 0) << "no point-mass dot at the chain's position";
+    }
+}
+
+TEST(ChainRender, ARoundedPolygonIsDrawnAsItsRoundedOutline) {
+    // Every outline vertex lies at the radius from the core outline, and
+    // the corners take more vertices than the sharp square's four.
+    for (const double r : {0.1, 0.4}) {
+        Scene scene;
+        const Entity e = scene.registry.create();
+        scene.registry.emplace<Position>(e, {{0.0, 0.0}});
+        Polygon p;
+        p.vertices = {{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}};
+        p.radius = r;
+        scene.registry.emplace<Polygon>(e, p);
+        render::FrameInput input;
+        input.scene = &scene;
+        input.camera = render::Camera{{0.0, 0.0}, 120.0};  // 100 px per metre at 600 px
+        input.hud = false;
+        const std::vector<std::array<float, 4>> segs = segmentsOf(render::buildDrawData(input, 800, 600));
+        EXPECT_GT(segs.size(), 12u);
+        for (const auto& s : segs) {
+            // Back to metres: the distance to the unit square's core.
+            const Vec2 q{(s[0] - 400.0) / 100.0, (s[1] - 300.0) / 100.0};
+            const Vec2 outside{std::max(std::abs(q.x) - 0.5, 0.0), std::max(std::abs(q.y) - 0.5, 0.0)};
+            EXPECT_NEAR(length(outside), r, 1e-5);
+        }
+    }
 }
