@@ -181,3 +181,41 @@ TEST(ChainRender, ARoundedPolygonIsDrawnAsItsRoundedOutline) {
         }
     }
 }
+
+TEST(ChainEditor, EditsAreRefusedWithTheLoadersWords) {
+    // The inspector's edits go through setFieldOnAll / addComponentToAll:
+    // what the loader refuses is refused, naming the entity and the field,
+    // and the scene is left as it was; a good edit goes through.
+    Scene s;
+    const Entity chain = s.registry.create();
+    s.registry.emplace<Name>(chain, {"ground"});
+    s.registry.emplace<Position>(chain, {{0.0, 0.0}});
+    s.registry.emplace<Static>(chain, {true});
+    s.registry.emplace<Chain>(chain, {{{2.0, 0.0}, {-2.0, 0.0}}, false});
+    const Entity ball = s.registry.create();
+    s.registry.emplace<Name>(ball, {"ball"});
+    s.registry.emplace<Position>(ball, {{0.0, 1.0}});
+    const ComponentInfo& info = *findComponent("chain");
+    const FieldInfo& points = info.fields[0];
+    const FieldInfo& loop = info.fields[1];
+    std::string problem;
+    // A loop needs three points.
+    EXPECT_EQ(editor::setFieldOnAll(s, info, loop, true, {chain}, &problem), 0u);
+    EXPECT_EQ(problem, "\"ground\" chain.loop: conflicts with chain.points: expected 3 to 1024 points in a loop, got 2");
+    EXPECT_FALSE(s.registry.tryGet<Chain>(chain)->loop);
+    // Two consecutive points the same.
+    EXPECT_EQ(editor::setFieldOnAll(s, info, points, std::vector<Vec2>{{2.0, 0.0}, {2.0, 0.0}}, {chain}, &problem), 0u);
+    EXPECT_NE(problem.find("point 1 {\"x\": 2, \"y\": 0} is the same point as point 0"), std::string::npos) << problem;
+    EXPECT_EQ(s.registry.tryGet<Chain>(chain)->points.size(), 2u);
+    EXPECT_EQ(s.registry.tryGet<Chain>(chain)->points[1], (Vec2{-2.0, 0.0}));
+    // A chain on a dynamic body.
+    EXPECT_EQ(editor::addComponentToAll(s, info, {ball}, &problem), 0u);
+    EXPECT_NE(problem.find("a chain must be on a static body"), std::string::npos) << problem;
+    EXPECT_FALSE(s.registry.has<Chain>(ball));
+    // Three points and a loop: accepted.
+    EXPECT_EQ(editor::setFieldOnAll(s, info, points, std::vector<Vec2>{{2.0, 0.0}, {0.0, 1.0}, {-2.0, 0.0}}, {chain},
+                                    &problem),
+              1u);
+    EXPECT_EQ(editor::setFieldOnAll(s, info, loop, true, {chain}, &problem), 1u);
+    EXPECT_TRUE(s.registry.tryGet<Chain>(chain)->loop);
+}
