@@ -758,14 +758,63 @@ void Builder::springs() {
 }
 
 void Builder::bodies() {
-    // Polygons first (filled triangles, then their outlines), then boxes
-    // and capsules, then discs: each kind is one batch.
+    // Chains first (lines under everything that rests on them), polygons
+    // (filled triangles, then their outlines), then boxes and capsules, then
+    // discs: each kind is one batch.
+    for (Entity e : scene_.registry.entities()) {
+        const Chain* chain = scene_.registry.tryGet<Chain>(e);
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!chain || !p || chain->points.size() < 2) continue;
+        const Angle* a = scene_.registry.tryGet<Angle>(e);
+        const double angle = a ? a->value : 0.0, c = std::cos(angle), s = std::sin(angle);
+        const auto world = [&](Vec2 v) { return p->value + Vec2{c * v.x - s * v.y, s * v.x + c * v.y}; };
+        const bool sel = selected_.count(e) != 0;
+        const Rgba colour = sel ? rgb(0xffd166) : bodyColour(e);
+        const double width = sel ? 3.5 : 2.5;
+        const std::size_t n = chain->points.size(), segments = chain->loop ? n : n - 1;
+        // Ticks on the solid side (the right of each segment's direction;
+        // pixels keep the world's handedness), at a segment's middle once
+        // 24 px of line have passed since the last, so short segments share
+        // them and the spacing stays even at any zoom.
+        double sinceTick = 24.0;
+        for (std::size_t k = 0; k < segments; ++k) {
+            const Vec2 a0 = toPx(world(chain->points[k])), a1 = toPx(world(chain->points[(k + 1) % n]));
+            segment(a0, a1, width, colour);
+            const Vec2 d = a1 - a0;
+            const double len = length(d);
+            sinceTick += 0.5 * len;
+            if (len > 0.0 && sinceTick >= 24.0) {
+                const Vec2 mid = 0.5 * (a0 + a1);
+                segment(mid, mid + (6.0 / len) * Vec2{d.y, -d.x}, 1.5, colour);
+                sinceTick = 0.0;
+            }
+            sinceTick += 0.5 * len;
+        }
+    }
     for (Entity e : scene_.registry.entities()) {
         const Polygon* poly = scene_.registry.tryGet<Polygon>(e);
         const Position* p = scene_.registry.tryGet<Position>(e);
         if (!poly || !p || poly->vertices.size() < 3) continue;
         const Angle* a = scene_.registry.tryGet<Angle>(e);
-        polygon(*poly, p->value, a ? a->value : 0.0, bodyColour(e), selected_.count(e) != 0,
+        // A rounded polygon is drawn as its outline: each corner an arc of
+        // the rounding radius between its two edges' normals.
+        Polygon rounded;
+        if (const double r = poly->radius.value_or(0.0); r > 0.0) {
+            rounded.vertices.clear();
+            const std::size_t n = poly->vertices.size();
+            for (std::size_t i = 0; i < n; ++i) {
+                const Vec2 v = poly->vertices[i], before = v - poly->vertices[(i + n - 1) % n],
+                           after = poly->vertices[(i + 1) % n] - v;
+                const double a0 = std::atan2(-before.x, before.y), turn = std::atan2(cross(before, after), dot(before, after));
+                const int pieces = std::max(2, int(std::ceil(turn / 0.2)));
+                for (int k = 0; k <= pieces; ++k) {
+                    const double th = a0 + turn * k / pieces;
+                    rounded.vertices.push_back(v + r * Vec2{std::cos(th), std::sin(th)});
+                }
+            }
+        }
+        polygon(rounded.vertices.size() > poly->vertices.size() ? rounded : *poly, p->value, a ? a->value : 0.0,
+                bodyColour(e), selected_.count(e) != 0,
                 isStatic(scene_, e));
     }
     for (Entity e : scene_.registry.entities()) {
@@ -837,7 +886,7 @@ void Builder::bodies() {
     for (Entity e : scene_.registry.entities()) {
         const Position* p = scene_.registry.tryGet<Position>(e);
         if (!p || scene_.registry.has<Box>(e) || scene_.registry.has<Polygon>(e) || scene_.registry.has<Capsule>(e) ||
-            scene_.registry.has<Shapes>(e) || scene_.registry.has<Spring>(e))
+            scene_.registry.has<Shapes>(e) || scene_.registry.has<Chain>(e) || scene_.registry.has<Spring>(e))
             continue;
         const Radius* r = scene_.registry.tryGet<Radius>(e);
         const Angle* a = scene_.registry.tryGet<Angle>(e);

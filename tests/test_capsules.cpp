@@ -133,7 +133,7 @@ TEST(CapsuleFormat, BadCapsulesAreRefusedNamingTheEntityAndField) {
               "t.json: error: /entities/0/capsule/radius: expected a number in [1e-30, 1e+30], got -1");
     EXPECT_EQ(loadError(level("{\"name\": \"pill\", \"position\": {\"x\": 0, \"y\": 0}, \"radius\": 1, " +
                               capsuleJson({0, 0}, {1, 0}, 0.5) + "}")),
-              "t.json: error: /entities/0: an entity has at most one shape (radius, box, polygon, capsule or plane), "
+              "t.json: error: /entities/0: an entity has at most one shape (radius, box, polygon, capsule, chain or plane), "
               "got 2");
     EXPECT_EQ(loadError(level("{\"name\": \"pill\", " + capsuleJson({0, 0}, {1, 0}, 0.5) + "}")),
               "t.json: error: /entities/0: component \"capsule\" on entity 0 (\"pill\") needs \"position\", which is "

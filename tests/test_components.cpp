@@ -159,6 +159,7 @@ TEST_P(ComponentRoundTrip, EveryFieldSurvivesSaveAndLoad) {
     }
     if (info->name == "boid") static_cast<Boid*>(component)->separationRadius = 0.5;
     if (info->name == "plane") static_cast<Plane*>(component)->normal = {0.6, 0.8};  // unit already
+    if (info->name == "chain") r.emplace<Static>(host, Static{true});  // chains are only on static bodies
 
     const std::string text = sceneToJsonText(scene);
     Result<Scene> loaded = parseScene(text, "roundtrip.json");

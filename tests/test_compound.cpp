@@ -122,7 +122,7 @@ TEST(CompoundFormat, ShapesWithASingleShapeAreRefusedNamingTheEntity) {
         EXPECT_EQ(loadError(level("{\"name\": \"ell\", \"position\": {\"x\": 0, \"y\": 0}, \"shapes\": [" +
                                   circleItem(0, 0, 1) + "], " + single + "}")),
                   "t.json: error: /entities/0: entity 0 (\"ell\") has both shapes and a single shape (radius, box, "
-                  "polygon, capsule or plane); a compound body lists every shape in shapes")
+                  "polygon, capsule, chain or plane); a compound body lists every shape in shapes")
             << single;
     }
 }

@@ -206,7 +206,7 @@ TEST(PolygonFormat, BadOutlinesAreRefusedWithTheEntityAndThePointer) {
                               "0}, {\"x\": 1, \"y\": \"a\"}, {\"x\": 0, \"y\": 1}]}}")),
               "t.json: error: /entities/0/polygon/vertices/1/y: expected a number in [-1e+30, 1e+30], got \"a\"");
     EXPECT_EQ(loadError(level("{\"position\": {\"x\": 0, \"y\": 0}, \"radius\": 1, \"polygon\": {}}")),
-              "t.json: error: /entities/0: an entity has at most one shape (radius, box, polygon, capsule or plane), got 2");
+              "t.json: error: /entities/0: an entity has at most one shape (radius, box, polygon, capsule, chain or plane), got 2");
     EXPECT_EQ(loadError(level("{\"polygon\": {}}")),
               "t.json: error: /entities/0: component \"polygon\" on entity 0 needs \"position\", which is missing");
 }

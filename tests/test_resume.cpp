@@ -366,7 +366,7 @@ TEST(Resume, BadSolverStateIsRefusedWithWhereAndWhat) {
         {R"({"contacts": [{"a": "wall", "b": "nobody", "feature": 0, "normal_impulse": 1, "tangent_impulse": 0}]})",
          "t.json: error: /solver_state/contacts/0/b: no entity is named \"nobody\""},
         {R"({"contacts": [{"a": "wall", "b": "dot", "feature": 0, "normal_impulse": 1, "tangent_impulse": 0}]})",
-         "t.json: error: /solver_state/contacts/0/b: entity \"dot\" has no shape (radius, box, polygon, capsule or plane), so it "
+         "t.json: error: /solver_state/contacts/0/b: entity \"dot\" has no shape (radius, box, polygon, capsule, chain or plane), so it "
          "has no contacts"},
         {R"({"contacts": [{"a": 1, "b": 7, "feature": 0, "normal_impulse": 1, "tangent_impulse": 0}]})",
          "t.json: error: /solver_state/contacts/0/b: expected an integer in [0, 3], got 7"},

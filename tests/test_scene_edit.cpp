@@ -74,7 +74,7 @@ TEST(Inspector, RefusesAtEditTimeWhatTheLoaderRefusesNamingEntityAndField) {
     Result<bool> refused =
         f.ed.tryEdit("add box", [&](Scene& s) { return changedAny(addComponentToAll(s, *findComponent("box"), {bob})); });
     ASSERT_FALSE(refused);
-    EXPECT_EQ(refused.error(), "\"bob\" box: an entity has at most one shape (radius, box, polygon, capsule or plane), got 2");
+    EXPECT_EQ(refused.error(), "\"bob\" box: an entity has at most one shape (radius, box, polygon, capsule, chain or plane), got 2");
     // A speed past the fastest a level holds.
     const ComponentInfo* velocity = findComponent("velocity");
     refused = f.ed.tryEdit("v", [&](Scene& s) {

@@ -231,7 +231,7 @@ TEST(SceneErrors, UnknownComponentNamesEntityAndSuggests) {
     EXPECT_EQ(refusal(R"({"entities": [{}, {"name": "ball", "position": {"x": 0, "y": 0}, "velocty": {"x": 1, "y": 0}}]})"),
               "t.json: error: /entities/1/velocty: unknown component \"velocty\" on entity 1 (\"ball\"); did you mean "
               "\"velocity\"? Known components: name, type, position, velocity, mass, static, kinematic, radius, box, polygon, "
-              "capsule, shapes, angle, angular_velocity, color, restitution, friction, drag, sensor, filter, plane, attractor, spring, "
+              "capsule, chain, shapes, angle, angular_velocity, color, restitution, friction, drag, sensor, filter, plane, attractor, spring, "
               "boid, joint");
     EXPECT_EQ(refusal(R"({"entities": [{"box": {"width": 1, "heigth": 2}, "position": {"x": 0, "y": 0}}]})"),
               "t.json: error: /entities/0/box/heigth: unknown field \"heigth\" in \"box\"; did you mean \"height\"? "
@@ -279,7 +279,7 @@ TEST(SceneErrors, ComponentsThatNeedABody) {
               "t.json: error: /entities/0: component \"radius\" on entity 0 (\"ghost\") needs \"position\", which is "
               "missing");
     EXPECT_EQ(refusal(R"({"entities": [{"position": {"x": 0, "y": 0}, "radius": 1, "box": {"width": 1, "height": 1}}]})"),
-              "t.json: error: /entities/0: an entity has at most one shape (radius, box, polygon, capsule or plane), got 2");
+              "t.json: error: /entities/0: an entity has at most one shape (radius, box, polygon, capsule, chain or plane), got 2");
     EXPECT_EQ(refusal(R"({"entities": [{"plane": {"normal": {"x": 0, "y": 0}}}]})"),
               "t.json: error: /entities/0/plane/normal: expected a non-zero vector, got {\"x\": 0, \"y\": 0}");
 }

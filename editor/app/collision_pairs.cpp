@@ -9,8 +9,8 @@ namespace stepwise::editor {
 namespace {
 
 bool hasShape(const Registry& reg, Entity e) {
-    return reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) || reg.has<Capsule>(e) || reg.has<Plane>(e) ||
-           reg.has<Shapes>(e);
+    return reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) || reg.has<Capsule>(e) || reg.has<Chain>(e) ||
+           reg.has<Plane>(e) || reg.has<Shapes>(e);
 }
 
 /// Planes are static; so is a body marked static.

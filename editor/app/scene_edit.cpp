@@ -308,6 +308,7 @@ std::string_view entityKind(const Registry& registry, Entity e) {
     if (registry.has<Polygon>(e)) return "polygon";
     if (registry.has<Capsule>(e)) return "capsule";
     if (registry.has<Shapes>(e)) return "compound";
+    if (registry.has<Chain>(e)) return "chain";
     if (registry.has<Attractor>(e)) return "attractor";
     if (registry.has<Boid>(e)) return "boid";
     return "point";
@@ -349,7 +350,7 @@ Entity pick(const Scene& scene, Vec2 world, double pickRadius) {
     for (auto it = order.rbegin(); it != order.rend(); ++it) {
         const Entity e = *it;
         const Position* p = reg.tryGet<Position>(e);
-        if (!p || reg.has<Spring>(e)) continue;
+        if (!p || reg.has<Spring>(e) || reg.has<Chain>(e)) continue;
         const Vec2 d = world - p->value;
         if (const Radius* r = reg.tryGet<Radius>(e)) {
             if (length(d) <= r->value) return e;
@@ -370,6 +371,11 @@ Entity pick(const Scene& scene, Vec2 world, double pickRadius) {
                 const Vec2 v0 = poly->vertices[i], v1 = poly->vertices[(i + 1) % poly->vertices.size()];
                 inside = cross(v1 - v0, local - v0) >= 0.0;
             }
+            // A rounded polygon reaches its radius beyond the outline.
+            if (const double r = poly->radius.value_or(0.0); !inside && r > 0.0)
+                for (std::size_t i = 0; !inside && i < poly->vertices.size(); ++i)
+                    inside = distanceToSegment(local, poly->vertices[i],
+                                               poly->vertices[(i + 1) % poly->vertices.size()]) <= r;
             if (inside) return e;
         } else if (const Capsule* cap = reg.tryGet<Capsule>(e)) {
             const Angle* a = reg.tryGet<Angle>(e);
@@ -386,6 +392,20 @@ Entity pick(const Scene& scene, Vec2 world, double pickRadius) {
         } else if (length(d) <= pickRadius) {
             return e;
         }
+    }
+    // Chains by distance to their polyline: they are lines, and bodies
+    // resting on them take the clicks inside themselves first.
+    for (auto it = order.rbegin(); it != order.rend(); ++it) {
+        const Chain* chain = reg.tryGet<Chain>(*it);
+        const Position* p = reg.tryGet<Position>(*it);
+        if (!chain || !p || chain->points.size() < 2) continue;
+        const Angle* a = reg.tryGet<Angle>(*it);
+        const double th = a ? a->value : 0.0;
+        const Vec2 d = world - p->value;
+        const Vec2 local{std::cos(th) * d.x + std::sin(th) * d.y, -std::sin(th) * d.x + std::cos(th) * d.y};
+        const std::size_t n = chain->points.size(), segments = chain->loop ? n : n - 1;
+        for (std::size_t k = 0; k < segments; ++k)
+            if (distanceToSegment(local, chain->points[k], chain->points[(k + 1) % n]) <= pickRadius) return *it;
     }
     for (auto it = order.rbegin(); it != order.rend(); ++it)
         if (const Spring* s = reg.tryGet<Spring>(*it)) {
@@ -700,7 +720,7 @@ bool entityBounds(const Registry& registry, Entity e, Vec2& lo, Vec2& hi) {
         rx = ry = 0.5 * std::hypot(b->width, b->height);
     }
     if (const Polygon* poly = registry.tryGet<Polygon>(e))
-        for (const Vec2 v : poly->vertices) rx = ry = std::max(rx, length(v));  // any angle
+        for (const Vec2 v : poly->vertices) rx = ry = std::max(rx, length(v) + poly->radius.value_or(0.0));  // any angle
     if (const Capsule* cap = registry.tryGet<Capsule>(e))
         rx = ry = std::max(length(cap->a), length(cap->b)) + cap->radius;  // any angle
     if (const Shapes* shapes = registry.tryGet<Shapes>(e))
@@ -708,6 +728,8 @@ bool entityBounds(const Registry& registry, Entity e, Vec2& lo, Vec2& hi) {
             const ShapeOutline outline = compoundShapeOutline(s);
             for (const Vec2 v : outline.points) rx = ry = std::max(rx, length(v) + outline.radius);  // any angle
         }
+    if (const Chain* chain = registry.tryGet<Chain>(e))
+        for (const Vec2 v : chain->points) rx = ry = std::max(rx, length(v));  // any angle
     lo = {p->value.x - rx, p->value.y - ry};
     hi = {p->value.x + rx, p->value.y + ry};
     return true;

@@ -55,7 +55,7 @@ std::string fieldPathName(const ComponentInfo& component, std::string_view key);
 /// (`finish`, which e.g. normalises a plane's normal) and the relations
 /// between entities (checkSceneRelations). Nothing when a file could hold
 /// the scene, else the refusal naming the entity and the field:
-/// `"circle" box: an entity has at most one shape (radius, box, polygon, capsule or plane), got 2`.
+/// `"circle" box: an entity has at most one shape (radius, box, polygon, capsule, chain or plane), got 2`.
 /// `context` ("box") names the field when the loader's message names none.
 std::optional<Error> checkEdited(Scene& scene, const std::vector<Entity>& entities, const std::string& context);
 /// A checkSceneRelations message ("/entities/20/spring/a: ...") with the

@@ -138,7 +138,7 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
     // What decides which pairs touch and where: an edit of any of these (or
     // one that adds or removes entities) makes the last step's contacts stale.
     static const std::uint64_t kContactShape = bit("position") | bit("angle") | bit("static") | bit("radius") |
-                                               bit("box") | bit("polygon") | bit("plane");
+                                               bit("box") | bit("polygon") | bit("chain") | bit("plane");
     bool keepContacts = world_ && running() && !edit.beyondComponents;
     for (const auto& [entity, changed] : edit.entities) keepContacts = keepContacts && (changed & kContactShape) == 0;
     if (keepContacts && !contactsKept_) {

@@ -30,7 +30,7 @@ std::vector<std::string> ineffectiveComponents(const Scene& scene) {
         if (const Name* n = r.tryGet<Name>(e)) label += " (\"" + n->value + "\")";
         const bool isStatic = r.has<Static>(e) && r.tryGet<Static>(e)->value;
         const bool hasShape = r.has<Radius>(e) || r.has<Box>(e) || r.has<Polygon>(e) || r.has<Capsule>(e) ||
-                               r.has<Plane>(e) || r.has<Shapes>(e);
+                               r.has<Chain>(e) || r.has<Plane>(e) || r.has<Shapes>(e);
         if (isStatic) {
             if (const Velocity* v = r.tryGet<Velocity>(e); v && (v->value.x != 0.0 || v->value.y != 0.0))
                 notes.push_back(label + ": \"velocity\" on a static body has no effect (static bodies never move)");

@@ -111,6 +111,13 @@ std::optional<Error> finishShapes(void* component) {
     return {};
 }
 
+std::optional<Error> finishChain(void* component) {
+    const auto& chain = *static_cast<Chain*>(component);
+    std::optional<Error> problem = chainProblem(chain.points, chain.loop);
+    if (!problem) return {};
+    return problem->within("points");
+}
+
 std::optional<Error> finishSpring(void* component) {
     auto& spring = *static_cast<Spring*>(component);
     if (spring.a.isNull()) return Error{"expected the name of an entity, got nothing", "a"};
@@ -177,7 +184,9 @@ std::vector<ComponentInfo> buildTable() {
             "polygon", "convex polygon shape, rotated by angle about position; the body collides", false,
             needsPosition,
             {field<&Polygon::vertices>("vertices", NumberRange{3.0, 8.0}, "m",
-                                       "3 to 8 vertices relative to position, counter-clockwise, convex")},
+                                       "3 to 8 vertices relative to position, counter-clockwise, convex"),
+             field<&Polygon::radius>("radius", kNonNegative, "m",
+                                     "rounds the corners by this radius; the mass includes the rounding")},
             &finishPolygon);
         polygon.finishNamesEntity = true;
         t.push_back(std::move(polygon));
@@ -194,6 +203,18 @@ std::vector<ComponentInfo> buildTable() {
         t.push_back(std::move(capsule));
     }
     {
+        ComponentInfo chain = row<Chain>(
+            "chain",
+            "chain shape on a static body: a smooth one-sided polyline, solid on the right of each segment's "
+            "direction; rotated by angle about position",
+            false, needsPosition,
+            {field<&Chain::points>("points", NumberRange{2.0, double(kMaxChainPoints)}, "m",
+                                   "2 to 1024 points relative to position (3 or more with loop); bodies collide on "
+                                   "the right of each segment"),
+             field<&Chain::loop>("loop", kAny, "", "closes the chain from the last point back to the first")},
+            &finishChain);
+        chain.finishNamesEntity = true;
+        t.push_back(std::move(chain));
         ComponentInfo shapes = row<Shapes>(
             "shapes",
             "compound body: several shapes (circle, box, polygon, capsule) on one body, each with its own material, "

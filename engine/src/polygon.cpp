@@ -114,6 +114,48 @@ PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& v) {
     return out;
 }
 
+PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& v, double r) {
+    PolygonMassProperties core = polygonMassProperties(v);
+    if (!(r > 0.0) || v.size() < 3) return core;
+    // Moments about the core's centroid c (so large coordinates lose no
+    // digits): area, first moment and polar second moment of each piece.
+    const Vec2 c = core.centroid;
+    double area = core.area, polar = core.secondMoment;
+    Vec2 first;
+    const std::size_t n = v.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec2 a = v[i] - c, b = v[(i + 1) % n] - c, e = b - a;
+        const double len = length(e);
+        const Vec2 normal{e.y / len, -e.x / len};  // outward (counter-clockwise outline)
+        // The rectangle on edge i: len by r, centred at the edge's middle
+        // pushed out by r/2; about its centre len r (len^2 + r^2) / 12.
+        const double rect = len * r;
+        const Vec2 centre = 0.5 * (a + b) + (0.5 * r) * normal;
+        area += rect;
+        first += rect * centre;
+        polar += rect * (len * len + r * r) / 12.0 + rect * lengthSquared(centre);
+        // The sector at vertex b, between edge i's normal and edge i+1's:
+        // angle theta, area theta r^2 / 2, polar moment about its apex
+        // theta r^4 / 4, first moment about the apex (2/3) r^3 sin(theta/2)
+        // along the bisector.
+        const Vec2 f = v[(i + 2) % n] - v[(i + 1) % n];
+        const Vec2 nextNormal = Vec2{f.y, -f.x} / length(f);
+        const double theta = std::atan2(cross(normal, nextNormal), dot(normal, nextNormal));
+        const Vec2 bisector = (normal + nextNormal) / length(normal + nextNormal);
+        const double sector = 0.5 * theta * r * r;
+        const Vec2 apexMoment = (2.0 / 3.0) * r * r * r * std::sin(0.5 * theta) * bisector;
+        area += sector;
+        first += sector * b + apexMoment;
+        polar += 0.25 * theta * r * r * r * r + 2.0 * dot(b, apexMoment) + sector * lengthSquared(b);
+    }
+    PolygonMassProperties out;
+    out.area = area;
+    const Vec2 shift = first / area;  // centroid relative to the core's
+    out.centroid = c + shift;
+    out.secondMoment = polar - area * lengthSquared(shift);
+    return out;
+}
+
 } // namespace stepwise
 
 namespace stepwise {
@@ -138,6 +180,37 @@ CapsuleMassProperties capsuleMassProperties(double length, double radius) {
 } // namespace stepwise
 
 namespace stepwise {
+
+std::optional<Error> chainProblem(const std::vector<Vec2>& p, bool loop) {
+    const std::size_t n = p.size();
+    const std::size_t least = loop ? 3 : 2;
+    if (n < least || n > kMaxChainPoints)
+        return Error{"expected " + std::to_string(least) + " to " + std::to_string(kMaxChainPoints) + " points" +
+                     (loop ? " in a loop" : "") + ", got " + std::to_string(n)};
+    for (std::size_t i = 0; i < n; ++i)
+        if (!(std::abs(p[i].x) <= kMaxMagnitude && std::abs(p[i].y) <= kMaxMagnitude))
+            return Error{"point " + std::to_string(i) + " " + pointText(p[i]) + " is not within " +
+                             formatNumber(kMaxMagnitude) + " m of the body's position on each axis",
+                         std::to_string(i)};
+    // A segment needs a direction: its normal decides which side is solid.
+    // Relative to the chain's size, like a polygon's vertices.
+    Vec2 lo = p[0], hi = p[0];
+    for (const Vec2& q : p) {
+        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+    }
+    const double samePoint = 1e-9 * std::max(hi.x - lo.x, hi.y - lo.y);
+    const std::size_t segments = loop ? n : n - 1;
+    for (std::size_t i = 0; i < segments; ++i) {
+        const std::size_t j = (i + 1) % n;
+        if (length(p[j] - p[i]) <= samePoint || p[j] == p[i])
+            return Error{"point " + std::to_string(j) + " " + pointText(p[j]) + " is the same point as point " +
+                             std::to_string(i) + (j == 0 ? " (the loop closes from the last point to the first)" : "") +
+                             "; each segment of a chain needs a length",
+                         std::to_string(j)};
+    }
+    return {};
+}
 
 std::optional<Error> compoundShapeProblem(const CompoundShape& shape) {
     using Kind = CompoundShape::Kind;

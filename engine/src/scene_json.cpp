@@ -484,7 +484,7 @@ void readWorld(const Json& v, WorldSettings& world) {
 /// name it.
 bool collides(const Registry& registry, Entity e) {
     return registry.has<Radius>(e) || registry.has<Box>(e) || registry.has<Polygon>(e) || registry.has<Capsule>(e) ||
-           registry.has<Plane>(e) || registry.has<Shapes>(e);
+           registry.has<Chain>(e) || registry.has<Plane>(e) || registry.has<Shapes>(e);
 }
 
 /// Reads one `solver_state` entry: an object with the given keys, each read
@@ -530,7 +530,7 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
     auto shapeAt = [&](const Json& ref, const std::string& at) {
         const Entity e = entityAt(ref, at);
         if (!collides(registry, e))
-            refuse(at, "entity " + ref.dump() + " has no shape (radius, box, polygon, capsule or plane), so it has no contacts");
+            refuse(at, "entity " + ref.dump() + " has no shape (radius, box, polygon, capsule, chain or plane), so it has no contacts");
         return e;
     };
     // shape_a and shape_b (a compound body's shape index) are optional: 0.
@@ -838,18 +838,24 @@ std::string relationsProblem(const Scene& scene) {
     for (std::size_t i = 0; i < entities.size(); ++i) {
         const Entity e = entities[i];
         const int shapes = int(registry.has<Radius>(e)) + int(registry.has<Box>(e)) + int(registry.has<Polygon>(e)) +
-                           int(registry.has<Capsule>(e)) + int(registry.has<Plane>(e));
+                           int(registry.has<Capsule>(e)) + int(registry.has<Chain>(e)) + int(registry.has<Plane>(e));
         if (registry.has<Shapes>(e) && shapes > 0) {
             const Name* name = registry.tryGet<Name>(e);
             return child("/entities", i) + ": entity " + std::to_string(i) +
                    (name && !name->value.empty() ? " (\"" + name->value + "\")" : std::string()) +
-                   " has both shapes and a single shape (radius, box, polygon, capsule or plane); a compound body "
+                   " has both shapes and a single shape (radius, box, polygon, capsule, chain or plane); a compound body "
                    "lists every shape in shapes";
         }
         if (shapes > 1)
             return child("/entities", i) +
-                   ": an entity has at most one shape (radius, box, polygon, capsule or plane), got " +
+                   ": an entity has at most one shape (radius, box, polygon, capsule, chain or plane), got " +
                    std::to_string(shapes);
+        // Each segment is a collider of its own; a moving body has one
+        // collider that turns and takes impulses, so chains stay still.
+        if (registry.has<Chain>(e) && !(registry.has<Static>(e) && registry.tryGet<Static>(e)->value))
+            return child("/entities", i) + "/chain: " + entityLabelOf(registry, i) +
+                   ": a chain must be on a static body (\"static\": true); chains on dynamic and kinematic bodies "
+                   "are not supported";
         if (registry.has<Static>(e) && registry.tryGet<Static>(e)->value && registry.has<Kinematic>(e) &&
             registry.tryGet<Kinematic>(e)->value)
             return child("/entities", i) + "/kinematic: a body is static or kinematic, not both";

@@ -20,7 +20,8 @@ std::optional<ShapeBox> shapeBox(const Scene& scene, Entity e) {
         const double c = std::cos(angle), s = std::sin(angle);
         Bounds bounds;
         for (const Vec2 v : poly->vertices) bounds.add(p->value + Vec2{c * v.x - s * v.y, s * v.x + c * v.y});
-        return ShapeBox{0.5 * (bounds.lo + bounds.hi), 0.5 * (bounds.hi - bounds.lo)};
+        const double r = poly->radius.value_or(0.0);
+        return ShapeBox{0.5 * (bounds.lo + bounds.hi), 0.5 * (bounds.hi - bounds.lo) + Vec2{r, r}};
     }
     if (const Capsule* cap = scene.registry.tryGet<Capsule>(e)) {
         const double c = std::cos(angle), s = std::sin(angle);
@@ -40,6 +41,12 @@ std::optional<ShapeBox> shapeBox(const Scene& scene, Entity e) {
                 bounds.add(w + r);
             }
         }
+        return ShapeBox{0.5 * (bounds.lo + bounds.hi), 0.5 * (bounds.hi - bounds.lo)};
+    }
+    if (const Chain* chain = scene.registry.tryGet<Chain>(e); chain && !chain->points.empty()) {
+        const double c = std::cos(angle), s = std::sin(angle);
+        Bounds bounds;
+        for (const Vec2 v : chain->points) bounds.add(p->value + Vec2{c * v.x - s * v.y, s * v.x + c * v.y});
         return ShapeBox{0.5 * (bounds.lo + bounds.hi), 0.5 * (bounds.hi - bounds.lo)};
     }
     return std::nullopt;

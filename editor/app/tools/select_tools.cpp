@@ -46,7 +46,7 @@ void Editor::pressSelectOrRotate(const ToolPress& press) {
     for (Entity s : selection) {
         if (const Position* p = reg.tryGet<Position>(s)) dragStart_.push_back({s, p->value});
         if (const Plane* pl = reg.tryGet<Plane>(s)) planeStart_.push_back({s, pl->offset});
-        if (reg.has<Box>(s) || reg.has<Polygon>(s) || reg.has<Capsule>(s) || reg.has<Shapes>(s) ||
+        if (reg.has<Box>(s) || reg.has<Polygon>(s) || reg.has<Capsule>(s) || reg.has<Chain>(s) || reg.has<Shapes>(s) ||
             reg.has<Angle>(s)) {
             const Angle* a = reg.tryGet<Angle>(s);
             angleStart_.push_back({s, a ? a->value : 0.0});

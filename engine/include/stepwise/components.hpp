@@ -52,6 +52,10 @@ struct Polygon {
     /// Default: a triangle whose centroid is its position (exact binary
     /// fractions, so it round-trips as written).
     std::vector<Vec2> vertices{{-0.5, -0.25}, {0.5, -0.25}, {0.0, 0.5}};
+    /// Rounds the corners by this radius (metres, >= 0): the shape is the
+    /// outline grown by a disc (Box2D's rounded polygons), and its mass
+    /// includes the rounding. Absent is 0 and is not written on save.
+    std::optional<double> radius;
 };
 
 /// Nothing when `vertices` is a valid polygon shape, else why not; the
@@ -68,6 +72,11 @@ struct PolygonMassProperties {
     double secondMoment = 0.0;
 };
 PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& vertices);
+/// The same for the outline rounded by `radius` (the polygon grown by a
+/// disc): the polygon, a rectangle r wide along each edge and a sector at
+/// each corner; area A + P r + pi r^2. radius 0 gives polygonMassProperties
+/// bit for bit.
+PolygonMassProperties polygonMassProperties(const std::vector<Vec2>& vertices, double radius);
 
 /// Capsule shape: the segment from `a` to `b` (metres, relative to
 /// `Position`, rotated by `Angle` about it) swept by `radius`: a stadium.
@@ -90,6 +99,27 @@ struct CapsuleMassProperties {
     double inertiaPerMass = 0.0;
 };
 CapsuleMassProperties capsuleMassProperties(double length, double radius);
+
+/// Chain shape: a polyline of segments in metres relative to `Position`
+/// (rotated by `Angle` about it), closed from the last point back to the
+/// first when `loop`. Smooth (a body sliding across a joint between two
+/// segments feels no bump) and one-sided: it collides with bodies on the
+/// right of each segment's direction, so a counter-clockwise loop keeps
+/// bodies outside and a clockwise one inside. Only on a static body.
+struct Chain {
+    /// Default: a floor 4 m wide, drawn right to left so its solid side is up.
+    std::vector<Vec2> points{{2.0, 0.0}, {-2.0, 0.0}};
+    bool loop = false;
+};
+
+/// Most points a chain may have: a contact's feature id keeps the segment's
+/// number in 10 bits (collisions.md).
+inline constexpr std::size_t kMaxChainPoints = 1024;
+
+/// Nothing when `points` (with `loop`) is a valid chain, else why not; the
+/// error's `where` is the offending point's index, or empty for the whole
+/// list. The loader, the world and the editor all ask this one function.
+std::optional<Error> chainProblem(const std::vector<Vec2>& points, bool loop);
 
 /// Orientation, radians, counter-clockwise.
 struct Angle { double value = 0.0; };

@@ -26,7 +26,8 @@ double momentOfInertia(const Shape& shape, double mass) {
         const double w = 2.0 * shape.halfExtents.x, h = 2.0 * shape.halfExtents.y;
         return mass * (w * w + h * h) / 12.0;
     }
-    case ShapeKind::Plane: return 0.0;
+    case ShapeKind::Plane:
+    case ShapeKind::ChainSegment: return 0.0;  // only on static bodies
     case ShapeKind::Capsule:
         return mass * capsuleMassProperties(2.0 * length(shape.halfExtents), shape.radius).inertiaPerMass;
     case ShapeKind::Polygon: {
@@ -34,6 +35,12 @@ double momentOfInertia(const Shape& shape, double mass) {
         // origin of the outline): each has area cross(vi, vi+1)/2 and polar
         // second moment area/6 (vi.vi + vi.vi+1 + vi+1.vi+1); I = m J / A.
         const ConvexPolygon& p = *shape.polygon;
+        if (p.cornerRadius > 0.0) {
+            // Rounded: the polygon, its edge strips and corner sectors.
+            const std::vector<Vec2> outline(p.vertices, p.vertices + p.count);
+            const PolygonMassProperties props = polygonMassProperties(outline, p.cornerRadius);
+            return mass * props.secondMoment / props.area;
+        }
         double area = 0.0, polar = 0.0;
         for (int i = 0; i < p.count; ++i) {
             const Vec2 a = p.vertices[i], b = p.vertices[(i + 1) % p.count];
@@ -63,6 +70,10 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
         polygons_.push_back(*c.shape.polygon);
         colliders_.back().shape.polygon = &polygons_.back();
     }
+    if (c.shape.kind == ShapeKind::ChainSegment) {
+        segments_.push_back(*c.shape.segment);
+        colliders_.back().shape.segment = &segments_.back();
+    }
     if (c.hub >= 0) {
         // A shape of a compound body: everything that moves is its hub's.
         const std::size_t hub = std::size_t(c.hub);
@@ -82,7 +93,7 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
         // Reach about the body's centre of mass: the shape's own plus how
         // far its centre sits from the body's.
         const double own = c.shape.kind == ShapeKind::Circle    ? c.shape.radius
-                           : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius
+                           : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius + c.shape.polygon->cornerRadius
                            : c.shape.kind == ShapeKind::Capsule ? length(c.shape.halfExtents) + c.shape.radius
                                                                 : length(c.shape.halfExtents);
         maxExtent_.push_back(own + length(c.centreOfMass - colliders_[hub].centreOfMass));
@@ -109,8 +120,10 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     invInertia_.push_back(inertia > 0.0 ? 1.0 / inertia : 0.0);
     maxExtent_.push_back(c.solverOnly                          ? 0.0
                          : c.shape.kind == ShapeKind::Circle    ? c.shape.radius
-                         : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius
+                         : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius + c.shape.polygon->cornerRadius
                          : c.shape.kind == ShapeKind::Capsule ? length(c.shape.halfExtents) + c.shape.radius
+                         : c.shape.kind == ShapeKind::ChainSegment
+                             ? std::max(length(c.shape.segment->p1), length(c.shape.segment->p2))
                                                               : length(c.shape.halfExtents));
     if (dynamic && (c.centreOfMass.x != 0.0 || c.centreOfMass.y != 0.0)) offsetBodies_.push_back(index);
     if (c.solverOnly) {
@@ -334,11 +347,7 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
         if (!colliderAsleep_[a] && !colliderAsleep_[b]) continue;
         if (colliders_[a].sensor || colliders_[b].sensor) continue;  // a sensor wakes nothing
         if (!collides(a, b)) continue;
-        if (!noCollide_.empty()) {
-            const std::uint32_t oa = ownerOf(a), ob = ownerOf(b);
-            const std::uint64_t key = (std::uint64_t(std::min(oa, ob)) << 32) | std::max(oa, ob);
-            if (std::binary_search(noCollide_.begin(), noCollide_.end(), key)) continue;
-        }
+        if (!noCollide_.empty() && joinedNotColliding(a, b)) continue;
         const double closing = std::max(length(startV_[a] - startV_[b]), length(endV_[a] - endV_[b]));
         // Within reach this step: the gap the two can close in dt (the
         // speeds at both ends of the step, forces included, and the spin)
@@ -352,6 +361,20 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
     if (woken.empty()) return true;
     for (const std::uint32_t body : woken) wakeBody_(body);
     return false;
+}
+
+bool CollisionSystem::joinedNotColliding(std::uint32_t a, std::uint32_t b) const {
+    // Joints name a body's first collider: a moving compound body's hub; a
+    // static compound body's first shape, which its others follow in order;
+    // a chain's first segment, which its others follow in order.
+    const auto first = [&](std::uint32_t c) {
+        const Collider& col = colliders_[c];
+        if (col.hub >= 0) return std::uint32_t(col.hub);
+        return col.shape.kind == ShapeKind::ChainSegment ? c - col.shape.segment->index : c - col.part;
+    };
+    const std::uint32_t fa = first(a), fb = first(b);
+    const std::uint64_t key = (std::uint64_t(std::min(fa, fb)) << 32) | std::max(fa, fb);
+    return std::binary_search(noCollide_.begin(), noCollide_.end(), key);
 }
 
 void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_t filterA, std::int32_t filterB,
@@ -634,12 +657,8 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
         if (!shapesOfHubs_.empty() && sameBody(a, b)) continue;
         if (anySensor_ && sensedInstead(a, b)) continue;
         if (!collides(a, b)) continue;
-        if (!noCollide_.empty()) {
-            // Bodies joined with collide_connected false do not collide.
-            const std::uint32_t oa = ownerOf(a), ob = ownerOf(b);
-            const std::uint64_t key = (std::uint64_t(std::min(oa, ob)) << 32) | std::max(oa, ob);
-            if (std::binary_search(noCollide_.begin(), noCollide_.end(), key)) continue;
-        }
+        // Bodies joined with collide_connected false do not collide.
+        if (!noCollide_.empty() && joinedNotColliding(a, b)) continue;
         const Shape& shapeA = colliders_[a].shape;
         const Shape& shapeB = colliders_[b].shape;
         if (shapeA.kind == ShapeKind::Circle && shapeB.kind == ShapeKind::Circle) {

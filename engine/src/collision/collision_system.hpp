@@ -255,6 +255,7 @@ private:
 
     std::vector<Collider> colliders_;
     std::deque<ConvexPolygon> polygons_;  // the polygon shapes' outlines (addresses stay fixed)
+    std::deque<ChainSegment> segments_;   // the chain segments (addresses stay fixed)
     std::vector<std::uint32_t> offsetBodies_;  // dynamic colliders whose centre of mass is off their position
     std::vector<double> offsetAngleBefore_;    // their angles at the start of the substep, rad
     std::vector<double> angles_, angularVelocities_;
@@ -303,6 +304,9 @@ private:
     std::vector<std::pair<std::uint32_t, double>> stiffened_;  // bodies whose inertia a joint raised this substep
     std::vector<double> stiffenScratch_;
     std::vector<std::uint64_t> noCollide_;  // sorted (min collider << 32 | max collider)
+    /// Whether colliders a and b belong to bodies joined with
+    /// collide_connected false (noCollide_).
+    bool joinedNotColliding(std::uint32_t a, std::uint32_t b) const;
     /// Whether any collider has a filter other than the default: without
     /// one every pair passes and the test is skipped.
     bool filtered_ = false;

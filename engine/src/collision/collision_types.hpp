@@ -10,7 +10,7 @@
 
 namespace stepwise::collision {
 
-enum class ShapeKind : std::uint8_t { Circle, Box, Plane, Polygon, Capsule };
+enum class ShapeKind : std::uint8_t { Circle, Box, Plane, Polygon, Capsule, ChainSegment };
 
 /// Rotation as cosine/sine, so rotating a vector is 4 multiplies.
 struct Rot {
@@ -52,6 +52,9 @@ struct ConvexPolygon {
     Vec2 vertices[kMaxPolygonVertices];
     Vec2 normals[kMaxPolygonVertices];
     double radius = 0.0;  ///< farthest vertex from the centre of mass, metres
+    /// The corners rounded by this radius (the outline grown by a disc),
+    /// metres; 0 for a sharp polygon.
+    double cornerRadius = 0.0;
     /// Builds from vertices already relative to the centre of mass (valid:
     /// convex, counter-clockwise, 3..8).
     static ConvexPolygon fromVertices(const Vec2* v, int n) {
@@ -67,6 +70,24 @@ struct ConvexPolygon {
     }
 };
 
+/// One segment of a chain, in its body's frame (relative to the position):
+/// from p1 to p2, solid on the right (the normal is (d.y, -d.x) / |d|).
+/// The ghosts are the neighbouring segments' far points, which tell the
+/// narrow phase which contact normals belong to the neighbour instead (so a
+/// body crossing a joint feels no bump). An open end gets a ghost that
+/// makes it a square corner: a wall down behind the segment.
+struct ChainSegment {
+    Vec2 p1, p2;
+    Vec2 ghost1, ghost2;
+    bool open1 = false, open2 = false;  ///< p1 / p2 is an end of an open chain
+    std::uint32_t index = 0;            ///< the segment's number in its chain (feature ids)
+};
+
+/// A chain contact's feature id holds the segment's number above its low
+/// 6 bits, so an entity-keyed warm start (a saved level) finds the segment
+/// again: 10 bits of a 16-bit id, hence at most 1024 segments.
+inline constexpr int kChainFeatureShift = 6;
+
 /// Geometry of one collider in its body's frame.
 struct Shape {
     ShapeKind kind = ShapeKind::Circle;
@@ -80,6 +101,8 @@ struct Shape {
     /// Polygons: the outline about the centre of mass. Owned by whoever made
     /// the shape (the collision system keeps its polygons at fixed addresses).
     const ConvexPolygon* polygon = nullptr;
+    /// Chain segments: the segment, owned like the polygons' outlines.
+    const ChainSegment* segment = nullptr;
 };
 
 /// One contact point of a manifold.

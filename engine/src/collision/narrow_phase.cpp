@@ -315,29 +315,29 @@ WorldPolygon worldSegment(Vec2 a, Vec2 b) {
 /// capsule A is, or one point between an end of A and a vertex of B.
 constexpr std::uint32_t kCapsuleFaceOfB = 0x1000, kCapsuleFaceOfA = 0x2000, kCapsuleCorner = 0x3000;
 
-/// Capsule A (core a1-a2, radius rA) against the convex polygon B swept by
-/// rB (a box or polygon with rB = 0, or another capsule's core as a
-/// two-sided polygon). The separating axis test over both cores' face
-/// normals picks a reference face; the other core's edge is clipped to that
-/// face's side planes, which gives two points when a capsule lies along a
-/// face. When the cores are apart and nearest at an end of A and a vertex of
-/// B (a cap against a corner) one point on the line between them, the
-/// distance measured exactly (Box2D v3's b2CollidePolygons does the same
-/// with its rounded polygons).
-Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPolygon& b, double rB, double margin) {
+/// Convex polygon A swept by rA against convex polygon B swept by rB:
+/// rounded polygons, and capsules (a capsule is its core as a two-sided
+/// polygon with its radius; boxes and sharp polygons have radius 0). The
+/// separating axis test over both cores' face normals picks a reference
+/// face; the other core's edge is clipped to that face's side planes, which
+/// gives two points when a shape lies along a face. When the cores are apart
+/// and nearest at a vertex of each (a rounded corner against a corner) one
+/// point on the line between them, the distance measured exactly (Box2D
+/// v3's b2CollidePolygons does the same with its rounded polygons).
+Manifold collideWorldRoundedPolygons(const WorldPolygon& a, double rA, const WorldPolygon& b, double rB,
+                                     double margin) {
     const double rSum = rA + rB;
-    const WorldPolygon a = worldSegment(a1, a2);
     const auto [edgeB, separationB] = maxSeparation(b, a);
     if (separationB - rSum > margin) return Manifold{};
     const auto [edgeA, separationA] = maxSeparation(a, b);
     if (separationA - rSum > margin) return Manifold{};
-    // B's face unless the capsule's is clearly better (the boxes' rule, so
-    // the reference does not flicker between steps).
+    // B's face unless A's is clearly better (the boxes' rule, so the
+    // reference does not flicker between steps).
     const bool capsuleReference = separationA > 0.98 * separationB + 0.0005;
     const Vec2 referenceNormal = capsuleReference ? a.normals[edgeA] : -b.normals[edgeB];  // from A to B
 
     // One point from the exact closest points.
-    const auto cornerPoint = [&](const SegmentClosest& c, int vertexB) {
+    const auto cornerPoint = [&](const SegmentClosest& c, int vertexA, int vertexB) {
         Manifold m;
         const Vec2 d = c.onSecond - c.onFirst;
         const double dist = length(d);
@@ -347,33 +347,39 @@ Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPoly
         m.pointCount = 1;
         m.points[0].separation = separation;
         m.points[0].point = 0.5 * ((c.onFirst + rA * m.normal) + (c.onSecond - rB * m.normal));
-        m.points[0].id = kCapsuleCorner | (std::uint32_t(c.s > 0.5) << 8) | std::uint32_t(vertexB);
+        m.points[0].id = kCapsuleCorner | (std::uint32_t(vertexA) << 8) | std::uint32_t(vertexB);
         return m;
     };
     std::optional<SegmentClosest> nearest;
-    int nearestVertex = 0;
+    int nearestVertex = 0, nearestVertexA = 0;
     if (std::max(separationA, separationB) > 0.0) {
         // The cores are apart: their distance is the nearest pair of edges.
         double best = std::numeric_limits<double>::infinity();
         const int edges = b.count == 2 ? 1 : b.count;
-        for (int i = 0; i < edges; ++i) {
-            const int next = (i + 1) % b.count;
-            const SegmentClosest c = closestOnSegments(a1, a2, b.vertices[i], b.vertices[next]);
-            const double d2 = lengthSquared(c.onSecond - c.onFirst);
-            if (d2 < best) {
-                best = d2;
-                nearest = c;
-                nearestVertex = c.t > 0.5 ? next : i;
+        const int edgesA = a.count == 2 ? 1 : a.count;
+        for (int j = 0; j < edgesA; ++j) {
+            const int nextA = (j + 1) % a.count;
+            for (int i = 0; i < edges; ++i) {
+                const int next = (i + 1) % b.count;
+                const SegmentClosest c = closestOnSegments(a.vertices[j], a.vertices[nextA], b.vertices[i], b.vertices[next]);
+                const double d2 = lengthSquared(c.onSecond - c.onFirst);
+                if (d2 < best) {
+                    best = d2;
+                    nearest = c;
+                    nearestVertex = c.t > 0.5 ? next : i;
+                    nearestVertexA = c.s > 0.5 ? nextA : j;
+                }
             }
         }
         if (std::sqrt(best) - rSum > margin) return Manifold{};
         const bool cornerToCorner = (nearest->s == 0.0 || nearest->s == 1.0) && (nearest->t == 0.0 || nearest->t == 1.0);
         const double dist = std::sqrt(best);
-        // A cap against a corner, unless the line between them is (nearly)
-        // the reference face's normal: two parallel capsules stacked end
-        // to end are nearest at their ends too, and must rest on two points.
+        // A rounded corner against a corner, unless the line between them is
+        // (nearly) the reference face's normal: two parallel capsules
+        // stacked end to end are nearest at their ends too, and must rest
+        // on two points.
         if (cornerToCorner && dist > 0.0 && dot(nearest->onSecond - nearest->onFirst, referenceNormal) < 0.999 * dist)
-            return cornerPoint(*nearest, nearestVertex);
+            return cornerPoint(*nearest, nearestVertexA, nearestVertex);
     }
 
     Manifold m;
@@ -398,7 +404,7 @@ Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPoly
     ClipVertex clipped1[2], clipped2[2];
     const bool clipped = clipSegment(incident, clipped1, -t, -dot(t, v1), 16 + std::uint32_t(refEdge)) == 2 &&
                          clipSegment(clipped1, clipped2, t, dot(t, v2), 24 + std::uint32_t(refEdge)) == 2;
-    if (!clipped) return nearest ? cornerPoint(*nearest, nearestVertex) : m;
+    if (!clipped) return nearest ? cornerPoint(*nearest, nearestVertexA, nearestVertex) : m;
     // The reference side's radius and the incident side's.
     const double rRef = capsuleReference ? rA : rB, rInc = capsuleReference ? rB : rA;
     m.normal = capsuleReference ? n : -n;
@@ -413,26 +419,376 @@ Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPoly
         p.point = cv.v - 0.5 * (depth - rRef + rInc) * n;
         p.id = (capsuleReference ? kCapsuleFaceOfA : kCapsuleFaceOfB) | (std::uint32_t(refEdge) << 8) | cv.id;
     }
-    if (m.pointCount == 0 && nearest) return cornerPoint(*nearest, nearestVertex);
+    if (m.pointCount == 0 && nearest) return cornerPoint(*nearest, nearestVertexA, nearestVertex);
     return m;
 }
 
+Manifold collideWorldCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const WorldPolygon& b, double rB, double margin) {
+    return collideWorldRoundedPolygons(worldSegment(a1, a2), rA, b, rB, margin);
+}
+
+
+// ------------------------------------------------------------ chain segments
+// A chain segment is one-sided and smooth: Box2D v3's chain segments (its
+// b2CollideChainSegmentAndPolygon and the Gauss-map classification of
+// https://box2d.org/posts/2020/06/ghost-collisions/), written for this
+// engine's manifolds: world coordinates, speculative margin, no GJK (the
+// closest features of a segment and a convex polygon come from the edge
+// pairs directly).
+
+/// A chain segment placed in the world, with the quantities its contacts
+/// are judged by.
+struct WorldChainSegment {
+    Vec2 p1, p2;
+    Vec2 edge1;            ///< unit direction p1 -> p2
+    Vec2 normal1;          ///< right of edge1: the solid side
+    Vec2 normal0, normal2; ///< the neighbours' normals
+    bool convex1 = false, convex2 = false;  ///< whether each joint bends away from the solid side
+    bool open1 = false, open2 = false;
+    std::uint32_t index = 0;
+};
+
+Vec2 rightPerp(Vec2 v) { return {v.y, -v.x}; }
+
+WorldChainSegment worldChainSegment(const ChainSegment& s, Vec2 p, Rot q) {
+    WorldChainSegment w;
+    w.p1 = p + rotate(q, s.p1);
+    w.p2 = p + rotate(q, s.p2);
+    const Vec2 g1 = p + rotate(q, s.ghost1), g2 = p + rotate(q, s.ghost2);
+    w.edge1 = (w.p2 - w.p1) / length(w.p2 - w.p1);
+    w.normal1 = rightPerp(w.edge1);
+    // Box2D's tolerance: a joint bent by less than about half a degree is
+    // flat, and its contacts snap to this segment's normal.
+    constexpr double kConvexTol = 0.01;
+    const Vec2 edge0 = (w.p1 - g1) / length(w.p1 - g1);
+    w.normal0 = rightPerp(edge0);
+    w.convex1 = cross(edge0, w.edge1) >= kConvexTol;
+    const Vec2 edge2 = (g2 - w.p2) / length(g2 - w.p2);
+    w.normal2 = rightPerp(edge2);
+    w.convex2 = cross(w.edge1, edge2) >= kConvexTol;
+    w.open1 = s.open1;
+    w.open2 = s.open2;
+    w.index = s.index;
+    return w;
+}
+
+enum class NormalType { Skip, Admit, Snap };
+
+/// Where a contact normal (from the segment toward the body) falls on the
+/// segment's Gauss map: past a convex joint it belongs to the neighbour
+/// (Skip); toward a concave joint it snaps to the segment's own normal.
+NormalType classifyNormal(const WorldChainSegment& s, Vec2 normal) {
+    constexpr double kSinTol = 0.01;
+    if (dot(normal, s.edge1) <= 0.0) {
+        if (!s.convex1) return NormalType::Snap;
+        return cross(normal, s.normal0) > kSinTol ? NormalType::Skip : NormalType::Admit;
+    }
+    if (!s.convex2) return NormalType::Snap;
+    return cross(s.normal2, normal) > kSinTol ? NormalType::Skip : NormalType::Admit;
+}
+
+/// Local feature ids of chain contacts (6 bits; the segment's number sits
+/// above them): the segment is the reference face (0x00 | end << 3 |
+/// polygon vertex), a polygon face is (0x10 | end flag << 3 | vertex), one
+/// point between a segment end and a polygon vertex (0x20 | end << 3 |
+/// vertex), a circle (0x30 | region).
+constexpr std::uint32_t kChainSegmentFace = 0x00, kChainPolygonFace = 0x10, kChainCorner = 0x20, kChainCircle = 0x30;
+std::uint32_t chainId(const WorldChainSegment& s, std::uint32_t local) { return (s.index << kChainFeatureShift) | local; }
+
+/// Two-point manifold of Box2D's b2ClipSegments: the incident edge b1-b2
+/// clipped to the reference edge a1-a2 along its tangent; `normal` is the
+/// reference face's outward normal, ra and rb the two sides' radii. Points
+/// midway between the surfaces; those farther apart than `margin` dropped.
+Manifold clipChainSegments(Vec2 a1, Vec2 a2, Vec2 b1, Vec2 b2, Vec2 normal, double ra, double rb,
+                           std::uint32_t id1, std::uint32_t id2, double margin) {
+    Manifold m;
+    const Vec2 tangent = perp(normal);
+    const double lower1 = 0.0, upper1 = dot(a2 - a1, tangent);
+    // The incident edge runs against the tangent (counter-clockwise winding).
+    const double upper2 = dot(b1 - a1, tangent), lower2 = dot(b2 - a1, tangent);
+    if (upper2 < lower1 || upper1 < lower2) return m;
+    constexpr double kTiny = 1e-12;
+    const Vec2 vLower = lower2 < lower1 && upper2 - lower2 > kTiny
+                            ? b2 + ((lower1 - lower2) / (upper2 - lower2)) * (b1 - b2)
+                            : b2;
+    const Vec2 vUpper = upper2 > upper1 && upper2 - lower2 > kTiny
+                            ? b2 + ((upper1 - lower2) / (upper2 - lower2)) * (b1 - b2)
+                            : b1;
+    const double radius = ra + rb;
+    const Vec2 v[2] = {vLower, vUpper};
+    const std::uint32_t ids[2] = {id1, id2};
+    m.normal = normal;
+    for (int i = 0; i < 2; ++i) {
+        const double depth = dot(v[i] - a1, normal);
+        const double separation = depth - radius;
+        if (separation > margin) continue;
+        ManifoldPoint& p = m.points[m.pointCount++];
+        p.separation = separation;
+        p.point = v[i] + (0.5 * (ra - rb - depth)) * normal;
+        p.id = ids[i];
+    }
+    return m;
+}
+
+/// The closest features of segment p1-p2 and a convex polygon (or a
+/// capsule's two-sided core): what Box2D reads from GJK's simplex.
+struct SegmentPolygonDistance {
+    double distance = 0.0;
+    Vec2 pointA, pointB;
+    int indexA = -1;       ///< the segment end that is closest (0 or 1), -1: an inner point
+    int ib1 = -1, ib2 = -1;  ///< the polygon's closest vertex (ib1 == ib2) or edge
+};
+
+SegmentPolygonDistance segmentPolygonDistance(Vec2 p1, Vec2 p2, const WorldPolygon& b) {
+    SegmentPolygonDistance out;
+    // An end inside the polygon: they overlap.
+    if (b.count >= 3) {
+        bool inside = true;
+        for (int i = 0; i < b.count && inside; ++i) inside = dot(b.normals[i], p1 - b.vertices[i]) <= 0.0;
+        if (inside) return out;
+    }
+    double best = std::numeric_limits<double>::infinity();
+    SegmentClosest nearest;
+    int edge = 0;
+    const int edges = b.count == 2 ? 1 : b.count;
+    for (int i = 0; i < edges; ++i) {
+        const SegmentClosest c = closestOnSegments(p1, p2, b.vertices[i], b.vertices[(i + 1) % b.count]);
+        const double d2 = lengthSquared(c.onSecond - c.onFirst);
+        if (d2 < best) {
+            best = d2;
+            nearest = c;
+            edge = i;
+        }
+    }
+    out.distance = std::sqrt(best);
+    out.pointA = nearest.onFirst;
+    out.pointB = nearest.onSecond;
+    const int next = (edge + 1) % b.count;
+    if (nearest.s == 0.0 || nearest.s == 1.0) out.indexA = nearest.s == 1.0 ? 1 : 0;
+    if (nearest.t == 0.0 || nearest.t == 1.0 || out.indexA < 0) {
+        out.ib1 = out.ib2 = nearest.t > 0.5 ? next : edge;
+    } else {
+        out.ib1 = edge;
+        out.ib2 = next;
+    }
+    return out;
+}
+
+/// Chain segment A against convex polygon B swept by rB (a box or polygon,
+/// or a capsule's core with its radius). Normal from the segment to B.
+Manifold collideWorldChainPolygon(const WorldChainSegment& s, const WorldPolygon& b, Vec2 centroidB, double rB,
+                                  double margin) {
+    const Vec2 p1 = s.p1, p2 = s.p2, normal1 = s.normal1;
+    // One-sided: a body whose centre is behind this segment and behind the
+    // convex neighbours passes.
+    const bool behind1 = dot(normal1, centroidB - p1) < 0.0;
+    const bool behind0 = !s.convex1 || dot(s.normal0, centroidB - p1) < 0.0;
+    const bool behind2 = !s.convex2 || dot(s.normal2, centroidB - p2) < 0.0;
+    if (behind1 && behind0 && behind2) return Manifold{};
+
+    const SegmentPolygonDistance output = segmentPolygonDistance(p1, p2, b);
+    if (output.distance > rB + margin) return Manifold{};
+    const int count = b.count;
+    const Vec2 n0 = s.convex1 ? s.normal0 : normal1;  // concave neighbours snap to this segment
+    const Vec2 n2 = s.convex2 ? s.normal2 : normal1;
+    // Whether the neighbour across the near joint is the one the body meets
+    // along face normal n of B (n points out of B).
+    const auto neighbourIncident = [&](Vec2 n, Vec2 faceStart) {
+        const double dot1 = dot(n, p1 - faceStart), dot2 = dot(n, p2 - faceStart);
+        return dot1 < dot2 ? dot(n0, n) < dot(normal1, n) : dot(n2, n) < dot(normal1, n);
+    };
+    const auto withIds = [&](Manifold m) {
+        for (int i = 0; i < m.pointCount; ++i) m.points[i].id = chainId(s, m.points[i].id);
+        return m;
+    };
+    // B's face i as the reference: the normal from the segment is -n.
+    const auto polygonFace = [&](int i) {
+        const int i2 = (i + 1) % count;
+        Manifold m = clipChainSegments(b.vertices[i], b.vertices[i2], p1, p2, b.normals[i], rB, 0.0,
+                                       kChainPolygonFace | 0x8 | std::uint32_t(i), kChainPolygonFace | std::uint32_t(i2),
+                                       margin);
+        m.normal = -b.normals[i];
+        return withIds(m);
+    };
+
+    constexpr double kTouching = 0.1 * 0.005;  // a tenth of the linear slop, metres
+    int incidentIndex = -1, incidentNormal = -1;
+    if (!behind1 && output.distance > kTouching) {
+        // Apart: the closest features may be two vertices or a vertex and an
+        // edge even when the contact should be face to face.
+        if (output.indexA >= 0 && output.ib1 == output.ib2) {
+            const Vec2 normal = (output.pointB - output.pointA) / output.distance;
+            const NormalType type = classifyNormal(s, normal);
+            if (type == NormalType::Skip) return Manifold{};
+            if (type == NormalType::Admit) {
+                Manifold m;
+                m.normal = normal;
+                m.pointCount = 1;
+                m.points[0].separation = output.distance - rB;
+                m.points[0].point = output.pointA + (0.5 * (output.distance - rB)) * normal;
+                m.points[0].id = chainId(s, kChainCorner | (std::uint32_t(output.indexA) << 3) | std::uint32_t(output.ib1));
+                return m;
+            }
+            incidentIndex = output.ib1;  // snap: the segment's face
+        } else if (output.indexA >= 0) {
+            // A segment end against an edge of B: B's face most aligned with
+            // the line between them.
+            const Vec2 toA = output.pointA - output.pointB;
+            const int ib = dot(toA, b.normals[output.ib1]) > dot(toA, b.normals[output.ib2]) ? output.ib1 : output.ib2;
+            const Vec2 normalB = b.normals[ib];
+            const NormalType type = classifyNormal(s, -normalB);
+            if (type == NormalType::Skip) return Manifold{};
+            if (type == NormalType::Admit) {
+                if (neighbourIncident(normalB, b.vertices[ib])) return Manifold{};
+                return polygonFace(ib);
+            }
+            incidentNormal = ib;
+        } else {
+            // A vertex of B against the inside of the segment.
+            incidentIndex = output.ib1;
+        }
+    } else {
+        // Overlapping or touching: separating axes. The segment's own normal
+        // and its convex neighbours' ...
+        double edgeSeparation = std::numeric_limits<double>::infinity();
+        for (int i = 0; i < count; ++i) {
+            const double d = dot(normal1, b.vertices[i] - p1);
+            if (d < edgeSeparation) {
+                edgeSeparation = d;
+                incidentIndex = i;
+            }
+        }
+        if (s.convex1) {
+            double s0 = std::numeric_limits<double>::infinity();
+            for (int i = 0; i < count; ++i) s0 = std::min(s0, dot(s.normal0, b.vertices[i] - p1));
+            if (s0 > edgeSeparation) {
+                edgeSeparation = s0;
+                incidentIndex = -1;  // the neighbour owns this axis
+            }
+        }
+        if (s.convex2) {
+            double s2 = std::numeric_limits<double>::infinity();
+            for (int i = 0; i < count; ++i) s2 = std::min(s2, dot(s.normal2, b.vertices[i] - p2));
+            if (s2 > edgeSeparation) {
+                edgeSeparation = s2;
+                incidentIndex = -1;
+            }
+        }
+        // ... and B's face normals that this segment admits.
+        double polygonSeparation = -std::numeric_limits<double>::infinity();
+        int referenceIndex = -1;
+        for (int i = 0; i < count; ++i) {
+            const Vec2 n = b.normals[i];
+            if (classifyNormal(s, -n) != NormalType::Admit) continue;
+            const double sep = std::min(dot(n, p2 - b.vertices[i]), dot(n, p1 - b.vertices[i]));
+            if (sep > polygonSeparation) {
+                polygonSeparation = sep;
+                referenceIndex = i;
+            }
+        }
+        if (polygonSeparation > edgeSeparation) {
+            if (neighbourIncident(b.normals[referenceIndex], b.vertices[referenceIndex])) return Manifold{};
+            return polygonFace(referenceIndex);
+        }
+        if (incidentIndex == -1) return Manifold{};  // a neighbour's axis separates best
+    }
+
+    // The segment's face is the reference: B's incident edge is the one
+    // beside the deepest vertex most against the segment's normal.
+    int ib1, ib2;
+    if (incidentNormal != -1) {
+        ib1 = incidentNormal;
+        ib2 = (ib1 + 1) % count;
+    } else {
+        const int i2 = incidentIndex, i1 = i2 > 0 ? i2 - 1 : count - 1;
+        if (dot(normal1, b.normals[i1]) < dot(normal1, b.normals[i2])) {
+            ib1 = i1;
+            ib2 = i2;
+        } else {
+            ib1 = i2;
+            ib2 = (i2 + 1) % count;
+        }
+    }
+    return withIds(clipChainSegments(p1, p2, b.vertices[ib1], b.vertices[ib2], normal1, 0.0, rB,
+                                     kChainSegmentFace | std::uint32_t(ib2), kChainSegmentFace | 0x8 | std::uint32_t(ib1),
+                                     margin));
+}
+
+/// Chain segment A against circle B (centre pB, radius r).
+Manifold collideWorldChainCircle(const WorldChainSegment& s, double r, Vec2 pB, double margin) {
+    const Vec2 p1 = s.p1, p2 = s.p2, e = p2 - p1;
+    // One-sided: a centre behind the segment passes.
+    if (dot(rightPerp(e), pB - p1) < 0.0) return Manifold{};
+    const double u = dot(e, p2 - pB), v = dot(e, pB - p1);
+    Vec2 pA;
+    std::uint32_t region = 0;
+    if (v <= 0.0) {
+        // Before p1: that joint's corner belongs to the previous segment (it
+        // meets it past its p2), so only an open end answers here.
+        if (!s.open1) return Manifold{};
+        pA = p1;
+        region = 1;
+    } else if (u <= 0.0) {
+        // Past p2: in the next segment's Voronoi region (ahead along its
+        // direction) the next segment answers; an open end's ghost points
+        // straight down behind it, so it answers here.
+        if (dot(perp(s.normal2), pB - p2) > 0.0) return Manifold{};
+        pA = p2;
+        region = 2;
+    } else {
+        pA = p1 + (v / dot(e, e)) * e;
+    }
+    const Vec2 d = pB - pA;
+    const double dist = length(d);
+    const double separation = dist - r;
+    if (separation > margin) return Manifold{};
+    Manifold m;
+    m.normal = dist > 1e-12 ? d / dist : s.normal1;
+    m.pointCount = 1;
+    m.points[0].separation = separation;
+    m.points[0].point = pA + (0.5 * separation) * m.normal;
+    m.points[0].id = chainId(s, kChainCircle | region);
+    return m;
+}
 } // namespace
+
+// A rounded polygon (cornerRadius > 0) takes the rounded routines; a sharp
+// one the plain ones, as before rounding existed.
 
 Manifold collidePolygons(const ConvexPolygon& a, Vec2 pA, Rot qA, const ConvexPolygon& b, Vec2 pB, Rot qB,
                          double margin) {
+    if (a.cornerRadius > 0.0 || b.cornerRadius > 0.0)
+        return collideWorldRoundedPolygons(worldPolygon(a, pA, qA), a.cornerRadius, worldPolygon(b, pB, qB),
+                                           b.cornerRadius, margin);
     return collideWorldPolygons(worldPolygon(a, pA, qA), worldPolygon(b, pB, qB), margin);
 }
 
 Manifold collideBoxPolygon(Vec2 hA, Vec2 pA, Rot qA, const ConvexPolygon& b, Vec2 pB, Rot qB, double margin) {
+    if (b.cornerRadius > 0.0)
+        return collideWorldRoundedPolygons(worldPolygon(worldBox(hA, pA, qA)), 0.0, worldPolygon(b, pB, qB),
+                                           b.cornerRadius, margin);
     return collideWorldPolygons(worldPolygon(worldBox(hA, pA, qA)), worldPolygon(b, pB, qB), margin);
 }
 
 Manifold collidePolygonCircle(const ConvexPolygon& a, Vec2 pA, Rot qA, double rB, Vec2 pB, double margin) {
+    if (a.cornerRadius > 0.0) {
+        // The core against a circle as large as both radii; the point then
+        // moves out by the rounding to sit midway between the surfaces.
+        Manifold m = collideWorldPolygonCircle(worldPolygon(a, pA, qA), rB + a.cornerRadius, pB, margin);
+        for (int i = 0; i < m.pointCount; ++i) m.points[i].point += a.cornerRadius * m.normal;
+        return m;
+    }
     return collideWorldPolygonCircle(worldPolygon(a, pA, qA), rB, pB, margin);
 }
 
 Manifold collidePlanePolygon(Vec2 n, double offset, const ConvexPolygon& b, Vec2 pB, Rot qB, double margin) {
+    if (b.cornerRadius > 0.0) {
+        // The core against the plane moved out by the rounding; the point
+        // then moves back to sit midway between the surfaces.
+        Manifold m = collidePlaneWorldPolygon(n, offset + b.cornerRadius, worldPolygon(b, pB, qB), margin);
+        for (int i = 0; i < m.pointCount; ++i) m.points[i].point -= b.cornerRadius * n;
+        return m;
+    }
     return collidePlaneWorldPolygon(n, offset, worldPolygon(b, pB, qB), margin);
 }
 
@@ -546,7 +902,7 @@ Manifold collideCapsuleBox(Vec2 a1, Vec2 a2, double rA, Vec2 hB, Vec2 pB, Rot qB
 
 Manifold collideCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const ConvexPolygon& b, Vec2 pB, Rot qB,
                                double margin) {
-    return collideWorldCapsulePolygon(a1, a2, rA, worldPolygon(b, pB, qB), 0.0, margin);
+    return collideWorldCapsulePolygon(a1, a2, rA, worldPolygon(b, pB, qB), b.cornerRadius, margin);
 }
 
 Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot qB, double margin) {
@@ -554,6 +910,36 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
         m.normal = -m.normal;
         return m;
     };
+    if (a.kind == ShapeKind::ChainSegment || b.kind == ShapeKind::ChainSegment) {
+        // Chain first: every pair with a chain segment is written as segment
+        // A against B, then flipped back. Chains sit on static bodies, so a
+        // chain never meets a plane or another chain (neither moves).
+        const bool chainA = a.kind == ShapeKind::ChainSegment;
+        const Shape& chain = chainA ? a : b;
+        const Shape& other = chainA ? b : a;
+        const Vec2 pC = chainA ? pA : pB, pO = chainA ? pB : pA;
+        const Rot qC = chainA ? qA : qB, qO = chainA ? qB : qA;
+        const WorldChainSegment s = worldChainSegment(*chain.segment, pC, qC);
+        Manifold m;
+        switch (other.kind) {
+        case ShapeKind::Circle: m = collideWorldChainCircle(s, other.radius, pO, margin); break;
+        case ShapeKind::Box:
+            m = collideWorldChainPolygon(s, worldPolygon(worldBox(other.halfExtents, pO, qO)), pO, 0.0, margin);
+            break;
+        case ShapeKind::Polygon:
+            m = collideWorldChainPolygon(s, worldPolygon(*other.polygon, pO, qO), pO, other.polygon->cornerRadius,
+                                         margin);
+            break;
+        case ShapeKind::Capsule: {
+            const Vec2 h = rotate(qO, other.halfExtents);
+            m = collideWorldChainPolygon(s, worldSegment(pO - h, pO + h), pO, other.radius, margin);
+            break;
+        }
+        case ShapeKind::Plane:
+        case ShapeKind::ChainSegment: break;
+        }
+        return chainA ? m : flipped(m);
+    }
     if (a.kind == ShapeKind::Capsule || b.kind == ShapeKind::Capsule) {
         // Capsule first: every pair with a capsule is written as capsule (or
         // plane) A against B, then flipped back.
@@ -572,6 +958,7 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
                 const auto [b1, b2] = ends(b, pB, qB);
                 return collideCapsules(a1, a2, a.radius, b1, b2, b.radius, margin);
             }
+            case ShapeKind::ChainSegment: break;  // handled above
             }
             return Manifold{};
         }
@@ -581,7 +968,8 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
         case ShapeKind::Box: return flipped(collideCapsuleBox(b1, b2, b.radius, a.halfExtents, pA, qA, margin));
         case ShapeKind::Polygon: return flipped(collideCapsulePolygon(b1, b2, b.radius, *a.polygon, pA, qA, margin));
         case ShapeKind::Plane: return collidePlaneCapsule(a.normal, a.offset, b1, b2, b.radius, margin);
-        case ShapeKind::Capsule: break;  // handled above
+        case ShapeKind::Capsule:
+        case ShapeKind::ChainSegment: break;  // handled above
         }
         return Manifold{};
     }
@@ -594,7 +982,8 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
             case ShapeKind::Box: return flipped(collideBoxPolygon(b.halfExtents, pB, qB, *a.polygon, pA, qA, margin));
             case ShapeKind::Polygon: return collidePolygons(*a.polygon, pA, qA, *b.polygon, pB, qB, margin);
             case ShapeKind::Plane: return flipped(collidePlanePolygon(b.normal, b.offset, *a.polygon, pA, qA, margin));
-            case ShapeKind::Capsule: break;  // handled above
+            case ShapeKind::Capsule:
+            case ShapeKind::ChainSegment: break;  // handled above
             }
             return Manifold{};
         }
@@ -603,7 +992,8 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
         case ShapeKind::Box: return collideBoxPolygon(a.halfExtents, pA, qA, *b.polygon, pB, qB, margin);
         case ShapeKind::Plane: return collidePlanePolygon(a.normal, a.offset, *b.polygon, pB, qB, margin);
         case ShapeKind::Polygon:
-        case ShapeKind::Capsule: break;
+        case ShapeKind::Capsule:
+        case ShapeKind::ChainSegment: break;
         }
         return Manifold{};
     }
@@ -621,7 +1011,8 @@ Manifold collide(const Shape& a, Vec2 pA, Rot qA, const Shape& b, Vec2 pB, Rot q
         if (b.kind == ShapeKind::Box) return collidePlaneBox(a.normal, a.offset, b.halfExtents, pB, qB, margin);
         return Manifold{};  // two infinite walls never collide
     case ShapeKind::Polygon:
-    case ShapeKind::Capsule: break;  // handled above
+    case ShapeKind::Capsule:
+    case ShapeKind::ChainSegment: break;  // handled above
     }
     return Manifold{};
 }
@@ -635,7 +1026,15 @@ Aabb computeAabb(const Shape& shape, Vec2 p, Rot q) {
             box.lower = {std::min(box.lower.x, v.x), std::min(box.lower.y, v.y)};
             box.upper = {std::max(box.upper.x, v.x), std::max(box.upper.y, v.y)};
         }
+        if (const double r = shape.polygon->cornerRadius; r > 0.0) {
+            box.lower -= Vec2{r, r};
+            box.upper += Vec2{r, r};
+        }
         return box;
+    }
+    if (shape.kind == ShapeKind::ChainSegment) {
+        const Vec2 p1 = p + rotate(q, shape.segment->p1), p2 = p + rotate(q, shape.segment->p2);
+        return {{std::min(p1.x, p2.x), std::min(p1.y, p2.y)}, {std::max(p1.x, p2.x), std::max(p1.y, p2.y)}};
     }
     if (shape.kind == ShapeKind::Capsule) {
         const Vec2 h = rotate(q, shape.halfExtents);

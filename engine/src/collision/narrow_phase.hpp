@@ -40,7 +40,8 @@ Manifold collideCapsuleBox(Vec2 a1, Vec2 a2, double rA, Vec2 hB, Vec2 pB, Rot qB
 Manifold collideCapsulePolygon(Vec2 a1, Vec2 a2, double rA, const ConvexPolygon& b, Vec2 pB, Rot qB,
                                double margin);
 
-/// World-space bounding box of a circle, box, polygon or capsule (planes have none).
+/// World-space bounding box of a circle, box, polygon, capsule or chain
+/// segment (planes have none).
 Aabb computeAabb(const Shape& shape, Vec2 p, Rot q);
 
 } // namespace stepwise::collision

@@ -597,6 +597,16 @@ void World::setSolverState(const SolverState& state) {
     for (const ContactImpulse& c : state.contacts) {
         const std::optional<std::uint32_t> a = colliderFor(c.a, c.shapeA), b = colliderFor(c.b, c.shapeB);
         if (!a || !b) continue;  // no longer collides: nothing to warm
+        // A chain's segments follow its first collider; the feature id
+        // holds the segment's number.
+        const auto segmentOf = [&](std::uint32_t first) -> std::int64_t {
+            if (w.collision->collider(first).shape.kind != collision::ShapeKind::ChainSegment) return first;
+            const std::size_t k = first + (c.feature >> collision::kChainFeatureShift);
+            if (k >= colliders.size() || colliders[k] != colliders[first]) return -1;
+            return std::int64_t(k);
+        };
+        const std::int64_t ca = segmentOf(*a), cb = segmentOf(*b);
+        if (ca < 0 || cb < 0) continue;  // a segment the chain no longer has
         const double largest = std::max(std::abs(c.normalImpulse), std::abs(c.tangentImpulse));
         if (bounded && !(largest <= bound)) {
             if (!w.dropped) w.dropped = DroppedImpulses{.bound = bound};
@@ -604,7 +614,8 @@ void World::setSolverState(const SolverState& state) {
             w.dropped->largest = std::max(w.dropped->largest, largest);
             continue;
         }
-        cache.push_back({CachedImpulse::makeKey(*a, *b, c.feature), c.normalImpulse, c.tangentImpulse});
+        cache.push_back({CachedImpulse::makeKey(std::uint32_t(ca), std::uint32_t(cb), c.feature), c.normalImpulse,
+                         c.tangentImpulse});
     }
     // Kept in the given order when it is sorted (always, for a state this
     // engine wrote): entries with equal keys then stay in the order the

@@ -219,7 +219,8 @@ void compileBoids(const Registry& reg, WorldImpl& w) {
     if (f.boidsOn) f.boids.prepare();
 }
 
-/// The loader refuses bad outlines (and capsules without a segment), but a
+/// The loader refuses bad outlines (capsules without a segment, chains
+/// with too few or repeated points or on a moving body), but a
 /// scene built in code or edited in the editor reaches here unchecked.
 std::optional<Error> checkPolygons(const Registry& reg) {
     const std::vector<Entity>& order = reg.entities();
@@ -242,8 +243,25 @@ std::optional<Error> checkPolygons(const Registry& reg) {
             return Error{"a and b are the same point; a capsule needs a segment of non-zero length",
                          entityLabel(i, name ? &name->value : nullptr) + ": capsule.b"};
         }
+        if (const Chain* chain = reg.tryGet<Chain>(order[i])) {
+            const Name* name = reg.tryGet<Name>(order[i]);
+            const std::string label = entityLabel(i, name ? &name->value : nullptr);
+            if (std::optional<Error> problem = chainProblem(chain->points, chain->loop))
+                return Error{problem->message,
+                             label + ": chain.points" + (problem->where.empty() ? "" : "[" + problem->where + "]")};
+            if (!(reg.has<Static>(order[i]) && reg.tryGet<Static>(order[i])->value))
+                return Error{"a chain must be on a static body (\"static\": true); chains on dynamic and kinematic "
+                             "bodies are not supported",
+                             label + ": chain"};
+        }
         const Polygon* poly = reg.tryGet<Polygon>(order[i]);
         if (!poly) continue;
+        if (poly->radius && !(*poly->radius >= 0.0 && *poly->radius <= kMaxMagnitude)) {
+            const Name* name = reg.tryGet<Name>(order[i]);
+            return Error{"expected a number in [0, " + formatNumber(kMaxMagnitude) + "], got " +
+                             formatNumber(*poly->radius),
+                         entityLabel(i, name ? &name->value : nullptr) + ": polygon.radius"};
+        }
         if (std::optional<Error> problem = polygonProblem(poly->vertices)) {
             // Vertex 3 is named "polygon.vertices[3]".
             const Name* name = reg.tryGet<Name>(order[i]);

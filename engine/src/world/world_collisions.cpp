@@ -167,11 +167,14 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         } else if (const Polygon* poly = reg.tryGet<Polygon>(e)) {
             // The engine works about the centre of mass: the outline is
             // shifted so the centroid is its origin, and the offset kept.
-            const PolygonMassProperties props = polygonMassProperties(poly->vertices);
+            const double rounding = poly->radius.value_or(0.0);
+            const PolygonMassProperties props = rounding > 0.0 ? polygonMassProperties(poly->vertices, rounding)
+                                                               : polygonMassProperties(poly->vertices);
             Vec2 local[collision::kMaxPolygonVertices];
             const int count = int(poly->vertices.size());
             for (int i = 0; i < count; ++i) local[i] = poly->vertices[std::size_t(i)] - props.centroid;
             polygon = collision::ConvexPolygon::fromVertices(local, count);
+            polygon.cornerRadius = rounding;
             c.shape.kind = collision::ShapeKind::Polygon;
             c.shape.polygon = &polygon;
             c.centreOfMass = props.centroid;
@@ -184,6 +187,8 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
             c.shape.radius = cap->radius;
             c.shape.halfExtents = 0.5 * (cap->b - cap->a);
             c.centreOfMass = mid;
+        } else if (reg.has<Chain>(e)) {
+            c.shape.kind = collision::ShapeKind::ChainSegment;  // one collider per segment, below
         } else if (const Plane* p = reg.tryGet<Plane>(e)) {
             c.shape.kind = collision::ShapeKind::Plane;
             c.shape.normal = p->normal;
@@ -205,6 +210,31 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         makeSystem();
         colliderOf.emplace(e.index, std::int32_t(system->colliderCount()));
         const Filter* filter = reg.tryGet<Filter>(e);
+        if (c.shape.kind == collision::ShapeKind::ChainSegment) {
+            // Each segment is a collider and a broad-phase proxy of its own
+            // (a long terrain is not one huge box), in order, so segment k
+            // is the chain's first collider plus k.
+            const Chain& chain = *reg.tryGet<Chain>(e);
+            const std::vector<Vec2>& pts = chain.points;
+            const std::size_t n = pts.size(), segments = chain.loop ? n : n - 1;
+            for (std::size_t k = 0; k < segments; ++k) {
+                collision::ChainSegment s;
+                s.index = std::uint32_t(k);
+                s.p1 = pts[k];
+                s.p2 = pts[(k + 1) % n];
+                // An open end's ghost lies straight behind the segment: the
+                // end is a square corner.
+                const Vec2 d = s.p2 - s.p1;
+                const Vec2 behind{-d.y, d.x};  // the left of the segment, as long as it
+                s.open1 = !chain.loop && k == 0;
+                s.open2 = !chain.loop && k + 1 == segments;
+                s.ghost1 = s.open1 ? s.p1 + behind : pts[(k + n - 1) % n];
+                s.ghost2 = s.open2 ? s.p2 + behind : pts[(k + 2) % n];
+                c.shape.segment = &s;
+                system->add(c, angle, spin, filter ? *filter : Filter{});
+            }
+            continue;
+        }
         system->add(c, angle, spin, filter ? *filter : Filter{});
     }
 
@@ -343,7 +373,7 @@ double halfExtentAlong(const Registry& reg, Entity e, Vec2 dir) {
             hi = first ? d : std::max(hi, d);
             first = false;
         }
-        return 0.5 * (hi - lo);
+        return 0.5 * (hi - lo) + p->radius.value_or(0.0);
     }
     if (const Capsule* cap = reg.tryGet<Capsule>(e)) return 0.5 * std::abs(dot(cap->b - cap->a, local)) + cap->radius;
     if (const Shapes* shapes = reg.tryGet<Shapes>(e)) {

@@ -80,9 +80,16 @@ bool sameCollider(const collision::Collider& a, const collision::Collider& b) {
         return false;
     if (a.shape.polygon && b.shape.polygon) {
         const collision::ConvexPolygon &p = *a.shape.polygon, &q = *b.shape.polygon;
-        if (p.count != q.count) return false;
+        if (p.count != q.count || !sameBits(p.cornerRadius, q.cornerRadius)) return false;
         for (int i = 0; i < p.count; ++i)
             if (!sameBits(p.vertices[i], q.vertices[i])) return false;
+    }
+    if ((a.shape.segment == nullptr) != (b.shape.segment == nullptr)) return false;
+    if (a.shape.segment) {
+        const collision::ChainSegment &p = *a.shape.segment, &q = *b.shape.segment;
+        if (!sameBits(p.p1, q.p1) || !sameBits(p.p2, q.p2) || !sameBits(p.ghost1, q.ghost1) ||
+            !sameBits(p.ghost2, q.ghost2) || p.open1 != q.open1 || p.open2 != q.open2 || p.index != q.index)
+            return false;
     }
     return true;
 }
@@ -171,6 +178,7 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
         const auto oldColliderOf = [&](const collision::Collider& col) {
             std::uint32_t o = oldFirst.find(col.entity);
             if (o == EntitySlots::kNone) return o;
+            if (col.shape.segment) o += col.shape.segment->index;  // a chain's segments follow its first in order
             for (; o < before.collision->colliderCount() && before.collision->collider(o).entity == col.entity; ++o)
                 if (before.collision->collider(o).part == col.part) return o;
             return EntitySlots::kNone;
