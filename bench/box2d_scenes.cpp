@@ -161,9 +161,13 @@ Scene manyPyramids() {
     const double extent = 0.5;
     const double groundDeltaY = 2.0 * extent * (base + 1.0);
     const double groundWidth = 2.0 * extent * columns * (base + 1.0);
-    // A segment has no thickness; a 0.2 m box whose top is the segment.
-    for (int i = 0; i < rows; ++i)
-        staticBox(s, "ground " + std::to_string(i), {0.0, i * groundDeltaY - 0.1}, groundWidth, 0.2);
+    // Box2D's segments are two-sided; each row's ground is a two-point
+    // chain, solid on top (drawn right to left), which is all a pyramid meets.
+    for (int i = 0; i < rows; ++i) {
+        const Entity ground = body(s, "ground " + std::to_string(i), {0.0, i * groundDeltaY}, 0.6, kGrey);
+        s.registry.emplace<Static>(ground, Static{true});
+        s.registry.emplace<Chain>(ground, Chain{{{0.5 * groundWidth, 0.0}, {-0.5 * groundWidth, 0.0}}, false});
+    }
     const double baseWidth = 2.0 * extent * base;
     int index = 0;
     for (int row = 0; row < rows; ++row) {
@@ -281,40 +285,36 @@ Scene smash() {
 // CreateSpinner: a drum of radius 40 m (a 360-point chain loop, friction
 // 0.1) with a 0.8 x 40 m bar rounded by 0.2 m (friction 0) turned at 5 rad/s
 // by an unlimited motor about (0, 12), and 6,076 bodies (capsules, circles
-// and squares in turn, density 0.25, friction 0.1, restitution 0.1).
+// and squares in turn, density 0.25, friction 0.1, restitution 0.1). Every
+// part is the same shape as Box2D's.
 Scene spinner() {
     Scene s = v3World();
     const int points = 360;
     const Vec2 centre{0.0, 32.0};
-    const double radius = 40.0, thickness = 1.0;
-    const double step = 2.0 * kPi / points;
-    // Each chain segment as a static box just outside the circle, a little
-    // longer than the segment so that neighbours close the gap at its joint.
-    const double segment = 2.0 * radius * std::sin(0.5 * step);
+    const double radius = 40.0;
+    // The drum: one clockwise loop (solid inside), as Box2D's chain.
+    Chain drum;
+    drum.points.clear();
+    drum.loop = true;
     for (int i = 0; i < points; ++i) {
-        const double mid = (i + 0.5) * step;
-        const double out = radius * std::cos(0.5 * step) + 0.5 * thickness;
-        staticBox(s, "drum " + std::to_string(i), centre + Vec2{out * std::cos(mid), out * std::sin(mid)},
-                  segment + 0.1, thickness, 0.1, mid + 0.5 * kPi);
+        const double a = -2.0 * kPi * i / points;
+        drum.points.push_back({radius * std::cos(a), radius * std::sin(a)});
     }
+    const Entity ground = body(s, "drum", centre, 0.1, kGrey);
+    s.registry.emplace<Static>(ground, Static{true});
+    s.registry.emplace<Chain>(ground, std::move(drum));
     const Vec2 pivot{0.0, 12.0};
-    // The rounded box's outline as a box 0.2 m larger each side; its mass
-    // is the rounded shape's (0.8 x 40 + perimeter x 0.2 + pi 0.2^2).
+    // b2MakeRoundedBox(0.4, 20, 0.2): a 0.8 x 40 m box rounded by 0.2 m, of
+    // density 1.
     const Entity bar = body(s, "spinner", pivot, 0.0, palette(3));
-    s.registry.emplace<Box>(bar, Box{1.2, 40.4});
-    s.registry.emplace<Mass>(bar, Mass{0.8 * 40.0 + 2.0 * (0.8 + 40.0) * 0.2 + kPi * 0.04});
+    Polygon rounded{{{-0.4, -20.0}, {0.4, -20.0}, {0.4, 20.0}, {-0.4, 20.0}}, 0.2};
+    s.registry.emplace<Mass>(bar, Mass{polygonMassProperties(rounded.vertices, 0.2).area});
+    s.registry.emplace<Polygon>(bar, std::move(rounded));
     // FLT_MAX in Box2D: far beyond any torque the bodies can resist.
     motorToWorld(s, "spinner motor", bar, pivot, pivot, 5.0, 1e10);
     const double density = 0.25;
-    // The capsule (segment -0.25..0.25, radius 0.25) as an octagon: its
-    // straight sides and, at each end, the cap through -90, -30, 30, 90 degrees.
-    Polygon capsule;
-    capsule.vertices.clear();
-    const double c30 = 0.25 * std::cos(kPi / 6.0), s30 = 0.125;
-    for (Vec2 v : {Vec2{0.25, -0.25}, Vec2{0.25 + c30, -s30}, Vec2{0.25 + c30, s30}, Vec2{0.25, 0.25},
-                   Vec2{-0.25, 0.25}, Vec2{-0.25 - c30, s30}, Vec2{-0.25 - c30, -s30}, Vec2{-0.25, -0.25}})
-        capsule.vertices.push_back(v);
-    const double capsuleArea = 0.5 * 0.5 + kPi * 0.25 * 0.25;  // the true capsule's mass
+    const Capsule capsule{{-0.25, 0.0}, {0.25, 0.0}, 0.25};
+    const double capsuleArea = capsuleMassProperties(0.5, 0.25).area;
     const int count = 2 * 3038;
     double x = -23.0, y = 2.0;
     for (int i = 0; i < count; ++i) {
@@ -322,7 +322,7 @@ Scene spinner() {
         switch (i % 3) {
         case 0: {
             const Entity e = body(s, name, {x, y}, 0.1, palette(i));
-            s.registry.emplace<Polygon>(e, capsule);
+            s.registry.emplace<Capsule>(e, capsule);
             s.registry.emplace<Mass>(e, Mass{density * capsuleArea});
             s.registry.emplace<Restitution>(e, Restitution{0.1});
             break;
@@ -358,6 +358,7 @@ Scene tumbler() {
     // collide), on one motor about its centre.
     const Entity drum = body(s, "walls", pivot, 0.6, kGrey);
     Shapes walls;
+    walls.items.clear();  // the default holds one circle
     for (const auto& [offset, w, h] : {std::tuple{Vec2{10.0, 0.0}, 1.0, 20.0}, std::tuple{Vec2{-10.0, 0.0}, 1.0, 20.0},
                                        std::tuple{Vec2{0.0, 10.0}, 20.0, 1.0}, std::tuple{Vec2{0.0, -10.0}, 20.0, 1.0}}) {
         CompoundShape wall;
