@@ -9,13 +9,15 @@
 #include <box2d/box2d.h>
 
 #include <cmath>
+#include <vector>
 
 namespace stepwise::bench {
 
 inline bool isStaticBody(const Registry& r, Entity e) { return r.has<Static>(e) && r.tryGet<Static>(e)->value; }
 
 /// Creates `e`'s body in `world` (static when Static, else dynamic), with a
-/// fixture for its radius, box or polygon (none when it has no shape). Mass
+/// fixture for its radius, box, polygon (rounded too) or chain, one per
+/// compound shape but capsules (none when it has no shape). Mass
 /// as Stepwise's: `mass`, else 1 kg, spread over the shape's area; friction
 /// and restitution as the components say, else Stepwise's defaults 0.2 and
 /// 0. Drag b (force -b v) becomes Box2D's linear damping b/m (dv/dt = -c v).
@@ -50,8 +52,24 @@ inline b2Body* createBox2dBody(b2World& world, const Registry& r, Entity e) {
         for (std::size_t k = 0; k < poly->vertices.size(); ++k)
             v[k].Set(float(poly->vertices[k].x), float(poly->vertices[k].y));
         polygon.Set(v, int(poly->vertices.size()));
+        // 2.4.1's polygon skin is the same Minkowski rounding.
+        if (poly->radius) polygon.m_radius = float(*poly->radius);
         fd.shape = &polygon;
-        fd.density = float(mass / polygonMassProperties(poly->vertices).area);
+        fd.density = float(mass / polygonMassProperties(poly->vertices, poly->radius.value_or(0.0)).area);
+    }
+    b2ChainShape chainShape;
+    if (const Chain* chain = r.tryGet<Chain>(e)) {
+        // One-sided with the solid side on the right of the direction, as
+        // Stepwise's; an open end's ghost continues the end segment straight.
+        std::vector<b2Vec2> v;
+        for (const Vec2 q : chain->points) v.emplace_back(float(q.x), float(q.y));
+        if (chain->loop) {
+            chainShape.CreateLoop(v.data(), int(v.size()));
+        } else {
+            const b2Vec2 prev = v.front() + (v.front() - v[1]), next = v.back() + (v.back() - v[v.size() - 2]);
+            chainShape.CreateChain(v.data(), int(v.size()), prev, next);
+        }
+        fd.shape = &chainShape;
     }
     if (fd.shape) body->CreateFixture(&fd);
     if (shapes) {
