@@ -367,6 +367,9 @@ int run(const RunOptions& options) {
                << world.settings().integrator << "; t = " << number(world.time()) << " s; "
               << world.bodyCount() - world.kinematicCount() << " dynamic bodies"
               << (world.kinematicCount() ? " and " + std::to_string(world.kinematicCount()) + " kinematic" : std::string())
+              << (world.emitterCount() ? "; " + std::to_string(world.copiesAlive()) + " emitted cop" +
+                                             (world.copiesAlive() == 1 ? "y" : "ies") + " alive"
+                                       : std::string())
               << "; total energy " << number(energy.total()) << " J; "
               << number(taken ? 1e3 * seconds / double(taken) : 0.0) << " ms/step";
     if (const std::size_t broke = world.jointBreaks().size())

@@ -7,6 +7,7 @@
 /// `step()` runs a named pipeline of timed stages (Box2D's b2World_Step
 /// shape); `writeBack()` copies the results into the Scene.
 
+#include "stepwise/components.hpp"
 #include "stepwise/entity.hpp"
 #include "stepwise/result.hpp"
 #include "stepwise/scene.hpp"
@@ -134,7 +135,16 @@ struct WorldLayout {
     std::vector<Entity> colliders;   ///< every shape, in collider order
     std::vector<std::uint8_t> colliderMoves;  ///< per collider: 1 when it is a dynamic body's
     std::vector<Entity> joints;      ///< every joint's entity, in solver (scene) order
-    friend bool operator==(const WorldLayout&, const WorldLayout&) = default;
+    /// With emitters: the run's registry when the layout was made (the
+    /// copies alive with their components, under the handles writeBack
+    /// gives them in a scene) and each emitter's component with its run
+    /// state. Null and empty without emitters.
+    std::shared_ptr<const Registry> registry;
+    std::vector<std::pair<Entity, Emitter>> emitters;
+    friend bool operator==(const WorldLayout& a, const WorldLayout& b) {
+        return a.bodies == b.bodies && a.spinBodies == b.spinBodies && a.colliders == b.colliders &&
+               a.colliderMoves == b.colliderMoves && a.joints == b.joints && a.emitters == b.emitters;
+    }
 };
 
 /// Everything a step reads that an earlier step wrote: a World restored
@@ -405,6 +415,12 @@ public:
     /// editor's "Save simulation state" after a settings edit, so that the
     /// file resumes as the session goes on). True if it woke something.
     bool wakeIfSettingsChanged();
+
+    /// Emitters in the level, and the copies they have alive (docs/format.md,
+    /// "Templates and emitters"): those copies' bodies are in the state
+    /// vector after the level's own, in the order they appeared.
+    std::size_t emitterCount() const;
+    std::size_t copiesAlive() const;
 
     /// Moving bodies (dynamic and kinematic), in the order of the state vector.
     std::size_t bodyCount() const;

@@ -106,6 +106,81 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     }
 }
 
+std::unique_ptr<CollisionSystem> CollisionSystem::changed(std::span<const std::uint8_t> dropCollider,
+                                                          std::span<const std::uint8_t> dropJoint,
+                                                          std::span<const std::int32_t> bodyMap,
+                                                          std::span<const ColliderAdd> added,
+                                                          std::span<const JointAdd> addedJoints) const {
+    auto next = std::make_unique<CollisionSystem>();
+    CollisionSystem& n = *next;
+    n.settings_ = settings_;
+    n.jointSettings_ = jointSettings_;
+    n.autoBroadPhase_ = autoBroadPhase_;
+    n.broadPhase_.setKind(broadPhase_.kind());
+    n.positionCorrection_ = positionCorrection_;
+    n.bodyAsleep_ = bodyAsleep_;
+    n.wakeBody_ = wakeBody_;
+    const std::size_t oldCount = colliders_.size();
+    std::vector<std::int32_t> colliderMap(oldCount, -1);
+    const auto keep = [&](std::size_t c) {
+        Collider copy = colliders_[c];
+        if (copy.body >= 0) copy.body = bodyMap[std::size_t(copy.body)];
+        colliderMap[c] = std::int32_t(n.colliders_.size());
+        n.add(copy, angles_[c], angularVelocities_[c], filters_[c]);
+    };
+    // Shapes in their order, the new ones, then the bodies in the solver
+    // only because a joint holds them: World::build's order.
+    for (std::size_t c = 0; c < oldCount; ++c)
+        if (!dropCollider[c] && !colliders_[c].solverOnly) keep(c);
+    std::vector<std::int32_t> addedIndex(added.size());
+    for (std::size_t k = 0; k < added.size(); ++k) {
+        addedIndex[k] = std::int32_t(n.colliders_.size());
+        n.add(added[k].collider, added[k].angle, added[k].angularVelocity, added[k].filter);
+    }
+    for (std::size_t c = 0; c < oldCount; ++c)
+        if (!dropCollider[c] && colliders_[c].solverOnly) keep(c);
+    bool anyBroken = false;
+    for (std::size_t k = 0; k < joints_.size(); ++k) {
+        if (dropJoint[k]) continue;
+        joints::JointConstraint j = joints_[k];
+        for (joints::JointEnd* end : {&j.a, &j.b}) {
+            if (end->collider < 0) continue;
+            end->collider = colliderMap[std::size_t(end->collider)];
+            end->solverBody = n.solverBodyOf(std::size_t(end->collider));
+        }
+        std::int32_t filter[2] = {-1, -1};
+        if (j.noCollideKey != 0) {
+            filter[0] = colliderMap[std::size_t(j.noCollideKey >> 32)];
+            filter[1] = colliderMap[std::size_t(j.noCollideKey & 0xFFFFFFFFu)];
+        }
+        j.noCollideKey = 0;
+        anyBroken = anyBroken || j.broken;
+        n.addJoint(j, filter[0], filter[1], filter[0] < 0 || filter[1] < 0);
+    }
+    for (const JointAdd& add : addedJoints) {
+        joints::JointConstraint j = add.joint;
+        for (joints::JointEnd* end : {&j.a, &j.b}) {
+            if (end->collider < 0) continue;
+            end->collider = addedIndex[std::size_t(end->collider)];
+            end->solverBody = n.solverBodyOf(std::size_t(end->collider));
+        }
+        const std::int32_t fa = add.filterA >= 0 ? addedIndex[std::size_t(add.filterA)] : -1;
+        const std::int32_t fb = add.filterB >= 0 ? addedIndex[std::size_t(add.filterB)] : -1;
+        n.addJoint(j, fa, fb, add.collideConnected);
+    }
+    if (anyBroken) n.jointsBroke();
+    // The warm start of every contact between kept colliders; the map keeps
+    // their order, so the cache stays sorted as it was.
+    std::vector<CachedImpulse> cache;
+    for (const CachedImpulse& c : warmStartCache()) {
+        const std::int32_t a = colliderMap[c.colliderA()], b = colliderMap[c.colliderB()];
+        if (a < 0 || b < 0) continue;
+        cache.push_back({CachedImpulse::makeKey(std::uint32_t(a), std::uint32_t(b), c.feature()), c.normal, c.tangent});
+    }
+    n.setWarmStartCache(std::move(cache));
+    return next;
+}
+
 void CollisionSystem::setWarmStartCache(std::vector<CachedImpulse> cache) {
     if (!std::is_sorted(cache.begin(), cache.end())) std::sort(cache.begin(), cache.end());
     cache_ = std::move(cache);

@@ -38,6 +38,8 @@
 #include "world/world_impl.hpp"
 #include "world/world_collisions.hpp"
 
+#include "templates.hpp"
+
 #include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
@@ -189,6 +191,7 @@ World::~World() = default;
 
 Result<void> World::step() {
     WorldImpl& w = *impl_;
+    w.runEmitters();  // copies due now appear (or leave) before the step reads the arrays
     detail::ForceModel& f = w.model;
     const bool timed = w.profiling;
     f.profiling = timed;
@@ -355,12 +358,44 @@ Result<void> World::step() {
 
 namespace {
 
+/// With emitters: the copies the run has alive are in the scene under the
+/// run's handles, with their components, after the scene's other entities
+/// in the order they appeared; the copies it removed are not; each
+/// emitter's run state is the run's.
+void syncCopies(const WorldLayout& layout, Scene& scene) {
+    if (!layout.registry) return;
+    Registry& reg = scene.registry;
+    const Registry& run = *layout.registry;
+    std::vector<std::string> prefixes;
+    for (const auto& [e, em] : layout.emitters) {
+        prefixes.push_back(em.templateName + "#");
+        if (Emitter* own = reg.tryGet<Emitter>(e)) {
+            own->next = em.next;
+            own->emitted = em.emitted;
+            own->alive = em.alive;
+            own->oldest = em.oldest;
+        }
+    }
+    const auto isCopy = [&](const Registry& r, Entity e) {
+        const Name* name = r.tryGet<Name>(e);
+        if (!name) return false;
+        for (const std::string& prefix : prefixes)
+            if (name->value.compare(0, prefix.size(), prefix) == 0) return true;
+        return false;
+    };
+    for (const Entity e : std::vector<Entity>(reg.entities()))
+        if (!run.alive(e) && isCopy(reg, e)) reg.destroy(e);
+    for (const Entity e : run.entities())
+        if (!reg.alive(e) && isCopy(run, e) && reg.createAt(e)) detail::copyComponents(run, e, reg, e);
+}
+
 /// World::writeBack and WorldState::writeBack: the arrays of one layout into
 /// the scene's components. `colliderAngle`/`colliderSpin` may be empty (no
 /// shapes).
 void writeStateBack(const WorldLayout& layout, const double* x, const double* v, std::span<const double> spinAngle,
                     std::span<const double> colliderAngle, std::span<const double> colliderSpin, double time,
                     double adaptiveStep, Scene& scene) {
+    syncCopies(layout, scene);
     Registry& reg = scene.registry;
     for (std::size_t b = 0; b < layout.bodies.size(); ++b) {
         const Entity e = layout.bodies[b];

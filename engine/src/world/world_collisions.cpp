@@ -1,5 +1,7 @@
 #include "world/world_collisions.hpp"
 
+#include "templates.hpp"
+
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
@@ -33,6 +35,92 @@ joints::JointKind jointKindOf(const std::string& type) {
 
 } // namespace
 
+bool colliderFor(const Registry& reg, Entity e, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody,
+             collision::ConvexPolygon& polygon, collision::CollisionSystem::ColliderAdd& out) {
+    collision::Collider c;
+    if (const Radius* r = reg.tryGet<Radius>(e)) {
+        c.shape.kind = collision::ShapeKind::Circle;
+        c.shape.radius = r->value;
+    } else if (const Box* b = reg.tryGet<Box>(e)) {
+        c.shape.kind = collision::ShapeKind::Box;
+        c.shape.halfExtents = {0.5 * b->width, 0.5 * b->height};
+    } else if (const Polygon* poly = reg.tryGet<Polygon>(e)) {
+        // The engine works about the centre of mass: the outline is
+        // shifted so the centroid is its origin, and the offset kept.
+        const PolygonMassProperties props = polygonMassProperties(poly->vertices);
+        Vec2 local[collision::kMaxPolygonVertices];
+        const int count = int(poly->vertices.size());
+        for (int i = 0; i < count; ++i) local[i] = poly->vertices[std::size_t(i)] - props.centroid;
+        polygon = collision::ConvexPolygon::fromVertices(local, count);
+        c.shape.kind = collision::ShapeKind::Polygon;
+        c.shape.polygon = &polygon;
+        c.centreOfMass = props.centroid;
+    } else if (const Capsule* cap = reg.tryGet<Capsule>(e)) {
+        // About the centre of mass, like polygons: the segment's
+        // midpoint, kept as the offset (exactly zero for a capsule
+        // centred on its position, which then takes the plain path).
+        const Vec2 mid = 0.5 * (cap->a + cap->b);
+        c.shape.kind = collision::ShapeKind::Capsule;
+        c.shape.radius = cap->radius;
+        c.shape.halfExtents = 0.5 * (cap->b - cap->a);
+        c.centreOfMass = mid;
+    } else if (const Plane* p = reg.tryGet<Plane>(e)) {
+        c.shape.kind = collision::ShapeKind::Plane;
+        c.shape.normal = p->normal;
+        c.shape.offset = p->offset;
+    } else {
+        return false;  // no shape: never collides, costs the collision stages nothing
+    }
+    const std::uint32_t body = c.shape.kind == collision::ShapeKind::Plane ? noBody : bodyOf(e);
+    c.body = body == noBody ? -1 : std::int32_t(body);
+    if (const Position* p = reg.tryGet<Position>(e)) c.staticPosition = p->value;
+    c.kinematic = c.body >= 0 && reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value;
+    c.mass = c.body >= 0 && !c.kinematic ? (reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0) : 0.0;
+    c.restitution = reg.has<Restitution>(e) ? reg.tryGet<Restitution>(e)->value : Restitution{}.value;
+    c.friction = reg.has<Friction>(e) ? reg.tryGet<Friction>(e)->value : Friction{}.value;
+    c.sensor = reg.has<Sensor>(e) && reg.tryGet<Sensor>(e)->value;
+    c.entity = e;
+    const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
+    const double spin = reg.has<AngularVelocity>(e) ? reg.tryGet<AngularVelocity>(e)->value : 0.0;
+    out.collider = c;
+    out.angle = angle;
+    out.angularVelocity = spin;
+    const Filter* filter = reg.tryGet<Filter>(e);
+    out.filter = filter ? *filter : Filter{};
+    return true;
+}
+
+bool fillJointParams(const Joint& joint, joints::JointConstraint& j) {
+    j.kind = jointKindOf(joint.type);
+    if (joint.axis) {
+        const double len = std::hypot(joint.axis->x, joint.axis->y);
+        if (!(len > 1e-12)) return false;
+        j.localAxis = *joint.axis / len;
+    }
+    j.referenceAngle = joint.referenceAngle.value_or(0.0);
+    j.hasLower = joint.lower.has_value();
+    j.hasUpper = joint.upper.has_value();
+    j.lower = joint.lower.value_or(0.0);
+    j.upper = joint.upper.value_or(0.0);
+    const std::optional<double>& maxMotor = j.kind == joints::JointKind::Slider ? joint.maxMotorForce
+                                                                                : joint.maxMotorTorque;
+    j.motor = maxMotor.has_value() && (j.kind == joints::JointKind::Hinge || j.kind == joints::JointKind::Slider ||
+                                       j.kind == joints::JointKind::Wheel);
+    j.maxMotor = maxMotor.value_or(0.0);
+    j.motorSpeed = joint.motorSpeed.value_or(0.0);
+    j.length = joint.length.value_or(0.0);
+    j.stiffnessHz = joint.stiffnessHz.value_or(0.0);
+    j.dampingRatio = joint.dampingRatio.value_or(1.0);
+    if (j.kind == joints::JointKind::Hinge) {
+        j.springHz = joint.springHz.value_or(0.0);
+        j.springDampingRatio = joint.springDampingRatio.value_or(1.0);
+    }
+    j.spring = (j.kind == joints::JointKind::Hinge && j.springHz > 0.0) ||
+               (j.kind == joints::JointKind::Wheel && j.stiffnessHz > 0.0);
+    j.maxForce = joint.maxForce.value_or(0.0);
+    return true;
+}
+
 std::unique_ptr<collision::CollisionSystem> buildCollisions(
     const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, bool shapes,
     std::string* problem) {
@@ -47,69 +135,25 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
     collision::ConvexPolygon polygon;  // copied by add()
     static const std::vector<Entity> kNoEntities;
     for (const Entity e : shapes ? reg.entities() : kNoEntities) {
-        collision::Collider c;
-        if (const Radius* r = reg.tryGet<Radius>(e)) {
-            c.shape.kind = collision::ShapeKind::Circle;
-            c.shape.radius = r->value;
-        } else if (const Box* b = reg.tryGet<Box>(e)) {
-            c.shape.kind = collision::ShapeKind::Box;
-            c.shape.halfExtents = {0.5 * b->width, 0.5 * b->height};
-        } else if (const Polygon* poly = reg.tryGet<Polygon>(e)) {
-            // The engine works about the centre of mass: the outline is
-            // shifted so the centroid is its origin, and the offset kept.
-            const PolygonMassProperties props = polygonMassProperties(poly->vertices);
-            Vec2 local[collision::kMaxPolygonVertices];
-            const int count = int(poly->vertices.size());
-            for (int i = 0; i < count; ++i) local[i] = poly->vertices[std::size_t(i)] - props.centroid;
-            polygon = collision::ConvexPolygon::fromVertices(local, count);
-            c.shape.kind = collision::ShapeKind::Polygon;
-            c.shape.polygon = &polygon;
-            c.centreOfMass = props.centroid;
-        } else if (const Capsule* cap = reg.tryGet<Capsule>(e)) {
-            // About the centre of mass, like polygons: the segment's
-            // midpoint, kept as the offset (exactly zero for a capsule
-            // centred on its position, which then takes the plain path).
-            const Vec2 mid = 0.5 * (cap->a + cap->b);
-            c.shape.kind = collision::ShapeKind::Capsule;
-            c.shape.radius = cap->radius;
-            c.shape.halfExtents = 0.5 * (cap->b - cap->a);
-            c.centreOfMass = mid;
-        } else if (const Plane* p = reg.tryGet<Plane>(e)) {
-            c.shape.kind = collision::ShapeKind::Plane;
-            c.shape.normal = p->normal;
-            c.shape.offset = p->offset;
-        } else {
-            continue;  // no shape: never collides, costs the collision stages nothing
-        }
-        const std::uint32_t body = c.shape.kind == collision::ShapeKind::Plane ? noBody : bodyOf(e);
-        c.body = body == noBody ? -1 : std::int32_t(body);
-        if (const Position* p = reg.tryGet<Position>(e)) c.staticPosition = p->value;
-        c.kinematic = c.body >= 0 && reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value;
-        c.mass = c.body >= 0 && !c.kinematic ? (reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0) : 0.0;
-        c.restitution = reg.has<Restitution>(e) ? reg.tryGet<Restitution>(e)->value : Restitution{}.value;
-        c.friction = reg.has<Friction>(e) ? reg.tryGet<Friction>(e)->value : Friction{}.value;
-        c.sensor = reg.has<Sensor>(e) && reg.tryGet<Sensor>(e)->value;
-        c.entity = e;
-        const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
-        const double spin = reg.has<AngularVelocity>(e) ? reg.tryGet<AngularVelocity>(e)->value : 0.0;
+        if (inTemplate(reg, e)) continue;  // a prefab: never collides
+        collision::CollisionSystem::ColliderAdd add;
+        if (!colliderFor(reg, e, bodyOf, noBody, polygon, add)) continue;
         makeSystem();
         colliderOf.emplace(e.index, std::int32_t(system->colliderCount()));
-        const Filter* filter = reg.tryGet<Filter>(e);
-        system->add(c, angle, spin, filter ? *filter : Filter{});
+        system->add(add.collider, add.angle, add.angularVelocity, add.filter);
     }
 
     // Joints, in scene order.
     const auto& order = reg.entities();
     for (std::size_t i = 0; i < order.size(); ++i) {
         const Joint* stored = reg.tryGet<Joint>(order[i]);
-        if (!stored) continue;
+        if (!stored || inTemplate(reg, order[i])) continue;
         // A scene built in code may leave anchor, reference_angle or length
         // to their defaults; the loader has already filled them for files.
         Joint completed = *stored;
         completeJoint(reg, completed);
         const Joint* joint = &completed;
         joints::JointConstraint j;
-        j.kind = jointKindOf(joint->type);
         j.entity = order[i];
         j.entityA = joint->a;
         j.entityB = joint->b;
@@ -163,35 +207,10 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
             if (problem) *problem = labelOf(reg, i) + ": joint joins two static bodies; at least one end must be dynamic";
             return nullptr;
         }
-        if (joint->axis) {
-            const double len = std::hypot(joint->axis->x, joint->axis->y);
-            if (!(len > 1e-12)) {
-                if (problem) *problem = labelOf(reg, i) + ": joint axis: a slider axis needs a non-zero length";
-                return nullptr;
-            }
-            j.localAxis = *joint->axis / len;
+        if (!fillJointParams(*joint, j)) {
+            if (problem) *problem = labelOf(reg, i) + ": joint axis: a slider axis needs a non-zero length";
+            return nullptr;
         }
-        j.referenceAngle = joint->referenceAngle.value_or(0.0);
-        j.hasLower = joint->lower.has_value();
-        j.hasUpper = joint->upper.has_value();
-        j.lower = joint->lower.value_or(0.0);
-        j.upper = joint->upper.value_or(0.0);
-        const std::optional<double>& maxMotor = j.kind == joints::JointKind::Slider ? joint->maxMotorForce
-                                                                                    : joint->maxMotorTorque;
-        j.motor = maxMotor.has_value() && (j.kind == joints::JointKind::Hinge || j.kind == joints::JointKind::Slider ||
-                                           j.kind == joints::JointKind::Wheel);
-        j.maxMotor = maxMotor.value_or(0.0);
-        j.motorSpeed = joint->motorSpeed.value_or(0.0);
-        j.length = joint->length.value_or(0.0);
-        j.stiffnessHz = joint->stiffnessHz.value_or(0.0);
-        j.dampingRatio = joint->dampingRatio.value_or(1.0);
-        if (j.kind == joints::JointKind::Hinge) {
-            j.springHz = joint->springHz.value_or(0.0);
-            j.springDampingRatio = joint->springDampingRatio.value_or(1.0);
-        }
-        j.spring = (j.kind == joints::JointKind::Hinge && j.springHz > 0.0) ||
-                   (j.kind == joints::JointKind::Wheel && j.stiffnessHz > 0.0);
-        j.maxForce = joint->maxForce.value_or(0.0);
         makeSystem();
         system->addJoint(j, filter[0], filter[1], joint->collideConnected);
     }
@@ -291,7 +310,7 @@ double springRate(const Scene& scene, const SystemSwitches& switches) {
         return 0.0;
     const Registry& reg = scene.registry;
     const auto dynamicMass = [&](Entity e) -> double {
-        if (e.isNull() || !reg.alive(e) || !reg.has<Position>(e)) return 0.0;
+        if (e.isNull() || !reg.alive(e) || !reg.has<Position>(e) || detail::emittedOrTemplate(reg, e)) return 0.0;
         if (const Static* st = reg.tryGet<Static>(e); st && st->value) return 0.0;
         if (const Kinematic* k = reg.tryGet<Kinematic>(e); k && k->value) return 0.0;
         return reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0;
@@ -373,7 +392,11 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     const auto hasShape = [&](Entity e) {
         return switches.collisions && (reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) || reg.has<Capsule>(e));
     };
-    const auto dynamic = [&](Entity e) { return reg.alive(e) && reg.has<Position>(e) && !isStatic(e); };
+    // Templates, an emitter's copies and shapeless emitters are left out:
+    // the choice is the scene's as written, whatever copies a run has made.
+    const auto dynamic = [&](Entity e) {
+        return reg.alive(e) && reg.has<Position>(e) && !isStatic(e) && !detail::emittedOrTemplate(reg, e);
+    };
     const auto massOf = [&](Entity e) { return reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0; };
     const auto sizeOf = [&](Entity e) {
         return hasShape(e) ? 2.0 * std::max(halfExtentAlong(reg, e, across), halfExtentAlong(reg, e, down))

@@ -28,6 +28,15 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
     const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, bool shapes = true,
     std::string* problem = nullptr);
 
+/// The collider of entity `e` (its shape, body, material, rotation and
+/// filter) as World::build makes it; false when `e` has no shape.
+/// `polygon` holds a polygon's outline until CollisionSystem::add copies it.
+bool colliderFor(const Registry& reg, Entity e, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody,
+                 collision::ConvexPolygon& polygon, collision::CollisionSystem::ColliderAdd& out);
+/// A joint's kind, limits, motor, springs and breaking force from its
+/// component; false when a slider axis has no length.
+bool fillJointParams(const Joint& joint, joints::JointConstraint& j);
+
 /// A dynamic body held by a joint but without a shape turns like a solid
 /// disc of this radius (I = m r^2 / 2), metres: a point mass (I = 0) could
 /// not be welded or driven by a motor, and a small disc changes nothing for
