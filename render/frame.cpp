@@ -717,6 +717,7 @@ void Builder::trails() {
 
 void Builder::springs() {
     scene_.registry.each<Spring>([&](Entity e, const Spring& sp) {
+        if (scene_.registry.has<Template>(sp.a)) return;  // a template's spring: not drawn, as its joints
         auto endOf = [&](Entity end) -> std::optional<Vec2> {
             const Position* p = scene_.registry.tryGet<Position>(end);
             return p ? std::optional<Vec2>(p->value) : std::nullopt;
@@ -893,7 +894,9 @@ void Builder::joints() {
     // angle limits as an arc with a tick at b's current direction.
     for (Entity e : scene_.registry.entities()) {
         const Joint* j = scene_.registry.tryGet<Joint>(e);
-        if (!j) continue;
+        // A template's joints hold nothing until it is copied: its faded
+        // bodies show the prefab, without the joints' marks.
+        if (!j || scene_.registry.has<Template>(j->a)) continue;
         struct End {
             Vec2 centre;
             double angle = 0.0;
