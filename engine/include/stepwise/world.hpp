@@ -141,6 +141,9 @@ struct WorldLayout {
     /// state. Null and empty without emitters.
     std::shared_ptr<const Registry> registry;
     std::vector<std::pair<Entity, Emitter>> emitters;
+    /// With emitters: which run the layout belongs to (one per build, kept
+    /// by restoreState's rebuild); 0 without.
+    std::uint64_t run = 0;
     friend bool operator==(const WorldLayout& a, const WorldLayout& b) {
         return a.bodies == b.bodies && a.spinBodies == b.spinBodies && a.colliders == b.colliders &&
                a.colliderMoves == b.colliderMoves && a.joints == b.joints && a.emitters == b.emitters;
@@ -317,7 +320,10 @@ public:
     WorldState saveState() const;
     /// Restores a snapshot taken from this World or from one built from a
     /// scene with the same entities, shapes and systems (the same layout).
-    /// Fails, changing nothing, when the layout differs.
+    /// Fails, changing nothing, when the layout differs, except for a
+    /// snapshot of this run taken while its emitters had other copies
+    /// alive: then the World is rebuilt from the snapshot's own scene (the
+    /// only time an emitter's copies cost a build).
     Result<void> restoreState(const WorldState& state);
 
     /// Recompiles `scene` (an edited version of the scene this World runs)
@@ -453,6 +459,9 @@ private:
     const WorldImpl& impl() const { return *impl_; }
 
     explicit World(std::unique_ptr<WorldImpl> impl);
+    /// restoreState of a snapshot from before the emitters added or removed
+    /// copies: this World is rebuilt from the snapshot's scene, only then.
+    Result<void> restoreOtherCopies(const WorldState& s);
     std::unique_ptr<WorldImpl> impl_;
 };
 

@@ -672,12 +672,27 @@ WorldState World::saveState() const {
     return s;
 }
 
+namespace {
+/// Whether snapshot `s` comes from this World's run with other copies
+/// alive: both have emitters, the same ones.
+bool sameEmitters(const WorldState& s, const WorldImpl& w) {
+    if (!s.layout || !s.layout->registry || !w.registry || s.layout->run != w.run ||
+        s.layout->emitters.size() != w.emitters.size())
+        return false;
+    for (std::size_t k = 0; k < w.emitters.size(); ++k)
+        if (s.layout->emitters[k].first != w.emitters[k].entity) return false;
+    return true;
+}
+} // namespace
+
 Result<void> World::restoreState(const WorldState& s) {
     WorldImpl& w = *impl_;
     if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout) || s.joints.size() != w.layout->joints.size() ||
         s.sleepTimer.size() != w.bodyEntity.size() || s.sleepIsland.size() != w.bodyEntity.size() ||
-        s.sleepAnchor.size() != detail::kAnchorStride * w.bodyEntity.size() || s.sleepAnchored.size() != w.bodyEntity.size())
-        return Error{"the snapshot was taken from a world with other bodies or shapes"};
+        s.sleepAnchor.size() != detail::kAnchorStride * w.bodyEntity.size() || s.sleepAnchored.size() != w.bodyEntity.size()) {
+        if (!sameEmitters(s, w)) return Error{"the snapshot was taken from a world with other bodies or shapes"};
+        return restoreOtherCopies(s);
+    }
     std::copy(s.x.begin(), s.x.end(), w.x[w.current].begin());
     std::copy(s.v.begin(), s.v.end(), w.v[w.current].begin());
     w.angle = s.spinAngle;
@@ -713,6 +728,31 @@ Result<void> World::restoreState(const WorldState& s) {
     w.settings.adaptiveStep = s.adaptiveStep;
     w.integrator->setProposedStep(s.adaptiveStep);
     w.stats.step = s.steps;
+    return {};
+}
+
+Result<void> World::restoreOtherCopies(const WorldState& s) {
+    // The snapshot's own scene: the run's registry as it was then (its
+    // copies alive, broken joints kept, so that the joints line up with the
+    // snapshot's), its state written back, built and restored. Only a World
+    // whose emitters added or removed copies since the snapshot comes here.
+    const WorldImpl& w = *impl_;
+    Scene scene;
+    scene.world = w.sceneWorld;
+    scene.world.integrator = w.settings.integrator;
+    scene.registry = *s.layout->registry;
+    writeStateBack(*s.layout, s.x.data(), s.v.data(), s.spinAngle, s.colliderAngle, s.colliderSpin, s.time,
+                   s.adaptiveStep, scene);
+    scene.solverState = s.solverState();
+    if (w.settingsSource != SettingsSource::Given)
+        scene.solverState->chosen = ChosenSettings{w.settings.substeps, w.settings.solverIterations};
+    Result<World> next = build(scene, w.switches);
+    if (!next) return Error{next.error()};
+    next->impl_->profiling = w.profiling;
+    next->impl_->run = w.run;  // the same run: its snapshots restore here too
+    next->impl_->layout = next->impl_->makeLayout();
+    if (Result<void> restored = next->restoreState(s); !restored) return restored;
+    impl_ = std::move(next->impl_);
     return {};
 }
 

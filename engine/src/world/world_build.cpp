@@ -45,6 +45,7 @@ bool isPointEmitter(const Registry& reg, Entity e) {
 }
 
 std::atomic<std::uint64_t> buildCount{0};
+std::atomic<std::uint64_t> runCount{0};  // WorldLayout::run
 
 /// Dynamic bodies (a position and not static), in scene order: the state
 /// vector's order, stable across save and load.
@@ -400,6 +401,7 @@ std::shared_ptr<const WorldLayout> WorldImpl::makeLayout() const {
         for (const joints::JointConstraint& j : w.collision->jointConstraints()) layout->joints.push_back(j.entity);
     }
     layout->registry = w.registry;
+    layout->run = w.run;
     for (const EmitterRun& e : w.emitters) layout->emitters.emplace_back(e.entity, e.params);
     return layout;
 }
@@ -429,6 +431,7 @@ Result<World> World::build(const Scene& scene, const SystemSwitches& switches) {
     WorldImpl& w = *impl;
     w.settings = scene.world;
     w.switches = switches;
+    w.sceneWorld = scene.world;
     if (!switches.gravity) w.settings.gravity = {0.0, 0.0};
     const Registry& reg = scene.registry;
     BodyIndex bodies;
@@ -447,6 +450,7 @@ Result<World> World::build(const Scene& scene, const SystemSwitches& switches) {
     w.listActiveSystems();
     allocateState(w, start, *kind);
     if (std::optional<Error> refused = compileEmitters(scene, w)) return std::move(*refused);
+    if (w.registry) w.run = ++runCount;
     w.layout = w.makeLayout();
     ++buildCount;
     if (w.collision && w.collision->hasSensors()) w.collision->initSensors(detail::asVec2(w.xs(), w.model.n));
