@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <unordered_set>
 #include <sstream>
@@ -398,4 +400,32 @@ TEST(Emitters, ASavedRunWithCopiesRoundTripsByteForByte) {
     EXPECT_NE(saved.find("\"alive\": 3"), std::string::npos);
     const std::string again = sceneToJsonText(parseLevel(saved));
     EXPECT_EQ(again, saved);
+}
+
+TEST(Emitters, RunLogsEachEmissionAndRemovalAndCountsTheCopiesAlive) {
+    // Interval 10 steps, count 2: copies at steps 1, 11, 21, 31; from step
+    // 21 on each new copy pushes the oldest out in the same step.
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "stepwise_emitters_cli";
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path level = dir / "drops.json", log = dir / "contacts.jsonl";
+    {
+        std::ofstream out(level);
+        out << ballLevel(R"("interval": )" + exactNumber(10.0 / 60.0) + R"(, "count": 2, "velocity": {"x": 3, "y": 0})");
+    }
+    const CommandResult run = runCommand(std::string(STEPWISE_BINARY) + " run " + level.string() +
+                                         " --steps 35 --contacts " + log.string() + " 2>&1");
+    ASSERT_EQ(run.exitCode, 0) << run.out;
+    EXPECT_NE(run.out.find("; 2 emitted copies alive;"), std::string::npos) << run.out;
+    std::vector<std::string> events;
+    std::istringstream lines(readFile(log));
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind("{\"event\"", 0) == 0) events.push_back(line.substr(0, line.find(", \"time\"")) + line.substr(line.find(", \"emitter\"")));
+    EXPECT_EQ(events, (std::vector<std::string>{
+                          R"({"event": "emit", "step": 1, "emitter": "spout", "copy": "drop#1"})",
+                          R"({"event": "emit", "step": 11, "emitter": "spout", "copy": "drop#2"})",
+                          R"({"event": "remove", "step": 21, "emitter": "spout", "copy": "drop#1"})",
+                          R"({"event": "emit", "step": 21, "emitter": "spout", "copy": "drop#3"})",
+                          R"({"event": "remove", "step": 31, "emitter": "spout", "copy": "drop#2"})",
+                          R"({"event": "emit", "step": 31, "emitter": "spout", "copy": "drop#4"})"}));
+    std::filesystem::remove_all(dir);
 }

@@ -77,6 +77,15 @@ struct SensorEvent {
     friend bool operator==(const SensorEvent&, const SensorEvent&) = default;
 };
 
+/// A copy an emitter added (`added`) or removed at the start of the last
+/// step, by the copy's name ("doll#3").
+struct EmitterEvent {
+    Entity emitter;
+    std::string copy;
+    bool added = true;
+    friend bool operator==(const EmitterEvent&, const EmitterEvent&) = default;
+};
+
 /// One joint at the end of the last step, for the debugging views.
 struct JointRecord {
     Entity joint;              ///< the joint's entity
@@ -427,6 +436,13 @@ public:
     /// vector after the level's own, in the order they appeared.
     std::size_t emitterCount() const;
     std::size_t copiesAlive() const;
+    /// Copies added and removed at the start of the last step, in the order
+    /// it made them (per emitter: removals, then additions).
+    std::span<const EmitterEvent> emitterEvents() const;
+    /// The name of `e` when it is one of the copies alive (a scene the
+    /// World was built from does not hold them until writeBack); nullptr
+    /// otherwise.
+    const std::string* copyName(Entity e) const;
 
     /// Moving bodies (dynamic and kinematic), in the order of the state vector.
     std::size_t bodyCount() const;

@@ -104,6 +104,7 @@ std::optional<Error> compileEmitters(const Scene& scene, WorldImpl& w) {
 
 void WorldImpl::runEmitters() {
     if (emitters.empty()) return;
+    emitterEvents.clear();
     // Due at the first step that starts within half a step of the time, so
     // an interval that is a whole number of steps emits every that many
     // steps, whatever the rounding of the summed time.
@@ -121,6 +122,8 @@ void WorldImpl::runEmitters() {
     for (EmitterRun& em : emitters) {
         Emitter& p = em.params;
         const auto removeOldest = [&] {
+            if (const Name* name = reg.tryGet<Name>(em.copies.front().front()))
+                emitterEvents.push_back({em.entity, name->value, false});
             for (const Entity e : em.copies.front()) {
                 const auto it = std::find(added.begin(), added.end(), e);
                 if (it != added.end()) added.erase(it);
@@ -173,6 +176,7 @@ void WorldImpl::runEmitters() {
                     if (const auto it = copyOf.find(ref); it != copyOf.end()) ref = it->second;
                 });
             added.insert(added.end(), copy.begin(), copy.end());
+            emitterEvents.push_back({em.entity, base, true});
             em.copies.push_back(std::move(copy));
             if (p.alive == 0) p.oldest = *p.next;
             ++p.alive;
@@ -417,6 +421,15 @@ void WorldImpl::changeBodies(const std::vector<Entity>& removed, const std::vect
 }
 
 std::size_t World::emitterCount() const { return impl().emitters.size(); }
+
+std::span<const EmitterEvent> World::emitterEvents() const { return impl().emitterEvents; }
+
+const std::string* World::copyName(Entity e) const {
+    const WorldImpl& w = impl();
+    if (!w.registry || !w.registry->alive(e)) return nullptr;
+    const Name* name = w.registry->tryGet<Name>(e);
+    return name ? &name->value : nullptr;
+}
 
 std::size_t World::copiesAlive() const {
     std::size_t n = 0;

@@ -115,6 +115,7 @@ public:
     /// destroys the copies in the scene under them). Shared with the
     /// snapshots that hold it; cloned before a change while one does.
     std::vector<EmitterRun> emitters;
+    std::vector<EmitterEvent> emitterEvents;  ///< of the last step
     std::shared_ptr<Registry> registry;
     SystemSwitches switches;  ///< what build left out; copies are compiled the same way
     WorldSettings sceneWorld;
