@@ -776,6 +776,20 @@ std::string templatesProblem(const Registry& registry) {
         if (em->alive > 0 && (!em->oldest || !em->next))
             return at + "/oldest: " + who + ": with copies alive the run state needs \"next\" and \"oldest\"";
         // The copies alive, by the names they were given.
+        // Names of its copies belong to the run: only those alive may be in
+        // the scene, or a later copy would take a name that is in use.
+        const std::string prefix = em->templateName + "#";
+        for (std::size_t j = 0; j < entities.size(); ++j) {
+            const Name* n = registry.tryGet<Name>(entities[j]);
+            if (!n || n->value.compare(0, prefix.size(), prefix) != 0) continue;
+            const std::string rest = n->value.substr(prefix.size(), n->value.find('/', prefix.size()) - prefix.size());
+            if (rest.empty() || rest.size() > 9 || rest.find_first_not_of("0123456789") != std::string::npos) continue;
+            const long k = std::stol(rest);
+            if (k <= em->emitted - em->alive || k > em->emitted)
+                return child("/entities", j) + "/name: \"" + n->value + "\" is a name the " + who +
+                       " gives its copies, and that copy is not alive in its run state (" + std::to_string(em->alive) +
+                       " alive of " + std::to_string(em->emitted) + " emitted)";
+        }
         for (int k = em->emitted - em->alive + 1; k <= em->emitted; ++k) {
             const std::string copy = em->templateName + "#" + std::to_string(k);
             bool found = false;

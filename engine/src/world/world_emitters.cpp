@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_set>
 
 namespace stepwise {
@@ -29,7 +30,7 @@ namespace {
 
 /// An emitter makes at most this many copies in one step; the rest wait for
 /// the next step (an interval far below dt would otherwise loop for long).
-constexpr int kMaxEmissionsPerStep = 10000;
+constexpr int kMaxEmissionsPerStep = 1000;
 
 bool hasShape(const Registry& reg, Entity e) {
     return reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) || reg.has<Capsule>(e);
@@ -139,7 +140,12 @@ void WorldImpl::runEmitters() {
         };
         while (p.lifetime && p.alive > 0 && now >= *p.oldest + *p.lifetime) removeOldest();
         const Entity anchor = anchorOf(reg, em.members);
-        for (int made = 0; now >= *p.next && made < kMaxEmissionsPerStep; ++made) {
+        // A run never writes a time or a count a level cannot hold: past
+        // them the emitter stops.
+        const auto canEmit = [&p] {
+            return *p.next + p.interval <= kMaxMagnitude && p.emitted < std::numeric_limits<int>::max();
+        };
+        for (int made = 0; now >= *p.next && made < kMaxEmissionsPerStep && canEmit(); ++made) {
             if (p.alive >= p.count) removeOldest();
             const int number = ++p.emitted;
             const std::string base = p.templateName + "#" + std::to_string(number);
