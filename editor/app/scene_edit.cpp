@@ -308,6 +308,7 @@ std::string_view entityKind(const Registry& registry, Entity e) {
     if (registry.has<Capsule>(e)) return "capsule";
     if (registry.has<Attractor>(e)) return "attractor";
     if (registry.has<Boid>(e)) return "boid";
+    if (registry.has<Emitter>(e)) return "emitter";
     return "point";
 }
 
