@@ -317,3 +317,28 @@ TEST(Simulation, StepBackAcrossEmissionsIsExact) {
         ASSERT_EQ(textOf(f.ed.doc.scene), pass[std::size_t(i)]) << "on to step " << i;
     }
 }
+
+TEST(Simulation, AnEditUndoneBetweenEmissionsLeavesTheRunExact) {
+    // Paused after the second doll appeared: a copy's mass and the
+    // emitter's interval are edited and undone; the run then goes on as if
+    // nothing happened, through the next emissions.
+    Fixture straight("emitter_rain.json");
+    for (int i = 0; i < 100; ++i) straight.ed.stepForward();
+    Fixture f("emitter_rain.json");
+    for (int i = 0; i < 40; ++i) f.ed.stepForward();
+    const std::string before = textOf(f.ed.doc.scene);
+    ASSERT_FALSE(f.named("doll#2/head").isNull());
+    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
+        s.registry.tryGet<Mass>(f.named("doll#2/head"))->value = 9.0;
+        return true;
+    }));
+    ASSERT_TRUE(f.ed.applyEdit("interval", [&](Scene& s) {
+        s.registry.tryGet<Emitter>(f.named("hatch"))->interval = 0.25;
+        return true;
+    }));
+    ASSERT_TRUE(f.ed.undo());
+    ASSERT_TRUE(f.ed.undo());
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+    for (int i = 40; i < 100; ++i) f.ed.stepForward();
+    EXPECT_EQ(textOf(f.ed.doc.scene), textOf(straight.ed.doc.scene));
+}
