@@ -480,3 +480,29 @@ TEST(Emitters, ACopyRemovedWhileItsIslandSleepsWakesItAndResumeStaysExact) {
         ASSERT_EQ(savedRunText(again, resumed), expected);
     }
 }
+
+TEST(Emitters, ValidateNotesWhatATemplateIgnores) {
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "stepwise_emitters_validate";
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path level = dir / "t.json";
+    {
+        std::ofstream out(level);
+        out << R"({"entities": [
+          {"name": "a", "template": "lonely", "position": {"x": 0, "y": 0}, "radius": 1},
+          {"name": "b", "template": "lonely", "position": {"x": 3, "y": 0}, "radius": 1},
+          {"name": "c", "template": "used", "position": {"x": 0, "y": 5}, "velocity": {"x": 1, "y": 0}, "radius": 1},
+          {"name": "e", "position": {"x": 0, "y": 9}, "emitter": {"template": "used"}}]})";
+    }
+    const CommandResult r = runCommand(std::string(STEPWISE_BINARY) + " validate " + level.string() + " 2>&1");
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("warning: entity 0 (\"a\"): template \"lonely\" has no emitter, so it is never copied (and "
+                         "never simulated)"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("entity 1 (\"b\"): template"), std::string::npos) << r.out;  // said once per template
+    EXPECT_NE(r.out.find("warning: entity 2 (\"c\"): \"velocity\" on a template body has no effect (each copy takes "
+                         "its emitter's velocity)"),
+              std::string::npos)
+        << r.out;
+    std::filesystem::remove_all(dir);
+}
