@@ -506,3 +506,15 @@ TEST(Emitters, ValidateNotesWhatATemplateIgnores) {
         << r.out;
     std::filesystem::remove_all(dir);
 }
+
+TEST(Emitters, ABuildRefusesATemplateBodyWithoutAShapeMadeInCode) {
+    // The loader refuses it; a scene made in code reaches World::build.
+    Scene scene = parseLevel(ballLevel(R"("interval": 1, "count": 2)"));
+    Registry& reg = scene.registry;
+    const Entity proto = reg.entities()[0];
+    reg.remove<Radius>(proto);
+    Result<World> w = World::build(scene);
+    ASSERT_FALSE(w);
+    EXPECT_EQ(w.error(), "entity 0 (\"proto\"): template \"drop\": a template entity is a dynamic body with a shape "
+                         "(radius, box, polygon or capsule)");
+}

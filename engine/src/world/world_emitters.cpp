@@ -84,6 +84,21 @@ std::optional<Error> compileEmitters(const Scene& scene, WorldImpl& w) {
         run.members = templateMembers(reg, em->templateName);
         if (anchorOf(reg, run.members).isNull())
             return Error{label + ": emitter: no body has \"template\": \"" + em->templateName + "\""};
+        // The loader refuses these; a scene made in code or in the editor
+        // reaches here unchecked. A copy's bodies join the contact solver as
+        // shapes, after the level's own, as a build orders them.
+        for (const Entity m : run.members) {
+            if (reg.has<Joint>(m) || reg.has<Spring>(m)) continue;
+            const bool fixed = (reg.has<Static>(m) && reg.tryGet<Static>(m)->value) ||
+                               (reg.has<Kinematic>(m) && reg.tryGet<Kinematic>(m)->value);
+            if (fixed || !hasShape(reg, m) || reg.has<Attractor>(m) || reg.has<Boid>(m) || reg.has<Emitter>(m)) {
+                const auto at = std::find(order.begin(), order.end(), m);
+                const Name* mn = reg.tryGet<Name>(m);
+                return Error{detail::entityLabel(std::size_t(at - order.begin()), mn ? &mn->value : nullptr) +
+                             ": template \"" + em->templateName +
+                             "\": a template entity is a dynamic body with a shape (radius, box, polygon or capsule)"};
+            }
+        }
         run.key = detail::emitterKey(reg, e, i);
         const Entity anchor = anchorOf(reg, run.members);
         for (int k = em->emitted - em->alive + 1; k <= em->emitted; ++k) {
