@@ -321,6 +321,9 @@ public:
         order_ = std::move(s.order);
     }
 
+    /// Slots in the slot table (every entity index is below it).
+    std::size_t slotCount() const { return generations_.size(); }
+
     /// Handle currently in slot `index` if alive (used to turn dense pool
     /// owners back into handles).
     Entity handleAt(std::uint32_t index) const { return Entity{index, generations_[index]}; }

@@ -122,6 +122,19 @@ std::unique_ptr<CollisionSystem> CollisionSystem::changed(std::span<const std::u
     n.wakeBody_ = wakeBody_;
     const std::size_t oldCount = colliders_.size();
     std::vector<std::int32_t> colliderMap(oldCount, -1);
+    // Room for all of them at once: a joint is a large struct, and growing
+    // a dozen arrays one push at a time would copy each many times.
+    const std::size_t most = oldCount + added.size();
+    for (auto* v : {&n.angles_, &n.angularVelocities_, &n.invMass_, &n.invInertia_, &n.maxExtent_}) v->reserve(most);
+    n.colliders_.reserve(most);
+    n.filters_.reserve(most);
+    n.colliderAsleep_.reserve(most);
+    n.solverIndex_.reserve(most);
+    n.bodies_.reserve(most + 1);
+    n.finite_.reserve(most);
+    n.awakeSolverColliders_.reserve(most);
+    n.joints_.reserve(joints_.size() + addedJoints.size());
+    n.noCollide_.reserve(noCollide_.size() + addedJoints.size());
     const auto keep = [&](std::size_t c) {
         Collider copy = colliders_[c];
         if (copy.body >= 0) copy.body = bodyMap[std::size_t(copy.body)];

@@ -64,7 +64,8 @@ std::optional<Error> compileEmitters(const Scene& scene, WorldImpl& w) {
     const Registry& reg = scene.registry;
     if (reg.count<Emitter>() == 0) return std::nullopt;
     w.registry = std::make_shared<Registry>(reg);
-    for (std::size_t b = 0; b < w.bodyEntity.size(); ++b) w.bodyOfSlot.emplace(w.bodyEntity[b].index, std::uint32_t(b));
+    w.bodyOfSlot.assign(reg.slotCount(), kNoBody);
+    for (std::size_t b = 0; b < w.bodyEntity.size(); ++b) w.bodyOfSlot[w.bodyEntity[b].index] = std::uint32_t(b);
     std::unordered_map<std::string, Entity> byName;
     for (const Entity e : reg.entities())
         if (const Name* n = reg.tryGet<Name>(e); n && !n->value.empty()) byName.emplace(n->value, e);
@@ -79,7 +80,7 @@ std::optional<Error> compileEmitters(const Scene& scene, WorldImpl& w) {
         run.entity = e;
         run.params = *em;
         if (!run.params.next) run.params.next = scene.world.time;
-        if (const auto it = w.bodyOfSlot.find(e.index); it != w.bodyOfSlot.end()) run.body = it->second;
+        run.body = w.bodyOfSlot[e.index];
         if (const Position* p = reg.tryGet<Position>(e)) run.position = p->value;
         run.members = templateMembers(reg, em->templateName);
         if (anchorOf(reg, run.members).isNull())
@@ -131,8 +132,9 @@ void WorldImpl::runEmitters() {
         due = due || now >= *p.next || (p.lifetime && p.alive > 0 && now >= *p.oldest + *p.lifetime);
     }
     if (!due) return;
-    // Snapshots hold the registry their layout was made with: change a copy.
-    registry = std::make_shared<Registry>(*registry);
+    // Snapshots hold the registry their layout was made with: while one
+    // does (anything but this World and its own layout), change a copy.
+    if (layout.use_count() > 1 || registry.use_count() > 2) registry = std::make_shared<Registry>(*registry);
     Registry& reg = *registry;
     std::vector<Entity> removed, added;
     for (EmitterRun& em : emitters) {
@@ -209,15 +211,20 @@ void WorldImpl::runEmitters() {
 
 void WorldImpl::changeBodies(const std::vector<Entity>& removed, const std::vector<Entity>& added) {
     const Registry& reg = *registry;
-    const std::unordered_set<Entity> gone(removed.begin(), removed.end());
+    // Flags by entity slot: a removed entity's slot may be reused by an
+    // added one, which is told apart by its generation.
+    const std::size_t slots = std::max(reg.slotCount(), bodyOfSlot.size());
+    std::vector<Entity> goneAt(slots);
+    for (const Entity e : removed) goneAt[e.index] = e;
+    const auto isGone = [&goneAt](Entity e) { return e.index < goneAt.size() && goneAt[e.index] == e; };
     const std::size_t oldN = bodyEntity.size();
     // A removed body's island wakes: what touched it moves on without it.
     for (std::size_t b = 0; b < oldN; ++b)
-        if (sleep.island[b] >= 0 && gone.count(bodyEntity[b])) sleep.wake(std::uint32_t(b));
+        if (sleep.island[b] >= 0 && isGone(bodyEntity[b])) sleep.wake(std::uint32_t(b));
     std::vector<std::int32_t> bodyMap(oldN, -1);
     std::size_t n = 0;
     for (std::size_t b = 0; b < oldN; ++b)
-        if (!gone.count(bodyEntity[b])) bodyMap[b] = std::int32_t(n++);
+        if (!isGone(bodyEntity[b])) bodyMap[b] = std::int32_t(n++);
     const auto compact = [&](auto& values, std::size_t stride) {
         if (values.empty()) return;
         std::size_t out = 0;
@@ -256,7 +263,7 @@ void WorldImpl::changeBodies(const std::vector<Entity>& removed, const std::vect
         std::size_t out = 0;
         for (std::size_t s = 0; s < model.springs.size(); ++s) {
             detail::SpringData d = model.springs[s];
-            if (gone.count(d.entity) || (d.a != kNoBody && bodyMap[d.a] < 0) || (d.b != kNoBody && bodyMap[d.b] < 0))
+            if (isGone(d.entity) || (d.a != kNoBody && bodyMap[d.a] < 0) || (d.b != kNoBody && bodyMap[d.b] < 0))
                 continue;
             remap(d.a);
             remap(d.b);
@@ -294,17 +301,14 @@ void WorldImpl::changeBodies(const std::vector<Entity>& removed, const std::vect
     }
     n = bodyEntity.size();
     model.n = n;
-    bodyOfSlot.clear();
-    for (std::size_t b = 0; b < n; ++b) bodyOfSlot.emplace(bodyEntity[b].index, std::uint32_t(b));
-    const auto bodyOf = [this](Entity e) {
-        const auto it = bodyOfSlot.find(e.index);
-        return it == bodyOfSlot.end() ? kNoBody : it->second;
-    };
+    bodyOfSlot.assign(slots, kNoBody);
+    for (std::size_t b = 0; b < n; ++b) bodyOfSlot[bodyEntity[b].index] = std::uint32_t(b);
+    const auto bodyOf = [this](Entity e) { return e.index < bodyOfSlot.size() ? bodyOfSlot[e.index] : kNoBody; };
     // Where each entity stands in the scene order (messages name it so).
-    std::unordered_map<Entity, std::uint32_t> sceneIndex;
-    for (std::size_t i = 0; i < reg.entities().size(); ++i) sceneIndex.emplace(reg.entities()[i], std::uint32_t(i));
+    std::vector<std::uint32_t> sceneIndex(slots, 0);
+    for (std::size_t i = 0; i < reg.entities().size(); ++i) sceneIndex[reg.entities()[i].index] = std::uint32_t(i);
     bodySceneIndex.resize(n);
-    for (std::size_t b = 0; b < n; ++b) bodySceneIndex[b] = sceneIndex[bodyEntity[b]];
+    for (std::size_t b = 0; b < n; ++b) bodySceneIndex[b] = sceneIndex[bodyEntity[b].index];
 
     // Forces: gravity pulls once there is a body; drag as World::build sets it.
     model.gravityOn = n > 0 && (model.gx != 0.0 || model.gy != 0.0);
@@ -339,7 +343,7 @@ void WorldImpl::changeBodies(const std::vector<Entity>& removed, const std::vect
             d.k = s->k;
             d.c = s->damping;
             d.rest = s->restLength ? *s->restLength : length(pa - pb);
-            d.sceneIndex = sceneIndex[e];
+            d.sceneIndex = sceneIndex[e.index];
             d.entity = e;
             model.springs.push_back(d);
             const Name* name = reg.tryGet<Name>(e);
@@ -349,10 +353,10 @@ void WorldImpl::changeBodies(const std::vector<Entity>& removed, const std::vect
     // Shapes and joints.
     if (collision) {
         std::vector<std::uint8_t> dropCollider(collision->colliderCount(), 0);
-        for (std::size_t c = 0; c < dropCollider.size(); ++c) dropCollider[c] = gone.count(collision->collider(c).entity) ? 1 : 0;
+        for (std::size_t c = 0; c < dropCollider.size(); ++c) dropCollider[c] = isGone(collision->collider(c).entity) ? 1 : 0;
         const std::span<const joints::JointConstraint> oldJoints = collision->jointConstraints();
         std::vector<std::uint8_t> dropJoint(oldJoints.size(), 0);
-        for (std::size_t k = 0; k < oldJoints.size(); ++k) dropJoint[k] = gone.count(oldJoints[k].entity) ? 1 : 0;
+        for (std::size_t k = 0; k < oldJoints.size(); ++k) dropJoint[k] = isGone(oldJoints[k].entity) ? 1 : 0;
         std::vector<collision::CollisionSystem::ColliderAdd> adds;
         std::vector<collision::CollisionSystem::JointAdd> jointAdds;
         std::deque<collision::ConvexPolygon> outlines;  // add() copies them; addresses stay fixed until then

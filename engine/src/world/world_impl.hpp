@@ -120,8 +120,9 @@ public:
     SystemSwitches switches;  ///< what build left out; copies are compiled the same way
     WorldSettings sceneWorld;
     std::uint64_t run = 0;  ///< WorldLayout::run  ///< the world settings of the scene built from (restoreState's rebuild)
-    /// Entity index -> state index of every dynamic body (kept with emitters only).
-    std::unordered_map<std::uint32_t, std::uint32_t> bodyOfSlot;
+    /// Entity index -> state index of every dynamic body, kNoBody for the
+    /// other slots (kept with emitters only).
+    std::vector<std::uint32_t> bodyOfSlot;
     /// Emissions and removals due at the start of a step (time + dt/2 past
     /// their time), applied in place: changeBodies.
     void runEmitters();
