@@ -518,3 +518,26 @@ TEST(Emitters, ABuildRefusesATemplateBodyWithoutAShapeMadeInCode) {
     EXPECT_EQ(w.error(), "entity 0 (\"proto\"): template \"drop\": a template entity is a dynamic body with a shape "
                          "(radius, box, polygon or capsule)");
 }
+
+TEST(Emitters, AnEmitterWithAShapeIsABodyAndCopiesAppearWhereItIsNow) {
+    // A kinematic box moving at 2 m/s drops a resting ball every half
+    // second, no gravity, the two never colliding (one negative group):
+    // copy k appears where the box is at the start of step 30 (k - 1) + 1,
+    // x = k - 1, and stays there.
+    const Scene scene = parseLevel(R"({"world": {"gravity": {"x": 0, "y": 0}},
+      "entities": [
+        {"name": "proto", "template": "drop", "position": {"x": 40, "y": 40}, "radius": 0.1,
+         "filter": {"category": 1, "mask": 4294967295, "group": -5}},
+        {"name": "cart", "position": {"x": 0, "y": 0}, "kinematic": true, "velocity": {"x": 2, "y": 0},
+         "box": {"width": 1, "height": 0.5}, "filter": {"category": 1, "mask": 4294967295, "group": -5},
+         "emitter": {"template": "drop", "interval": 0.5, "count": 10}}]})");
+    World world = buildWorld(scene);
+    EXPECT_EQ(world.bodyCount(), 1u);  // the cart
+    EXPECT_EQ(world.kinematicCount(), 1u);
+    for (int s = 0; s < 150; ++s) ASSERT_TRUE(world.step());
+    ASSERT_EQ(world.bodyCount(), 6u);
+    for (std::size_t k = 1; k <= 5; ++k) {
+        EXPECT_NEAR(world.bodyPosition(k).x, double(k - 1), 1e-9) << "copy " << k;
+        EXPECT_EQ(world.bodyPosition(k).y, 0.0);
+    }
+}
