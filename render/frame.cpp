@@ -56,6 +56,7 @@ constexpr double kPiD = 3.14159265358979323846;
 constexpr Rgba kAabb = rgb(0x68d391, 0.75f);
 constexpr Rgba kSelectionRing = rgb(0xffd166);  // the shaders' uHighlight (renderer.cpp)
 constexpr Rgba kKinematicMark = rgb(0x8be9fd);  // a kinematic body's diamond and motion marks
+constexpr Rgba kEmitterMark = rgb(0xffb86c);    // an emitter's ring, direction and spread
 constexpr Rgba kAabbCell = rgb(0x68d391, 0.06f);
 // The overlay's layer (Builder::boundingBoxes) is one colour with alpha per pixel.
 static_assert(kAabbCell.r == kAabb.r && kAabbCell.g == kAabb.g && kAabbCell.b == kAabb.b);
@@ -321,6 +322,7 @@ private:
     void springs();
     void bodies();
     void kinematicMarks();
+    void emitterMarks();
     void joints();
     void jointForces();
     void polygonPreview();
@@ -401,6 +403,8 @@ private:
         Rgba c = colourOf(scene_, e, kDefaultBody);
         // A sensor is a zone, not a solid: see-through, so what is inside shows.
         if (const Sensor* sensor = scene_.registry.tryGet<Sensor>(e); sensor && sensor->value) c.a *= 0.35f;
+        // A template is a prefab its emitter copies, not a body: faded.
+        if (scene_.registry.has<Template>(e)) c.a *= 0.3f;
         if (sleeping_.empty() || !sleeping_.count(e)) return c;
         return {0.55f * c.r, 0.55f * c.g, 0.55f * c.b, c.a};
     }
@@ -713,6 +717,7 @@ void Builder::trails() {
 
 void Builder::springs() {
     scene_.registry.each<Spring>([&](Entity e, const Spring& sp) {
+        if (scene_.registry.has<Template>(sp.a)) return;  // a template's spring: not drawn, as its joints
         auto endOf = [&](Entity end) -> std::optional<Vec2> {
             const Position* p = scene_.registry.tryGet<Position>(end);
             return p ? std::optional<Vec2>(p->value) : std::nullopt;
@@ -903,6 +908,7 @@ void Builder::bodies() {
         }
     }
     kinematicMarks();
+    emitterMarks();
 }
 
 void Builder::kinematicMarks() {
@@ -938,6 +944,35 @@ void Builder::kinematicMarks() {
     }
 }
 
+void Builder::emitterMarks() {
+    // An emitter: a ring with a cross at its position, an arrow along its
+    // velocity (fixed length: a mark, not a measure) and the two edges of
+    // its spread, the cone its copies leave in.
+    for (Entity e : scene_.registry.entities()) {
+        const Emitter* em = scene_.registry.tryGet<Emitter>(e);
+        const Position* p = scene_.registry.tryGet<Position>(e);
+        if (!em || !p) continue;
+        const Vec2 c = toPx(p->value);
+        constexpr double r = 8.0, reach = 34.0;
+        constexpr int pieces = 16;
+        for (int i = 0; i < pieces; ++i) {
+            const double a0 = 2.0 * 3.14159265358979323846 * i / pieces, a1 = 2.0 * 3.14159265358979323846 * (i + 1) / pieces;
+            segment(c + r * Vec2{std::cos(a0), std::sin(a0)}, c + r * Vec2{std::cos(a1), std::sin(a1)}, 1.5, kEmitterMark);
+        }
+        segment(c + Vec2{-r * 0.5, 0}, c + Vec2{r * 0.5, 0}, 1.5, kEmitterMark);
+        segment(c + Vec2{0, -r * 0.5}, c + Vec2{0, r * 0.5}, 1.5, kEmitterMark);
+        const double speed = length(em->velocity);
+        const Vec2 dir = speed > 0.0 ? em->velocity / speed : Vec2{0.0, -1.0};
+        arrow(c + dir * (r + 2.0), c + dir * (r + reach), 2.0, kEmitterMark);
+        if (em->spread > 0.0)
+            for (const double turn : {-em->spread, em->spread}) {
+                const double cs = std::cos(turn), sn = std::sin(turn);
+                const Vec2 edge{cs * dir.x - sn * dir.y, sn * dir.x + cs * dir.y};
+                segment(c + edge * (r + 2.0), c + edge * (r + reach * 0.8), 1.0, kEmitterMark);
+            }
+    }
+}
+
 void Builder::joints() {
     // Each joint: a thin line from each body's centre to its anchor, a ring
     // at the anchor (a filled pin for the world), the line between the two
@@ -945,7 +980,9 @@ void Builder::joints() {
     // angle limits as an arc with a tick at b's current direction.
     for (Entity e : scene_.registry.entities()) {
         const Joint* j = scene_.registry.tryGet<Joint>(e);
-        if (!j) continue;
+        // A template's joints hold nothing until it is copied: its faded
+        // bodies show the prefab, without the joints' marks.
+        if (!j || scene_.registry.has<Template>(j->a)) continue;
         struct End {
             Vec2 centre;
             double angle = 0.0;

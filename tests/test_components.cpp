@@ -157,6 +157,19 @@ TEST_P(ComponentRoundTrip, EveryFieldSurvivesSaveAndLoad) {
         j->b = Entity{};   // the world
         j->anchor.reset(); // input only: the loader turns it into the locals
     }
+    if (info->name == "template") {
+        // A template body is a dynamic body with a shape.
+        r.emplace<Position>(host, Position{{-1.0, 2.0}});
+        r.emplace<Radius>(host, Radius{0.25});
+    }
+    if (info->name == "emitter") {
+        // It copies an existing template; no copies alive (they would be
+        // entities of their own).
+        auto* em = static_cast<Emitter*>(component);
+        em->alive = 0;
+        r.emplace<Template>(target, Template{em->templateName});
+        r.emplace<Radius>(target, Radius{0.25});
+    }
     if (info->name == "boid") static_cast<Boid*>(component)->separationRadius = 0.5;
     if (info->name == "plane") static_cast<Plane*>(component)->normal = {0.6, 0.8};  // unit already
     if (info->name == "chain") r.emplace<Static>(host, Static{true});  // chains are only on static bodies

@@ -232,7 +232,7 @@ TEST(SceneErrors, UnknownComponentNamesEntityAndSuggests) {
               "t.json: error: /entities/1/velocty: unknown component \"velocty\" on entity 1 (\"ball\"); did you mean "
               "\"velocity\"? Known components: name, type, position, velocity, mass, static, kinematic, radius, box, polygon, "
               "capsule, chain, shapes, angle, angular_velocity, color, restitution, friction, drag, sensor, filter, plane, attractor, spring, "
-              "boid, joint");
+              "boid, template, emitter, joint");
     EXPECT_EQ(refusal(R"({"entities": [{"box": {"width": 1, "heigth": 2}, "position": {"x": 0, "y": 0}}]})"),
               "t.json: error: /entities/0/box/heigth: unknown field \"heigth\" in \"box\"; did you mean \"height\"? "
               "Known fields: width, height");

@@ -311,6 +311,7 @@ std::string_view entityKind(const Registry& registry, Entity e) {
     if (registry.has<Chain>(e)) return "chain";
     if (registry.has<Attractor>(e)) return "attractor";
     if (registry.has<Boid>(e)) return "boid";
+    if (registry.has<Emitter>(e)) return "emitter";
     return "point";
 }
 

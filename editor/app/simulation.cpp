@@ -446,7 +446,7 @@ bool Simulation::stepBack(Scene& scene) {
     // it is recompiled from the restored scene first, with the entry's warm
     // start. Either way the next step is the one the first pass took.
     const bool sameBuild = world_ && !stale_ && entry.scene == sceneAtBuild_;
-    if (!sameBuild) {
+    const auto rebuild = [&] {
         Entity springEntity;
         SystemSwitches on = switches();
         std::optional<Scene> dragged = withMouseSpring(scene, on, &springEntity);
@@ -466,12 +466,18 @@ bool Simulation::stepBack(Scene& scene) {
         builtMouseSpring_ = springEntity;
         builtMouseBody_ = springEntity.isNull() ? Entity{} : mouseSpring->first;
         stale_ = !world_;
-    }
+    };
+    if (!sameBuild) rebuild();
     // The restored state came out of the step before it: replay that step
     // from the entry before, so the contacts, joint forces and net forces
     // on screen are that step's (a restore alone carries none, and the
-    // contacts table would be empty until the next step).
-    if (world_ && !replayStepInto(*world_, entry)) (void)world_->restoreState(entry.state);  // refused only for another layout: then reload set it
+    // contacts table would be empty until the next step). A state from
+    // before an emitter added or removed copies has other bodies than the
+    // live World: that World is rebuilt from the restored scene, only then.
+    if (world_ && !replayStepInto(*world_, entry) && !world_->restoreState(entry.state)) {
+        rebuild();
+        if (world_ && !replayStepInto(*world_, entry)) (void)world_->restoreState(entry.state);
+    }
     sceneAtBuild_ = world_ ? entry.scene : nullptr;
     gained_ = entry.gained;
     sceneCounts_ = stateComponentCounts(scene.registry);

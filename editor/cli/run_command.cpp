@@ -57,9 +57,12 @@ void appendTraceRow(std::string& csv, std::uint64_t step, const World& world) {
 }
 
 /// How a contact names an entity: its name, or "entity N" (scene index).
-std::string entityRef(const Scene& scene, Entity e) {
+/// An entity's name, or "entity N". An emitter's copies are named by the
+/// World (`world`): the scene holds them only once the run is written back.
+std::string entityRef(const Scene& scene, Entity e, const World* world = nullptr) {
     const auto& order = scene.registry.entities();
     if (const Name* name = scene.registry.tryGet<Name>(e)) return name->value;
+    if (const std::string* copy = world ? world->copyName(e) : nullptr) return *copy;
     const auto it = std::find(order.begin(), order.end(), e);
     return "entity " + std::to_string(it - order.begin());
 }
@@ -73,7 +76,8 @@ void appendContactLine(std::string& jsonl, std::uint64_t step, const World& worl
     for (const ContactRecord& c : world.contacts()) {
         if (!first) jsonl += ", ";
         first = false;
-        jsonl += "{\"a\": " + jsonString(entityRef(scene, c.a)) + ", \"b\": " + jsonString(entityRef(scene, c.b)) +
+        jsonl += "{\"a\": " + jsonString(entityRef(scene, c.a, &world)) +
+                 ", \"b\": " + jsonString(entityRef(scene, c.b, &world)) +
                  ", \"point\": {\"x\": " + number(c.point.x) + ", \"y\": " + number(c.point.y) +
                  "}, \"normal\": {\"x\": " + number(c.normal.x + 0.0) + ", \"y\": " + number(c.normal.y + 0.0) +
                  "}, \"depth\": " + number(c.depth) + ", \"normal_impulse\": " + number(c.normalImpulse) +
@@ -92,9 +96,9 @@ void appendContactLine(std::string& jsonl, std::uint64_t step, const World& worl
             const auto vector = [](Vec2 v) {
                 return "{\"x\": " + number(v.x + 0.0) + ", \"y\": " + number(v.y + 0.0) + "}";
             };
-            jsonl += "{\"joint\": " + jsonString(entityRef(scene, j.joint)) + ", \"a\": " +
-                     jsonString(entityRef(scene, j.a)) +
-                     ", \"b\": " + (j.b.isNull() ? std::string("null") : jsonString(entityRef(scene, j.b))) +
+            jsonl += "{\"joint\": " + jsonString(entityRef(scene, j.joint, &world)) + ", \"a\": " +
+                     jsonString(entityRef(scene, j.a, &world)) +
+                     ", \"b\": " + (j.b.isNull() ? std::string("null") : jsonString(entityRef(scene, j.b, &world))) +
                      ", \"anchor_a\": " + vector(j.anchorA) + ", \"anchor_b\": " + vector(j.anchorB) +
                      ", \"separation\": " + number(j.separation) + ", \"force\": " + vector(j.force) +
                      ", \"torque\": " + number(j.torque + 0.0) + ", \"angle\": " + number(j.angle + 0.0) + "}";
@@ -105,10 +109,17 @@ void appendContactLine(std::string& jsonl, std::uint64_t step, const World& worl
     // A line of its own for each body entering or leaving a sensor, after
     // the step's line: {"event": "begin" or "end", "step", "time",
     // "sensor", "body"} (the same shape as a joint's "break" line).
+    // And for each copy an emitter added or removed at the step's start:
+    // {"event": "emit" or "remove", "step", "time", "emitter", "copy"}.
+    for (const EmitterEvent& e : world.emitterEvents())
+        jsonl += std::string("{\"event\": \"") + (e.added ? "emit" : "remove") + "\", \"step\": " +
+                 std::to_string(step) + ", \"time\": " + number(world.time()) +
+                 ", \"emitter\": " + jsonString(entityRef(scene, e.emitter, &world)) + ", \"copy\": " + jsonString(e.copy) +
+                 "}\n";
     for (const SensorEvent& e : world.sensorEvents())
         jsonl += std::string("{\"event\": \"") + (e.begin ? "begin" : "end") + "\", \"step\": " + std::to_string(step) +
-                 ", \"time\": " + number(world.time()) + ", \"sensor\": " + jsonString(entityRef(scene, e.sensor)) +
-                 ", \"body\": " + jsonString(entityRef(scene, e.body)) + "}\n";
+                 ", \"time\": " + number(world.time()) + ", \"sensor\": " + jsonString(entityRef(scene, e.sensor, &world)) +
+                 ", \"body\": " + jsonString(entityRef(scene, e.body, &world)) + "}\n";
 }
 
 /// One JSON line per joint that broke in this step, after the step's line:
@@ -117,8 +128,9 @@ void appendBreakLines(std::string& jsonl, std::uint64_t step, const World& world
     for (const JointBreak& b : world.jointBreaks()) {
         if (b.step != step) continue;
         jsonl += "{\"event\": \"break\", \"step\": " + std::to_string(step) + ", \"time\": " + number(world.time()) +
-                 ", \"joint\": " + jsonString(entityRef(scene, b.joint)) + ", \"a\": " + jsonString(entityRef(scene, b.a)) +
-                 ", \"b\": " + (b.b.isNull() ? std::string("null") : jsonString(entityRef(scene, b.b))) +
+                 ", \"joint\": " + jsonString(entityRef(scene, b.joint, &world)) +
+                 ", \"a\": " + jsonString(entityRef(scene, b.a, &world)) +
+                 ", \"b\": " + (b.b.isNull() ? std::string("null") : jsonString(entityRef(scene, b.b, &world))) +
                  ", \"force\": " + number(b.force) + ", \"max_force\": " + number(b.maxForce) + "}\n";
     }
 }
@@ -367,6 +379,9 @@ int run(const RunOptions& options) {
                << world.settings().integrator << "; t = " << number(world.time()) << " s; "
               << world.bodyCount() - world.kinematicCount() << " dynamic bodies"
               << (world.kinematicCount() ? " and " + std::to_string(world.kinematicCount()) + " kinematic" : std::string())
+              << (world.emitterCount() ? "; " + std::to_string(world.copiesAlive()) + " emitted cop" +
+                                             (world.copiesAlive() == 1 ? "y" : "ies") + " alive"
+                                       : std::string())
               << "; total energy " << number(energy.total()) << " J; "
               << number(taken ? 1e3 * seconds / double(taken) : 0.0) << " ms/step";
     if (const std::size_t broke = world.jointBreaks().size())

@@ -11,6 +11,7 @@
 
 #include <iostream>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@ std::vector<std::string> ineffectiveComponents(const Scene& scene) {
     std::vector<std::string> notes;
     const Registry& r = scene.registry;
     const auto& order = r.entities();
+    std::set<std::string> uncopied;  // templates noted as never copied, once each
     for (std::size_t i = 0; i < order.size(); ++i) {
         const Entity e = order[i];
         std::string label = "entity " + std::to_string(i);
@@ -50,6 +52,16 @@ std::vector<std::string> ineffectiveComponents(const Scene& scene) {
                 notes.push_back(label + ": \"drag\" on a kinematic body has no effect (only its velocity moves it)");
             if (r.has<Boid>(e))
                 notes.push_back(label + ": \"boid\" on a kinematic body has no effect (only its velocity moves it)");
+        }
+        if (const Template* t = r.tryGet<Template>(e)) {
+            if (const Velocity* v = r.tryGet<Velocity>(e); v && (v->value.x != 0.0 || v->value.y != 0.0))
+                notes.push_back(label + ": \"velocity\" on a template body has no effect (each copy takes its "
+                                        "emitter's velocity)");
+            bool copied = false;
+            r.each<Emitter>([&](Entity, const Emitter& em) { copied = copied || em.templateName == t->value; });
+            if (!copied && uncopied.insert(t->value).second)
+                notes.push_back(label + ": template \"" + t->value +
+                                "\" has no emitter, so it is never copied (and never simulated)");
         }
         if (!hasShape) {
             if (r.has<Restitution>(e))

@@ -75,11 +75,12 @@ bool fieldWidget(UiState& ui, const FieldInfo& f, FieldValue& value, const char*
         return ImGui::DragScalar(label, ImGuiDataType_Double, &v, dragSpeed(ui, ImGui::GetID(label), v), lo, hi, "%.6g");
     }
     case FieldKind::Integer: {
-        // In the world settings, whose integers are never negative, 0 is
-        // "not given" (the engine chooses), shown as "auto" until dragged.
+        // Where 0 is below the range (substeps, solver_iterations), 0 is
+        // "not given" (the engine chooses), shown as "auto" until dragged;
+        // where 0 is a value (an emitter's copies so far), it shows as 0.
         int& v = std::get<int>(value);
         const int intLo = lo ? int(*lo) : 0, intHi = hi ? int(*hi) : 0;
-        const bool autoAtZero = lo && *lo >= 0.0;
+        const bool autoAtZero = lo && *lo >= 1.0;
         if (!ImGui::DragInt(label, &v, 0.1f, intLo, intHi, v == 0 && autoAtZero ? "auto" : "%d")) return false;
         if (lo && hi) v = std::clamp(v, intLo, intHi);
         return true;

@@ -276,6 +276,22 @@ std::vector<ComponentInfo> buildTable() {
          field<&Boid::goalWeight>("goal_weight", kNonNegative, "m/s^2", "weight of seeking the goal"),
          field<&Boid::maxSpeed>("max_speed", NumberRange{0.0, kMaxSpeed, true}, "m/s", "speed limit of steering")},
         &finishBoid));
+    t.push_back(row<Template>("template", "a prefab for emitters: not simulated, copied whole with every entity "
+                                          "of the same template value",
+                              true, {}, {field<&Template::value>("", kAny, "", "the template's name")}));
+    t.push_back(row<Emitter>(
+        "emitter", "adds a copy of a template at its position every interval seconds", false, needsPosition,
+        {field<&Emitter::templateName>("template", kAny, "", "the template value of the entities it copies"),
+         field<&Emitter::interval>("interval", kPositive, "s", "seconds between copies"),
+         field<&Emitter::count>("count", NumberRange{1.0, 100000.0}, "", "copies alive at most; the oldest goes first"),
+         field<&Emitter::velocity>("velocity", kAnySpeed, "m/s", "velocity of each copy before the random turn"),
+         field<&Emitter::spread>("spread", NumberRange{0.0, 3.141592653589793}, "rad",
+                                 "each copy's velocity turns by a random angle in +/- spread (world.seed)"),
+         field<&Emitter::lifetime>("lifetime", kPositive, "s", "seconds a copy lives; absent: until count pushes it out"),
+         field<&Emitter::next>("next", kAny, "s", "run state: world time of the next copy; absent: the time at load"),
+         field<&Emitter::emitted>("emitted", NumberRange{0.0, 2147483647.0}, "", "run state: copies made so far"),
+         field<&Emitter::alive>("alive", NumberRange{0.0, 100000.0}, "", "run state: the newest this many are alive"),
+         field<&Emitter::oldest>("oldest", kAny, "s", "run state: when the oldest copy alive appeared")}));
     {
         FieldInfo type = field<&Joint::type>("type", kAny, "", "hinge, slider, weld, distance, rope or wheel");
         type.choices = kJointTypes;

@@ -820,6 +820,116 @@ std::string checkJoint(const Registry& registry, std::size_t index, const Joint&
 
 namespace {
 
+/// Templates and emitters (docs/format.md, "Templates and emitters"): a
+/// template body is a dynamic body with a shape; its joints and springs stay
+/// within it; an emitter names an existing template, one emitter per
+/// template, and its run state names copies that exist. "" when fine.
+const std::string kNoTemplate;
+
+std::string templatesProblem(const Registry& registry) {
+    const auto& entities = registry.entities();
+    if (registry.count<Template>() == 0 && registry.count<Emitter>() == 0) return {};
+    std::map<std::string, std::size_t> firstOf;  // template value -> its first entity
+    for (std::size_t i = 0; i < entities.size(); ++i) {
+        const Entity e = entities[i];
+        const Template* t = registry.tryGet<Template>(e);
+        if (!t) continue;
+        const std::string at = child("/entities", i) + "/template";
+        const std::string who = entityLabelOf(registry, i);
+        if (t->value.empty()) return at + ": " + who + ": expected a template name, got \"\"";
+        if (t->value.find('#') != std::string::npos)
+            return at + ": " + who + ": a template name cannot contain '#' (its copies are named \"" + t->value +
+                   "#N\"), got \"" + t->value + "\"";
+        firstOf.emplace(t->value, i);
+        if (registry.has<Joint>(e) || registry.has<Spring>(e)) continue;
+        for (const auto& [name, present] :
+             {std::pair<const char*, bool>{"static", registry.has<Static>(e) && registry.tryGet<Static>(e)->value},
+              {"kinematic", registry.has<Kinematic>(e) && registry.tryGet<Kinematic>(e)->value},
+              {"plane", registry.has<Plane>(e)},
+              {"attractor", registry.has<Attractor>(e)},
+              {"boid", registry.has<Boid>(e)},
+              {"emitter", registry.has<Emitter>(e)}})
+            if (present)
+                return at + ": " + who + ": a template entity is a dynamic body with a shape; remove \"" + name + "\"";
+        if (!registry.has<Position>(e))
+            return at + ": " + who + ": a template entity is a dynamic body with a shape; it has no position";
+        if (!registry.has<Radius>(e) && !registry.has<Box>(e) && !registry.has<Polygon>(e) && !registry.has<Capsule>(e) &&
+            !registry.has<Shapes>(e))
+            return at + ": " + who +
+                   ": a template body needs a shape (radius, box, polygon, capsule or shapes): its copies are added to the "
+                   "contact solver as they appear";
+    }
+    // Joints and springs: all of their ends in one template, or none.
+    for (std::size_t i = 0; i < entities.size(); ++i) {
+        const Entity e = entities[i];
+        const Joint* joint = registry.tryGet<Joint>(e);
+        const Spring* spring = registry.tryGet<Spring>(e);
+        if (!joint && !spring) continue;
+        const Template* own = registry.tryGet<Template>(e);
+        const Entity ends[2] = {joint ? joint->a : spring->a, joint ? joint->b : spring->b};
+        const char* kind = joint ? "joint" : "spring";
+        const std::string* expected = own ? &own->value : nullptr;
+        const std::string* first = nullptr;
+        for (const Entity end : ends) {
+            if (end.isNull() || !registry.alive(end)) continue;
+            const Template* t = registry.tryGet<Template>(end);
+            const std::string* value = t ? &t->value : nullptr;
+            if (!first) first = value ? value : &kNoTemplate;
+            const std::string& have = value ? *value : kNoTemplate;
+            const std::string& want = expected ? *expected : *first;
+            if (have != want)
+                return child(child("/entities", i), kind) + ": " + kind + " on " + entityLabelOf(registry, i) +
+                       ": joins " + (have.empty() ? "" : "template \"" + have + "\" entity ") + endLabel(registry, end) +
+                       (want.empty() ? " to bodies outside any template" : " to template \"" + want + "\"") +
+                       "; a template's joints and springs stay within it";
+        }
+    }
+    std::map<std::string, std::size_t> emitterOf;  // template value -> its emitter
+    for (std::size_t i = 0; i < entities.size(); ++i) {
+        const Emitter* em = registry.tryGet<Emitter>(entities[i]);
+        if (!em) continue;
+        const std::string at = child("/entities", i) + "/emitter";
+        const std::string who = "emitter on " + entityLabelOf(registry, i);
+        if (firstOf.find(em->templateName) == firstOf.end())
+            return at + "/template: " + who + ": no entity has \"template\": \"" + em->templateName + "\"";
+        if (const auto [it, inserted] = emitterOf.emplace(em->templateName, i); !inserted)
+            return at + "/template: " + who + ": template \"" + em->templateName + "\" is copied by " +
+                   entityLabelOf(registry, it->second) + " already; give each emitter its own template";
+        if (em->alive > em->count)
+            return at + "/alive: " + who + ": " + std::to_string(em->alive) + " copies alive, more than count " +
+                   std::to_string(em->count);
+        if (em->alive > em->emitted)
+            return at + "/alive: " + who + ": " + std::to_string(em->alive) + " copies alive, more than the " +
+                   std::to_string(em->emitted) + " emitted";
+        if (em->alive > 0 && (!em->oldest || !em->next))
+            return at + "/oldest: " + who + ": with copies alive the run state needs \"next\" and \"oldest\"";
+        // The copies alive, by the names they were given.
+        // Names of its copies belong to the run: only those alive may be in
+        // the scene, or a later copy would take a name that is in use.
+        const std::string prefix = em->templateName + "#";
+        for (std::size_t j = 0; j < entities.size(); ++j) {
+            const Name* n = registry.tryGet<Name>(entities[j]);
+            if (!n || n->value.compare(0, prefix.size(), prefix) != 0) continue;
+            const std::string rest = n->value.substr(prefix.size(), n->value.find('/', prefix.size()) - prefix.size());
+            if (rest.empty() || rest.size() > 9 || rest.find_first_not_of("0123456789") != std::string::npos) continue;
+            const long k = std::stol(rest);
+            if (k <= em->emitted - em->alive || k > em->emitted)
+                return child("/entities", j) + "/name: \"" + n->value + "\" is a name the " + who +
+                       " gives its copies, and that copy is not alive in its run state (" + std::to_string(em->alive) +
+                       " alive of " + std::to_string(em->emitted) + " emitted)";
+        }
+        for (int k = em->emitted - em->alive + 1; k <= em->emitted; ++k) {
+            const std::string copy = em->templateName + "#" + std::to_string(k);
+            bool found = false;
+            for (const Entity e : entities)
+                if (const Name* n = registry.tryGet<Name>(e); n && n->value == copy) found = true;
+            if (!found)
+                return at + "/alive: " + who + ": copy \"" + copy + "\" is alive in its run state but not in the scene";
+        }
+    }
+    return {};
+}
+
 /// checkSceneRelations' walk: "" when fine (internal; the public function
 /// returns the message as an Error).
 std::string relationsProblem(const Scene& scene) {
@@ -900,7 +1010,7 @@ std::string relationsProblem(const Scene& scene) {
             return child("/entities", i) + "/spring/b: a spring cannot join \"" + registry.tryGet<Name>(spring->a)->value +
                    "\" to itself";
     }
-    return {};
+    return templatesProblem(registry);
 }
 
 } // namespace

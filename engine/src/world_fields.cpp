@@ -70,6 +70,9 @@ std::vector<WorldFieldInfo> buildTable() {
         {makeField<&WorldSettings::jointDampingRatio>("joint_damping_ratio", {0.0, 1e3}, "",
                                                       "damping ratio of rigid joints' position correction; absent: "
                                                       "the engine's choice (docs/joints.md)")},
+        {makeField<&WorldSettings::seed>("seed", {0.0, 1e9}, "",
+                                         "seed of every random choice in a run (emitters' spread); absent: 0"),
+         true},
     };
 }
 

@@ -141,6 +141,30 @@ struct Drag { double value = 0.0; };
 /// (World::sensorEvents); nothing about any body's motion changes.
 struct Sensor { bool value = true; };
 
+/// The entity is a prefab, not simulated: every entity with the same
+/// `value` (and the joints and springs among them) is one template that
+/// emitters copy. No body, no contacts, no energy.
+struct Template { std::string value; };
+
+/// Adds a copy of template `templateName` at the entity's position every
+/// `interval` seconds, up to `count` alive (the oldest removed first), each
+/// with `velocity` turned by a random angle in +/- `spread` (world.seed),
+/// removed `lifetime` seconds after it appeared when given. The last four
+/// fields are the run's state, written by a save so that a resume is exact.
+struct Emitter {
+    std::string templateName;
+    double interval = 1.0;               ///< s between copies, > 0
+    int count = 10;                      ///< copies alive at most, >= 1
+    Vec2 velocity;                       ///< m/s of each copy before the turn
+    double spread = 0.0;                 ///< rad, each copy's velocity turned by a uniform angle in +/- spread
+    std::optional<double> lifetime;      ///< s a copy lives; absent: until pushed out by count
+    std::optional<double> next;          ///< s, world time of the next copy; absent: the world's time at build
+    int emitted = 0;                     ///< copies made so far (the next is TEMPLATE#(emitted + 1))
+    int alive = 0;                       ///< the newest `alive` of them are in the scene
+    std::optional<double> oldest;        ///< s, when the oldest copy alive appeared
+    friend bool operator==(const Emitter&, const Emitter&) = default;
+};
+
 /// Which pairs of shapes collide (Box2D's collision filter). Two shapes
 /// with the same non-zero `group` always collide when it is positive and
 /// never when it is negative; otherwise they collide when each one's

@@ -186,6 +186,26 @@ public:
         return e;
     }
 
+    /// Makes the entity with handle `e`, appended to the scene order: an
+    /// entity of another registry made here under the same handle (a run's
+    /// emitted copies written back to its scene). False, changing nothing,
+    /// when that slot is alive or has been used by a later generation.
+    bool createAt(Entity e) {
+        if (e.isNull()) return false;
+        if (e.index < generations_.size() && (alive_[e.index] || generations_[e.index] > e.generation)) return false;
+        beforeSlotsChange();
+        while (generations_.size() <= e.index) {
+            freeList_.push_back(std::uint32_t(generations_.size()));
+            generations_.push_back(0);
+            alive_.push_back(false);
+        }
+        freeList_.erase(std::remove(freeList_.begin(), freeList_.end(), e.index), freeList_.end());
+        generations_[e.index] = e.generation;
+        alive_[e.index] = true;
+        order_.push_back(e);
+        return true;
+    }
+
     /// True when `e` names a live entity (not destroyed, not stale).
     bool alive(Entity e) const {
         return e.index < generations_.size() && alive_[e.index] && generations_[e.index] == e.generation;
@@ -300,6 +320,9 @@ public:
         freeList_ = std::move(s.freeList);
         order_ = std::move(s.order);
     }
+
+    /// Slots in the slot table (every entity index is below it).
+    std::size_t slotCount() const { return generations_.size(); }
 
     /// Handle currently in slot `index` if alive (used to turn dense pool
     /// owners back into handles).

@@ -64,6 +64,9 @@ struct WorldSettings {
     /// Damping ratio of that correction (Box2D v3's jointDampingRatio).
     /// Absent: the engine's choice.
     std::optional<double> jointDampingRatio;
+    /// Seed of every random choice in a run (the emitters' spread); 0 when
+    /// not given.
+    int seed = 0;
 
     friend bool operator==(const WorldSettings&, const WorldSettings&) = default;
 };

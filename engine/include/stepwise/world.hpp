@@ -7,6 +7,7 @@
 /// `step()` runs a named pipeline of timed stages (Box2D's b2World_Step
 /// shape); `writeBack()` copies the results into the Scene.
 
+#include "stepwise/components.hpp"
 #include "stepwise/entity.hpp"
 #include "stepwise/result.hpp"
 #include "stepwise/scene.hpp"
@@ -76,6 +77,15 @@ struct SensorEvent {
     friend bool operator==(const SensorEvent&, const SensorEvent&) = default;
 };
 
+/// A copy an emitter added (`added`) or removed at the start of the last
+/// step, by the copy's name ("doll#3").
+struct EmitterEvent {
+    Entity emitter;
+    std::string copy;
+    bool added = true;
+    friend bool operator==(const EmitterEvent&, const EmitterEvent&) = default;
+};
+
 /// One joint at the end of the last step, for the debugging views.
 struct JointRecord {
     Entity joint;              ///< the joint's entity
@@ -137,7 +147,19 @@ struct WorldLayout {
     std::vector<std::uint32_t> colliderParts;
     std::vector<std::uint8_t> colliderMoves;  ///< per collider: 1 when it is a dynamic body's
     std::vector<Entity> joints;      ///< every joint's entity, in solver (scene) order
-    friend bool operator==(const WorldLayout&, const WorldLayout&) = default;
+    /// With emitters: the run's registry when the layout was made (the
+    /// copies alive with their components, under the handles writeBack
+    /// gives them in a scene) and each emitter's component with its run
+    /// state. Null and empty without emitters.
+    std::shared_ptr<const Registry> registry;
+    std::vector<std::pair<Entity, Emitter>> emitters;
+    /// With emitters: which run the layout belongs to (one per build, kept
+    /// by restoreState's rebuild); 0 without.
+    std::uint64_t run = 0;
+    friend bool operator==(const WorldLayout& a, const WorldLayout& b) {
+        return a.bodies == b.bodies && a.spinBodies == b.spinBodies && a.colliders == b.colliders &&
+               a.colliderMoves == b.colliderMoves && a.joints == b.joints && a.emitters == b.emitters;
+    }
 };
 
 /// Everything a step reads that an earlier step wrote: a World restored
@@ -310,7 +332,10 @@ public:
     WorldState saveState() const;
     /// Restores a snapshot taken from this World or from one built from a
     /// scene with the same entities, shapes and systems (the same layout).
-    /// Fails, changing nothing, when the layout differs.
+    /// Fails, changing nothing, when the layout differs, except for a
+    /// snapshot of this run taken while its emitters had other copies
+    /// alive: then the World is rebuilt from the snapshot's own scene (the
+    /// only time an emitter's copies cost a build).
     Result<void> restoreState(const WorldState& state);
 
     /// Recompiles `scene` (an edited version of the scene this World runs)
@@ -409,6 +434,19 @@ public:
     /// file resumes as the session goes on). True if it woke something.
     bool wakeIfSettingsChanged();
 
+    /// Emitters in the level, and the copies they have alive (docs/format.md,
+    /// "Templates and emitters"): those copies' bodies are in the state
+    /// vector after the level's own, in the order they appeared.
+    std::size_t emitterCount() const;
+    std::size_t copiesAlive() const;
+    /// Copies added and removed at the start of the last step, in the order
+    /// it made them (per emitter: removals, then additions).
+    std::span<const EmitterEvent> emitterEvents() const;
+    /// The name of `e` when it is one of the copies alive (a scene the
+    /// World was built from does not hold them until writeBack); nullptr
+    /// otherwise.
+    const std::string* copyName(Entity e) const;
+
     /// Moving bodies (dynamic and kinematic), in the order of the state vector.
     std::size_t bodyCount() const;
     /// How many of them are kinematic.
@@ -440,6 +478,9 @@ private:
     const WorldImpl& impl() const { return *impl_; }
 
     explicit World(std::unique_ptr<WorldImpl> impl);
+    /// restoreState of a snapshot from before the emitters added or removed
+    /// copies: this World is rebuilt from the snapshot's scene, only then.
+    Result<void> restoreOtherCopies(const WorldState& s);
     std::unique_ptr<WorldImpl> impl_;
 };
 

@@ -146,6 +146,108 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     }
 }
 
+std::uint32_t CollisionSystem::addAll(std::span<const ColliderAdd> list) {
+    const std::uint32_t base = std::uint32_t(colliders_.size());
+    for (const ColliderAdd& a : list) {
+        Collider c = a.collider;
+        if (c.hub >= 0) c.hub += std::int32_t(base);
+        add(c, a.angle, a.angularVelocity, a.filter);
+        if (c.hub >= 0)
+            maxExtent_[std::size_t(c.hub)] = std::max(maxExtent_[std::size_t(c.hub)], maxExtent_.back());
+    }
+    return base;
+}
+
+std::unique_ptr<CollisionSystem> CollisionSystem::changed(std::span<const std::uint8_t> dropCollider,
+                                                          std::span<const std::uint8_t> dropJoint,
+                                                          std::span<const std::int32_t> bodyMap,
+                                                          std::span<const ColliderAdd> added,
+                                                          std::span<const JointAdd> addedJoints) const {
+    auto next = std::make_unique<CollisionSystem>();
+    CollisionSystem& n = *next;
+    n.settings_ = settings_;
+    n.jointSettings_ = jointSettings_;
+    n.autoBroadPhase_ = autoBroadPhase_;
+    n.broadPhase_.setKind(broadPhase_.kind());
+    n.positionCorrection_ = positionCorrection_;
+    n.bodyAsleep_ = bodyAsleep_;
+    n.wakeBody_ = wakeBody_;
+    const std::size_t oldCount = colliders_.size();
+    std::vector<std::int32_t> colliderMap(oldCount, -1);
+    // Room for all of them at once: a joint is a large struct, and growing
+    // a dozen arrays one push at a time would copy each many times.
+    const std::size_t most = oldCount + added.size();
+    for (auto* v : {&n.angles_, &n.angularVelocities_, &n.invMass_, &n.invInertia_, &n.maxExtent_}) v->reserve(most);
+    n.colliders_.reserve(most);
+    n.filters_.reserve(most);
+    n.colliderAsleep_.reserve(most);
+    n.solverIndex_.reserve(most);
+    n.bodies_.reserve(most + 1);
+    n.finite_.reserve(most);
+    n.awakeSolverColliders_.reserve(most);
+    n.joints_.reserve(joints_.size() + addedJoints.size());
+    n.noCollide_.reserve(noCollide_.size() + addedJoints.size());
+    const auto keep = [&](std::size_t c) {
+        Collider copy = colliders_[c];
+        if (copy.body >= 0) copy.body = bodyMap[std::size_t(copy.body)];
+        if (copy.hub >= 0) copy.hub = colliderMap[std::size_t(copy.hub)];  // kept before its shapes
+        colliderMap[c] = std::int32_t(n.colliders_.size());
+        n.add(copy, angles_[c], angularVelocities_[c], filters_[c]);
+        n.maxExtent_.back() = maxExtent_[c];  // a hub's reach is its shapes'
+    };
+    // Shapes (and compound bodies' hubs) in their order, the new ones, then
+    // the bodies in the solver only because a joint holds them: World::build's
+    // order.
+    const auto jointOnly = [&](std::size_t c) { return colliders_[c].solverOnly && !isHub(c); };
+    for (std::size_t c = 0; c < oldCount; ++c)
+        if (!dropCollider[c] && !jointOnly(c)) keep(c);
+    const std::uint32_t addedBase = n.addAll(added);
+    std::vector<std::int32_t> addedIndex(added.size());
+    for (std::size_t k = 0; k < added.size(); ++k) addedIndex[k] = std::int32_t(addedBase + k);
+    for (std::size_t c = 0; c < oldCount; ++c)
+        if (!dropCollider[c] && jointOnly(c)) keep(c);
+    bool anyBroken = false;
+    for (std::size_t k = 0; k < joints_.size(); ++k) {
+        if (dropJoint[k]) continue;
+        joints::JointConstraint j = joints_[k];
+        for (joints::JointEnd* end : {&j.a, &j.b}) {
+            if (end->collider < 0) continue;
+            end->collider = colliderMap[std::size_t(end->collider)];
+            end->solverBody = n.solverBodyOf(std::size_t(end->collider));
+        }
+        std::int32_t filter[2] = {-1, -1};
+        if (j.noCollideKey != 0) {
+            filter[0] = colliderMap[std::size_t(j.noCollideKey >> 32)];
+            filter[1] = colliderMap[std::size_t(j.noCollideKey & 0xFFFFFFFFu)];
+        }
+        j.noCollideKey = 0;
+        anyBroken = anyBroken || j.broken;
+        n.addJoint(j, filter[0], filter[1], filter[0] < 0 || filter[1] < 0);
+    }
+    for (const JointAdd& add : addedJoints) {
+        joints::JointConstraint j = add.joint;
+        for (joints::JointEnd* end : {&j.a, &j.b}) {
+            if (end->collider < 0) continue;
+            end->collider = addedIndex[std::size_t(end->collider)];
+            end->solverBody = n.solverBodyOf(std::size_t(end->collider));
+        }
+        const std::int32_t fa = add.filterA >= 0 ? addedIndex[std::size_t(add.filterA)] : -1;
+        const std::int32_t fb = add.filterB >= 0 ? addedIndex[std::size_t(add.filterB)] : -1;
+        n.addJoint(j, fa, fb, add.collideConnected);
+    }
+    if (anyBroken) n.jointsBroke();
+    // The warm start of every contact between kept colliders; the map keeps
+    // their order, so the cache stays sorted as it was.
+    std::vector<CachedImpulse> cache;
+    for (const CachedImpulse& c : warmStartCache()) {
+        const std::int32_t a = colliderMap[c.colliderA()], b = colliderMap[c.colliderB()];
+        if (a < 0 || b < 0) continue;
+        cache.push_back({CachedImpulse::makeKey(std::uint32_t(a), std::uint32_t(b), c.feature()), c.normal, c.tangent});
+    }
+    n.setWarmStartCache(std::move(cache));
+    return next;
+}
+
 void CollisionSystem::setWarmStartCache(std::vector<CachedImpulse> cache) {
     if (!std::is_sorted(cache.begin(), cache.end())) std::sort(cache.begin(), cache.end());
     cache_ = std::move(cache);

@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <memory>
 #include <utility>
 #include <span>
 #include <vector>
@@ -99,6 +100,38 @@ public:
     /// `collideConnected`, contacts between them are dropped.
     void addJoint(const joints::JointConstraint& joint, std::int32_t filterA, std::int32_t filterB,
                   bool collideConnected);
+    /// A collider to add in place (CollisionSystem::changed).
+    struct ColliderAdd {
+        Collider collider;
+        double angle = 0.0, angularVelocity = 0.0;
+        Filter filter;
+    };
+    /// Adds a list of colliders in order (an entity's, or an emission's);
+    /// a compound shape's `hub` is its hub's place in the list, and the hub
+    /// reaches as far as its farthest shape. Returns the first one's index.
+    std::uint32_t addAll(std::span<const ColliderAdd> list);
+    /// A joint to add in place: its ends' `collider` and the filters are
+    /// indices into the ColliderAdd list (-1: a fixed end, or none).
+    struct JointAdd {
+        joints::JointConstraint joint;
+        std::int32_t filterA = -1, filterB = -1;
+        bool collideConnected = false;
+    };
+    /// Bodies came and went (an emitter's copies): the system with the
+    /// colliders `dropCollider` marks and the joints `dropJoint` marks taken
+    /// out, the rest in their order with their state-vector bodies mapped by
+    /// `bodyMap` (old index -> new), and `added` appended after the shapes
+    /// (before the solver-only bodies, where World::build puts them) with
+    /// `addedJoints` after the joints: the very arrays a build of the scene
+    /// as it now is would make. Every kept collider's rotation and spin,
+    /// every kept joint's impulses and state and every warm-start entry
+    /// between kept colliders stay as they are; the removed bodies' entries
+    /// go. The settings, the broad-phase choice and the sleep source carry
+    /// over; the caller refreshes the sleeping set.
+    std::unique_ptr<CollisionSystem> changed(std::span<const std::uint8_t> dropCollider,
+                                             std::span<const std::uint8_t> dropJoint,
+                                             std::span<const std::int32_t> bodyMap, std::span<const ColliderAdd> added,
+                                             std::span<const JointAdd> addedJoints) const;
     /// Solver body of a collider (0 = static), for mapping joint ends.
     std::uint32_t solverBodyOf(std::size_t collider) const { return solverIndex_[collider]; }
     bool hasJoints() const { return !joints_.empty(); }

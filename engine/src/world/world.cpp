@@ -38,6 +38,8 @@
 #include "world/world_impl.hpp"
 #include "world/world_collisions.hpp"
 
+#include "templates.hpp"
+
 #include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
@@ -189,6 +191,7 @@ World::~World() = default;
 
 Result<void> World::step() {
     WorldImpl& w = *impl_;
+    w.runEmitters();  // copies due now appear (or leave) before the step reads the arrays
     detail::ForceModel& f = w.model;
     const bool timed = w.profiling;
     f.profiling = timed;
@@ -355,12 +358,44 @@ Result<void> World::step() {
 
 namespace {
 
+/// With emitters: the copies the run has alive are in the scene under the
+/// run's handles, with their components, after the scene's other entities
+/// in the order they appeared; the copies it removed are not; each
+/// emitter's run state is the run's.
+void syncCopies(const WorldLayout& layout, Scene& scene) {
+    if (!layout.registry) return;
+    Registry& reg = scene.registry;
+    const Registry& run = *layout.registry;
+    std::vector<std::string> prefixes;
+    for (const auto& [e, em] : layout.emitters) {
+        prefixes.push_back(em.templateName + "#");
+        if (Emitter* own = reg.tryGet<Emitter>(e)) {
+            own->next = em.next;
+            own->emitted = em.emitted;
+            own->alive = em.alive;
+            own->oldest = em.oldest;
+        }
+    }
+    const auto isCopy = [&](const Registry& r, Entity e) {
+        const Name* name = r.tryGet<Name>(e);
+        if (!name) return false;
+        for (const std::string& prefix : prefixes)
+            if (name->value.compare(0, prefix.size(), prefix) == 0) return true;
+        return false;
+    };
+    for (const Entity e : std::vector<Entity>(reg.entities()))
+        if (!run.alive(e) && isCopy(reg, e)) reg.destroy(e);
+    for (const Entity e : run.entities())
+        if (!reg.alive(e) && isCopy(run, e) && reg.createAt(e)) detail::copyComponents(run, e, reg, e);
+}
+
 /// World::writeBack and WorldState::writeBack: the arrays of one layout into
 /// the scene's components. `colliderAngle`/`colliderSpin` may be empty (no
 /// shapes).
 void writeStateBack(const WorldLayout& layout, const double* x, const double* v, std::span<const double> spinAngle,
                     std::span<const double> colliderAngle, std::span<const double> colliderSpin, double time,
                     double adaptiveStep, Scene& scene) {
+    syncCopies(layout, scene);
     Registry& reg = scene.registry;
     for (std::size_t b = 0; b < layout.bodies.size(); ++b) {
         const Entity e = layout.bodies[b];
@@ -663,12 +698,27 @@ WorldState World::saveState() const {
     return s;
 }
 
+namespace {
+/// Whether snapshot `s` comes from this World's run with other copies
+/// alive: both have emitters, the same ones.
+bool sameEmitters(const WorldState& s, const WorldImpl& w) {
+    if (!s.layout || !s.layout->registry || !w.registry || s.layout->run != w.run ||
+        s.layout->emitters.size() != w.emitters.size())
+        return false;
+    for (std::size_t k = 0; k < w.emitters.size(); ++k)
+        if (s.layout->emitters[k].first != w.emitters[k].entity) return false;
+    return true;
+}
+} // namespace
+
 Result<void> World::restoreState(const WorldState& s) {
     WorldImpl& w = *impl_;
     if (!s.layout || (s.layout != w.layout && *s.layout != *w.layout) || s.joints.size() != w.layout->joints.size() ||
         s.sleepTimer.size() != w.bodyEntity.size() || s.sleepIsland.size() != w.bodyEntity.size() ||
-        s.sleepAnchor.size() != detail::kAnchorStride * w.bodyEntity.size() || s.sleepAnchored.size() != w.bodyEntity.size())
-        return Error{"the snapshot was taken from a world with other bodies or shapes"};
+        s.sleepAnchor.size() != detail::kAnchorStride * w.bodyEntity.size() || s.sleepAnchored.size() != w.bodyEntity.size()) {
+        if (!sameEmitters(s, w)) return Error{"the snapshot was taken from a world with other bodies or shapes"};
+        return restoreOtherCopies(s);
+    }
     std::copy(s.x.begin(), s.x.end(), w.x[w.current].begin());
     std::copy(s.v.begin(), s.v.end(), w.v[w.current].begin());
     w.angle = s.spinAngle;
@@ -704,6 +754,31 @@ Result<void> World::restoreState(const WorldState& s) {
     w.settings.adaptiveStep = s.adaptiveStep;
     w.integrator->setProposedStep(s.adaptiveStep);
     w.stats.step = s.steps;
+    return {};
+}
+
+Result<void> World::restoreOtherCopies(const WorldState& s) {
+    // The snapshot's own scene: the run's registry as it was then (its
+    // copies alive, broken joints kept, so that the joints line up with the
+    // snapshot's), its state written back, built and restored. Only a World
+    // whose emitters added or removed copies since the snapshot comes here.
+    const WorldImpl& w = *impl_;
+    Scene scene;
+    scene.world = w.sceneWorld;
+    scene.world.integrator = w.settings.integrator;
+    scene.registry = *s.layout->registry;
+    writeStateBack(*s.layout, s.x.data(), s.v.data(), s.spinAngle, s.colliderAngle, s.colliderSpin, s.time,
+                   s.adaptiveStep, scene);
+    scene.solverState = s.solverState();
+    if (w.settingsSource != SettingsSource::Given)
+        scene.solverState->chosen = ChosenSettings{w.settings.substeps, w.settings.solverIterations};
+    Result<World> next = build(scene, w.switches);
+    if (!next) return Error{next.error()};
+    next->impl_->profiling = w.profiling;
+    next->impl_->run = w.run;  // the same run: its snapshots restore here too
+    next->impl_->layout = next->impl_->makeLayout();
+    if (Result<void> restored = next->restoreState(s); !restored) return restored;
+    impl_ = std::move(next->impl_);
     return {};
 }
 

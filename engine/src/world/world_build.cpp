@@ -6,9 +6,12 @@
 #include "world/world_impl.hpp"
 #include "world/world_collisions.hpp"
 
+#include "templates.hpp"
+
 #include "stepwise/components.hpp"
 #include "stepwise/world_fields.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <optional>
 #include <unordered_map>
@@ -36,6 +39,14 @@ struct InitialState {
     std::vector<double> x, v;
 };
 
+bool isPointEmitter(const Registry& reg, Entity e) {
+    return reg.has<Emitter>(e) && !reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) &&
+           !reg.has<Capsule>(e);
+}
+
+std::atomic<std::uint64_t> buildCount{0};
+std::atomic<std::uint64_t> runCount{0};  // WorldLayout::run
+
 /// Dynamic bodies (a position and not static), in scene order: the state
 /// vector's order, stable across save and load.
 std::optional<Error> compileBodies(const Registry& reg, WorldImpl& w, BodyIndex& bodies, InitialState& start) {
@@ -46,6 +57,8 @@ std::optional<Error> compileBodies(const Registry& reg, WorldImpl& w, BodyIndex&
         const Name* name = reg.tryGet<Name>(e);
         const Position* p = reg.tryGet<Position>(e);
         if (!p) continue;
+        // A template is a prefab; an emitter without a shape, a point.
+        if (reg.count<Template>() != 0 && (detail::inTemplate(reg, e) || isPointEmitter(reg, e))) continue;
         const Static* st = reg.tryGet<Static>(e);
         if (st && st->value) continue;
         const Velocity* vel = reg.tryGet<Velocity>(e);
@@ -143,7 +156,7 @@ std::optional<Error> compileSprings(const Registry& reg, const BodyIndex& bodies
     for (std::size_t i = 0; i < order.size(); ++i) {
         const Entity e = order[i];
         const Spring* s = reg.tryGet<Spring>(e);
-        if (!s) continue;
+        if (!s || detail::inTemplate(reg, e)) continue;
         const Name* name = reg.tryGet<Name>(e);
         const std::string label = entityLabel(i, name ? &name->value : nullptr);
         SpringEnd a, b;
@@ -180,7 +193,7 @@ void compileAttractors(const Registry& reg, const BodyIndex& bodies, double G, d
     for (const Entity e : reg.entities()) {
         const Attractor* at = reg.tryGet<Attractor>(e);
         const Position* p = reg.tryGet<Position>(e);
-        if (!at || !p) continue;
+        if (!at || !p || detail::inTemplate(reg, e)) continue;
         const Mass* m = reg.tryGet<Mass>(e);
         detail::AttractorData d;
         d.body = bodies.of(e);
@@ -305,6 +318,10 @@ std::optional<Error> compileCollisions(const Scene& scene, const SystemSwitches&
                                           switches.collisions, &jointProblem);
     if (!jointProblem.empty()) return Error{jointProblem};
     if (std::optional<Error> refused = chooseSolverCounts(scene, switches, w)) return refused;
+    // Copies an emitter adds join the contact solver in place: the system
+    // exists from the start, empty until the first copy.
+    if (!w.collision && scene.registry.count<Emitter>() != 0 && switches.collisions)
+        w.collision = std::make_unique<collision::CollisionSystem>();
     if (!w.collision) return std::nullopt;
     const WorldSettings& ws = w.settings;
     const double substepLength = ws.dt / double(w.settings.substeps);
@@ -376,19 +393,6 @@ void compileSleep(const WorldSettings& ws, WorldImpl& w) {
     w.sleptUnder = w.settings;
 }
 
-/// The names activeSystems() reports, in pipeline order.
-void listActiveSystems(WorldImpl& w) {
-    const detail::ForceModel& f = w.model;
-    if (f.gravityOn) w.active.push_back("gravity");
-    if (f.dragOn) w.active.push_back("drag");
-    if (f.springsOn()) w.active.push_back("springs");
-    if (f.attractorsOn()) w.active.push_back("attractors");
-    if (f.boidsOn) w.active.push_back("boids");
-    if (!w.spinBody.empty()) w.active.push_back("rotation");
-    if (w.collision && w.collision->hasShapes()) w.active.push_back("collisions");
-    if (w.collision && w.collision->hasJoints()) w.active.push_back("joints");
-}
-
 /// The state buffers (the start in buffer 0), the integrator and the
 /// stats' room, so that a step allocates nothing.
 void allocateState(WorldImpl& w, const InitialState& start, detail::IntegratorKind kind) {
@@ -406,8 +410,26 @@ void allocateState(WorldImpl& w, const InitialState& start, detail::IntegratorKi
     w.stats.systems.reserve(std::size_t(detail::ForceSystem::Count));
 }
 
+} // namespace
+
+/// The names activeSystems() reports, in pipeline order.
+void WorldImpl::listActiveSystems() {
+    WorldImpl& w = *this;
+    const detail::ForceModel& f = w.model;
+    w.active.clear();
+    if (f.gravityOn) w.active.push_back("gravity");
+    if (f.dragOn) w.active.push_back("drag");
+    if (f.springsOn()) w.active.push_back("springs");
+    if (f.attractorsOn()) w.active.push_back("attractors");
+    if (f.boidsOn) w.active.push_back("boids");
+    if (!w.spinBody.empty()) w.active.push_back("rotation");
+    if (w.collision && w.collision->hasShapes()) w.active.push_back("collisions");
+    if (w.collision && w.collision->hasJoints()) w.active.push_back("joints");
+}
+
 /// The entities behind each state array, for saveState/restoreState.
-std::shared_ptr<const WorldLayout> makeLayout(const WorldImpl& w) {
+std::shared_ptr<const WorldLayout> WorldImpl::makeLayout() const {
+    const WorldImpl& w = *this;
     auto layout = std::make_shared<WorldLayout>();
     layout->bodies = w.bodyEntity;
     for (const std::uint32_t b : w.spinBody) layout->spinBodies.push_back(w.bodyEntity[b]);
@@ -419,10 +441,13 @@ std::shared_ptr<const WorldLayout> makeLayout(const WorldImpl& w) {
         }
         for (const joints::JointConstraint& j : w.collision->jointConstraints()) layout->joints.push_back(j.entity);
     }
+    layout->registry = w.registry;
+    layout->run = w.run;
+    for (const EmitterRun& e : w.emitters) layout->emitters.emplace_back(e.entity, e.params);
     return layout;
 }
 
-} // namespace
+std::uint64_t worldBuildCount() { return buildCount.load(); }
 
 bool SystemSwitches::disable(std::string_view system) {
     for (auto [name, on] : {std::pair<std::string_view, bool*>{"gravity", &gravity}, {"drag", &drag}, {"springs", &springs},
@@ -446,6 +471,8 @@ Result<World> World::build(const Scene& scene, const SystemSwitches& switches) {
     auto impl = std::make_unique<WorldImpl>();
     WorldImpl& w = *impl;
     w.settings = scene.world;
+    w.switches = switches;
+    w.sceneWorld = scene.world;
     if (!switches.gravity) w.settings.gravity = {0.0, 0.0};
     const Registry& reg = scene.registry;
     BodyIndex bodies;
@@ -461,9 +488,12 @@ Result<World> World::build(const Scene& scene, const SystemSwitches& switches) {
     if (std::optional<Error> refused = compileCollisions(scene, switches, bodies, w)) return std::move(*refused);
     compileSpin(reg, w);
     compileSleep(w.settings, w);
-    listActiveSystems(w);
+    w.listActiveSystems();
     allocateState(w, start, *kind);
-    w.layout = makeLayout(w);
+    if (std::optional<Error> refused = compileEmitters(scene, w)) return std::move(*refused);
+    if (w.registry) w.run = ++runCount;
+    w.layout = w.makeLayout();
+    ++buildCount;
     if (w.collision && w.collision->hasSensors()) w.collision->initSensors(detail::asVec2(w.xs(), w.model.n));
 
     World world(std::move(impl));

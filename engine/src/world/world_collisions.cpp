@@ -1,5 +1,7 @@
 #include "world/world_collisions.hpp"
 
+#include "templates.hpp"
+
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 
@@ -80,11 +82,12 @@ void compoundGeometry(const CompoundShape& s, collision::Collider& c, collision:
 
 /// A compound body: for a moving one, a hub (the rigid body: summed mass,
 /// inertia about the common centre of mass, the one angle and spin, the
-/// solver body) and then each shape pointing at it; for a static one, each
-/// shape as a static collider at its place in the body frame.
-void addCompoundBody(const Registry& reg, Entity e, const Shapes& compound,
-                     const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody,
-                     collision::CollisionSystem& system, std::unordered_map<std::uint32_t, std::int32_t>& colliderOf) {
+/// solver body) and then each shape pointing at it (by its place in `out`);
+/// for a static one, each shape as a static collider at its place in the
+/// body frame.
+void appendCompound(const Registry& reg, Entity e, const Shapes& compound,
+                    const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, ShapeStorage& storage,
+                    std::vector<collision::CollisionSystem::ColliderAdd>& out) {
     const std::uint32_t body = bodyOf(e);
     const bool moving = body != noBody;
     const bool kinematic = moving && reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value;
@@ -100,25 +103,25 @@ void addCompoundBody(const Registry& reg, Entity e, const Shapes& compound,
     const Filter* filter = reg.tryGet<Filter>(e);
     std::int32_t hub = -1;
     if (moving) {
-        collision::Collider h;
-        h.body = std::int32_t(body);
-        h.part = collision::Collider::kHubPart;
-        h.kinematic = kinematic;
-        h.mass = kinematic ? 0.0 : props.mass;
-        h.inertia = props.inertia;
-        h.centreOfMass = props.centre;
-        h.entity = e;
-        h.solverOnly = true;
-        hub = std::int32_t(system.colliderCount());
-        colliderOf.emplace(e.index, hub);
-        system.add(h, angle, spin);
+        collision::CollisionSystem::ColliderAdd h;
+        h.collider.body = std::int32_t(body);
+        h.collider.part = collision::Collider::kHubPart;
+        h.collider.kinematic = kinematic;
+        h.collider.mass = kinematic ? 0.0 : props.mass;
+        h.collider.inertia = props.inertia;
+        h.collider.centreOfMass = props.centre;
+        h.collider.entity = e;
+        h.collider.solverOnly = true;
+        h.angle = angle;
+        h.angularVelocity = spin;
+        hub = std::int32_t(out.size());
+        out.push_back(h);
     }
-    collision::ConvexPolygon polygon;
-    double reach = 0.0;
     for (std::size_t k = 0; k < compound.items.size(); ++k) {
         const CompoundShape& s = compound.items[k];
-        collision::Collider c;
-        compoundGeometry(s, c, polygon);
+        collision::CollisionSystem::ColliderAdd add;
+        collision::Collider& c = add.collider;
+        compoundGeometry(s, c, storage.polygons.emplace_back());
         c.body = moving ? std::int32_t(body) : -1;
         c.hub = hub;
         c.part = std::uint32_t(k);
@@ -128,15 +131,133 @@ void addCompoundBody(const Registry& reg, Entity e, const Shapes& compound,
         c.friction = s.friction.value_or(friction);
         c.sensor = s.sensor.value_or(sensor);
         c.entity = e;
-        if (!moving) colliderOf.emplace(e.index, std::int32_t(system.colliderCount()));
-        const std::size_t index = system.colliderCount();
-        system.add(c, angle, 0.0, s.filter ? *s.filter : filter ? *filter : Filter{});
-        if (moving) reach = std::max(reach, system.maxExtent(index));
+        add.angle = angle;
+        add.filter = s.filter ? *s.filter : filter ? *filter : Filter{};
+        out.push_back(add);
     }
-    if (moving) system.setMaxExtent(std::size_t(hub), reach);
 }
 
 } // namespace
+
+void collidersFor(const Registry& reg, Entity e, const std::function<std::uint32_t(Entity)>& bodyOf,
+                  std::uint32_t noBody, ShapeStorage& storage, std::vector<collision::CollisionSystem::ColliderAdd>& out) {
+    if (const Shapes* compound = reg.tryGet<Shapes>(e)) {
+        appendCompound(reg, e, *compound, bodyOf, noBody, storage, out);
+        return;
+    }
+    collision::Collider c;
+    if (const Radius* r = reg.tryGet<Radius>(e)) {
+        c.shape.kind = collision::ShapeKind::Circle;
+        c.shape.radius = r->value;
+    } else if (const Box* b = reg.tryGet<Box>(e)) {
+        c.shape.kind = collision::ShapeKind::Box;
+        c.shape.halfExtents = {0.5 * b->width, 0.5 * b->height};
+    } else if (const Polygon* poly = reg.tryGet<Polygon>(e)) {
+        // The engine works about the centre of mass: the outline is
+        // shifted so the centroid is its origin, and the offset kept.
+        const double rounding = poly->radius.value_or(0.0);
+        const PolygonMassProperties props = rounding > 0.0 ? polygonMassProperties(poly->vertices, rounding)
+                                                           : polygonMassProperties(poly->vertices);
+        Vec2 local[collision::kMaxPolygonVertices];
+        const int count = int(poly->vertices.size());
+        for (int i = 0; i < count; ++i) local[i] = poly->vertices[std::size_t(i)] - props.centroid;
+        collision::ConvexPolygon& polygon = storage.polygons.emplace_back(collision::ConvexPolygon::fromVertices(local, count));
+        polygon.cornerRadius = rounding;
+        c.shape.kind = collision::ShapeKind::Polygon;
+        c.shape.polygon = &polygon;
+        c.centreOfMass = props.centroid;
+    } else if (const Capsule* cap = reg.tryGet<Capsule>(e)) {
+        // About the centre of mass, like polygons: the segment's
+        // midpoint, kept as the offset (exactly zero for a capsule
+        // centred on its position, which then takes the plain path).
+        const Vec2 mid = 0.5 * (cap->a + cap->b);
+        c.shape.kind = collision::ShapeKind::Capsule;
+        c.shape.radius = cap->radius;
+        c.shape.halfExtents = 0.5 * (cap->b - cap->a);
+        c.centreOfMass = mid;
+    } else if (reg.has<Chain>(e)) {
+        c.shape.kind = collision::ShapeKind::ChainSegment;  // one collider per segment, below
+    } else if (const Plane* p = reg.tryGet<Plane>(e)) {
+        c.shape.kind = collision::ShapeKind::Plane;
+        c.shape.normal = p->normal;
+        c.shape.offset = p->offset;
+    } else {
+        return;  // no shape: never collides
+    }
+    const std::uint32_t body = c.shape.kind == collision::ShapeKind::Plane ? noBody : bodyOf(e);
+    c.body = body == noBody ? -1 : std::int32_t(body);
+    if (const Position* p = reg.tryGet<Position>(e)) c.staticPosition = p->value;
+    c.kinematic = c.body >= 0 && reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value;
+    c.mass = c.body >= 0 && !c.kinematic ? (reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0) : 0.0;
+    c.restitution = reg.has<Restitution>(e) ? reg.tryGet<Restitution>(e)->value : Restitution{}.value;
+    c.friction = reg.has<Friction>(e) ? reg.tryGet<Friction>(e)->value : Friction{}.value;
+    c.sensor = reg.has<Sensor>(e) && reg.tryGet<Sensor>(e)->value;
+    c.entity = e;
+    collision::CollisionSystem::ColliderAdd add;
+    add.angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
+    add.angularVelocity = reg.has<AngularVelocity>(e) ? reg.tryGet<AngularVelocity>(e)->value : 0.0;
+    const Filter* filter = reg.tryGet<Filter>(e);
+    add.filter = filter ? *filter : Filter{};
+    if (c.shape.kind != collision::ShapeKind::ChainSegment) {
+        add.collider = c;
+        out.push_back(add);
+        return;
+    }
+    // Each segment is a collider and a broad-phase proxy of its own (a long
+    // terrain is not one huge box), in order, so segment k is the chain's
+    // first collider plus k.
+    const Chain& chain = *reg.tryGet<Chain>(e);
+    const std::vector<Vec2>& pts = chain.points;
+    const std::size_t n = pts.size(), segments = chain.loop ? n : n - 1;
+    for (std::size_t k = 0; k < segments; ++k) {
+        collision::ChainSegment& seg = storage.segments.emplace_back();
+        seg.index = std::uint32_t(k);
+        seg.p1 = pts[k];
+        seg.p2 = pts[(k + 1) % n];
+        // An open end's ghost lies straight behind the segment: the end is
+        // a square corner.
+        const Vec2 d = seg.p2 - seg.p1;
+        const Vec2 behind{-d.y, d.x};  // the left of the segment, as long as it
+        seg.open1 = !chain.loop && k == 0;
+        seg.open2 = !chain.loop && k + 1 == segments;
+        seg.ghost1 = seg.open1 ? seg.p1 + behind : pts[(k + n - 1) % n];
+        seg.ghost2 = seg.open2 ? seg.p2 + behind : pts[(k + 2) % n];
+        add.collider = c;
+        add.collider.shape.segment = &seg;
+        out.push_back(add);
+    }
+}
+
+bool fillJointParams(const Joint& joint, joints::JointConstraint& j) {
+    j.kind = jointKindOf(joint.type);
+    if (joint.axis) {
+        const double len = std::hypot(joint.axis->x, joint.axis->y);
+        if (!(len > 1e-12)) return false;
+        j.localAxis = *joint.axis / len;
+    }
+    j.referenceAngle = joint.referenceAngle.value_or(0.0);
+    j.hasLower = joint.lower.has_value();
+    j.hasUpper = joint.upper.has_value();
+    j.lower = joint.lower.value_or(0.0);
+    j.upper = joint.upper.value_or(0.0);
+    const std::optional<double>& maxMotor = j.kind == joints::JointKind::Slider ? joint.maxMotorForce
+                                                                                : joint.maxMotorTorque;
+    j.motor = maxMotor.has_value() && (j.kind == joints::JointKind::Hinge || j.kind == joints::JointKind::Slider ||
+                                       j.kind == joints::JointKind::Wheel);
+    j.maxMotor = maxMotor.value_or(0.0);
+    j.motorSpeed = joint.motorSpeed.value_or(0.0);
+    j.length = joint.length.value_or(0.0);
+    j.stiffnessHz = joint.stiffnessHz.value_or(0.0);
+    j.dampingRatio = joint.dampingRatio.value_or(1.0);
+    if (j.kind == joints::JointKind::Hinge) {
+        j.springHz = joint.springHz.value_or(0.0);
+        j.springDampingRatio = joint.springDampingRatio.value_or(1.0);
+    }
+    j.spring = (j.kind == joints::JointKind::Hinge && j.springHz > 0.0) ||
+               (j.kind == joints::JointKind::Wheel && j.stiffnessHz > 0.0);
+    j.maxForce = joint.maxForce.value_or(0.0);
+    return true;
+}
 
 std::unique_ptr<collision::CollisionSystem> buildCollisions(
     const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, bool shapes,
@@ -149,100 +270,23 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         system = std::make_unique<collision::CollisionSystem>();
         system->settings().iterations = scene.world.solverIterations;
     };
-    collision::ConvexPolygon polygon;  // copied by add()
+    ShapeStorage storage;
+    std::vector<collision::CollisionSystem::ColliderAdd> adds;
     static const std::vector<Entity> kNoEntities;
     for (const Entity e : shapes ? reg.entities() : kNoEntities) {
-        if (const Shapes* compound = reg.tryGet<Shapes>(e)) {
-            makeSystem();
-            addCompoundBody(reg, e, *compound, bodyOf, noBody, *system, colliderOf);
-            continue;
-        }
-        collision::Collider c;
-        if (const Radius* r = reg.tryGet<Radius>(e)) {
-            c.shape.kind = collision::ShapeKind::Circle;
-            c.shape.radius = r->value;
-        } else if (const Box* b = reg.tryGet<Box>(e)) {
-            c.shape.kind = collision::ShapeKind::Box;
-            c.shape.halfExtents = {0.5 * b->width, 0.5 * b->height};
-        } else if (const Polygon* poly = reg.tryGet<Polygon>(e)) {
-            // The engine works about the centre of mass: the outline is
-            // shifted so the centroid is its origin, and the offset kept.
-            const double rounding = poly->radius.value_or(0.0);
-            const PolygonMassProperties props = rounding > 0.0 ? polygonMassProperties(poly->vertices, rounding)
-                                                               : polygonMassProperties(poly->vertices);
-            Vec2 local[collision::kMaxPolygonVertices];
-            const int count = int(poly->vertices.size());
-            for (int i = 0; i < count; ++i) local[i] = poly->vertices[std::size_t(i)] - props.centroid;
-            polygon = collision::ConvexPolygon::fromVertices(local, count);
-            polygon.cornerRadius = rounding;
-            c.shape.kind = collision::ShapeKind::Polygon;
-            c.shape.polygon = &polygon;
-            c.centreOfMass = props.centroid;
-        } else if (const Capsule* cap = reg.tryGet<Capsule>(e)) {
-            // About the centre of mass, like polygons: the segment's
-            // midpoint, kept as the offset (exactly zero for a capsule
-            // centred on its position, which then takes the plain path).
-            const Vec2 mid = 0.5 * (cap->a + cap->b);
-            c.shape.kind = collision::ShapeKind::Capsule;
-            c.shape.radius = cap->radius;
-            c.shape.halfExtents = 0.5 * (cap->b - cap->a);
-            c.centreOfMass = mid;
-        } else if (reg.has<Chain>(e)) {
-            c.shape.kind = collision::ShapeKind::ChainSegment;  // one collider per segment, below
-        } else if (const Plane* p = reg.tryGet<Plane>(e)) {
-            c.shape.kind = collision::ShapeKind::Plane;
-            c.shape.normal = p->normal;
-            c.shape.offset = p->offset;
-        } else {
-            continue;  // no shape: never collides, costs the collision stages nothing
-        }
-        const std::uint32_t body = c.shape.kind == collision::ShapeKind::Plane ? noBody : bodyOf(e);
-        c.body = body == noBody ? -1 : std::int32_t(body);
-        if (const Position* p = reg.tryGet<Position>(e)) c.staticPosition = p->value;
-        c.kinematic = c.body >= 0 && reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value;
-        c.mass = c.body >= 0 && !c.kinematic ? (reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value : 1.0) : 0.0;
-        c.restitution = reg.has<Restitution>(e) ? reg.tryGet<Restitution>(e)->value : Restitution{}.value;
-        c.friction = reg.has<Friction>(e) ? reg.tryGet<Friction>(e)->value : Friction{}.value;
-        c.sensor = reg.has<Sensor>(e) && reg.tryGet<Sensor>(e)->value;
-        c.entity = e;
-        const double angle = reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0;
-        const double spin = reg.has<AngularVelocity>(e) ? reg.tryGet<AngularVelocity>(e)->value : 0.0;
+        if (inTemplate(reg, e)) continue;  // a prefab: never collides
+        adds.clear();
+        collidersFor(reg, e, bodyOf, noBody, storage, adds);
+        if (adds.empty()) continue;  // no shape: never collides, costs the collision stages nothing
         makeSystem();
-        colliderOf.emplace(e.index, std::int32_t(system->colliderCount()));
-        const Filter* filter = reg.tryGet<Filter>(e);
-        if (c.shape.kind == collision::ShapeKind::ChainSegment) {
-            // Each segment is a collider and a broad-phase proxy of its own
-            // (a long terrain is not one huge box), in order, so segment k
-            // is the chain's first collider plus k.
-            const Chain& chain = *reg.tryGet<Chain>(e);
-            const std::vector<Vec2>& pts = chain.points;
-            const std::size_t n = pts.size(), segments = chain.loop ? n : n - 1;
-            for (std::size_t k = 0; k < segments; ++k) {
-                collision::ChainSegment s;
-                s.index = std::uint32_t(k);
-                s.p1 = pts[k];
-                s.p2 = pts[(k + 1) % n];
-                // An open end's ghost lies straight behind the segment: the
-                // end is a square corner.
-                const Vec2 d = s.p2 - s.p1;
-                const Vec2 behind{-d.y, d.x};  // the left of the segment, as long as it
-                s.open1 = !chain.loop && k == 0;
-                s.open2 = !chain.loop && k + 1 == segments;
-                s.ghost1 = s.open1 ? s.p1 + behind : pts[(k + n - 1) % n];
-                s.ghost2 = s.open2 ? s.p2 + behind : pts[(k + 2) % n];
-                c.shape.segment = &s;
-                system->add(c, angle, spin, filter ? *filter : Filter{});
-            }
-            continue;
-        }
-        system->add(c, angle, spin, filter ? *filter : Filter{});
+        colliderOf.emplace(e.index, std::int32_t(system->addAll(adds)));
     }
 
     // Joints, in scene order.
     const auto& order = reg.entities();
     for (std::size_t i = 0; i < order.size(); ++i) {
         const Joint* stored = reg.tryGet<Joint>(order[i]);
-        if (!stored) continue;
+        if (!stored || inTemplate(reg, order[i])) continue;
         // A scene built in code may leave anchor, reference_angle or length
         // to their defaults; the loader has already filled them for files
         // and refused what cannot be filled, so a refusal here leaves the
@@ -251,7 +295,6 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
         (void)completeJoint(reg, completed);
         const Joint* joint = &completed;
         joints::JointConstraint j;
-        j.kind = jointKindOf(joint->type);
         j.entity = order[i];
         j.entityA = joint->a;
         j.entityB = joint->b;
@@ -305,35 +348,10 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
             if (problem) *problem = labelOf(reg, i) + ": joint joins two static bodies; at least one end must be dynamic";
             return nullptr;
         }
-        if (joint->axis) {
-            const double len = std::hypot(joint->axis->x, joint->axis->y);
-            if (!(len > 1e-12)) {
-                if (problem) *problem = labelOf(reg, i) + ": joint axis: a slider axis needs a non-zero length";
-                return nullptr;
-            }
-            j.localAxis = *joint->axis / len;
+        if (!fillJointParams(*joint, j)) {
+            if (problem) *problem = labelOf(reg, i) + ": joint axis: a slider axis needs a non-zero length";
+            return nullptr;
         }
-        j.referenceAngle = joint->referenceAngle.value_or(0.0);
-        j.hasLower = joint->lower.has_value();
-        j.hasUpper = joint->upper.has_value();
-        j.lower = joint->lower.value_or(0.0);
-        j.upper = joint->upper.value_or(0.0);
-        const std::optional<double>& maxMotor = j.kind == joints::JointKind::Slider ? joint->maxMotorForce
-                                                                                    : joint->maxMotorTorque;
-        j.motor = maxMotor.has_value() && (j.kind == joints::JointKind::Hinge || j.kind == joints::JointKind::Slider ||
-                                           j.kind == joints::JointKind::Wheel);
-        j.maxMotor = maxMotor.value_or(0.0);
-        j.motorSpeed = joint->motorSpeed.value_or(0.0);
-        j.length = joint->length.value_or(0.0);
-        j.stiffnessHz = joint->stiffnessHz.value_or(0.0);
-        j.dampingRatio = joint->dampingRatio.value_or(1.0);
-        if (j.kind == joints::JointKind::Hinge) {
-            j.springHz = joint->springHz.value_or(0.0);
-            j.springDampingRatio = joint->springDampingRatio.value_or(1.0);
-        }
-        j.spring = (j.kind == joints::JointKind::Hinge && j.springHz > 0.0) ||
-                   (j.kind == joints::JointKind::Wheel && j.stiffnessHz > 0.0);
-        j.maxForce = joint->maxForce.value_or(0.0);
         makeSystem();
         system->addJoint(j, filter[0], filter[1], joint->collideConnected);
     }
@@ -457,7 +475,7 @@ double springRate(const Scene& scene, const SystemSwitches& switches) {
         return 0.0;
     const Registry& reg = scene.registry;
     const auto dynamicMass = [&](Entity e) -> double {
-        if (e.isNull() || !reg.alive(e) || !reg.has<Position>(e)) return 0.0;
+        if (e.isNull() || !reg.alive(e) || !reg.has<Position>(e) || detail::emittedOrTemplate(reg, e)) return 0.0;
         if (const Static* st = reg.tryGet<Static>(e); st && st->value) return 0.0;
         if (const Kinematic* k = reg.tryGet<Kinematic>(e); k && k->value) return 0.0;
         if (reg.has<Mass>(e)) return reg.tryGet<Mass>(e)->value;
@@ -542,7 +560,11 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         return switches.collisions && (reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) ||
                                        reg.has<Capsule>(e) || reg.has<Shapes>(e));
     };
-    const auto dynamic = [&](Entity e) { return reg.alive(e) && reg.has<Position>(e) && !isStatic(e); };
+    // Templates, an emitter's copies and shapeless emitters are left out:
+    // the choice is the scene's as written, whatever copies a run has made.
+    const auto dynamic = [&](Entity e) {
+        return reg.alive(e) && reg.has<Position>(e) && !isStatic(e) && !detail::emittedOrTemplate(reg, e);
+    };
     const auto massOf = [&](Entity e) {
         if (reg.has<Mass>(e)) return reg.tryGet<Mass>(e)->value;
         const Shapes* shapes = reg.tryGet<Shapes>(e);

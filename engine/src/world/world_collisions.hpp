@@ -7,6 +7,7 @@
 #include "stepwise/scene.hpp"
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
@@ -27,6 +28,23 @@ namespace stepwise::detail {
 std::unique_ptr<collision::CollisionSystem> buildCollisions(
     const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, bool shapes = true,
     std::string* problem = nullptr);
+
+/// Where the outlines and chain segments of colliders about to be added
+/// live: CollisionSystem::add copies them, so they only need to outlast that.
+struct ShapeStorage {
+    std::deque<collision::ConvexPolygon> polygons;
+    std::deque<collision::ChainSegment> segments;
+};
+/// Appends the colliders of entity `e` as World::build makes them (its
+/// shape, body, material, rotation and filter): none without a shape, one
+/// per segment of a chain, and for a compound body a hub (when it moves)
+/// and one per shape, whose `hub` is the hub's place in `out`
+/// (CollisionSystem::addAll).
+void collidersFor(const Registry& reg, Entity e, const std::function<std::uint32_t(Entity)>& bodyOf,
+                  std::uint32_t noBody, ShapeStorage& storage, std::vector<collision::CollisionSystem::ColliderAdd>& out);
+/// A joint's kind, limits, motor, springs and breaking force from its
+/// component; false when a slider axis has no length.
+bool fillJointParams(const Joint& joint, joints::JointConstraint& j);
 
 /// A dynamic body held by a joint but without a shape turns like a solid
 /// disc of this radius (I = m r^2 / 2), metres: a point mass (I = 0) could

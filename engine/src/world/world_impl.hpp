@@ -9,8 +9,11 @@
 #include "stepwise/world.hpp"
 
 #include <chrono>
+#include <deque>
 #include <memory>
+#include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace stepwise {
@@ -20,6 +23,26 @@ namespace detail {
 /// messages name an entity, by its place in the scene's order.
 std::string entityLabel(std::size_t index, const std::string* name);
 } // namespace detail
+
+/// How many Worlds World::build has made in this process: the tests check
+/// that emitting and removing copies builds none.
+std::uint64_t worldBuildCount();
+
+class WorldImpl;
+/// The emitters of `scene` into `w` (after its bodies and collisions): their
+/// templates, run state and the run's registry. Nothing without emitters.
+std::optional<Error> compileEmitters(const Scene& scene, WorldImpl& w);
+
+/// One emitter as the run has it (docs/format.md, "Templates and emitters").
+struct EmitterRun {
+    Entity entity;
+    std::uint32_t body = 0xFFFFFFFFu;  ///< state index when the emitter is a dynamic body (it has a shape)
+    Vec2 position;                     ///< where it is when it is not a dynamic body
+    Emitter params;                    ///< the component; its run state (next, emitted, alive, oldest) kept current
+    std::vector<Entity> members;       ///< the template's entities in the run's registry, scene order
+    std::uint64_t key = 0;             ///< detail::emitterKey
+    std::deque<std::vector<Entity>> copies;  ///< the copies alive, oldest first, each its entities in scene order
+};
 
 class WorldImpl {
 public:
@@ -85,6 +108,34 @@ public:
     bool profiling = true;
     /// Entities of the state arrays (saveState/restoreState); set by build.
     std::shared_ptr<const WorldLayout> layout;
+
+    /// Emitters (empty in a level without one) and the run's own registry:
+    /// the scene as built plus the copies the emitters made, minus those
+    /// they removed, with the same entity handles (writeBack creates and
+    /// destroys the copies in the scene under them). Shared with the
+    /// snapshots that hold it; cloned before a change while one does.
+    std::vector<EmitterRun> emitters;
+    std::vector<EmitterEvent> emitterEvents;  ///< of the last step
+    std::shared_ptr<Registry> registry;
+    SystemSwitches switches;  ///< what build left out; copies are compiled the same way
+    WorldSettings sceneWorld;
+    std::uint64_t run = 0;  ///< WorldLayout::run  ///< the world settings of the scene built from (restoreState's rebuild)
+    /// Entity index -> state index of every dynamic body, kNoBody for the
+    /// other slots (kept with emitters only).
+    std::vector<std::uint32_t> bodyOfSlot;
+    /// Emissions and removals due at the start of a step (time + dt/2 past
+    /// their time), applied in place: changeBodies.
+    void runEmitters();
+    /// Takes the bodies of `removed` (with their shapes, joints and springs)
+    /// out of every array in place and appends those of `added` (entities
+    /// of `registry`, scene order), so the arrays are what World::build would
+    /// make of the scene as it now is; every other body's state and warm
+    /// start stay.
+    void changeBodies(const std::vector<Entity>& removed, const std::vector<Entity>& added);
+    /// The layout of the arrays as they are now.
+    std::shared_ptr<const WorldLayout> makeLayout() const;
+    /// The names activeSystems() reports, in pipeline order.
+    void listActiveSystems();
 
     /// Sleeping islands (world/islands.hpp) and, per body, its collider
     /// (-1: none).

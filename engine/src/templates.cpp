@@ -1,0 +1,96 @@
+#include "templates.hpp"
+
+#include "stepwise/component_table.hpp"
+
+#include <cmath>
+#include <optional>
+
+namespace stepwise::detail {
+
+const std::string* templateOf(const Registry& reg, Entity e) {
+    if (const Template* t = reg.tryGet<Template>(e)) return &t->value;
+    Entity end;
+    if (const Joint* j = reg.tryGet<Joint>(e)) end = j->a;
+    else if (const Spring* s = reg.tryGet<Spring>(e)) end = s->a;
+    if (end.isNull()) return nullptr;
+    const Template* t = reg.tryGet<Template>(end);
+    return t ? &t->value : nullptr;
+}
+
+bool isEmittedCopy(const Registry& reg, Entity e) {
+    const Name* name = reg.tryGet<Name>(e);
+    if (!name) return false;
+    const std::size_t hash = name->value.find('#');
+    if (hash == std::string::npos || hash == 0) return false;
+    const std::string_view prefix(name->value.data(), hash);
+    if (reg.count<Template>() == 0) return false;
+    bool found = false;
+    reg.each<Template>([&](Entity, const Template& t) { found = found || t.value == prefix; });
+    return found;
+}
+
+namespace {
+
+void copyField(const FieldInfo& field, const void* src, void* dst) {
+    void* from = field.address(const_cast<void*>(src));
+    void* to = field.address(dst);
+    switch (field.kind) {
+    case FieldKind::Number: *static_cast<double*>(to) = *static_cast<const double*>(from); break;
+    case FieldKind::Integer: *static_cast<int*>(to) = *static_cast<const int*>(from); break;
+    case FieldKind::Bits: *static_cast<std::uint32_t*>(to) = *static_cast<const std::uint32_t*>(from); break;
+    case FieldKind::OptionalNumber:
+        *static_cast<std::optional<double>*>(to) = *static_cast<const std::optional<double>*>(from);
+        break;
+    case FieldKind::Vector: *static_cast<Vec2*>(to) = *static_cast<const Vec2*>(from); break;
+    case FieldKind::OptionalVector:
+        *static_cast<std::optional<Vec2>*>(to) = *static_cast<const std::optional<Vec2>*>(from);
+        break;
+    case FieldKind::Color: *static_cast<Rgb*>(to) = *static_cast<const Rgb*>(from); break;
+    case FieldKind::Bool: *static_cast<bool*>(to) = *static_cast<const bool*>(from); break;
+    case FieldKind::VectorList:
+        *static_cast<std::vector<Vec2>*>(to) = *static_cast<const std::vector<Vec2>*>(from);
+        break;
+    case FieldKind::String: *static_cast<std::string*>(to) = *static_cast<const std::string*>(from); break;
+    case FieldKind::EntityRef: *static_cast<Entity*>(to) = *static_cast<const Entity*>(from); break;
+    }
+}
+
+std::uint64_t splitMix64(std::uint64_t z) {
+    z += 0x9E3779B97F4A7C15ull;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+} // namespace
+
+void copyComponents(const Registry& src, Entity from, Registry& dst, Entity to) {
+    for (const ComponentInfo& info : componentTable()) {
+        const void* c = info.getConst(src, from);
+        if (!c) continue;
+        void* d = info.emplaceDefault(dst, to);
+        for (const FieldInfo& f : info.fields) copyField(f, c, d);
+    }
+}
+
+double emitterTurn(int seed, std::uint64_t key, int number, double spread) {
+    if (spread == 0.0) return 0.0;
+    const std::uint64_t bits =
+        splitMix64(splitMix64(splitMix64(std::uint64_t(std::uint32_t(seed))) ^ key) ^ std::uint64_t(std::uint32_t(number)));
+    // 53 random bits: u in [0, 1), then a uniform angle in [-spread, spread).
+    const double u = double(bits >> 11) * 0x1.0p-53;
+    return spread * (2.0 * u - 1.0);
+}
+
+std::uint64_t emitterKey(const Registry& reg, Entity emitter, std::size_t sceneIndex) {
+    const Name* name = reg.tryGet<Name>(emitter);
+    if (!name || name->value.empty()) return splitMix64(sceneIndex);
+    std::uint64_t h = 0xCBF29CE484222325ull;  // FNV-1a
+    for (const char c : name->value) {
+        h ^= std::uint8_t(c);
+        h *= 0x100000001B3ull;
+    }
+    return h;
+}
+
+} // namespace stepwise::detail

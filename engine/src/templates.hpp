@@ -1,0 +1,52 @@
+#pragma once
+// Templates and emitters (docs/format.md, "Templates and emitters"): which
+// entities are prefabs, which are an emitter's copies, and how a copy is
+// made. The loader's checks, World::build and the emitters share these, so
+// every part agrees on what a template holds.
+
+#include "stepwise/components.hpp"
+#include "stepwise/registry.hpp"
+
+#include <cstdint>
+#include <string>
+
+namespace stepwise::detail {
+
+/// The template `e` belongs to, or nullptr: its own `template` component,
+/// or, for a joint or spring without one, the template of its first end
+/// (the loader refuses a joint or spring whose ends are in different
+/// templates, or in one and outside it).
+const std::string* templateOf(const Registry& reg, Entity e);
+
+/// Whether `e` is part of a template (never simulated).
+inline bool inTemplate(const Registry& reg, Entity e) { return templateOf(reg, e) != nullptr; }
+
+/// Whether `e` is an emitter's copy: named "TEMPLATE#N" or "TEMPLATE#N/..."
+/// with TEMPLATE the value of some entity's `template`. What the engine
+/// chooses from the scene's structure (substeps) leaves copies out, so a
+/// resumed run chooses what the run that saved it chose.
+bool isEmittedCopy(const Registry& reg, Entity e);
+
+/// Not a body of the scene as written: part of a template, an emitter's
+/// copy, or an emitter without a shape (a point in the world).
+inline bool emittedOrTemplate(const Registry& reg, Entity e) {
+    if (reg.count<Template>() == 0) return false;
+    if (reg.has<Emitter>(e) && !reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) && !reg.has<Capsule>(e))
+        return true;
+    return inTemplate(reg, e) || isEmittedCopy(reg, e);
+}
+
+/// Copies every component of `from` (in `src`) onto `to` (in `dst`), field
+/// by field; entity references are copied as they are.
+void copyComponents(const Registry& src, Entity from, Registry& dst, Entity to);
+
+/// The random turn of copy `number` of an emitter: a uniform angle in
+/// [-spread, spread] from (world seed, emitter key, number) alone, so a
+/// resumed run draws what the long run drew without carrying a generator.
+double emitterTurn(int seed, std::uint64_t emitterKey, int number, double spread);
+
+/// The emitter's key: a hash of its name (its place in the scene when it
+/// has none), stable across save and load.
+std::uint64_t emitterKey(const Registry& reg, Entity emitter, std::size_t sceneIndex);
+
+} // namespace stepwise::detail

@@ -1,0 +1,609 @@
+// Templates and emitters: copies of a prefab added and removed while a World
+// runs, in place (no World is built for them), on exact times, with their
+// joints and springs, a seeded spread, and a save that resumes bit for bit.
+#include "test_support.hpp"
+
+#include "world/world_internals.hpp"
+
+#include "stepwise/components.hpp"
+#include "stepwise/scene_io.hpp"
+#include "stepwise/world.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <unordered_set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace stepwise;
+using namespace stepwise::test;
+
+namespace {
+
+std::string refusal(const std::string& text) {
+    Result<Scene> scene = parseScene(text, "t.json");
+    return scene ? std::string("(loaded)") : scene.error();
+}
+
+/// A level with one ball template `drop` and an emitter at (0, 5). `emitter`
+/// is the emitter's JSON fields after "template"; `world` the world's.
+std::string ballLevel(const std::string& emitter, const std::string& world = R"("gravity": {"x": 0, "y": 0})") {
+    return R"({"world": {)" + world + R"(},
+      "entities": [
+        {"name": "proto", "template": "drop", "position": {"x": 40, "y": 40}, "radius": 0.1, "mass": 2},
+        {"name": "spout", "position": {"x": 0, "y": 5}, "emitter": {"template": "drop", )" + emitter + R"(}}
+      ]})";
+}
+
+/// Names of the emitted copies alive, in scene order, as a save writes them.
+std::vector<std::string> copiesAlive(const World& world, Scene scene) {
+    world.writeBack(scene);
+    std::vector<std::string> out;
+    for (const Entity e : scene.registry.entities())
+        if (const Name* n = scene.registry.tryGet<Name>(e); n && n->value.find('#') != std::string::npos)
+            out.push_back(n->value);
+    return out;
+}
+
+std::string ragdollLevel(int substeps, int count, const std::string& lifetime = "", int seed = 0) {
+    std::ostringstream s;
+    s << R"({"world": {"gravity": {"x": 0, "y": -9.81}, "dt": 0.016666666666666666)";
+    if (substeps > 0) s << R"(, "substeps": )" << substeps;
+    if (seed != 0) s << R"(, "seed": )" << seed;
+    s << R"(},
+      "entities": [
+        {"name": "ground", "position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 12, "height": 1},
+         "friction": 0.6},
+        {"name": "wall_l", "position": {"x": -6, "y": 3}, "static": true, "box": {"width": 0.4, "height": 8}},
+        {"name": "wall_r", "position": {"x": 6, "y": 3}, "static": true, "box": {"width": 0.4, "height": 8}},
+        {"name": "torso", "template": "doll", "position": {"x": 20, "y": 20}, "capsule": {"a": {"x": 0, "y": -0.3},
+         "b": {"x": 0, "y": 0.3}, "radius": 0.15}, "mass": 2},
+        {"name": "head", "template": "doll", "position": {"x": 20, "y": 20.65}, "radius": 0.15, "mass": 0.5,
+         "filter": {"category": 1, "mask": 4294967295, "group": -1}},
+        {"name": "leg", "template": "doll", "position": {"x": 20, "y": 19.3}, "capsule": {"a": {"x": 0, "y": -0.25},
+         "b": {"x": 0, "y": 0.25}, "radius": 0.1}, "mass": 1, "filter": {"category": 1, "mask": 4294967295, "group": -1}},
+        {"name": "neck", "joint": {"type": "hinge", "a": "torso", "b": "head", "anchor": {"x": 20, "y": 20.45},
+         "spring_hz": 2, "spring_damping_ratio": 0.7}},
+        {"name": "hip", "joint": {"type": "hinge", "a": "torso", "b": "leg", "anchor": {"x": 20, "y": 19.6},
+         "lower": -1, "upper": 1}},
+        {"name": "tie", "spring": {"a": "head", "b": "leg", "k": 5, "damping": 0.5}},
+        {"name": "hatch", "position": {"x": 0, "y": 6}, "emitter": {"template": "doll", "interval": 0.5, "count": )"
+      << count << R"(, "velocity": {"x": 1, "y": 0}, "spread": 0.8)" << lifetime << R"(}}
+      ]})";
+    return s.str();
+}
+
+} // namespace
+
+TEST(Emitters, ACopyAppearsEveryIntervalUpToCountAndTheOldestGoesFirst) {
+    // Intervals of 1, 3 and 30 steps and counts 1, 2 and 4: copy k (from 1)
+    // appears at the start of step (k - 1) * interval + 1; while `count` are
+    // alive the oldest leaves as the next one comes; names count on.
+    const double dt = 1.0 / 60.0;
+    for (const int every : {1, 3, 30})
+        for (const int count : {1, 2, 4}) {
+            SCOPED_TRACE("every " + std::to_string(every) + " steps, count " + std::to_string(count));
+            const Scene scene = parseLevel(ballLevel(R"("interval": )" + exactNumber(every * dt) + R"(, "count": )" +
+                                                     std::to_string(count) + R"(, "velocity": {"x": 3, "y": 0})"));
+            World world = buildWorld(scene);
+            EXPECT_EQ(world.bodyCount(), 0u);
+            for (int step = 1; step <= 4 * every * count + 5; ++step) {
+                ASSERT_TRUE(world.step());
+                const int emitted = (step - 1) / every + 1;
+                const int alive = std::min(emitted, count);
+                ASSERT_EQ(world.bodyCount(), std::size_t(alive)) << "step " << step;
+                if (step % every == 0 || step < 3) {
+                    std::vector<std::string> expected;
+                    for (int k = emitted - alive + 1; k <= emitted; ++k) expected.push_back("drop#" + std::to_string(k));
+                    ASSERT_EQ(copiesAlive(world, scene), expected) << "step " << step;
+                }
+            }
+        }
+}
+
+TEST(Emitters, AnIntervalThatIsNoWholeNumberOfStepsEmitsAtTheFirstStepWithinHalfAStep) {
+    // dt 0.125 s, interval 0.31 s: copy k (from 0) is due at 0.31 k and
+    // appears at the first step that starts at or after 0.31 k - dt / 2.
+    const Scene scene = parseLevel(
+        ballLevel(R"("interval": 0.31, "count": 100, "velocity": {"x": 3, "y": 0})", R"("gravity": {"x": 0, "y": 0}, "dt": 0.125)"));
+    World world = buildWorld(scene);
+    std::vector<int> appeared;
+    std::size_t before = 0;
+    for (int step = 1; step <= 20; ++step) {
+        ASSERT_TRUE(world.step());
+        for (std::size_t k = before; k < world.bodyCount(); ++k) appeared.push_back(step);
+        before = world.bodyCount();
+    }
+    // (s - 1) * 0.125 >= 0.31 k - 0.0625: s = ceil(2.48 k - 0.5) + 1.
+    EXPECT_EQ(appeared, (std::vector<int>{1, 3, 6, 8, 11, 13, 16, 18}));
+}
+
+TEST(Emitters, ALifetimeRemovesEachCopyThatLongAfterItAppeared) {
+    // Interval 10 steps; lifetimes of 5, 25 and 40 steps (40 > count *
+    // interval: then count removes them first). Copy k appears at step
+    // 10 (k - 1) + 1 and leaves at the first step that starts at or after
+    // its time plus the lifetime.
+    const double dt = 1.0 / 60.0;
+    for (const int life : {5, 25, 40}) {
+        SCOPED_TRACE("lifetime " + std::to_string(life) + " steps");
+        const Scene scene = parseLevel(ballLevel(R"("interval": )" + exactNumber(10 * dt) + R"(, "count": 3, "lifetime": )" +
+                                                 exactNumber(life * dt) + R"(, "velocity": {"x": 3, "y": 0})"));
+        World world = buildWorld(scene);
+        for (int step = 1; step <= 200; ++step) {
+            ASSERT_TRUE(world.step());
+            int alive = 0;
+            for (int k = 1; 10 * (k - 1) + 1 <= step; ++k) {
+                const int born = 10 * (k - 1) + 1, gone = born + life;
+                const int pushedOut = 10 * (k + 3 - 1) + 1;  // when copy k + 3 arrives with 3 alive
+                if (step < gone && step < pushedOut) ++alive;
+            }
+            ASSERT_EQ(world.bodyCount(), std::size_t(alive)) << "step " << step;
+        }
+    }
+}
+
+TEST(Emitters, CopiesCarryTheTemplatesJointsAndSprings) {
+    // The doll: three bodies, two hinges (one with a spring, one with
+    // limits) and a spring. Every copy alive holds its own joints and
+    // spring, its hinges stay closed, and what is removed takes its
+    // joints and spring along.
+    const Scene scene = parseLevel(ragdollLevel(4, 3));
+    World world = buildWorld(scene);
+    const WorldImpl& w = internals(world);
+    for (int step = 1; step <= 360; ++step) {
+        ASSERT_TRUE(world.step());
+        const std::size_t copies = world.bodyCount() / 3;
+        ASSERT_EQ(world.bodyCount(), 3 * copies);
+        ASSERT_EQ(world.joints().size(), 2 * copies) << "step " << step;
+        ASSERT_EQ(w.model.springs.size(), copies) << "step " << step;
+        for (const JointRecord& j : world.joints()) ASSERT_LT(j.separation, 5e-3) << "step " << step;
+        for (const detail::SpringData& s : w.model.springs) {
+            // Both ends of each spring in the same copy: adjacent bodies.
+            ASSERT_NE(s.b, detail::kNoBody);
+            ASSERT_EQ(s.a / 3, s.b / 3);
+        }
+    }
+    EXPECT_EQ(world.bodyCount(), 9u);
+    // The copies' names: the first body is the copy's own name.
+    const std::vector<std::string> names = copiesAlive(world, scene);
+    EXPECT_NE(std::find(names.begin(), names.end(), "doll#12"), names.end());
+    EXPECT_NE(std::find(names.begin(), names.end(), "doll#12/head"), names.end());
+    EXPECT_NE(std::find(names.begin(), names.end(), "doll#12/neck"), names.end());
+    EXPECT_EQ(std::find(names.begin(), names.end(), "doll#9"), names.end());
+}
+
+TEST(Emitters, EachCopysVelocityIsTurnedWithinTheSpreadBySeed) {
+    // Zero gravity, nothing to hit: each copy keeps the velocity it got.
+    // Its direction is within +- spread of the emitter's, spread over the
+    // range; the same seed gives the same turns, another seed others.
+    const auto turns = [](int seed, double spread) {
+        const Scene scene = parseLevel(ballLevel(R"("interval": 0.1, "count": 50, "velocity": {"x": 4, "y": 0}, "spread": )" +
+                                                     exactNumber(spread),
+                                                 R"("gravity": {"x": 0, "y": 0}, "seed": )" + std::to_string(seed)));
+        World world = buildWorld(scene);
+        for (int step = 0; step < 240; ++step) EXPECT_TRUE(world.step());
+        std::vector<double> out;
+        for (std::size_t b = 0; b < world.bodyCount(); ++b) {
+            const Vec2 v = world.bodyVelocity(b);
+            EXPECT_NEAR(length(v), 4.0, 1e-12);
+            out.push_back(std::atan2(v.y, v.x));
+        }
+        return out;
+    };
+    for (const double spread : {0.05, 0.5, 3.0}) {
+        SCOPED_TRACE("spread " + std::to_string(spread));
+        const std::vector<double> a = turns(7, spread);
+        ASSERT_EQ(a.size(), 40u);
+        double lo = 1e9, hi = -1e9;
+        for (const double t : a) {
+            EXPECT_LE(std::abs(t), spread + 1e-12);
+            lo = std::min(lo, t);
+            hi = std::max(hi, t);
+        }
+        EXPECT_GT(hi - lo, 1.2 * spread);  // 40 uniform draws cover most of the 2 spread range
+        EXPECT_EQ(turns(7, spread), a);
+        const std::vector<double> b = turns(8, spread);
+        int same = 0;
+        for (std::size_t k = 0; k < a.size(); ++k) same += a[k] == b[k];
+        EXPECT_EQ(same, 0);
+    }
+    // No spread: every copy goes straight.
+    for (const double t : turns(3, 0.0)) EXPECT_EQ(t, 0.0);
+}
+
+TEST(Emitters, SaveLoadAndContinueIsBitIdenticalToRunningOn) {
+    // 600 steps straight against a save after `split` steps, a load and the
+    // rest, over split points on and around emissions (every 30 steps) and
+    // removals, at 1, 2 and 4 substeps and the engine's own choice, with
+    // and without a lifetime.
+    struct Case {
+        int substeps;
+        std::string lifetime, integrator;
+    };
+    std::vector<Case> cases;
+    for (const int substeps : {1, 2, 4, 0})
+        for (const std::string lifetime : {std::string(), std::string(R"(, "lifetime": 2.1)")})
+            cases.push_back({substeps, lifetime, "semi_implicit_euler"});
+    // The integrators whose scratch is sized by the bodies, or that carry a step.
+    for (const char* integrator : {"rk4", "velocity_verlet", "implicit_euler", "dopri5"})
+        cases.push_back({2, R"(, "lifetime": 2.1)", integrator});
+    for (const Case& c : cases) {
+        {
+            const int substeps = c.substeps;
+            const std::string& lifetime = c.lifetime;
+            SCOPED_TRACE("substeps " + std::to_string(substeps) + (lifetime.empty() ? "" : ", lifetime 2.1 s") + ", " +
+                         c.integrator);
+            Scene scene = parseLevel(ragdollLevel(substeps, 4, lifetime));
+            scene.world.integrator = c.integrator;
+            World straight = buildWorld(scene);
+            for (int s = 0; s < 600; ++s) ASSERT_TRUE(straight.step());
+            const std::string expected = savedRunText(straight, scene);
+            for (const int split : {1, 29, 30, 31, 121, 200, 451}) {
+                SCOPED_TRACE("split " + std::to_string(split));
+                Scene first = scene;
+                World world = buildWorld(first);
+                for (int s = 0; s < split; ++s) ASSERT_TRUE(world.step());
+                const std::string saved = savedRunText(world, first);
+                Scene resumed = parseLevel(saved);
+                EXPECT_EQ(sceneToJsonText(resumed).size(), saved.size());
+                World again = buildWorld(resumed);
+                for (int s = split; s < 600; ++s) ASSERT_TRUE(again.step());
+                ASSERT_EQ(savedRunText(again, resumed), expected);
+            }
+        }
+    }
+}
+
+TEST(Emitters, CopiesComeAndGoWithoutBuildingAWorld) {
+    const Scene scene = parseLevel(ragdollLevel(4, 3, R"(, "lifetime": 1.2)"));
+    World world = buildWorld(scene);
+    const std::uint64_t builds = worldBuildCount();
+    std::set<std::size_t> counts;
+    for (int s = 0; s < 600; ++s) {
+        ASSERT_TRUE(world.step());
+        counts.insert(world.bodyCount());
+    }
+    EXPECT_EQ(worldBuildCount(), builds);
+    EXPECT_EQ(counts, (std::set<std::size_t>{3, 6, 9}));
+}
+
+TEST(Emitters, TemplatesNeverMoveCollideOrCount) {
+    // The template doll sits inside the ground: were it simulated it would
+    // be pushed out. It is no body, has no contacts and no energy, and a
+    // save writes it as it was.
+    std::string level = ragdollLevel(4, 3);
+    for (const char* y : {"\"y\": 20}", "\"y\": 20.65}", "\"y\": 19.3}"}) {
+        const std::size_t at = level.find(std::string("\"x\": 20, ") + y);
+        ASSERT_NE(at, std::string::npos);
+        level.replace(at, std::string("\"x\": 20, ").size() + std::string(y).size(), "\"x\": 0, \"y\": -0.5}");
+    }
+    const Scene scene = parseLevel(level);
+    World world = buildWorld(scene);
+    EXPECT_EQ(world.bodyCount(), 0u);
+    EXPECT_EQ(world.energy().total(), 0.0);
+    std::unordered_set<Entity> templates;
+    for (const Entity e : scene.registry.entities())
+        if (scene.registry.has<Template>(e)) templates.insert(e);
+    ASSERT_EQ(templates.size(), 3u);
+    for (int s = 0; s < 300; ++s) {
+        ASSERT_TRUE(world.step());
+        for (const ContactRecord& c : world.contacts()) {
+            ASSERT_EQ(templates.count(c.a), 0u);
+            ASSERT_EQ(templates.count(c.b), 0u);
+        }
+        for (std::size_t b = 0; b < world.bodyCount(); ++b) ASSERT_EQ(templates.count(world.bodyEntity(b)), 0u);
+    }
+    Scene after = scene;
+    world.writeBack(after);
+    for (const Entity e : templates) {
+        EXPECT_EQ(after.registry.tryGet<Position>(e)->value, scene.registry.tryGet<Position>(e)->value);
+        EXPECT_FALSE(after.registry.has<Velocity>(e));
+    }
+}
+
+TEST(Emitters, TheArraysAStepWalksHoldTheCopiesAliveAndNothingElse) {
+    // What a step costs follows the copies alive: the state vector, the
+    // colliders, the joints and the springs hold exactly theirs (plus the
+    // three static walls), growing as copies come and shrinking as they
+    // go, never the copies made so far.
+    const Scene scene = parseLevel(ragdollLevel(2, 5, R"(, "lifetime": 1.6)"));
+    World world = buildWorld(scene);
+    const WorldImpl& w = internals(world);
+    std::size_t most = 0;
+    bool shrank = false;
+    std::size_t last = 0;
+    for (int s = 0; s < 900; ++s) {
+        ASSERT_TRUE(world.step());
+        const std::size_t copies = world.bodyCount() / 3;
+        ASSERT_EQ(w.model.n, 3 * copies);
+        ASSERT_EQ(w.xs() ? w.x[w.current].size() : 0, 6 * copies);
+        ASSERT_EQ(w.collision->colliderCount(), 3 + 3 * copies);
+        ASSERT_EQ(w.collision->jointConstraints().size(), 2 * copies);
+        ASSERT_EQ(w.model.springs.size(), copies);
+        ASSERT_LE(w.collision->warmStartCache().size(), 8 * (3 + 3 * copies));
+        most = std::max(most, copies);
+        shrank = shrank || copies < last;
+        last = copies;
+    }
+    EXPECT_EQ(most, 4u);  // a lifetime of 1.6 s keeps 4 of a copy every 0.5 s
+    EXPECT_TRUE(shrank);
+}
+
+TEST(Emitters, SnapshotsAcrossEmissionsRestoreExactlyWithOneBuildEach) {
+    // Step back across emissions and removals: a snapshot from before the
+    // copies changed is restored by building the World from the snapshot's
+    // own scene (one build, only then); one with the same copies in place.
+    // Either way the World steps on exactly as the one that took it.
+    const Scene scene = parseLevel(ragdollLevel(2, 2, R"(, "lifetime": 0.7)"));
+    for (const int at : {10, 25, 30, 31, 45, 61}) {
+        SCOPED_TRACE("snapshot at step " + std::to_string(at));
+        World world = buildWorld(scene);
+        for (int s = 0; s < at; ++s) ASSERT_TRUE(world.step());
+        const WorldState before = world.saveState();
+        World reference = buildWorld(scene);
+        for (int s = 0; s < at; ++s) ASSERT_TRUE(reference.step());
+        for (int s = 0; s < 40; ++s) ASSERT_TRUE(world.step());
+        const std::size_t copiesThen = reference.bodyCount(), copiesNow = world.bodyCount();
+        const std::uint64_t builds = worldBuildCount();
+        ASSERT_TRUE(world.restoreState(before));
+        EXPECT_EQ(world.bodyCount(), copiesThen);
+        // Another layout since: the one build; the same bodies: none. (The
+        // copies in place can be the same bodies with other copies between.)
+        EXPECT_LE(worldBuildCount() - builds, 1u);
+        if (copiesThen != copiesNow) EXPECT_EQ(worldBuildCount() - builds, 1u);
+        for (int s = 0; s < 100; ++s) {
+            ASSERT_TRUE(world.step());
+            ASSERT_TRUE(reference.step());
+        }
+        EXPECT_EQ(savedRunText(world, scene), savedRunText(reference, scene));
+    }
+    // A snapshot of another level is still refused.
+    World other = buildWorld(parseLevel(ragdollLevel(2, 3)));
+    World world = buildWorld(scene);
+    ASSERT_TRUE(other.step());
+    EXPECT_FALSE(world.restoreState(other.saveState()));
+}
+
+TEST(Emitters, RefusalsNameTheEmitterOrTemplate) {
+    const std::string ground = R"({"name": "ground", "position": {"x": 0, "y": 0}, "static": true, "box": {"width": 4, "height": 1}})";
+    const std::string proto = R"({"name": "proto", "template": "drop", "position": {"x": 9, "y": 9}, "radius": 0.1})";
+    const auto level = [&](const std::string& emitter, const std::string& extra = "") {
+        return R"({"entities": [)" + ground + "," + proto + extra +
+               R"(, {"name": "spout", "position": {"x": 0, "y": 5}, "emitter": )" + emitter + "}]}";
+    };
+    EXPECT_EQ(refusal(level(R"({"template": "rain", "interval": 1, "count": 3})")),
+              "t.json: error: /entities/2/emitter/template: emitter on entity 2 (\"spout\"): no entity has "
+              "\"template\": \"rain\"");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 0, "count": 3})")),
+              "t.json: error: /entities/2/emitter/interval: expected a number in (0, 1e+30], got 0");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 0})")),
+              "t.json: error: /entities/2/emitter/count: expected an integer in [1, 100000], got 0");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2, "spread": -0.1})")),
+              "t.json: error: /entities/2/emitter/spread: expected a number in [0, 3.14159], got -0.1");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2, "lifetime": -1})")),
+              "t.json: error: /entities/2/emitter/lifetime: expected a number in (0, 1e+30], got -1");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2})",
+                            R"(, {"name": "spout2", "position": {"x": 0, "y": 5}, "emitter": {"template": "drop"}})")),
+              "t.json: error: /entities/3/emitter/template: emitter on entity 3 (\"spout\"): template \"drop\" is "
+              "copied by entity 2 (\"spout2\") already; give each emitter its own template");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2, "emitted": 4, "alive": 1, "next": 5, "oldest": 4})")),
+              "t.json: error: /entities/2/emitter/alive: emitter on entity 2 (\"spout\"): copy \"drop#4\" is alive in "
+              "its run state but not in the scene");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2})",
+                            R"(, {"name": "drop#3", "position": {"x": 0, "y": 5}})")),
+              "t.json: error: /entities/2/name: \"drop#3\" is a name the emitter on entity 3 (\"spout\") gives its "
+              "copies, and that copy is not alive in its run state (0 alive of 0 emitted)");
+    EXPECT_EQ(refusal(R"({"entities": [{"name": "p", "template": "t", "position": {"x": 0, "y": 0}, "static": true,
+                          "radius": 1}]})"),
+              "t.json: error: /entities/0/template: entity 0 (\"p\"): a template entity is a dynamic body with a "
+              "shape; remove \"static\"");
+    EXPECT_EQ(refusal(R"({"entities": [{"name": "p", "template": "t", "position": {"x": 0, "y": 0}}]})"),
+              "t.json: error: /entities/0/template: entity 0 (\"p\"): a template body needs a shape (radius, box, "
+              "polygon, capsule or shapes): its copies are added to the contact solver as they appear");
+    EXPECT_EQ(refusal(R"({"entities": [)" + ground + "," + proto +
+                      R"(, {"name": "j", "joint": {"type": "hinge", "a": "proto", "b": "ground"}}]})"),
+              "t.json: error: /entities/2/joint: joint on entity 2 (\"j\"): joins \"ground\" to template \"drop\"; a "
+              "template's joints and springs stay within it");
+}
+
+TEST(Emitters, ASavedRunWithCopiesRoundTripsByteForByte) {
+    const Scene scene = parseLevel(ragdollLevel(4, 3, R"(, "lifetime": 1.2)"));
+    World world = buildWorld(scene);
+    for (int s = 0; s < 100; ++s) ASSERT_TRUE(world.step());
+    const std::string saved = savedRunText(world, scene);
+    EXPECT_NE(saved.find("\"doll#4\""), std::string::npos);
+    EXPECT_NE(saved.find("\"alive\": 3"), std::string::npos);
+    const std::string again = sceneToJsonText(parseLevel(saved));
+    EXPECT_EQ(again, saved);
+}
+
+TEST(Emitters, RunLogsEachEmissionAndRemovalAndCountsTheCopiesAlive) {
+    // Interval 10 steps, count 2: copies at steps 1, 11, 21, 31; from step
+    // 21 on each new copy pushes the oldest out in the same step.
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "stepwise_emitters_cli";
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path level = dir / "drops.json", log = dir / "contacts.jsonl";
+    {
+        std::ofstream out(level);
+        out << ballLevel(R"("interval": )" + exactNumber(10.0 / 60.0) + R"(, "count": 2, "velocity": {"x": 3, "y": 0})");
+    }
+    const CommandResult run = runCommand(std::string(STEPWISE_BINARY) + " run " + level.string() +
+                                         " --steps 35 --contacts " + log.string() + " 2>&1");
+    ASSERT_EQ(run.exitCode, 0) << run.out;
+    EXPECT_NE(run.out.find("; 2 emitted copies alive;"), std::string::npos) << run.out;
+    std::vector<std::string> events;
+    std::istringstream lines(readFile(log));
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind("{\"event\"", 0) == 0) events.push_back(line.substr(0, line.find(", \"time\"")) + line.substr(line.find(", \"emitter\"")));
+    EXPECT_EQ(events, (std::vector<std::string>{
+                          R"({"event": "emit", "step": 1, "emitter": "spout", "copy": "drop#1"})",
+                          R"({"event": "emit", "step": 11, "emitter": "spout", "copy": "drop#2"})",
+                          R"({"event": "remove", "step": 21, "emitter": "spout", "copy": "drop#1"})",
+                          R"({"event": "emit", "step": 21, "emitter": "spout", "copy": "drop#3"})",
+                          R"({"event": "remove", "step": 31, "emitter": "spout", "copy": "drop#2"})",
+                          R"({"event": "emit", "step": 31, "emitter": "spout", "copy": "drop#4"})"}));
+    std::filesystem::remove_all(dir);
+}
+
+TEST(Emitters, ACopyRemovedWhileItsIslandSleepsWakesItAndResumeStaysExact) {
+    // A doll every 5 s, one alive: each lands, settles and sleeps before
+    // the next arrives and pushes it, asleep, out. Saving around those
+    // steps resumes bit for bit.
+    std::string text = ragdollLevel(4, 1);
+    const std::string every = R"("interval": 0.5)";
+    text.replace(text.find(every), every.size(), R"("interval": 5)");
+    const Scene scene = parseLevel(text);
+    World straight = buildWorld(scene);
+    std::size_t asleepAtRemoval = 0;
+    for (int s = 1; s <= 800; ++s) {
+        const std::size_t asleep = straight.sleepingBodyCount();
+        if (s == 301 || s == 601) EXPECT_EQ(asleep, 3u) << "step " << s;
+        ASSERT_TRUE(straight.step());
+        for (const EmitterEvent& e : straight.emitterEvents())
+            if (!e.added) asleepAtRemoval = std::max(asleepAtRemoval, asleep);
+    }
+    EXPECT_GE(asleepAtRemoval, 3u);  // a whole doll asleep when one was removed
+    const std::string expected = savedRunText(straight, scene);
+    for (const int split : {250, 300, 301, 302, 600, 601}) {
+        SCOPED_TRACE("split " + std::to_string(split));
+        Scene first = scene;
+        World world = buildWorld(first);
+        for (int s = 0; s < split; ++s) ASSERT_TRUE(world.step());
+        Scene resumed = parseLevel(savedRunText(world, first));
+        World again = buildWorld(resumed);
+        for (int s = split; s < 800; ++s) ASSERT_TRUE(again.step());
+        ASSERT_EQ(savedRunText(again, resumed), expected);
+    }
+}
+
+TEST(Emitters, ValidateNotesWhatATemplateIgnores) {
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "stepwise_emitters_validate";
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path level = dir / "t.json";
+    {
+        std::ofstream out(level);
+        out << R"({"entities": [
+          {"name": "a", "template": "lonely", "position": {"x": 0, "y": 0}, "radius": 1},
+          {"name": "b", "template": "lonely", "position": {"x": 3, "y": 0}, "radius": 1},
+          {"name": "c", "template": "used", "position": {"x": 0, "y": 5}, "velocity": {"x": 1, "y": 0}, "radius": 1},
+          {"name": "e", "position": {"x": 0, "y": 9}, "emitter": {"template": "used"}}]})";
+    }
+    const CommandResult r = runCommand(std::string(STEPWISE_BINARY) + " validate " + level.string() + " 2>&1");
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("warning: entity 0 (\"a\"): template \"lonely\" has no emitter, so it is never copied (and "
+                         "never simulated)"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("entity 1 (\"b\"): template"), std::string::npos) << r.out;  // said once per template
+    EXPECT_NE(r.out.find("warning: entity 2 (\"c\"): \"velocity\" on a template body has no effect (each copy takes "
+                         "its emitter's velocity)"),
+              std::string::npos)
+        << r.out;
+    std::filesystem::remove_all(dir);
+}
+
+TEST(Emitters, ABuildRefusesATemplateBodyWithoutAShapeMadeInCode) {
+    // The loader refuses it; a scene made in code reaches World::build.
+    Scene scene = parseLevel(ballLevel(R"("interval": 1, "count": 2)"));
+    Registry& reg = scene.registry;
+    const Entity proto = reg.entities()[0];
+    reg.remove<Radius>(proto);
+    Result<World> w = World::build(scene);
+    ASSERT_FALSE(w);
+    EXPECT_EQ(w.error(), "entity 0 (\"proto\"): template \"drop\": a template entity is a dynamic body with a shape "
+                         "(radius, box, polygon, capsule or shapes)");
+}
+
+TEST(Emitters, AnEmitterWithAShapeIsABodyAndCopiesAppearWhereItIsNow) {
+    // A kinematic box moving at 2 m/s drops a resting ball every half
+    // second, no gravity, the two never colliding (one negative group):
+    // copy k appears where the box is at the start of step 30 (k - 1) + 1,
+    // x = k - 1, and stays there.
+    const Scene scene = parseLevel(R"({"world": {"gravity": {"x": 0, "y": 0}},
+      "entities": [
+        {"name": "proto", "template": "drop", "position": {"x": 40, "y": 40}, "radius": 0.1,
+         "filter": {"category": 1, "mask": 4294967295, "group": -5}},
+        {"name": "cart", "position": {"x": 0, "y": 0}, "kinematic": true, "velocity": {"x": 2, "y": 0},
+         "box": {"width": 1, "height": 0.5}, "filter": {"category": 1, "mask": 4294967295, "group": -5},
+         "emitter": {"template": "drop", "interval": 0.5, "count": 10}}]})");
+    World world = buildWorld(scene);
+    EXPECT_EQ(world.bodyCount(), 1u);  // the cart
+    EXPECT_EQ(world.kinematicCount(), 1u);
+    for (int s = 0; s < 150; ++s) ASSERT_TRUE(world.step());
+    ASSERT_EQ(world.bodyCount(), 6u);
+    for (std::size_t k = 1; k <= 5; ++k) {
+        EXPECT_NEAR(world.bodyPosition(k).x, double(k - 1), 1e-9) << "copy " << k;
+        EXPECT_EQ(world.bodyPosition(k).y, 0.0);
+    }
+}
+
+// Copies of a compound template (a dumbbell of two discs on a capsule bar,
+// hinged to a rounded block) poured onto a chain floor beside a standing
+// compound L: every emission rebuilds the collision arrays in place with
+// hubs, shapes and chain segments among them, and those arrays must be the
+// ones a build of the saved file makes. So a run saved at any step and
+// continued equals the straight run bit for bit, no emission builds a
+// World, and every copy lands on the chain.
+TEST(Emitters, CompoundCopiesOnAChainResumeExactlyWithoutBuilds) {
+    const auto level = [](int substeps) {
+        std::ostringstream s;
+        s << R"({"world": {"gravity": {"x": 0, "y": -9.81})";
+        if (substeps > 0) s << R"(, "substeps": )" << substeps;
+        s << R"(},
+          "entities": [
+            {"name": "floor", "position": {"x": 0, "y": 0}, "static": true, "friction": 0.6,
+             "chain": {"points": [{"x": 8, "y": 3}, {"x": 4, "y": 0.5}, {"x": 0, "y": 0}, {"x": -4, "y": 0.4},
+                                  {"x": -8, "y": 3}]}},
+            {"name": "L", "position": {"x": 3, "y": 0.9},
+             "shapes": [{"box": {"center": {"x": 0, "y": 0}, "width": 1.5, "height": 0.3, "angle": 0}},
+                        {"box": {"center": {"x": -0.6, "y": 0.6}, "width": 0.3, "height": 0.9, "angle": 0}}]},
+            {"name": "bell", "template": "drop", "position": {"x": 30, "y": 30},
+             "shapes": [{"circle": {"center": {"x": -0.4, "y": 0}, "radius": 0.2}},
+                        {"circle": {"center": {"x": 0.4, "y": 0}, "radius": 0.2}, "density": 3},
+                        {"capsule": {"a": {"x": -0.4, "y": 0}, "b": {"x": 0.4, "y": 0}, "radius": 0.05}}]},
+            {"name": "block", "template": "drop", "position": {"x": 30, "y": 29.3}, "mass": 0.5,
+             "polygon": {"vertices": [{"x": -0.2, "y": -0.15}, {"x": 0.2, "y": -0.15}, {"x": 0.2, "y": 0.15},
+                                      {"x": -0.2, "y": 0.15}], "radius": 0.05}},
+            {"name": "link", "joint": {"type": "hinge", "a": "bell", "b": "block", "anchor": {"x": 30, "y": 29.6}}},
+            {"name": "hatch", "position": {"x": -1, "y": 4},
+             "emitter": {"template": "drop", "interval": 0.5, "count": 3, "velocity": {"x": 1, "y": 0}, "spread": 0.5}}
+          ]})";
+        return s.str();
+    };
+    for (const int substeps : {1, 4, 0}) {
+        SCOPED_TRACE("substeps " + std::to_string(substeps));
+        const Scene scene = parseLevel(level(substeps));
+        World straight = buildWorld(scene);
+        const std::uint64_t builds = worldBuildCount();
+        for (int s = 0; s < 300; ++s) ASSERT_TRUE(straight.step());
+        EXPECT_EQ(worldBuildCount(), builds) << "an emission built a World";
+        const std::string expected = savedRunText(straight, scene);
+        // Every copy alive rests on the chain (its lowest point is 0 m
+        // there), none fell through it.
+        Scene after = parseLevel(expected);
+        int copies = 0;
+        for (const Entity e : after.registry.entities()) {
+            const Name* n = after.registry.tryGet<Name>(e);
+            const Position* p = after.registry.tryGet<Position>(e);
+            if (!n || !p || n->value.find('#') == std::string::npos) continue;  // not a copied body
+            ++copies;
+            EXPECT_GT(p->value.y, 0.0) << n->value;
+        }
+        EXPECT_EQ(copies, 6) << "three copies of two bodies";
+        for (const int split : {1, 29, 30, 31, 151, 240}) {
+            SCOPED_TRACE("split " + std::to_string(split));
+            Scene first = scene;
+            World world = buildWorld(first);
+            for (int s = 0; s < split; ++s) ASSERT_TRUE(world.step());
+            Scene resumed = parseLevel(savedRunText(world, first));
+            World again = buildWorld(resumed);
+            for (int s = split; s < 300; ++s) ASSERT_TRUE(again.step());
+            ASSERT_EQ(savedRunText(again, resumed), expected);
+        }
+    }
+}
