@@ -593,6 +593,14 @@ TEST(Emitters, CompoundCopiesOnAChainResumeExactlyWithoutBuilds) {
             if (!n || !p || n->value.find('#') == std::string::npos) continue;  // not a copied body
             ++copies;
             EXPECT_GT(p->value.y, 0.0) << n->value;
+            // A copy carries the template's shapes, not the component's default.
+            if (const Shapes* shapes = after.registry.tryGet<Shapes>(e)) {
+                ASSERT_EQ(shapes->items.size(), 3u) << n->value;
+                EXPECT_EQ(shapes->items[1].density, std::optional<double>(3.0)) << n->value;
+            } else {
+                ASSERT_TRUE(after.registry.has<Polygon>(e)) << n->value;
+                EXPECT_EQ(after.registry.tryGet<Polygon>(e)->radius, std::optional<double>(0.05)) << n->value;
+            }
         }
         EXPECT_EQ(copies, 6) << "three copies of two bodies";
         for (const int split : {1, 29, 30, 31, 151, 240}) {

@@ -54,7 +54,7 @@ TEST(Inspector, CopyEntityIsTableDrivenAndExact) {
     copy.version = s->version;
     copy.world = s->world;
     copy.view = s->view;
-    for (Entity e : s->registry.entities()) copyEntity(s->registry, e, copy.registry, copy.registry.create());
+    for (Entity e : s->registry.entities()) copyComponents(s->registry, e, copy.registry, copy.registry.create());
     EXPECT_EQ(textOf(copy), textOf(*s));
 }
 

@@ -13,34 +13,6 @@
 
 namespace stepwise::editor {
 
-void copyField(const FieldInfo& field, const void* src, void* dst) {
-    // FieldInfo::address takes a non-const pointer; reading through it does
-    // not modify the source.
-    void* from = field.address(const_cast<void*>(src));
-    void* to = field.address(dst);
-    switch (field.kind) {
-    case FieldKind::Number: *static_cast<double*>(to) = *static_cast<const double*>(from); break;
-    case FieldKind::Integer: *static_cast<int*>(to) = *static_cast<const int*>(from); break;
-    case FieldKind::Bits: *static_cast<std::uint32_t*>(to) = *static_cast<const std::uint32_t*>(from); break;
-    case FieldKind::OptionalNumber:
-        *static_cast<std::optional<double>*>(to) = *static_cast<const std::optional<double>*>(from);
-        break;
-    case FieldKind::Vector: *static_cast<Vec2*>(to) = *static_cast<const Vec2*>(from); break;
-    case FieldKind::OptionalVector:
-        *static_cast<std::optional<Vec2>*>(to) = *static_cast<const std::optional<Vec2>*>(from);
-        break;
-    case FieldKind::Color: *static_cast<Rgb*>(to) = *static_cast<const Rgb*>(from); break;
-    case FieldKind::Bool: *static_cast<bool*>(to) = *static_cast<const bool*>(from); break;
-    case FieldKind::VectorList:
-        *static_cast<std::vector<Vec2>*>(to) = *static_cast<const std::vector<Vec2>*>(from);
-        break;
-    case FieldKind::ShapeList:
-        *static_cast<std::vector<CompoundShape>*>(to) = *static_cast<const std::vector<CompoundShape>*>(from);
-        break;
-    case FieldKind::String: *static_cast<std::string*>(to) = *static_cast<const std::string*>(from); break;
-    case FieldKind::EntityRef: *static_cast<Entity*>(to) = *static_cast<const Entity*>(from); break;
-    }
-}
 
 FieldValue readField(const FieldInfo& field, const void* component) {
     const void* at = field.address(const_cast<void*>(component));
@@ -252,14 +224,6 @@ Result<std::size_t> removeComponentFromAll(Scene& scene, const ComponentInfo& co
     return n;
 }
 
-void copyEntity(const Registry& src, Entity from, Registry& dst, Entity to) {
-    for (const ComponentInfo& info : componentTable()) {
-        const void* c = info.getConst(src, from);
-        if (!c) continue;
-        void* d = info.emplaceDefault(dst, to);
-        for (const FieldInfo& f : info.fields) copyField(f, c, d);
-    }
-}
 
 Entity findByName(const Registry& registry, std::string_view name) {
     if (name.empty()) return {};
@@ -474,7 +438,7 @@ std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>
     for (Entity e : entities) {
         if (!src.alive(e)) continue;
         const Entity c = dst.registry.create();
-        copyEntity(src, e, dst.registry, c);
+        copyComponents(src, e, dst.registry, c);
         if (Name* n = dst.registry.tryGet<Name>(c)) n->value = names.take(n->value.empty() ? std::string("entity") : n->value);
         if (Position* p = dst.registry.tryGet<Position>(c)) p->value += offset;
         if (Plane* pl = dst.registry.tryGet<Plane>(c)) pl->offset += dot(pl->normal, offset);

@@ -21,14 +21,6 @@
 
 namespace stepwise::editor {
 
-/// Copies field `field` of a component from `src` to `dst` (both point at
-/// the component structs). The field's kind gives the C++ type.
-void copyField(const FieldInfo& field, const void* src, void* dst);
-
-/// Copies every component of `from` (in `src`) onto `to` (in `dst`),
-/// replacing what `to` had for those components. Works across registries.
-void copyEntity(const Registry& src, Entity from, Registry& dst, Entity to);
-
 /// A field's value, by kind (FieldKind -> alternative).
 using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string, Entity,
                                 std::vector<Vec2>, int, std::uint32_t, std::vector<CompoundShape>>;

@@ -467,4 +467,46 @@ std::optional<std::string_view> closestName(std::string_view name,
     return best;
 }
 
+namespace {
+
+void copyField(const FieldInfo& field, const void* src, void* dst) {
+    // FieldInfo::address takes a non-const pointer; reading through it does
+    // not modify the source.
+    void* from = field.address(const_cast<void*>(src));
+    void* to = field.address(dst);
+    switch (field.kind) {
+    case FieldKind::Number: *static_cast<double*>(to) = *static_cast<const double*>(from); break;
+    case FieldKind::Integer: *static_cast<int*>(to) = *static_cast<const int*>(from); break;
+    case FieldKind::Bits: *static_cast<std::uint32_t*>(to) = *static_cast<const std::uint32_t*>(from); break;
+    case FieldKind::OptionalNumber:
+        *static_cast<std::optional<double>*>(to) = *static_cast<const std::optional<double>*>(from);
+        break;
+    case FieldKind::Vector: *static_cast<Vec2*>(to) = *static_cast<const Vec2*>(from); break;
+    case FieldKind::OptionalVector:
+        *static_cast<std::optional<Vec2>*>(to) = *static_cast<const std::optional<Vec2>*>(from);
+        break;
+    case FieldKind::Color: *static_cast<Rgb*>(to) = *static_cast<const Rgb*>(from); break;
+    case FieldKind::Bool: *static_cast<bool*>(to) = *static_cast<const bool*>(from); break;
+    case FieldKind::VectorList:
+        *static_cast<std::vector<Vec2>*>(to) = *static_cast<const std::vector<Vec2>*>(from);
+        break;
+    case FieldKind::ShapeList:
+        *static_cast<std::vector<CompoundShape>*>(to) = *static_cast<const std::vector<CompoundShape>*>(from);
+        break;
+    case FieldKind::String: *static_cast<std::string*>(to) = *static_cast<const std::string*>(from); break;
+    case FieldKind::EntityRef: *static_cast<Entity*>(to) = *static_cast<const Entity*>(from); break;
+    }
+}
+
+} // namespace
+
+void copyComponents(const Registry& src, Entity from, Registry& dst, Entity to) {
+    for (const ComponentInfo& info : componentTable()) {
+        const void* c = info.getConst(src, from);
+        if (!c) continue;
+        void* d = info.emplaceDefault(dst, to);
+        for (const FieldInfo& f : info.fields) copyField(f, c, d);
+    }
+}
+
 } // namespace stepwise

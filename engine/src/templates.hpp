@@ -36,10 +36,6 @@ inline bool emittedOrTemplate(const Registry& reg, Entity e) {
     return inTemplate(reg, e) || isEmittedCopy(reg, e);
 }
 
-/// Copies every component of `from` (in `src`) onto `to` (in `dst`), field
-/// by field; entity references are copied as they are.
-void copyComponents(const Registry& src, Entity from, Registry& dst, Entity to);
-
 /// The random turn of copy `number` of an emitter: a uniform angle in
 /// [-spread, spread] from (world seed, emitter key, number) alone, so a
 /// resumed run draws what the long run drew without carrying a generator.

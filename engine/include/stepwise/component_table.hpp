@@ -163,6 +163,11 @@ void forEachEntityRef(const Registry& registry, Entity e, Fn&& fn) {
     }
 }
 
+/// Copies every component of `from` (in `src`) onto `to` (in `dst`), field
+/// by field through the table; entity references are copied as they are.
+/// A paste, a duplicate and an emitter's copy all go through it.
+void copyComponents(const Registry& src, Entity from, Registry& dst, Entity to);
+
 /// Same, with the handle writable (to rewire a copy, or clear a reference).
 template <class Fn>
 void forEachEntityRefMutable(Registry& registry, Entity e, Fn&& fn) {

@@ -386,7 +386,7 @@ void syncCopies(const WorldLayout& layout, Scene& scene) {
     for (const Entity e : std::vector<Entity>(reg.entities()))
         if (!run.alive(e) && isCopy(reg, e)) reg.destroy(e);
     for (const Entity e : run.entities())
-        if (!reg.alive(e) && isCopy(run, e) && reg.createAt(e)) detail::copyComponents(run, e, reg, e);
+        if (!reg.alive(e) && isCopy(run, e) && reg.createAt(e)) copyComponents(run, e, reg, e);
 }
 
 /// World::writeBack and WorldState::writeBack: the arrays of one layout into

@@ -180,9 +180,9 @@ void WorldImpl::runEmitters() {
                 // could move the source while its pool grows.
                 Registry scratch;
                 const Entity t = scratch.create();
-                detail::copyComponents(reg, member, scratch, t);
+                copyComponents(reg, member, scratch, t);
                 const Entity e = reg.create();
-                detail::copyComponents(scratch, t, reg, e);
+                copyComponents(scratch, t, reg, e);
                 reg.remove<Template>(e);
                 reg.emplace<Name>(e, Name{name});
                 if (Position* pos = reg.tryGet<Position>(e)) {
