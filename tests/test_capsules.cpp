@@ -11,6 +11,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -25,6 +26,8 @@
 #include <vector>
 
 using namespace stepwise;
+using test::named;
+using test::Sim;
 using namespace stepwise::collision;
 
 namespace {
@@ -42,12 +45,6 @@ std::string loadError(const std::string& text) {
     return s ? "loaded" : s.error();
 }
 
-Entity named(const Scene& scene, const std::string& name) {
-    for (Entity e : scene.registry.entities())
-        if (const Name* n = scene.registry.tryGet<Name>(e); n && n->value == name) return e;
-    return {};
-}
-
 std::string number(double v) {
     char b[40];
     std::snprintf(b, sizeof b, "%.17g", v);
@@ -60,54 +57,16 @@ std::string capsuleJson(Vec2 a, Vec2 b, double r) {
     return "\"capsule\": {\"a\": " + vec(a.x, a.y) + ", \"b\": " + vec(b.x, b.y) + ", \"radius\": " + number(r) + "}";
 }
 
-/// Loads `text` and steps it, recording what the tests look at.
-struct Sim {
-    Scene scene;
-    std::unique_ptr<World> world;
-    explicit Sim(const std::string& text) {
-        Result<Scene> loaded = parseScene(text, "t.json");
-        EXPECT_TRUE(loaded) << loaded.error();
-        if (!loaded) return;
-        scene = std::move(*loaded);
-        Result<World> w = World::build(scene);
-        EXPECT_TRUE(w) << w.error();
-        if (w) world = std::make_unique<World>(std::move(*w));
-    }
-    bool step(int n) {
-        if (!world) return false;
-        for (int i = 0; i < n; ++i) {
-            Result<void> r = world->step();
-            EXPECT_TRUE(r) << r.error();
-            if (!r) return false;
-        }
-        world->writeBack(scene);
-        // What a saved run carries (as `stepwise run --out` writes it): the
-        // warm-start impulses and the chosen settings.
-        SolverState solver = world->solverState();
-        scene.solverState = solver.empty() ? std::nullopt : std::optional<SolverState>(std::move(solver));
-        return true;
-    }
-    Vec2 position(const std::string& name) const { return scene.registry.tryGet<Position>(named(scene, name))->value; }
-    double angle(const std::string& name) const {
-        const Angle* a = scene.registry.tryGet<Angle>(named(scene, name));
-        return a ? a->value : 0.0;
-    }
-    Vec2 velocity(const std::string& name) const {
-        const Velocity* v = scene.registry.tryGet<Velocity>(named(scene, name));
-        return v ? v->value : Vec2{};
-    }
-    /// The centre of mass: the position, or a capsule's segment midpoint.
-    Vec2 centre(const std::string& name) const {
-        const Entity e = named(scene, name);
-        const Vec2 p = position(name);
-        const Capsule* c = scene.registry.tryGet<Capsule>(e);
-        if (!c) return p;
-        const Vec2 mid = 0.5 * (c->a + c->b);
-        const double th = angle(name);
-        return p + Vec2{std::cos(th) * mid.x - std::sin(th) * mid.y, std::sin(th) * mid.x + std::cos(th) * mid.y};
-    }
-};
-
+/// The centre of mass: the position, or a capsule's segment midpoint.
+Vec2 centre(const test::Sim& sim, const std::string& name) {
+    const Entity e = test::named(sim.scene, name);
+    const Vec2 p = sim.position(name);
+    const Capsule* c = sim.scene.registry.tryGet<Capsule>(e);
+    if (!c) return p;
+    const Vec2 mid = 0.5 * (c->a + c->b);
+    const double th = sim.angle(name);
+    return p + Vec2{std::cos(th) * mid.x - std::sin(th) * mid.y, std::sin(th) * mid.x + std::cos(th) * mid.y};
+}
 Shape capsuleShape(Vec2 halfSegment, double r) {
     Shape s;
     s.kind = ShapeKind::Capsule;
@@ -242,7 +201,7 @@ TEST(CapsuleMass, OffCentreCapsuleTurnsAboutItsMidpointAndGravityActsThere) {
         ASSERT_TRUE(r.step(100));
         const double t = 1.0;
         EXPECT_NEAR(r.angle("pill"), spin * t, 1e-12);
-        const Vec2 c = r.centre("pill");
+        const Vec2 c = centre(r, "pill");
         EXPECT_NEAR(c.x, 2.0 + 1.0 * t, 1e-9) << spin;
         // Semi-implicit Euler's free-fall error: g dt t / 2 = 0.049 m in y.
         EXPECT_NEAR(c.y, 0.5 + 3.0 * t - 0.5 * kG * t * t, 0.06) << spin;
@@ -433,9 +392,9 @@ StackResult settleStack(const Piece& bottom, const Piece& top, double ratio, con
     Sim r(level(entities, world));
     StackResult out;
     if (!r.step(180)) return out;
-    out.bottomError = r.centre("bottom").y - yBottom;
-    out.topError = r.centre("top").y - yTop;
-    out.drift = std::max(std::abs(r.centre("bottom").x), std::abs(r.centre("top").x));
+    out.bottomError = centre(r, "bottom").y - yBottom;
+    out.topError = centre(r, "top").y - yTop;
+    out.drift = std::max(std::abs(centre(r, "bottom").x), std::abs(centre(r, "top").x));
     out.turn = std::max(std::abs(r.angle("bottom")), std::abs(r.angle("top")));
     return out;
 }
@@ -513,11 +472,11 @@ TEST(CapsuleWorld, CapsuleOnStaticShapesAndStandingOnItsEnd) {
                             world));
                 ASSERT_TRUE(r.step(180));
                 const std::string what = piece.label + " on " + support.support + " " + world;
-                EXPECT_NEAR(r.centre("p").y, y, 2e-3) << what;
+                EXPECT_NEAR(centre(r, "p").y, y, 2e-3) << what;
                 // Exactly symmetric cases stay at 0 to rounding; an
                 // off-centre body, and two contacts solved one after the
                 // other, lean by at most 2.3e-5 rad (measured).
-                EXPECT_NEAR(r.centre("p").x, 0.0, 2e-5) << what;
+                EXPECT_NEAR(centre(r, "p").x, 0.0, 2e-5) << what;
                 EXPECT_NEAR(r.angle("p"), 0.0, 1e-4) << what;
             }
         }

@@ -11,6 +11,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -22,6 +23,8 @@
 #include <vector>
 
 using namespace stepwise;
+using test::named;
+using test::Sim;
 using namespace stepwise::collision;
 
 namespace {
@@ -79,52 +82,6 @@ std::vector<Vec2> circlePoints(double R, int count, bool cw) {
     }
     return points;
 }
-
-Entity named(const Scene& scene, const std::string& name) {
-    for (Entity e : scene.registry.entities())
-        if (const Name* n = scene.registry.tryGet<Name>(e); n && n->value == name) return e;
-    return {};
-}
-
-/// Loads `text` and steps it.
-struct Sim {
-    Scene scene;
-    std::unique_ptr<World> world;
-    explicit Sim(const std::string& text) {
-        Result<Scene> loaded = parseScene(text, "t.json");
-        EXPECT_TRUE(loaded) << loaded.error();
-        if (!loaded) return;
-        scene = std::move(*loaded);
-        Result<World> w = World::build(scene);
-        EXPECT_TRUE(w) << w.error();
-        if (w) world = std::make_unique<World>(std::move(*w));
-    }
-    bool step(int n = 1) {
-        if (!world) return false;
-        for (int i = 0; i < n; ++i) {
-            Result<void> r = world->step();
-            EXPECT_TRUE(r) << r.error();
-            if (!r) return false;
-        }
-        world->writeBack(scene);
-        SolverState solver = world->solverState();
-        scene.solverState = solver.empty() ? std::nullopt : std::optional<SolverState>(std::move(solver));
-        return true;
-    }
-    Vec2 position(const std::string& name) const { return scene.registry.tryGet<Position>(named(scene, name))->value; }
-    Vec2 velocity(const std::string& name) const {
-        const Velocity* v = scene.registry.tryGet<Velocity>(named(scene, name));
-        return v ? v->value : Vec2{};
-    }
-    double angularVelocity(const std::string& name) const {
-        const AngularVelocity* w = scene.registry.tryGet<AngularVelocity>(named(scene, name));
-        return w ? w->value : 0.0;
-    }
-    double angle(const std::string& name) const {
-        const Angle* a = scene.registry.tryGet<Angle>(named(scene, name));
-        return a ? a->value : 0.0;
-    }
-};
 
 Shape segmentShape(const ChainSegment& s) {
     Shape shape;

@@ -11,6 +11,7 @@
 #include "stepwise/integrators.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -28,6 +29,8 @@
 #include <vector>
 
 using namespace stepwise;
+using test::named;
+using test::Sim;
 
 namespace {
 
@@ -49,12 +52,6 @@ std::string loadError(const std::string& text) {
     return s ? "loaded" : s.error();
 }
 
-Entity named(const Scene& scene, const std::string& name) {
-    for (Entity e : scene.registry.entities())
-        if (const Name* n = scene.registry.tryGet<Name>(e); n && n->value == name) return e;
-    return {};
-}
-
 std::string boxItem(double cx, double cy, double w, double h, const std::string& extra = "", double angle = 0.0) {
     return "{\"box\": {\"center\": " + vec(cx, cy) + ", \"width\": " + number(w) + ", \"height\": " + number(h) +
            ", \"angle\": " + number(angle) + "}" + extra + "}";
@@ -68,46 +65,6 @@ std::string capsuleItem(Vec2 a, Vec2 b, double r, const std::string& extra = "")
 }
 
 const std::string kFloor = "{\"name\": \"floor\", \"plane\": {\"normal\": {\"x\": 0, \"y\": 1}, \"offset\": 0}}";
-
-struct Sim {
-    Scene scene;
-    std::unique_ptr<World> world;
-    explicit Sim(const std::string& text) {
-        Result<Scene> loaded = parseScene(text, "t.json");
-        EXPECT_TRUE(loaded) << loaded.error();
-        if (!loaded) return;
-        scene = std::move(*loaded);
-        Result<World> w = World::build(scene);
-        EXPECT_TRUE(w) << w.error();
-        if (w) world = std::make_unique<World>(std::move(*w));
-    }
-    bool step(int n, const std::function<void()>& each = {}) {
-        if (!world) return false;
-        for (int i = 0; i < n; ++i) {
-            Result<void> r = world->step();
-            EXPECT_TRUE(r) << r.error();
-            if (!r) return false;
-            if (each) each();
-        }
-        world->writeBack(scene);
-        SolverState solver = world->solverState();
-        scene.solverState = solver.empty() ? std::nullopt : std::optional<SolverState>(std::move(solver));
-        return true;
-    }
-    Vec2 position(const std::string& name) const { return scene.registry.tryGet<Position>(named(scene, name))->value; }
-    double angle(const std::string& name) const {
-        const Angle* a = scene.registry.tryGet<Angle>(named(scene, name));
-        return a ? a->value : 0.0;
-    }
-    double spin(const std::string& name) const {
-        const AngularVelocity* a = scene.registry.tryGet<AngularVelocity>(named(scene, name));
-        return a ? a->value : 0.0;
-    }
-    Vec2 velocity(const std::string& name) const {
-        const Velocity* v = scene.registry.tryGet<Velocity>(named(scene, name));
-        return v ? v->value : Vec2{};
-    }
-};
 
 const int kSubsteps[] = {0, 1, 2, 4, 8};  // 0: the engine's choice
 std::string substepsWorld(int s) { return s == 0 ? std::string() : ", \"substeps\": " + std::to_string(s); }
@@ -288,7 +245,7 @@ TEST(CompoundMass, TheWorldMovesTheSummedBody) {
             ASSERT_TRUE(sim.step(60));
             // Free motion: energy kept, the spin unchanged.
             EXPECT_NEAR(sim.world->energy().kinetic, expected, 1e-9 * expected);
-            EXPECT_NEAR(sim.spin("ell"), w, 1e-12);
+            EXPECT_NEAR(sim.angularVelocity("ell"), w, 1e-12);
             EXPECT_NEAR(sim.angle("ell"), w * 1.0, 1e-9);
         }
     }
@@ -337,7 +294,7 @@ TEST(CompoundWorld, AnLTipsWhenItsCentreIsPastItsFoot) {
             Sim sim(text);
             ASSERT_TRUE(sim.step(240));
             EXPECT_NEAR(sim.angle("ell"), expected, 2e-3) << "substeps " << substeps << ", density " << density;
-            EXPECT_NEAR(sim.spin("ell"), 0.0, 1e-3) << "substeps " << substeps << ", density " << density;
+            EXPECT_NEAR(sim.angularVelocity("ell"), 0.0, 1e-3) << "substeps " << substeps << ", density " << density;
         }
     }
 }
@@ -443,7 +400,7 @@ TEST(CompoundWorld, AMotorTurnsADynamicDrumOnAHinge) {
         // The motor sets b's speed relative to a: the world (b) against the
         // drum (a) at +speed turns the drum at -speed.
         EXPECT_NEAR(sim.angle("drum"), -speed * 5.0, 0.02 * speed * 5.0) << speed;
-        EXPECT_NEAR(sim.spin("drum"), -speed, 0.03 * speed) << speed;
+        EXPECT_NEAR(sim.angularVelocity("drum"), -speed, 0.03 * speed) << speed;
         EXPECT_LT(length(sim.position("drum")), 1e-3) << speed;
         for (int i = 0; i < 24; ++i)
             EXPECT_LT(length(sim.position("b" + std::to_string(i))), 2.0 * std::sqrt(2.0)) << i << " at " << speed;

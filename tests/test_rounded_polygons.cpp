@@ -10,6 +10,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -22,6 +23,8 @@
 #include <vector>
 
 using namespace stepwise;
+using test::named;
+using test::Sim;
 using namespace stepwise::collision;
 
 namespace {
@@ -54,43 +57,6 @@ std::string polygonJson(const std::vector<Vec2>& v, double radius) {
 }
 
 std::vector<Vec2> rectangle(double w, double h) { return {{-w / 2, -h / 2}, {w / 2, -h / 2}, {w / 2, h / 2}, {-w / 2, h / 2}}; }
-
-Entity named(const Scene& scene, const std::string& name) {
-    for (Entity e : scene.registry.entities())
-        if (const Name* n = scene.registry.tryGet<Name>(e); n && n->value == name) return e;
-    return {};
-}
-
-struct Sim {
-    Scene scene;
-    std::unique_ptr<World> world;
-    explicit Sim(const std::string& text) {
-        Result<Scene> loaded = parseScene(text, "t.json");
-        EXPECT_TRUE(loaded) << loaded.error();
-        if (!loaded) return;
-        scene = std::move(*loaded);
-        Result<World> w = World::build(scene);
-        EXPECT_TRUE(w) << w.error();
-        if (w) world = std::make_unique<World>(std::move(*w));
-    }
-    bool step(int n = 1) {
-        if (!world) return false;
-        for (int i = 0; i < n; ++i) {
-            Result<void> r = world->step();
-            EXPECT_TRUE(r) << r.error();
-            if (!r) return false;
-        }
-        world->writeBack(scene);
-        SolverState solver = world->solverState();
-        scene.solverState = solver.empty() ? std::nullopt : std::optional<SolverState>(std::move(solver));
-        return true;
-    }
-    Vec2 position(const std::string& name) const { return scene.registry.tryGet<Position>(named(scene, name))->value; }
-    double angle(const std::string& name) const {
-        const Angle* a = scene.registry.tryGet<Angle>(named(scene, name));
-        return a ? a->value : 0.0;
-    }
-};
 
 /// Distance from p to the outline's core (0 inside it).
 double distanceToPolygon(const std::vector<Vec2>& v, Vec2 p) {

@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -192,5 +194,56 @@ inline std::string savedRunText(const World& world, Scene scene) {
     if (!solver.empty()) scene.solverState = std::move(solver);
     return sceneToJsonText(scene);
 }
+
+/// The entity called `name` (null when none is).
+inline Entity named(const Scene& scene, const std::string& name) {
+    for (Entity e : scene.registry.entities())
+        if (const Name* n = scene.registry.tryGet<Name>(e); n && n->value == name) return e;
+    return {};
+}
+
+/// A level loaded from `text` and stepped, with its state written back
+/// after each step() as `stepwise run --out` would save it (the warm start
+/// and chosen settings in the solver state), for reading bodies by name.
+struct Sim {
+    Scene scene;
+    std::unique_ptr<World> world;
+    explicit Sim(const std::string& text) {
+        Result<Scene> loaded = parseScene(text, "t.json");
+        EXPECT_TRUE(loaded) << loaded.error();
+        if (!loaded) return;
+        scene = std::move(*loaded);
+        Result<World> w = World::build(scene);
+        EXPECT_TRUE(w) << w.error();
+        if (w) world = std::make_unique<World>(std::move(*w));
+    }
+    /// Takes `n` steps, calling `each` after every one.
+    bool step(int n = 1, const std::function<void()>& each = {}) {
+        if (!world) return false;
+        for (int i = 0; i < n; ++i) {
+            Result<void> r = world->step();
+            EXPECT_TRUE(r) << r.error();
+            if (!r) return false;
+            if (each) each();
+        }
+        world->writeBack(scene);
+        SolverState solver = world->solverState();
+        scene.solverState = solver.empty() ? std::nullopt : std::optional<SolverState>(std::move(solver));
+        return true;
+    }
+    Vec2 position(const std::string& name) const { return scene.registry.tryGet<Position>(named(scene, name))->value; }
+    Vec2 velocity(const std::string& name) const {
+        const Velocity* v = scene.registry.tryGet<Velocity>(named(scene, name));
+        return v ? v->value : Vec2{};
+    }
+    double angle(const std::string& name) const {
+        const Angle* a = scene.registry.tryGet<Angle>(named(scene, name));
+        return a ? a->value : 0.0;
+    }
+    double angularVelocity(const std::string& name) const {
+        const AngularVelocity* w = scene.registry.tryGet<AngularVelocity>(named(scene, name));
+        return w ? w->value : 0.0;
+    }
+};
 
 } // namespace stepwise::test
