@@ -186,63 +186,93 @@ Scene manyPyramids() {
     return s;
 }
 
-/// A ragdoll of levels/ragdoll.json's proportions (10 boxes and a circle
-/// head, hinged with its limits) standing in for Box2D's 11-capsule human.
-void ragdoll(Scene& s, const std::string& prefix, Vec2 at) {
-    struct Part {
+/// Box2D's human (shared/human.c at scale 1): eleven capsule bones, the
+/// lower legs with a foot, hinged with Box2D's limits; each hinge has joint
+/// friction (a motor at rest, torque 0.05 N m times the bone's share) and a
+/// 5 Hz spring of damping ratio 0.5. Bones of one human never collide
+/// (group -groupIndex); feet meet only the ground (mask 1). Density 1,
+/// friction 0.2 (feet 0.05). Box2D rounds the foot by 0.015 m; a compound
+/// body's polygon is not rounded, so the foot is its sharp outline.
+void human(Scene& s, const std::string& prefix, Vec2 at, int groupIndex) {
+    const Filter bones{2u, 1u | 2u, -groupIndex};
+    struct Bone {
         const char* name;
-        Vec2 offset;  // from the torso's centre
-        double w, h, mass;
+        double y;           // body position above `at`
+        double a, b, r;     // capsule from (0, a) to (0, b), radius r
+        int parent;         // index into this table; -1 for the hip
+        double pivot;       // joint height above `at`
+        double lower, upper, reference, frictionScale, damping;
+        bool foot;
     };
-    static const Part parts[] = {
-        {"torso", {0.0, 0.0}, 0.45, 0.8, 20.0},        {"upper arm L", {-0.36, 0.15}, 0.14, 0.45, 2.0},
-        {"lower arm L", {-0.36, -0.3}, 0.12, 0.45, 1.5}, {"upper arm R", {0.36, 0.15}, 0.14, 0.45, 2.0},
-        {"lower arm R", {0.36, -0.3}, 0.12, 0.45, 1.5},  {"thigh L", {-0.12, -0.65}, 0.18, 0.5, 6.0},
-        {"shin L", {-0.12, -1.15}, 0.15, 0.5, 4.0},      {"thigh R", {0.12, -0.65}, 0.18, 0.5, 6.0},
-        {"shin R", {0.12, -1.15}, 0.15, 0.5, 4.0},
+    constexpr double pi = kPi;
+    static const Bone table[] = {
+        {"hip", 0.95, -0.02, 0.02, 0.095, -1, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, false},
+        {"torso", 1.2, -0.135, 0.135, 0.09, 0, 1.0, -0.25 * pi, 0.0, 0.0, 0.5, 0.0, false},
+        {"head", 1.475, -0.038, 0.039, 0.075, 1, 1.4, -0.3 * pi, 0.1 * pi, 0.0, 0.25, 0.1, false},
+        {"upper left leg", 0.775, -0.125, 0.125, 0.06, 0, 0.9, -0.05 * pi, 0.4 * pi, 0.0, 1.0, 0.0, false},
+        {"lower left leg", 0.475, -0.155, 0.125, 0.045, 3, 0.625, -0.5 * pi, -0.02 * pi, 0.0, 0.5, 0.0, true},
+        {"upper right leg", 0.775, -0.125, 0.125, 0.06, 0, 0.9, -0.05 * pi, 0.4 * pi, 0.0, 1.0, 0.0, false},
+        {"lower right leg", 0.475, -0.155, 0.125, 0.045, 5, 0.625, -0.5 * pi, -0.02 * pi, 0.0, 0.5, 0.0, true},
+        {"upper left arm", 1.225, -0.125, 0.125, 0.035, 1, 1.35, -0.1 * pi, 0.8 * pi, 0.0, 0.5, 0.0, false},
+        {"lower left arm", 0.975, -0.125, 0.125, 0.03, 7, 1.1, -0.2 * pi, 0.3 * pi, 0.25 * pi, 0.1, 0.1, false},
+        {"upper right arm", 1.225, -0.125, 0.125, 0.035, 1, 1.35, -0.1 * pi, 0.8 * pi, 0.0, 0.5, 0.0, false},
+        {"lower right arm", 0.975, -0.125, 0.125, 0.03, 9, 1.1, -0.2 * pi, 0.3 * pi, 0.25 * pi, 0.1, 0.1, false},
     };
+    const std::vector<Vec2> footOutline{{-0.03, -0.185}, {0.11, -0.185}, {0.11, -0.16}, {-0.03, -0.14}};
     std::vector<Entity> e;
-    for (const Part& p : parts)
-        e.push_back(dynamicBox(s, prefix + p.name, at + p.offset, p.w, p.h, p.mass / (p.w * p.h), 0.6,
-                               palette(int(e.size()))));
-    const Entity head = dynamicCircle(s, prefix + "head", at + Vec2{0.0, 0.6}, 0.22, 4.0 / (kPi * 0.22 * 0.22), 0.6,
-                                      {0.93, 0.76, 0.6});
-    struct Link {
-        const char* name;
-        int a, b;  // indices into e; -1: the head
-        Vec2 localA, localB;
-        double lower, upper;
-    };
-    static const Link links[] = {
-        {"neck", 0, -1, {0.0, 0.4}, {0.0, -0.2}, -0.5, 0.5},
-        {"shoulder L", 0, 1, {-0.36, 0.35}, {0.0, 0.2}, -2.5, 1.0},
-        {"elbow L", 1, 2, {0.0, -0.22}, {0.0, 0.23}, 0.0, 2.4},
-        {"shoulder R", 0, 3, {0.36, 0.35}, {0.0, 0.2}, -1.0, 2.5},
-        {"elbow R", 3, 4, {0.0, -0.22}, {0.0, 0.23}, -2.4, 0.0},
-        {"hip L", 0, 5, {-0.12, -0.4}, {0.0, 0.25}, -1.6, 0.6},
-        {"knee L", 5, 6, {0.0, -0.25}, {0.0, 0.25}, 0.0, 2.2},
-        {"hip R", 0, 7, {0.12, -0.4}, {0.0, 0.25}, -1.6, 0.6},
-        {"knee R", 7, 8, {0.0, -0.25}, {0.0, 0.25}, 0.0, 2.2},
-    };
-    for (const Link& l : links) {
-        Registry& r = s.registry;
+    Registry& r = s.registry;
+    for (const Bone& bone : table) {
+        const Entity part = body(s, prefix + bone.name, at + Vec2{0.0, bone.y}, 0.2, palette(int(e.size())));
+        const Capsule capsule{{0.0, bone.a}, {0.0, bone.b}, bone.r};
+        double mass = capsuleMassProperties(bone.b - bone.a, bone.r).area;
+        if (bone.foot) {
+            Shapes shapes;
+            shapes.items.clear();
+            CompoundShape leg;
+            leg.kind = CompoundShape::Kind::Capsule;
+            leg.a = capsule.a;
+            leg.b = capsule.b;
+            leg.radius = capsule.radius;
+            shapes.items.push_back(leg);
+            CompoundShape foot;
+            foot.kind = CompoundShape::Kind::Polygon;
+            foot.vertices = footOutline;
+            foot.friction = 0.05;
+            foot.filter = Filter{2u, 1u, -groupIndex};
+            shapes.items.push_back(foot);
+            mass = compoundMassProperties(shapes, std::nullopt).mass;
+            r.emplace<Shapes>(part, std::move(shapes));
+        } else {
+            r.emplace<Capsule>(part, capsule);
+            r.emplace<Mass>(part, Mass{mass});
+        }
+        r.emplace<Filter>(part, bones);
+        if (bone.damping > 0.0) r.emplace<Drag>(part, Drag{bone.damping * mass});  // linearDamping c: drag c m
+        e.push_back(part);
+        if (bone.parent < 0) continue;
+        const Bone& parent = table[bone.parent];
         const Entity j = r.create();
-        r.emplace<Name>(j, Name{prefix + l.name});
+        r.emplace<Name>(j, Name{prefix + bone.name + " joint"});
         Joint joint;
         joint.type = "hinge";
-        joint.a = e[std::size_t(l.a)];
-        joint.b = l.b < 0 ? head : e[std::size_t(l.b)];
-        joint.localA = l.localA;
-        joint.localB = l.localB;
-        joint.referenceAngle = 0.0;
-        joint.lower = l.lower;
-        joint.upper = l.upper;
+        joint.a = e[std::size_t(bone.parent)];
+        joint.b = part;
+        joint.localA = {0.0, bone.pivot - parent.y};
+        joint.localB = {0.0, bone.pivot - bone.y};
+        joint.referenceAngle = bone.reference;
+        joint.lower = bone.lower;
+        joint.upper = bone.upper;
+        joint.motorSpeed = 0.0;
+        joint.maxMotorTorque = 0.05 * bone.frictionScale;
+        joint.springHz = 5.0;
+        joint.springDampingRatio = 0.5;
         r.emplace<Joint>(j, joint);
     }
 }
 
 // CreateRain: five floors 45 m apart, each a row of 501 static 0.5 m boxes;
-// above each floor, 40 columns of groups of five ragdolls 0.5 m apart.
+// above each floor, 40 columns of groups of five humans 0.5 m apart (the
+// k-th human of every group in collision group -k, as Box2D numbers them).
 // Box2D adds a column every 8 steps and then recycles the oldest; here all
 // 200 groups are there from the first step.
 Scene rain() {
@@ -258,7 +288,7 @@ Scene rain() {
         for (int column = 0; column < columns; ++column) {
             Vec2 at{-0.5 * span + groupDistance * (column + 0.5), 40.0 + 45.0 * row};
             for (int k = 0; k < groupSize; ++k) {
-                ragdoll(s, label("human ", row, column) + "." + std::to_string(k) + " ", at);
+                human(s, label("human ", row, column) + "." + std::to_string(k) + " ", at, k + 1);
                 at.x += 0.5;
             }
         }
