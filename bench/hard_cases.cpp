@@ -66,7 +66,8 @@ struct Bodies {
 bool isStatic(const Registry& r, Entity e) { return r.has<Static>(e) && r.tryGet<Static>(e)->value; }
 
 bool hasShape(const Registry& r, Entity e) {
-    return r.has<Radius>(e) || r.has<Box>(e) || r.has<Polygon>(e) || r.has<Shapes>(e);
+    return r.has<Radius>(e) || r.has<Box>(e) || r.has<Polygon>(e) || r.has<Capsule>(e) || r.has<Chain>(e) ||
+           r.has<Shapes>(e);
 }
 
 Bodies bodiesOf(const Scene& scene) {

@@ -9,15 +9,41 @@
 #include <box2d/box2d.h>
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 namespace stepwise::bench {
 
 inline bool isStaticBody(const Registry& r, Entity e) { return r.has<Static>(e) && r.tryGet<Static>(e)->value; }
 
+/// Box2D 2.4.1 has no capsule: the same outline as the union of a box along
+/// the segment and a disc at each end, three fixtures of equal density
+/// whose areas sum to `mass` (the overlaps make the inertia a little high).
+inline void addBox2dCapsule(b2Body* body, b2FixtureDef fd, Vec2 a, Vec2 b, double radius, double mass) {
+    const Vec2 d = b - a;
+    const double length = std::sqrt(d.x * d.x + d.y * d.y);
+    const double area = 2.0 * radius * length + 2.0 * M_PI * radius * radius;
+    fd.density = float(mass / area);
+    b2CircleShape ends[2];
+    for (int k = 0; k < 2; ++k) {
+        const Vec2 c = k == 0 ? a : b;
+        ends[k].m_radius = float(radius);
+        ends[k].m_p.Set(float(c.x), float(c.y));
+        fd.shape = &ends[k];
+        body->CreateFixture(&fd);
+    }
+    if (length > 0.0) {
+        b2PolygonShape core;
+        core.SetAsBox(float(0.5 * length), float(radius), b2Vec2(float(0.5 * (a.x + b.x)), float(0.5 * (a.y + b.y))),
+                      float(std::atan2(d.y, d.x)));
+        fd.shape = &core;
+        body->CreateFixture(&fd);
+    }
+}
+
 /// Creates `e`'s body in `world` (static when Static, else dynamic), with a
-/// fixture for its radius, box, polygon (rounded too) or chain, one per
-/// compound shape but capsules (none when it has no shape). Mass
+/// fixture for its radius, box, polygon (rounded too), chain or capsule (see
+/// addBox2dCapsule), one per compound shape (none when it has no shape). Mass
 /// as Stepwise's: `mass`, else 1 kg, spread over the shape's area; friction
 /// and restitution as the components say, else Stepwise's defaults 0.2 and
 /// 0. Drag b (force -b v) becomes Box2D's linear damping b/m (dv/dt = -c v).
@@ -37,6 +63,15 @@ inline b2Body* createBox2dBody(b2World& world, const Registry& r, Entity e) {
     b2FixtureDef fd;
     fd.friction = float(r.has<Friction>(e) ? r.tryGet<Friction>(e)->value : 0.2);
     fd.restitution = float(r.has<Restitution>(e) ? r.tryGet<Restitution>(e)->value : 0.0);
+    // 2.4.1's filter has 16-bit categories and masks and a 16-bit group.
+    const auto box2dFilter = [](const Filter& f) {
+        b2Filter out;
+        out.categoryBits = std::uint16_t(f.category & 0xFFFFu);
+        out.maskBits = std::uint16_t(f.mask & 0xFFFFu);
+        out.groupIndex = std::int16_t(f.group);
+        return out;
+    };
+    if (const Filter* f = r.tryGet<Filter>(e)) fd.filter = box2dFilter(*f);
     b2CircleShape circle;
     b2PolygonShape polygon;
     if (const Radius* c = r.tryGet<Radius>(e)) {
@@ -72,6 +107,7 @@ inline b2Body* createBox2dBody(b2World& world, const Registry& r, Entity e) {
         fd.shape = &chainShape;
     }
     if (fd.shape) body->CreateFixture(&fd);
+    if (const Capsule* cap = r.tryGet<Capsule>(e)) addBox2dCapsule(body, fd, cap->a, cap->b, cap->radius, mass);
     if (shapes) {
         // A fixture per shape; densities scaled as Stepwise scales them to `mass`.
         const double scale = mass / compoundMassProperties(*shapes, std::nullopt).mass;
@@ -80,6 +116,7 @@ inline b2Body* createBox2dBody(b2World& world, const Registry& r, Entity e) {
             part.friction = float(s.friction.value_or(fd.friction));
             part.restitution = float(s.restitution.value_or(fd.restitution));
             part.isSensor = s.sensor.value_or(false);
+            if (s.filter) part.filter = box2dFilter(*s.filter);
             part.density = float(s.density.value_or(1.0) * scale);
             b2CircleShape c;
             b2PolygonShape p;
@@ -98,7 +135,9 @@ inline b2Body* createBox2dBody(b2World& world, const Registry& r, Entity e) {
                 p.Set(v, int(s.vertices.size()));
                 part.shape = &p;
             } else {
-                continue;  // Box2D 2.4.1 has no capsule
+                const double area = capsuleMassProperties(length(s.b - s.a), s.radius).area;
+                addBox2dCapsule(body, part, s.a, s.b, s.radius, part.density * area);
+                continue;
             }
             body->CreateFixture(&part);
         }
