@@ -191,8 +191,7 @@ Scene manyPyramids() {
 /// friction (a motor at rest, torque 0.05 N m times the bone's share) and a
 /// 5 Hz spring of damping ratio 0.5. Bones of one human never collide
 /// (group -groupIndex); feet meet only the ground (mask 1). Density 1,
-/// friction 0.2 (feet 0.05). Box2D rounds the foot by 0.015 m; a compound
-/// body's polygon is not rounded, so the foot is its sharp outline.
+/// friction 0.2 (feet 0.05); the foot is rounded by 0.015 m.
 void human(Scene& s, const std::string& prefix, Vec2 at, int groupIndex) {
     const Filter bones{2u, 1u | 2u, -groupIndex};
     struct Bone {
@@ -237,6 +236,7 @@ void human(Scene& s, const std::string& prefix, Vec2 at, int groupIndex) {
             CompoundShape foot;
             foot.kind = CompoundShape::Kind::Polygon;
             foot.vertices = footOutline;
+            foot.cornerRadius = 0.015;
             foot.friction = 0.05;
             foot.filter = Filter{2u, 1u, -groupIndex};
             shapes.items.push_back(foot);

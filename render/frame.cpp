@@ -851,7 +851,7 @@ void Builder::bodies() {
             switch (shape.kind) {
             case CompoundShape::Kind::Polygon:
                 if (shape.vertices.size() >= 3)
-                    polygon(Polygon{shape.vertices}, p->value, angle, colour, selected_.count(e) != 0,
+                    polygon(Polygon{shape.vertices, shape.cornerRadius}, p->value, angle, colour, selected_.count(e) != 0,
                             isStatic(scene_, e));
                 break;
             case CompoundShape::Kind::Box:

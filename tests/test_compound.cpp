@@ -529,3 +529,35 @@ TEST(CompoundWorld, ResumesBitForBitFromAMidRunSave) {
         EXPECT_EQ(sceneToJsonText(second.scene), sceneToJsonText(whole.scene)) << substeps;
     }
 }
+
+// A polygon item may be rounded as the polygon component is: its mass is
+// the rounded outline's, it rests on its rounding, it is picked within it,
+// and the file keeps the radius byte for byte.
+TEST(CompoundWorld, APolygonItemIsRoundedByItsRadius) {
+    const std::string level = R"({"world": {"gravity": {"x": 0, "y": -9.81}, "substeps": 4},
+      "entities": [
+        {"name": "floor", "plane": {"normal": {"x": 0, "y": 1}, "offset": 0}},
+        {"name": "pebble", "position": {"x": 0, "y": 0.301},
+         "shapes": [{"polygon": {"vertices": [{"x": -0.25, "y": -0.25}, {"x": 0.25, "y": -0.25},
+                                              {"x": 0.25, "y": 0.25}, {"x": -0.25, "y": 0.25}], "radius": 0.05}}]}
+      ]})";
+    Result<Scene> scene = parseScene(level, "t.json");
+    ASSERT_TRUE(scene) << scene.error();
+    EXPECT_EQ(sceneToJsonText(*parseScene(sceneToJsonText(*scene), "t.json")), sceneToJsonText(*scene));
+    const Shapes& shapes = *scene->registry.tryGet<Shapes>(named(*scene, "pebble"));
+    ASSERT_EQ(shapes.items[0].cornerRadius, std::optional<double>(0.05));
+    const std::vector<Vec2> square{{-0.25, -0.25}, {0.25, -0.25}, {0.25, 0.25}, {-0.25, 0.25}};
+    // 0.25 + 4 x 0.5 x 0.05 + pi 0.05^2 at density 1.
+    EXPECT_NEAR(compoundMassProperties(shapes, std::nullopt).mass, 0.25 + 0.1 + std::numbers::pi * 0.0025, 1e-12);
+    EXPECT_NEAR(compoundMassProperties(shapes, std::nullopt).inertia,
+                polygonMassProperties(square, 0.05).secondMoment, 1e-12);
+    EXPECT_TRUE(compoundShapeContains(shapes.items[0], {0.28, 0.0}));
+    EXPECT_FALSE(compoundShapeContains(shapes.items[0], {0.32, 0.0}));
+    EXPECT_TRUE(compoundShapeContains(shapes.items[0], {0.25 + 0.03, 0.25 + 0.03}));
+    EXPECT_FALSE(compoundShapeContains(shapes.items[0], {0.25 + 0.04, 0.25 + 0.04}));
+    Sim sim(level);
+    ASSERT_TRUE(sim.step(120));
+    // Half the height plus the rounding, less the 4-substep contact's sag.
+    EXPECT_NEAR(sim.position("pebble").y, 0.3, 2e-4);
+    EXPECT_NEAR(sim.angle("pebble"), 0.0, 1e-6);
+}

@@ -133,6 +133,7 @@ inline b2Body* createBox2dBody(b2World& world, const Registry& r, Entity e) {
                 for (std::size_t k = 0; k < s.vertices.size(); ++k)
                     v[k].Set(float(s.vertices[k].x), float(s.vertices[k].y));
                 p.Set(v, int(s.vertices.size()));
+                if (s.cornerRadius) p.m_radius = float(*s.cornerRadius);
                 part.shape = &p;
             } else {
                 const double area = capsuleMassProperties(length(s.b - s.a), s.radius).area;

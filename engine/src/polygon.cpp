@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace stepwise {
@@ -240,7 +241,7 @@ ShapeAreaProperties compoundShapeArea(const CompoundShape& shape) {
         out.secondMoment = out.area * (shape.width * shape.width + shape.height * shape.height) / 12.0;
         break;
     case CompoundShape::Kind::Polygon: {
-        const PolygonMassProperties p = polygonMassProperties(shape.vertices);
+        const PolygonMassProperties p = polygonMassProperties(shape.vertices, shape.cornerRadius.value_or(0.0));
         out.area = p.area;
         out.centroid = p.centroid;
         out.secondMoment = p.secondMoment;
@@ -302,7 +303,10 @@ ShapeOutline compoundShapeOutline(const CompoundShape& s) {
             out.points.push_back(s.center + Vec2{c * k.x - sn * k.y, sn * k.x + c * k.y});
         break;
     }
-    case CompoundShape::Kind::Polygon: out.points = s.vertices; break;
+    case CompoundShape::Kind::Polygon:
+        out.points = s.vertices;
+        out.radius = s.cornerRadius.value_or(0.0);
+        break;
     case CompoundShape::Kind::Capsule:
         out.points = {s.a, s.b};
         out.radius = s.radius;
@@ -321,12 +325,20 @@ bool compoundShapeContains(const CompoundShape& s, Vec2 local) {
     }
     case CompoundShape::Kind::Box:
     case CompoundShape::Kind::Polygon: {
-        // Inside a counter-clockwise convex outline: left of every edge.
-        const std::vector<Vec2> v = compoundShapeOutline(s).points;
+        // Inside a counter-clockwise convex outline (left of every edge), or
+        // within its rounding of an edge.
+        const ShapeOutline outline = compoundShapeOutline(s);
+        const std::vector<Vec2>& v = outline.points;
         if (v.size() < 3) return false;
-        for (std::size_t i = 0; i < v.size(); ++i)
-            if (cross(v[(i + 1) % v.size()] - v[i], local - v[i]) < 0.0) return false;
-        return true;
+        bool inside = true;
+        double nearest = std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < v.size(); ++i) {
+            const Vec2 p = v[i], edge = v[(i + 1) % v.size()] - p;
+            inside = inside && cross(edge, local - p) >= 0.0;
+            const double t = std::clamp(dot(local - p, edge) / dot(edge, edge), 0.0, 1.0);
+            nearest = std::min(nearest, length(local - (p + t * edge)));
+        }
+        return inside || nearest <= outline.radius;
     }
     }
     return false;

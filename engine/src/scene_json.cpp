@@ -204,8 +204,12 @@ CompoundShape readCompoundShape(const Json& v, const std::string& pointer) {
         } else if (key == "polygon") {
             ++kinds;
             s.kind = CompoundShape::Kind::Polygon;
-            readKeys(value, at, std::array<std::string_view, 1>{"vertices"}, "a polygon",
-                     [&](const std::string&, const Json& fv, const std::string& fa) {
+            readKeys(value, at, std::array<std::string_view, 2>{"vertices", "radius"}, "a polygon",
+                     [&](const std::string& k, const Json& fv, const std::string& fa) {
+                         if (k == "radius") {
+                             s.cornerRadius = readNumber(fv, fa, NumberRange{0.0, kMaxMagnitude, false});
+                             return;
+                         }
                          if (!fv.is_array()) refuse(fa, "expected an array of vectors, got " + describeFound(fv));
                          for (std::size_t i = 0; i < fv.size(); ++i) s.vertices.push_back(readVector(fv[i], child(fa, i)));
                      });
@@ -255,6 +259,7 @@ Json compoundShapeJson(const CompoundShape& s) {
         Json list = Json::array();
         for (const Vec2 p : s.vertices) list.push_back(vec(p));
         j["polygon"] = Json{{"vertices", list}};
+        if (s.cornerRadius) j["polygon"]["radius"] = *s.cornerRadius;
         break;
     }
     case CompoundShape::Kind::Capsule: j["capsule"] = Json{{"a", vec(s.a)}, {"b", vec(s.b)}, {"radius", s.radius}}; break;

@@ -65,8 +65,10 @@ Json fieldSchema(const FieldInfo& f) {
                  {"box", object(Json{{"center", ref("vector")}, {"width", size}, {"height", size}, {"angle", number}},
                                 "box: centre in the body frame, full sizes (m), turn in the body frame (rad)")},
                  {"polygon", object(Json{{"vertices", Json{{"type", "array"}, {"items", ref("vector")}, {"minItems", 3},
-                                                           {"maxItems", 8}}}},
-                                    "convex polygon: 3 to 8 vertices in the body frame, counter-clockwise")},
+                                                           {"maxItems", 8}}},
+                                         {"radius", Json{{"type", "number"}, {"minimum", 0}}}},
+                                    "convex polygon: 3 to 8 vertices in the body frame, counter-clockwise, its "
+                                    "corners rounded by radius (m)")},
                  {"capsule", object(Json{{"a", ref("vector")}, {"b", ref("vector")}, {"radius", size}},
                                     "capsule: a segment in the body frame swept by a radius")},
                  {"density", Json{{"type", "number"}, {"exclusiveMinimum", 0}, {"description", "kg/m^2; absent: 1"}}},

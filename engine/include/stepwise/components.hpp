@@ -204,6 +204,9 @@ struct CompoundShape {
     double width = 1.0, height = 1.0;  ///< box, metres
     double angle = 0.0;             ///< box: its turn in the body frame, rad
     std::vector<Vec2> vertices;     ///< polygon: 3 to 8, counter-clockwise, convex
+    /// polygon: its corners rounded by this, metres (the item's "radius",
+    /// as polygon.radius); absent = sharp
+    std::optional<double> cornerRadius;
     Vec2 a{-0.5, 0.0}, b{0.5, 0.0}; ///< capsule: the segment's ends
     std::optional<double> density;  ///< kg/m^2; absent = 1
     std::optional<double> friction, restitution;

@@ -61,11 +61,14 @@ void compoundGeometry(const CompoundShape& s, collision::Collider& c, collision:
             return;
         }
     case CompoundShape::Kind::Polygon: {
-        const PolygonMassProperties props = polygonMassProperties(s.vertices);
+        const double rounding = s.cornerRadius.value_or(0.0);
+        const PolygonMassProperties props =
+            rounding > 0.0 ? polygonMassProperties(s.vertices, rounding) : polygonMassProperties(s.vertices);
         Vec2 local[collision::kMaxPolygonVertices];
         const int count = int(s.vertices.size());
         for (int i = 0; i < count; ++i) local[i] = s.vertices[std::size_t(i)] - props.centroid;
         polygon = collision::ConvexPolygon::fromVertices(local, count);
+        polygon.cornerRadius = rounding;
         c.shape.kind = collision::ShapeKind::Polygon;
         c.shape.polygon = &polygon;
         c.centreOfMass = props.centroid;
