@@ -171,9 +171,10 @@ TEST(Emitters, CopiesCarryTheTemplatesJointsAndSprings) {
     EXPECT_EQ(world.bodyCount(), 9u);
     // The copies' names: the first body is the copy's own name.
     const std::vector<std::string> names = copiesAlive(world, scene);
-    EXPECT_NE(std::find(names.begin(), names.end(), "doll#12"), names.end());
-    EXPECT_NE(std::find(names.begin(), names.end(), "doll#12/head"), names.end());
-    EXPECT_NE(std::find(names.begin(), names.end(), "doll#12/neck"), names.end());
+    const std::string newest = "doll#" + std::to_string(12);  // the twelfth copy
+    EXPECT_NE(std::find(names.begin(), names.end(), newest), names.end());
+    EXPECT_NE(std::find(names.begin(), names.end(), newest + "/head"), names.end());
+    EXPECT_NE(std::find(names.begin(), names.end(), newest + "/neck"), names.end());
     EXPECT_EQ(std::find(names.begin(), names.end(), "doll#9"), names.end());
 }
 
