@@ -26,6 +26,9 @@
 #include <vector>
 
 using namespace stepwise;
+using test::exactNumber;
+using test::loadError;
+using test::vectorJson;
 using test::named;
 using test::Sim;
 using namespace stepwise::collision;
@@ -40,21 +43,11 @@ std::string level(const std::string& entities, const std::string& world = "") {
            "}, \"entities\": [" + entities + "]}";
 }
 
-std::string loadError(const std::string& text) {
-    Result<Scene> s = parseScene(text, "t.json");
-    return s ? "loaded" : s.error();
-}
 
-std::string number(double v) {
-    char b[40];
-    std::snprintf(b, sizeof b, "%.17g", v);
-    return b;
-}
 
-std::string vec(double x, double y) { return "{\"x\": " + number(x) + ", \"y\": " + number(y) + "}"; }
 
 std::string capsuleJson(Vec2 a, Vec2 b, double r) {
-    return "\"capsule\": {\"a\": " + vec(a.x, a.y) + ", \"b\": " + vec(b.x, b.y) + ", \"radius\": " + number(r) + "}";
+    return "\"capsule\": {\"a\": " + vectorJson(a.x, a.y) + ", \"b\": " + vectorJson(b.x, b.y) + ", \"radius\": " + exactNumber(r) + "}";
 }
 
 /// The centre of mass: the position, or a capsule's segment midpoint.
@@ -195,7 +188,7 @@ TEST(CapsuleMass, OffCentreCapsuleTurnsAboutItsMidpointAndGravityActsThere) {
     // parabola; the energy's gravity term is the midpoint's height.
     for (const double spin : {2.0, -5.0}) {
         Sim r(level("{\"name\": \"pill\", \"position\": {\"x\": 0, \"y\": 0}, \"velocity\": {\"x\": 1, \"y\": 3}, "
-                    "\"angular_velocity\": " + number(spin) + ", \"mass\": 2, " + capsuleJson({1, 0.5}, {3, 0.5}, 0.3) +
+                    "\"angular_velocity\": " + exactNumber(spin) + ", \"mass\": 2, " + capsuleJson({1, 0.5}, {3, 0.5}, 0.3) +
                     "}",
                     "\"gravity\": {\"x\": 0, \"y\": -9.81}, \"dt\": 0.01, \"substeps\": 2"));
         ASSERT_TRUE(r.step(100));
@@ -353,25 +346,25 @@ struct Piece {
     Vec2 comOffset;     ///< centre of mass from the position, m
 };
 
-Piece circlePiece(double r) { return {"circle r=" + number(r), "\"radius\": " + number(r), r, r, {}}; }
+Piece circlePiece(double r) { return {"circle r=" + exactNumber(r), "\"radius\": " + exactNumber(r), r, r, {}}; }
 Piece boxPiece(double w, double h) {
-    return {"box " + number(w) + "x" + number(h),
-            "\"box\": {\"width\": " + number(w) + ", \"height\": " + number(h) + "}", 0.5 * h, 0.5 * h, {}};
+    return {"box " + exactNumber(w) + "x" + exactNumber(h),
+            "\"box\": {\"width\": " + exactNumber(w) + ", \"height\": " + exactNumber(h) + "}", 0.5 * h, 0.5 * h, {}};
 }
 Piece hexPiece(double rho) {
     std::string v = "\"polygon\": {\"vertices\": [";
-    for (int i = 0; i < 6; ++i) v += (i ? ", " : "") + vec(rho * std::cos(i * kPi / 3), rho * std::sin(i * kPi / 3));
+    for (int i = 0; i < 6; ++i) v += (i ? ", " : "") + vectorJson(rho * std::cos(i * kPi / 3), rho * std::sin(i * kPi / 3));
     const double half = rho * std::sqrt(3.0) / 2.0;
-    return {"hexagon " + number(rho), v + "]}", half, half, {}};
+    return {"hexagon " + exactNumber(rho), v + "]}", half, half, {}};
 }
 /// Lying along x; `lift` moves the segment off the position (a centre of
 /// mass that is not the position).
 Piece lyingCapsule(double len, double r, double lift = 0.0) {
-    return {"capsule L=" + number(len) + " r=" + number(r) + (lift != 0.0 ? " off-centre" : ""),
+    return {"capsule L=" + exactNumber(len) + " r=" + exactNumber(r) + (lift != 0.0 ? " off-centre" : ""),
             capsuleJson({-0.5 * len + lift, lift}, {0.5 * len + lift, lift}, r), r, r, {lift, lift}};
 }
 Piece standingCapsule(double len, double r) {
-    return {"standing capsule L=" + number(len) + " r=" + number(r), capsuleJson({0, -0.5 * len}, {0, 0.5 * len}, r),
+    return {"standing capsule L=" + exactNumber(len) + " r=" + exactNumber(r), capsuleJson({0, -0.5 * len}, {0, 0.5 * len}, r),
             0.5 * len + r, 0.5 * len + r, {}};
 }
 
@@ -386,9 +379,9 @@ StackResult settleStack(const Piece& bottom, const Piece& top, double ratio, con
     const std::string entities =
         "{\"name\": \"floor\", \"plane\": {\"normal\": {\"x\": 0, \"y\": 1}, \"offset\": 0}}, "
         "{\"name\": \"bottom\", \"mass\": 1, \"position\": " +
-        vec(-bottom.comOffset.x, yBottom + 0.001 - bottom.comOffset.y) + ", " + bottom.json +
-        "}, {\"name\": \"top\", \"mass\": " + number(ratio) + ", \"position\": " +
-        vec(-top.comOffset.x, yTop + 0.002 - top.comOffset.y) + ", " + top.json + "}";
+        vectorJson(-bottom.comOffset.x, yBottom + 0.001 - bottom.comOffset.y) + ", " + bottom.json +
+        "}, {\"name\": \"top\", \"mass\": " + exactNumber(ratio) + ", \"position\": " +
+        vectorJson(-top.comOffset.x, yTop + 0.002 - top.comOffset.y) + ", " + top.json + "}";
     Sim r(level(entities, world));
     StackResult out;
     if (!r.step(180)) return out;
@@ -422,7 +415,7 @@ TEST(CapsuleWorld, RestHeightsOverEveryPairOfShapeKindsSizesAndMassRatios) {
                     if (other.label.rfind("circle", 0) != 0) pairs.push_back({&other, &capsule});
                     for (const auto& [bottom, top] : pairs) {
                         const StackResult s = settleStack(*bottom, *top, ratio, world);
-                        const std::string what = top->label + " on " + bottom->label + ", mass ratio " + number(ratio);
+                        const std::string what = top->label + " on " + bottom->label + ", mass ratio " + exactNumber(ratio);
                         EXPECT_NEAR(s.bottomError, 0.0, 1.5e-3) << what;
                         EXPECT_NEAR(s.topError, 0.0, 1.5e-3) << what;
                         EXPECT_LT(s.drift, 1e-3) << what;
@@ -468,7 +461,7 @@ TEST(CapsuleWorld, CapsuleOnStaticShapesAndStandingOnItsEnd) {
                                              std::string("\"gravity\": {\"x\": 0, \"y\": -9.81}, \"substeps\": 1")}) {
                 const double y = support.top + piece.down;
                 Sim r(level(support.support + ", {\"name\": \"p\", \"mass\": 3, \"position\": " +
-                                vec(-piece.comOffset.x, y + 0.001 - piece.comOffset.y) + ", " + piece.json + "}",
+                                vectorJson(-piece.comOffset.x, y + 0.001 - piece.comOffset.y) + ", " + piece.json + "}",
                             world));
                 ASSERT_TRUE(r.step(180));
                 const std::string what = piece.label + " on " + support.support + " " + world;
@@ -501,7 +494,7 @@ TEST(CapsuleWorld, CapsuleOnItsSideLiesStillForFiveSeconds) {
                  {std::string("\"gravity\": {\"x\": 0, \"y\": -9.81}, \"sleep\": false"),
                   std::string("\"gravity\": {\"x\": 0, \"y\": -9.81}, \"substeps\": 1, \"sleep\": false")}) {
                 Sim r(level(ground + ", {\"name\": \"p\", \"mass\": 2, \"friction\": 0.5, \"position\": " +
-                                vec(-piece.comOffset.x, piece.down - piece.comOffset.y) + ", " + piece.json + "}",
+                                vectorJson(-piece.comOffset.x, piece.down - piece.comOffset.y) + ", " + piece.json + "}",
                             world));
                 ASSERT_TRUE(r.step(60));
                 const Vec2 p0 = r.position("p");
@@ -530,15 +523,15 @@ TEST(CapsuleWorld, SlidesDownASlopeAtGTimesSinMinusMuCos) {
             const Vec2 slopeCentre = -0.5 * up;
             const Vec2 c = 0.0 * down + (r + 0.0005) * up;
             // Both have friction mu, so the pair's sqrt(mu mu) is mu.
-            Sim run(level("{\"name\": \"slope\", \"static\": true, \"friction\": " + number(mu) +
-                              ", \"position\": " + vec(slopeCentre.x, slopeCentre.y) + ", \"angle\": " +
-                              number(-theta) + ", \"box\": {\"width\": 30, \"height\": 1}}, {\"name\": \"p\", "
-                              "\"friction\": " + number(mu) + ", \"position\": " + vec(c.x, c.y) +
-                              ", \"angle\": " + number(-theta) + ", " + capsuleJson({-0.5, 0}, {0.5, 0}, r) + "}"));
+            Sim run(level("{\"name\": \"slope\", \"static\": true, \"friction\": " + exactNumber(mu) +
+                              ", \"position\": " + vectorJson(slopeCentre.x, slopeCentre.y) + ", \"angle\": " +
+                              exactNumber(-theta) + ", \"box\": {\"width\": 30, \"height\": 1}}, {\"name\": \"p\", "
+                              "\"friction\": " + exactNumber(mu) + ", \"position\": " + vectorJson(c.x, c.y) +
+                              ", \"angle\": " + exactNumber(-theta) + ", " + capsuleJson({-0.5, 0}, {0.5, 0}, r) + "}"));
             ASSERT_TRUE(run.step(60));
             const Vec2 v = run.velocity("p");
             const double along = dot(v, down);
-            const std::string what = number(degrees) + " deg, mu " + number(mu);
+            const std::string what = exactNumber(degrees) + " deg, mu " + exactNumber(mu);
             EXPECT_NEAR(run.angle("p"), -theta, 1e-3) << what << ": it slides flat, not tumbling";
             EXPECT_NEAR(dot(v, up), 0.0, 0.01) << what;
             if (mu < std::tan(theta)) {

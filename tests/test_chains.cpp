@@ -23,6 +23,9 @@
 #include <vector>
 
 using namespace stepwise;
+using test::exactNumber;
+using test::loadError;
+using test::vectorJson;
 using test::named;
 using test::Sim;
 using namespace stepwise::collision;
@@ -32,27 +35,17 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kG = 9.81;
 
-std::string number(double v) {
-    char b[40];
-    std::snprintf(b, sizeof b, "%.17g", v);
-    return b;
-}
 
-std::string vec(double x, double y) { return "{\"x\": " + number(x) + ", \"y\": " + number(y) + "}"; }
 
 std::string level(const std::string& entities, const std::string& world = "") {
     return "{\"world\": {\"gravity\": {\"x\": 0, \"y\": -9.81}" + (world.empty() ? std::string() : ", " + world) +
            "}, \"entities\": [" + entities + "]}";
 }
 
-std::string loadError(const std::string& text) {
-    Result<Scene> s = parseScene(text, "t.json");
-    return s ? "loaded" : s.error();
-}
 
 std::string chainJson(const std::vector<Vec2>& points, bool loop) {
     std::string out = "\"chain\": {\"points\": [";
-    for (std::size_t i = 0; i < points.size(); ++i) out += (i ? ", " : "") + vec(points[i].x, points[i].y);
+    for (std::size_t i = 0; i < points.size(); ++i) out += (i ? ", " : "") + vectorJson(points[i].x, points[i].y);
     return out + "], \"loop\": " + (loop ? "true" : "false") + "}";
 }
 
@@ -131,7 +124,7 @@ TEST(ChainFormat, BadChainsAreRefusedNamingTheEntityAndPoint) {
               "t.json: error: /entities/0: an entity has at most one shape (radius, box, polygon, capsule, chain or "
               "plane), got 2");
     std::string many = "{\"points\": [";
-    for (int i = 0; i < 1025; ++i) many += (i ? ", " : "") + vec(i, 0);
+    for (int i = 0; i < 1025; ++i) many += (i ? ", " : "") + vectorJson(i, 0);
     EXPECT_EQ(loadError(chainOn(many + "]}")),
               "t.json: error: /entities/0/chain/points: entity 0 (\"ground\"): expected 2 to 1024 points, got 1025");
 }
@@ -301,9 +294,9 @@ TEST(ChainWorld, ABallRollsAcrossJointsWithoutABump) {
                 const double end = 2.0 * v0 * 2.0 + 4.0;
                 const auto text = [&](const std::vector<Vec2>& floor) {
                     return level(chainEntity("floor", floor, false, "\"friction\": 0.6") +
-                                     ", {\"name\": \"ball\", \"position\": " + vec(0.0, r) + ", \"velocity\": " +
-                                     vec(v0, 0.0) + ", \"angular_velocity\": " + number(-v0 / r) +
-                                     ", \"radius\": " + number(r) + ", \"friction\": 0.6}",
+                                     ", {\"name\": \"ball\", \"position\": " + vectorJson(0.0, r) + ", \"velocity\": " +
+                                     vectorJson(v0, 0.0) + ", \"angular_velocity\": " + exactNumber(-v0 / r) +
+                                     ", \"radius\": " + exactNumber(r) + ", \"friction\": 0.6}",
                                  "\"substeps\": " + std::to_string(substeps));
                 };
                 Sim sim(text(flatFloor(end, -2.0, segment)));
@@ -314,7 +307,7 @@ TEST(ChainWorld, ABallRollsAcrossJointsWithoutABump) {
                     ASSERT_TRUE(one.step());
                     const Vec2 v = sim.velocity("ball"), vOne = one.velocity("ball");
                     const double y = sim.position("ball").y;
-                    const std::string what = "segment " + number(segment) + " v0 " + number(v0) + " substeps " +
+                    const std::string what = "segment " + exactNumber(segment) + " v0 " + exactNumber(v0) + " substeps " +
                                              std::to_string(substeps) + " step " + std::to_string(i);
                     ASSERT_NEAR(v.x, vOne.x, 1e-9 * v0) << what;
                     ASSERT_NEAR(v.y, vOne.y, 1e-9) << what;
@@ -351,9 +344,9 @@ TEST(ChainWorld, ABoxSlidesAcrossJointsDeceleratingByFrictionOnly) {
                 const double mu = 0.3, w = 0.6, h = 0.3;
                 const auto text = [&](const std::vector<Vec2>& floor) {
                     return level(chainEntity("floor", floor, false, "\"friction\": 0.3") +
-                                     ", {\"name\": \"box\", \"position\": " + vec(0.0, 0.5 * h) +
-                                     ", \"velocity\": " + vec(v0, 0.0) + ", \"box\": {\"width\": " + number(w) +
-                                     ", \"height\": " + number(h) + "}, \"friction\": 0.3}",
+                                     ", {\"name\": \"box\", \"position\": " + vectorJson(0.0, 0.5 * h) +
+                                     ", \"velocity\": " + vectorJson(v0, 0.0) + ", \"box\": {\"width\": " + exactNumber(w) +
+                                     ", \"height\": " + exactNumber(h) + "}, \"friction\": 0.3}",
                                  "\"substeps\": " + std::to_string(substeps));
                 };
                 Sim sim(text(flatFloor(16.0, -2.0, segment)));
@@ -366,7 +359,7 @@ TEST(ChainWorld, ABoxSlidesAcrossJointsDeceleratingByFrictionOnly) {
                     ASSERT_TRUE(one.step());
                     const Vec2 v = sim.velocity("box");
                     const double d = sim.position("box").x;
-                    const std::string what = "segment " + number(segment) + " v0 " + number(v0) + " substeps " +
+                    const std::string what = "segment " + exactNumber(segment) + " v0 " + exactNumber(v0) + " substeps " +
                                              std::to_string(substeps) + " step " + std::to_string(i);
                     // Several manifolds share the load where one long
                     // segment has one, so the iterations converge a little
@@ -410,7 +403,7 @@ TEST(ChainWorld, BodiesPassFromTheOpenSideAndLandOnTheSolidOne) {
         for (const double up : {5.0, 8.0}) {
             Sim sim(level(chainEntity("floor", flatFloor(3.0, -3.0, 0.5), false) +
                           ", {\"name\": \"body\", \"position\": {\"x\": 0.1, \"y\": -0.6}, \"velocity\": " +
-                          vec(0.0, up) + ", " + shape + "}"));
+                          vectorJson(0.0, up) + ", " + shape + "}"));
             ASSERT_TRUE(sim.world);
             double highest = -1.0;
             for (int i = 0; i < 300; ++i) {
@@ -449,7 +442,7 @@ TEST(ChainWorld, ACounterClockwiseLoopKeepsBodiesOutsideAClockwiseOneInside) {
                 const double R = 3.0, r = 0.2;
                 Sim sim(level(chainEntity("ring", circlePoints(R, 64, cw), true, "\"restitution\": 0.8") +
                               ", {\"name\": \"ball\", \"position\": {\"x\": 0.5, \"y\": 0}, \"velocity\": " +
-                              vec(speed * std::cos(direction), speed * std::sin(direction)) +
+                              vectorJson(speed * std::cos(direction), speed * std::sin(direction)) +
                               ", \"radius\": 0.2, \"restitution\": 0.8}"));
                 ASSERT_TRUE(sim.world);
                 double farthest = 0.0;
@@ -493,7 +486,7 @@ TEST(ChainWorld, RestHeightsOfEveryKindOnAFlatChain) {
         for (const double x : {0.0, 0.125, 0.37}) {
             for (const double segment : {0.25, 1.0}) {
                 Sim sim(level(chainEntity("floor", flatFloor(4.0, -4.0, segment), false) +
-                              ", {\"name\": \"body\", \"position\": " + vec(x, piece.height + 0.3) + ", " + piece.json +
+                              ", {\"name\": \"body\", \"position\": " + vectorJson(x, piece.height + 0.3) + ", " + piece.json +
                               "}"));
                 ASSERT_TRUE(sim.world);
                 ASSERT_TRUE(sim.step(180));
@@ -591,7 +584,7 @@ TEST(ChainWorld, ABallRollsOverBentJointsKeepingItsEnergy) {
             const Vec2 normal = Vec2{-slope, 1.0} / std::sqrt(1.0 + slope * slope);
             const Vec2 start = Vec2{x0, surface(x0)} + (r + 0.002) * normal;
             Sim sim(level(chainEntity("valley", points, false, "\"friction\": 1") +
-                              ", {\"name\": \"ball\", \"position\": " + vec(start.x, start.y) +
+                              ", {\"name\": \"ball\", \"position\": " + vectorJson(start.x, start.y) +
                               ", \"radius\": 0.2, \"friction\": 1}",
                           "\"substeps\": " + std::to_string(substeps)));
             ASSERT_TRUE(sim.world);

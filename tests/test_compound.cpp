@@ -29,6 +29,9 @@
 #include <vector>
 
 using namespace stepwise;
+using test::exactNumber;
+using test::loadError;
+using test::vectorJson;
 using test::named;
 using test::Sim;
 
@@ -36,31 +39,21 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-std::string number(double v) {
-    char b[40];
-    std::snprintf(b, sizeof b, "%.17g", v);
-    return b;
-}
-std::string vec(double x, double y) { return "{\"x\": " + number(x) + ", \"y\": " + number(y) + "}"; }
 
 std::string level(const std::string& entities, const std::string& world = "") {
     return "{\"world\": {\"gravity\": {\"x\": 0, \"y\": -9.81}" + world + "}, \"entities\": [" + entities + "]}";
 }
 
-std::string loadError(const std::string& text) {
-    Result<Scene> s = parseScene(text, "t.json");
-    return s ? "loaded" : s.error();
-}
 
 std::string boxItem(double cx, double cy, double w, double h, const std::string& extra = "", double angle = 0.0) {
-    return "{\"box\": {\"center\": " + vec(cx, cy) + ", \"width\": " + number(w) + ", \"height\": " + number(h) +
-           ", \"angle\": " + number(angle) + "}" + extra + "}";
+    return "{\"box\": {\"center\": " + vectorJson(cx, cy) + ", \"width\": " + exactNumber(w) + ", \"height\": " + exactNumber(h) +
+           ", \"angle\": " + exactNumber(angle) + "}" + extra + "}";
 }
 std::string circleItem(double cx, double cy, double r, const std::string& extra = "") {
-    return "{\"circle\": {\"center\": " + vec(cx, cy) + ", \"radius\": " + number(r) + "}" + extra + "}";
+    return "{\"circle\": {\"center\": " + vectorJson(cx, cy) + ", \"radius\": " + exactNumber(r) + "}" + extra + "}";
 }
 std::string capsuleItem(Vec2 a, Vec2 b, double r, const std::string& extra = "") {
-    return "{\"capsule\": {\"a\": " + vec(a.x, a.y) + ", \"b\": " + vec(b.x, b.y) + ", \"radius\": " + number(r) + "}" +
+    return "{\"capsule\": {\"a\": " + vectorJson(a.x, a.y) + ", \"b\": " + vectorJson(b.x, b.y) + ", \"radius\": " + exactNumber(r) + "}" +
            extra + "}";
 }
 
@@ -227,7 +220,7 @@ TEST(CompoundMass, TheWorldMovesTheSummedBody) {
         for (const double w : {0.5, -2.0}) {
             const std::string text = "{\"world\": {\"gravity\": {\"x\": 0, \"y\": 0}}, \"entities\": [{\"name\": "
                                      "\"ell\", \"position\": {\"x\": 0, \"y\": 0}, \"velocity\": {\"x\": 1, \"y\": 0}, "
-                                     "\"angular_velocity\": " + number(w) + (givenMass ? ", \"mass\": 3" : "") +
+                                     "\"angular_velocity\": " + exactNumber(w) + (givenMass ? ", \"mass\": 3" : "") +
                                      ", \"shapes\": [" + boxItem(0, 0, 2, 0.5) + ", " +
                                      boxItem(0.75, 0.75, 0.5, 1, ", \"density\": 3") + "]}]}";
             Sim sim(text);
@@ -258,7 +251,7 @@ namespace {
 // its end at `postX` (centre), resting on the floor with its foot's bottom
 // at y = 0 when the position's y is 0.25.
 std::string ell(double postX, double postW, const std::string& world, double x = 0.0) {
-    return level(kFloor + ", {\"name\": \"ell\", \"position\": " + vec(x, 0.25) + ", \"shapes\": [" +
+    return level(kFloor + ", {\"name\": \"ell\", \"position\": " + vectorJson(x, 0.25) + ", \"shapes\": [" +
                      boxItem(0, 0, 2, 0.5) + ", " + boxItem(postX, 1.0, postW, 1.5) + "]}",
                  world);
 }
@@ -269,7 +262,7 @@ TEST(CompoundWorld, AnLStandsWhenItsCentreIsOverItsFoot) {
         for (const double postX : {-0.75, 0.0, 0.75}) {
             Sim sim(ell(postX, 0.5, substepsWorld(substeps)));
             ASSERT_TRUE(sim.step(240));
-            const std::string what = "substeps " + std::to_string(substeps) + ", post at " + number(postX);
+            const std::string what = "substeps " + std::to_string(substeps) + ", post at " + exactNumber(postX);
             EXPECT_NEAR(sim.angle("ell"), 0.0, 1e-3) << what;
             EXPECT_NEAR(sim.position("ell").y, 0.25, 0.01) << what;
             EXPECT_NEAR(sim.position("ell").x, 0.0, 0.01) << what;
@@ -287,9 +280,9 @@ TEST(CompoundWorld, AnLTipsWhenItsCentreIsPastItsFoot) {
     for (const int substeps : kSubsteps) {
         for (const double density : {1.0, 2.0, 5.0}) {
             const std::string text =
-                level(kFloor + ", {\"name\": \"ell\", \"position\": " + vec(0, 0.25) + ", \"shapes\": [" +
+                level(kFloor + ", {\"name\": \"ell\", \"position\": " + vectorJson(0, 0.25) + ", \"shapes\": [" +
                           boxItem(0, 0, 0.5, 0.5) + ", " +
-                          boxItem(2.0, 0.5, 4.0, 0.5, ", \"density\": " + number(density)) + "]}",
+                          boxItem(2.0, 0.5, 4.0, 0.5, ", \"density\": " + exactNumber(density)) + "]}",
                       substepsWorld(substeps));
             Sim sim(text);
             ASSERT_TRUE(sim.step(240));
@@ -318,12 +311,12 @@ TEST(CompoundWorld, ADumbbellRollsAsOneBody) {
     const double r = 0.5, theta = 0.3, g = 9.81;
     const Vec2 n{-std::sin(theta), std::cos(theta)};
     for (const double weights : {1.0, 5.0, 20.0}) {
-        const std::string items = circleItem(0, 0, r) + ", " + circleItem(-0.3, 0, 0.1, ", \"density\": " + number(weights)) +
-                                  ", " + circleItem(0.3, 0, 0.1, ", \"density\": " + number(weights)) + ", " +
+        const std::string items = circleItem(0, 0, r) + ", " + circleItem(-0.3, 0, 0.1, ", \"density\": " + exactNumber(weights)) +
+                                  ", " + circleItem(0.3, 0, 0.1, ", \"density\": " + exactNumber(weights)) + ", " +
                                   capsuleItem({-0.3, 0}, {0.3, 0}, 0.04);
         const std::string text =
-            level("{\"name\": \"slope\", \"plane\": {\"normal\": " + vec(n.x, n.y) + ", \"offset\": 0}}, "
-                  "{\"name\": \"bell\", \"position\": " + vec(r * n.x, r * n.y) +
+            level("{\"name\": \"slope\", \"plane\": {\"normal\": " + vectorJson(n.x, n.y) + ", \"offset\": 0}}, "
+                  "{\"name\": \"bell\", \"position\": " + vectorJson(r * n.x, r * n.y) +
                   ", \"friction\": 1, \"shapes\": [" + items + "]}");
         Sim sim(text);
         ASSERT_TRUE(sim.world);
@@ -348,10 +341,10 @@ std::string drum(double spin, int count, const std::string& world = "") {
     std::string items = boxItem(2.0, 0, 0.2, 4.2) + ", " + boxItem(-2.0, 0, 0.2, 4.2) + ", " + boxItem(0, 2.0, 4.2, 0.2) +
                         ", " + boxItem(0, -2.0, 4.2, 0.2);
     std::string entities = "{\"name\": \"drum\", \"kinematic\": true, \"position\": {\"x\": 0, \"y\": 0}, "
-                           "\"angular_velocity\": " + number(spin) + ", \"shapes\": [" + items + "]}";
+                           "\"angular_velocity\": " + exactNumber(spin) + ", \"shapes\": [" + items + "]}";
     for (int i = 0; i < count; ++i) {
         const double x = -1.5 + 0.4 * (i % 8), y = -1.5 + 0.4 * (i / 8);
-        entities += ", {\"name\": \"b" + std::to_string(i) + "\", \"position\": " + vec(x, y) +
+        entities += ", {\"name\": \"b" + std::to_string(i) + "\", \"position\": " + vectorJson(x, y) +
                     (i % 2 ? ", \"radius\": 0.15}" : ", \"box\": {\"width\": 0.25, \"height\": 0.25}}");
     }
     return level(entities, world);
@@ -393,7 +386,7 @@ TEST(CompoundWorld, AMotorTurnsADynamicDrumOnAHinge) {
         const std::string kinematic = "\"kinematic\": true, ";
         text.replace(text.find(kinematic), kinematic.size(), "");
         text.insert(text.rfind("]}"), ", {\"name\": \"axle\", \"joint\": {\"type\": \"hinge\", \"a\": \"drum\", "
-                                      "\"anchor\": {\"x\": 0, \"y\": 0}, \"motor_speed\": " + number(speed) +
+                                      "\"anchor\": {\"x\": 0, \"y\": 0}, \"motor_speed\": " + exactNumber(speed) +
                                       ", \"max_motor_torque\": 1e6}}");
         Sim sim(text);
         ASSERT_TRUE(sim.step(300));
@@ -415,9 +408,9 @@ TEST(CompoundWorld, EachShapeKeepsItsOwnFriction) {
     for (const bool slippery : {true, false}) {
         const std::string item = boxItem(0, 0, 1, 0.5, slippery ? ", \"friction\": 0" : ", \"friction\": 1");
         const std::string text =
-            level("{\"name\": \"slope\", \"plane\": {\"normal\": " + vec(n.x, n.y) + ", \"offset\": 0}}, "
-                  "{\"name\": \"block\", \"position\": " + vec(0.25 * n.x, 0.25 * n.y) + ", \"angle\": " +
-                  number(slope) + ", \"friction\": " + (slippery ? "1" : "0") + ", \"shapes\": [" + item + "]}");
+            level("{\"name\": \"slope\", \"plane\": {\"normal\": " + vectorJson(n.x, n.y) + ", \"offset\": 0}}, "
+                  "{\"name\": \"block\", \"position\": " + vectorJson(0.25 * n.x, 0.25 * n.y) + ", \"angle\": " +
+                  exactNumber(slope) + ", \"friction\": " + (slippery ? "1" : "0") + ", \"shapes\": [" + item + "]}");
         Sim sim(text);
         ASSERT_TRUE(sim.step(60));
         const double moved = length(sim.position("block") - 0.25 * n);
@@ -472,7 +465,7 @@ TEST(CompoundWorld, ARestingCompoundBodySleepsAndABallWakesIt) {
     // The L rests and falls asleep as one body; a ball dropped on its post
     // (not on the shape that touches the floor) wakes it, and it settles
     // again with the ball on top.
-    const std::string text = level(kFloor + ", {\"name\": \"ell\", \"position\": " + vec(0, 0.25) +
+    const std::string text = level(kFloor + ", {\"name\": \"ell\", \"position\": " + vectorJson(0, 0.25) +
                                        ", \"shapes\": [" + boxItem(0, 0, 2, 0.5) + ", " + boxItem(0.75, 1.0, 0.5, 1.5) +
                                        "]}, {\"name\": \"ball\", \"position\": {\"x\": 0.75, \"y\": 30}, \"radius\": 0.2}",
                                    ", \"sleep\": true");

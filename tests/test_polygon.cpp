@@ -10,6 +10,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,6 +20,10 @@
 #include <vector>
 
 using namespace stepwise;
+using test::exactNumber;
+using test::loadError;
+using test::named;
+using test::vectorJson;
 using namespace stepwise::collision;
 
 namespace {
@@ -32,16 +37,6 @@ std::string level(const std::string& entities, const std::string& world = "") {
 }
 
 /// The loader's message for `text`, or "loaded" when it loads.
-std::string loadError(const std::string& text) {
-    Result<Scene> s = parseScene(text, "t.json");
-    return s ? "loaded" : s.error();
-}
-
-Entity named(const Scene& scene, const std::string& name) {
-    for (Entity e : scene.registry.entities())
-        if (const Name* n = scene.registry.tryGet<Name>(e); n && n->value == name) return e;
-    return {};
-}
 
 /// Loads `text`, steps it `steps` times, writes the state back.
 struct Stepped {
@@ -81,17 +76,7 @@ struct Stepped {
     }
 };
 
-std::string number(double v) {
-    char b[40];
-    std::snprintf(b, sizeof b, "%.17g", v);
-    return b;
-}
 
-std::string vec(double x, double y) {
-    char b[96];
-    std::snprintf(b, sizeof b, "{\"x\": %.17g, \"y\": %.17g}", x, y);
-    return b;
-}
 
 /// Regular n-gon of circumradius r, counter-clockwise, vertex 0 at `phase` rad.
 std::vector<Vec2> regular(int n, double r, double phase = 0.0) {
@@ -105,7 +90,7 @@ std::vector<Vec2> regular(int n, double r, double phase = 0.0) {
 
 std::string verticesJson(const std::vector<Vec2>& v) {
     std::string s = "{\"vertices\": [";
-    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + vec(v[i].x, v[i].y);
+    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + vectorJson(v[i].x, v[i].y);
     return s + "]}";
 }
 
@@ -193,7 +178,7 @@ TEST(PolygonFormat, BadOutlinesAreRefusedWithTheEntityAndThePointer) {
     std::string star;
     for (int i = 0; i < 5; ++i) {
         const double a = 2.0 * kPi * (2 * i) / 5.0;
-        star += (i ? ", " : "") + vec(std::cos(a), std::sin(a));
+        star += (i ? ", " : "") + vectorJson(std::cos(a), std::sin(a));
     }
     EXPECT_EQ(one(star), "t.json: error: /entities/0/polygon/vertices/3: entity 0 (\"wedge\"): not convex: the "
                          "outline crosses itself (vertex 3 is not inside edge 0-1)");
@@ -397,8 +382,8 @@ TEST(PolygonWorld, RotatedBlockOnAPolygonRampSticksOrSlidesAsCoulombSays) {
     for (const auto& [friction, slides] : {std::pair{0.36, false}, std::pair{0.01, true}}) {
         // The pair's coefficient is sqrt(f_block * f_ramp) = sqrt(friction).
         const double mu = std::sqrt(friction);
-        Stepped r(level(ramp + ", {\"name\": \"block\", \"position\": " + vec(centre.x, centre.y) +
-                        ", \"angle\": " + number(-slope) + ", \"friction\": " + number(friction) +
+        Stepped r(level(ramp + ", {\"name\": \"block\", \"position\": " + vectorJson(centre.x, centre.y) +
+                        ", \"angle\": " + exactNumber(-slope) + ", \"friction\": " + exactNumber(friction) +
                         ", \"polygon\": " + verticesJson({{-0.25, -0.25}, {0.25, -0.25}, {0.25, 0.25}, {-0.25, 0.25}}) +
                         "}",
                     "\"gravity\": {\"x\": 0, \"y\": -9.81}, \"substeps\": 4"),
@@ -476,8 +461,8 @@ TEST(PolygonWorld, PolygonsPileOnOneAnotherWithoutBlowingUp) {
         for (int i = 0; i < 24; ++i) {
             const int n = 3 + i % 6;
             entities += ", {\"name\": \"p" + std::to_string(i) + "\", \"position\": " +
-                        vec(-1.5 + (i % 6) * 0.6 + 0.05 * (i / 6), 0.5 + 0.7 * (i / 6)) +
-                        ", \"angle\": " + number(0.3 * i) + ", \"polygon\": " + verticesJson(regular(n, 0.28)) +
+                        vectorJson(-1.5 + (i % 6) * 0.6 + 0.05 * (i / 6), 0.5 + 0.7 * (i / 6)) +
+                        ", \"angle\": " + exactNumber(0.3 * i) + ", \"polygon\": " + verticesJson(regular(n, 0.28)) +
                         "}";
         }
         Stepped r(level(entities, "\"gravity\": {\"x\": 0, \"y\": -9.81}, " + settings), 600);

@@ -23,6 +23,9 @@
 #include <vector>
 
 using namespace stepwise;
+using test::exactNumber;
+using test::loadError;
+using test::vectorJson;
 using test::named;
 using test::Sim;
 using namespace stepwise::collision;
@@ -32,28 +35,18 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kG = 9.81;
 
-std::string number(double v) {
-    char b[40];
-    std::snprintf(b, sizeof b, "%.17g", v);
-    return b;
-}
 
-std::string vec(double x, double y) { return "{\"x\": " + number(x) + ", \"y\": " + number(y) + "}"; }
 
 std::string level(const std::string& entities, const std::string& world = "") {
     return "{\"world\": {\"gravity\": {\"x\": 0, \"y\": -9.81}" + (world.empty() ? std::string() : ", " + world) +
            "}, \"entities\": [" + entities + "]}";
 }
 
-std::string loadError(const std::string& text) {
-    Result<Scene> s = parseScene(text, "t.json");
-    return s ? "loaded" : s.error();
-}
 
 std::string polygonJson(const std::vector<Vec2>& v, double radius) {
     std::string out = "\"polygon\": {\"vertices\": [";
-    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + vec(v[i].x, v[i].y);
-    return out + "], \"radius\": " + number(radius) + "}";
+    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + vectorJson(v[i].x, v[i].y);
+    return out + "], \"radius\": " + exactNumber(radius) + "}";
 }
 
 std::vector<Vec2> rectangle(double w, double h) { return {{-w / 2, -h / 2}, {w / 2, -h / 2}, {w / 2, h / 2}, {-w / 2, h / 2}}; }
@@ -283,7 +276,7 @@ TEST(RoundedPolygonWorld, ARoundedBoxRestsAtHalfHeightPlusRadiusOnEverySupport) 
         for (const double r : {0.02, 0.1, 0.3})
             for (const double h : {0.2, 0.6})
                 for (const int substeps : {1, 4}) {
-                    Sim sim(level(support + ", {\"name\": \"soap\", \"position\": " + vec(0.1, h / 2 + r + 0.2) +
+                    Sim sim(level(support + ", {\"name\": \"soap\", \"position\": " + vectorJson(0.1, h / 2 + r + 0.2) +
                                       ", " + polygonJson(rectangle(0.8, h), r) + "}",
                                   "\"substeps\": " + std::to_string(substeps)));
                     ASSERT_TRUE(sim.world);
@@ -298,8 +291,8 @@ TEST(RoundedPolygonWorld, ARoundedBoxRestsAtHalfHeightPlusRadiusOnEverySupport) 
     for (const double r : {0.05, 0.2}) {
         Sim sim(level("{\"name\": \"floor\", \"plane\": {\"normal\": {\"x\": 0, \"y\": 1}, \"offset\": 0}}, "
                       "{\"name\": \"low\", \"position\": " +
-                      vec(0, 0.2 + r + 0.05) + ", " + polygonJson(rectangle(1.2, 0.4), r) +
-                      "}, {\"name\": \"high\", \"position\": " + vec(0, 0.4 + 2 * r + 0.15 + r + 0.1) + ", " +
+                      vectorJson(0, 0.2 + r + 0.05) + ", " + polygonJson(rectangle(1.2, 0.4), r) +
+                      "}, {\"name\": \"high\", \"position\": " + vectorJson(0, 0.4 + 2 * r + 0.15 + r + 0.1) + ", " +
                       polygonJson(rectangle(0.8, 0.3), r) + "}",
                       "\"substeps\": 4"));
         ASSERT_TRUE(sim.step(300));
@@ -319,18 +312,18 @@ TEST(RoundedPolygonWorld, AHeavilyRoundedTriangleRollsDownASlopeLikeADisc) {
         const double c = std::cos(theta), s = std::sin(theta);
         const std::string slope = "{\"name\": \"slope\", \"static\": true, \"position\": {\"x\": 0, \"y\": 0}, "
                                   "\"angle\": " +
-                                  number(-theta) + ", \"box\": {\"width\": 40, \"height\": 1}, \"friction\": 1}";
+                                  exactNumber(-theta) + ", \"box\": {\"width\": 40, \"height\": 1}, \"friction\": 1}";
         // Start where each touches the slope's top face (y = 0.5 in its frame).
         const auto on = [&](double along, double above) {
-            return vec(c * along + s * (0.5 + above), -s * along + c * (0.5 + above));
+            return vectorJson(c * along + s * (0.5 + above), -s * along + c * (0.5 + above));
         };
         const double tiny = 0.005;
         const std::vector<Vec2> tri{{-tiny / 2, -tiny / 3}, {tiny / 2, -tiny / 3}, {0, 2 * tiny / 3}};
         Sim sim(level(slope + ", {\"name\": \"pebble\", \"position\": " + on(-5, 0.3 + tiny / 3) +
-                          ", \"angle\": " + number(-theta) + ", " + polygonJson(tri, 0.3) +
+                          ", \"angle\": " + exactNumber(-theta) + ", " + polygonJson(tri, 0.3) +
                           ", \"friction\": 1}, {\"name\": \"disc\", \"position\": " + on(-9, 0.3) +
                           ", \"radius\": 0.3, \"friction\": 1}, {\"name\": \"sharp\", \"position\": " +
-                          on(-1, 0.3) + ", \"angle\": " + number(-theta) + ", " +
+                          on(-1, 0.3) + ", \"angle\": " + exactNumber(-theta) + ", " +
                           polygonJson(rectangle(0.6, 0.6), 0) + ", \"friction\": 1}",
                       "\"substeps\": 4"));
         ASSERT_TRUE(sim.world);

@@ -25,6 +25,9 @@
 #include <vector>
 
 using namespace stepwise;
+using test::exactNumber;
+using test::loadError;
+using test::vectorJson;
 using test::Sim;
 
 namespace {
@@ -37,19 +40,14 @@ struct Piece {
     bool flatTop = true;  ///< whether another body can rest on it
 };
 
-std::string number(double v) {
-    char b[40];
-    std::snprintf(b, sizeof b, "%.17g", v);
-    return b;
-}
 
-std::string point(double x, double y) { return "{\"x\": " + number(x) + ", \"y\": " + number(y) + "}"; }
+std::string point(double x, double y) { return "{\"x\": " + exactNumber(x) + ", \"y\": " + exactNumber(y) + "}"; }
 
 Piece circle(double r) {
-    return {"circle", "\"radius\": " + number(r), r, r, false};
+    return {"circle", "\"radius\": " + exactNumber(r), r, r, false};
 }
 Piece box(double w, double h) {
-    return {"box", "\"box\": {\"width\": " + number(w) + ", \"height\": " + number(h) + "}", h / 2, h / 2};
+    return {"box", "\"box\": {\"width\": " + exactNumber(w) + ", \"height\": " + exactNumber(h) + "}", h / 2, h / 2};
 }
 Piece hexagon(double r) {
     // Flat top and bottom: vertices at 0, 60, ... degrees.
@@ -64,13 +62,13 @@ Piece hexagon(double r) {
 Piece roundedBox(double w, double h, double radius) {
     const std::string v = point(-w / 2, -h / 2) + ", " + point(w / 2, -h / 2) + ", " + point(w / 2, h / 2) + ", " +
                           point(-w / 2, h / 2);
-    return {"rounded box", "\"polygon\": {\"vertices\": [" + v + "], \"radius\": " + number(radius) + "}",
+    return {"rounded box", "\"polygon\": {\"vertices\": [" + v + "], \"radius\": " + exactNumber(radius) + "}",
             h / 2 + radius, h / 2 + radius};
 }
 Piece capsule(double length, double r) {
     return {"capsule",
             "\"capsule\": {\"a\": " + point(-length / 2, 0) + ", \"b\": " + point(length / 2, 0) + ", \"radius\": " +
-                number(r) + "}",
+                exactNumber(r) + "}",
             r, r};
 }
 Piece compound(double w, double h) {
@@ -78,9 +76,9 @@ Piece compound(double w, double h) {
     // sides, centre of mass at the middle.
     const double r = h / 2;
     return {"compound",
-            "\"shapes\": [{\"box\": {\"center\": " + point(0, 0) + ", \"width\": " + number(w) + ", \"height\": " +
-                number(h) + ", \"angle\": 0}}, {\"circle\": {\"center\": " + point(-w / 2, 0) + ", \"radius\": " +
-                number(r) + "}}, {\"circle\": {\"center\": " + point(w / 2, 0) + ", \"radius\": " + number(r) + "}}]",
+            "\"shapes\": [{\"box\": {\"center\": " + point(0, 0) + ", \"width\": " + exactNumber(w) + ", \"height\": " +
+                exactNumber(h) + ", \"angle\": 0}}, {\"circle\": {\"center\": " + point(-w / 2, 0) + ", \"radius\": " +
+                exactNumber(r) + "}}, {\"circle\": {\"center\": " + point(w / 2, 0) + ", \"radius\": " + exactNumber(r) + "}}]",
             r, r};
 }
 
@@ -167,10 +165,10 @@ TEST(ShapePairs, EveryKindRestsOnEveryKindAtItsAnalyticHeight) {
                     const Outcome o =
                         settle(kFloor + ", {\"name\": \"bottom\", \"mass\": 1, \"position\": " +
                                    point(0, yBottom + 0.001) + ", " + bottom.json +
-                                   "}, {\"name\": \"top\", \"mass\": " + number(ratio) + ", \"position\": " +
+                                   "}, {\"name\": \"top\", \"mass\": " + exactNumber(ratio) + ", \"position\": " +
                                    point(0, yTop + 0.002) + ", " + top.json + "}",
                                world, yTop, yBottom);
-                    const std::string what = top.label + " on a " + bottom.label + ", mass ratio " + number(ratio) +
+                    const std::string what = top.label + " on a " + bottom.label + ", mass ratio " + exactNumber(ratio) +
                                              " (" + world + ")";
                     EXPECT_LT(o.heightError, 2.0 * (1.0 + ratio) * 9.81 / (o.omega * o.omega) + 2e-4) << what;
                     // Two sharp hexagons at one substep, the top five times

@@ -144,6 +144,17 @@ inline std::string exactNumber(double v) {
     return text;
 }
 
+/// A vector's JSON, {"x": X, "y": Y}, each number exact.
+inline std::string vectorJson(double x, double y) {
+    return "{\"x\": " + exactNumber(x) + ", \"y\": " + exactNumber(y) + "}";
+}
+
+/// The loader's refusal of `text` (as "t.json"), or "loaded".
+inline std::string loadError(const std::string& text) {
+    Result<Scene> s = parseScene(text, "t.json");
+    return s ? "loaded" : s.error();
+}
+
 /// A level parsed from text; throws (failing the test) if it is refused.
 inline Scene parseLevel(const std::string& text) {
     Result<Scene> s = parseScene(text, "t.json");
