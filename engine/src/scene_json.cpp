@@ -550,12 +550,18 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
         if (key != "contacts" && key != "joints" && key != "bodies" && key != "chosen")
             refuse(at, "unknown key \"" + key + "\" in solver_state. Known keys: contacts, joints, bodies, chosen");
         if (key == "chosen") {
-            // The substeps and iterations the engine chose for the run that
-            // wrote this file; both required.
-            static constexpr std::array<std::string_view, 2> kChosenKeys{"substeps", "solver_iterations"};
+            // What the engine chose for the run that wrote this file: the
+            // substeps and iterations (both required) and the contacts'
+            // stiffness cap (optional).
+            static constexpr std::array<std::string_view, 3> kChosenKeys{"substeps", "solver_iterations",
+                                                                         "contact_hertz_fraction"};
             ChosenSettings chosen;
-            readEntry(value, at, "the engine's chosen settings", kChosenKeys, kChosenKeys.size(),
+            readEntry(value, at, "the engine's chosen settings", kChosenKeys, 2,
                       [&](const std::string& field, const Json& fv, const std::string& fa) {
+                          if (field == "contact_hertz_fraction") {
+                              chosen.contactHertzFraction = readNumber(fv, fa, NumberRange{0.0, 0.25, true});
+                              return;
+                          }
                           const int count = int(readInteger(fv, fa, 1, 1000));
                           if (field == "substeps") chosen.substeps = count;
                           else chosen.solverIterations = count;
@@ -1213,9 +1219,13 @@ void appendSolverState(const SolverState& state, const Registry& registry, std::
     const auto number = [](double v) { return Json(v).dump(); };
     out.erase(out.size() - 2);  // "\n}"
     out += ",\n  \"solver_state\": {\n";
-    if (state.chosen)
+    if (state.chosen) {
         out += "    \"chosen\": {\"substeps\": " + std::to_string(state.chosen->substeps) +
-               ", \"solver_iterations\": " + std::to_string(state.chosen->solverIterations) + "},\n";
+               ", \"solver_iterations\": " + std::to_string(state.chosen->solverIterations);
+        if (state.chosen->contactHertzFraction)
+            out += ", \"contact_hertz_fraction\": " + number(*state.chosen->contactHertzFraction);
+        out += "},\n";
+    }
     out += "    \"contacts\": [";
     bool first = true;
     for (const ContactImpulse& c : state.contacts) {

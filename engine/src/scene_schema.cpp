@@ -227,12 +227,17 @@ std::string sceneJsonSchema() {
                         "editor's Save simulation state) so that a resumed run is bit-identical; absent: a cold start"},
         {"additionalProperties", false},
         {"properties", Json{{"chosen", Json{{"type", "object"},
-                                            {"description", "the substeps and solver_iterations the engine chose for a "
-                                                            "level that leaves them out, run again on resume"},
+                                            {"description", "what the engine chose for the run, run again on resume: the "
+                                                            "substeps and solver_iterations of a level that leaves them "
+                                                            "out, and the contacts' stiffness cap"},
                                             {"additionalProperties", false},
                                             {"required", Json::array({"substeps", "solver_iterations"})},
                                             {"properties", Json{{"substeps", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}},
-                                                                {"solver_iterations", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}}}}}},
+                                                                {"solver_iterations", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}},
+                                                                {"contact_hertz_fraction",
+                                                                 Json{{"type", "number"}, {"exclusiveMinimum", 0}, {"maximum", 0.25},
+                                                                      {"description", "the contacts' stiffness cap as a fraction of the "
+                                                                                      "substep rate (1/4, or 1/8 for a deep column)"}}}}}}},
                             {"contacts", Json{{"type", "array"}, {"items", contact}}},
                             {"joints", Json{{"type", "array"}, {"items", joint}}},
                             {"bodies", Json{{"type", "array"}, {"items", bodySleep}}}}}};

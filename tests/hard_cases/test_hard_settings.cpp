@@ -162,7 +162,9 @@ TEST(HardSettings, SavedRunRecordsTheChoiceAndAFreshLevelDoesNot) {
     World w = build(level);
     ASSERT_TRUE(advance(w, 5).ok());
     const std::string saved = savedText(w, level);
-    EXPECT_NE(saved.find("\"chosen\": {\"substeps\": 4, \"solver_iterations\": 2}"), std::string::npos) << saved.substr(0, 300);
+    EXPECT_NE(saved.find("\"chosen\": {\"substeps\": 4, \"solver_iterations\": 2, \"contact_hertz_fraction\": 0.25}"),
+              std::string::npos)
+        << saved.substr(0, 300);
     const Scene back = parse(saved);
     EXPECT_EQ(back.world.substeps, 0) << "recorded in solver_state, not as the level's own setting";
     ASSERT_TRUE(back.solverState && back.solverState->chosen);
@@ -176,13 +178,17 @@ TEST(HardSettings, SavedRunRecordsTheChoiceAndAFreshLevelDoesNot) {
     // A level's own setting wins over a record.
     edited.world.substeps = 3;
     EXPECT_EQ(build(edited).settings().substeps, 3);
-    // A level that gives both records nothing.
+    // A level that gives both records only the contacts' stiffness cap,
+    // which the engine chooses whatever the level gives, and only once it
+    // has run.
     Scene given = level;
     given.world.substeps = 8;
     given.world.solverIterations = 4;
     World g = build(given);
+    EXPECT_FALSE(g.solverState().chosen) << "nothing run yet: a fresh load chooses the same";
     ASSERT_TRUE(advance(g, 5).ok());
-    EXPECT_FALSE(g.solverState().chosen);
+    ASSERT_TRUE(g.solverState().chosen);
+    EXPECT_EQ(g.solverState().chosen->contactHertzFraction, std::optional<double>(0.25));
 }
 
 TEST(HardSettings, ChoiceDependsOnStructureNotOnWhereBodiesAre) {
@@ -432,3 +438,33 @@ TEST(HardSettings, ARecordedChoiceRaisesNoWarning) {
     }
 }
 
+
+// The contacts' stiffness cap is chosen from the structure a run starts
+// from (a deep column standing gets the softer one), whatever settings the
+// level gives. Boxes dropped with gaps between them are no column at the
+// start and one once they have landed: a resume, loading that column, must
+// still run the cap the run started with. Swept over the column's height
+// and the step the run is saved at.
+TEST(HardSettings, AResumeKeepsTheContactStiffnessTheRunStartedWith) {
+    for (const int boxes : {14, 20}) {
+        std::ostringstream s;
+        s << R"({"world": {"gravity": {"x": 0, "y": -10}, "substeps": 4, "solver_iterations": 2}, "entities": [)"
+          << R"({"name": "floor", "position": {"x": 0, "y": -0.5}, "box": {"width": 20, "height": 1}, "static": true})";
+        for (int k = 0; k < boxes; ++k)
+            s << R"(, {"name": "box )" << k << R"(", "position": {"x": 0, "y": )" << num(0.5 + 1.6 * k)
+              << R"(}, "box": {"width": 1, "height": 1}, "mass": 1})";
+        s << "]}";
+        const Scene level = parse(s.str());
+        EXPECT_EQ(build(level).settingsChoice().hertzFraction, 0.25) << boxes << " boxes apart: no column yet";
+        World landed = build(level);
+        ASSERT_TRUE(advance(landed, 120).ok());
+        Scene column = parse(savedText(landed, level));
+        ASSERT_TRUE(column.solverState && column.solverState->chosen);
+        EXPECT_EQ(column.solverState->chosen->contactHertzFraction, std::optional<double>(0.25)) << boxes;
+        column.solverState->chosen->contactHertzFraction.reset();
+        EXPECT_EQ(build(column).settingsChoice().hertzFraction, 0.125)
+            << boxes << " boxes landed: a fresh choice would see a deep column";
+        for (const std::uint64_t split : {30u, 120u})
+            expectResumeExact(level, split, 20, std::to_string(boxes) + " boxes, saved at step " + std::to_string(split));
+    }
+}

@@ -142,12 +142,16 @@ struct BodySleep {
 /// file's optional `solver_state` section (an addition to the format).
 /// Per-body solver state (sleep timers, ...) goes here next to `contacts`,
 /// keyed by entity the same way.
-/// The substeps and solver iterations the engine chose for a level that
-/// leaves them out, recorded by a run so that its resume runs the same
-/// (`solver_state.chosen`). A level that gives a setting keeps its own.
+/// What the engine chose for a run, recorded by the run so that its resume
+/// runs the same (`solver_state.chosen`): the substeps and solver iterations
+/// of a level that leaves them out (a level that gives a setting keeps its
+/// own), and the contacts' stiffness cap, which the engine always chooses
+/// from the scene's structure (ContactSettingsChoice::hertzFraction).
 struct ChosenSettings {
     int substeps = 1;
     int solverIterations = 8;
+    /// Absent in a file written without it: chosen again on load.
+    std::optional<double> contactHertzFraction;
 
     friend bool operator==(const ChosenSettings&, const ChosenSettings&) = default;
 };

@@ -496,6 +496,21 @@ std::vector<JointImpulse> jointImpulsesOf(const collision::CollisionSystem& syst
     for (const joints::JointConstraint& j : system.jointConstraints()) out.push_back(joints::impulsesOf(j));
     return out;
 }
+
+/// What the engine chose is part of the run: a resume must not choose
+/// again. The substeps and iterations when the level left either out; the
+/// contacts' stiffness cap once the run has moved on from the structure it
+/// was chosen from (or a record carried it), since a fresh load would choose
+/// it from the structure the bodies have then.
+std::optional<ChosenSettings> chosenSettings(const WorldImpl& w) {
+    const bool counts = w.settingsSource != World::SettingsSource::Given;
+    const bool stiffness =
+        w.collision && (counts || w.hertzFractionRecorded || w.stats.step > 0);
+    if (!counts && !stiffness) return std::nullopt;
+    ChosenSettings chosen{w.settings.substeps, w.settings.solverIterations, std::nullopt};
+    if (stiffness) chosen.contactHertzFraction = w.contactChoice.hertzFraction;
+    return chosen;
+}
 } // namespace
 
 SolverState WorldState::solverState() const {
@@ -507,9 +522,7 @@ SolverState World::solverState() const {
     const SleepArrays sleep{w.sleep.timer, w.sleep.island, w.sleep.anchor, w.sleep.anchored};
     SolverState state = w.collision ? entityKeyed(*w.layout, w.collision->warmStartCache(), jointImpulsesOf(*w.collision), sleep)
                                     : entityKeyed(*w.layout, {}, {}, sleep);
-    // What the engine chose is part of the run: a resume must not choose again.
-    if (w.settingsSource != SettingsSource::Given)
-        state.chosen = ChosenSettings{w.settings.substeps, w.settings.solverIterations};
+    state.chosen = chosenSettings(w);
     return state;
 }
 
@@ -770,8 +783,7 @@ Result<void> World::restoreOtherCopies(const WorldState& s) {
     writeStateBack(*s.layout, s.x.data(), s.v.data(), s.spinAngle, s.colliderAngle, s.colliderSpin, s.time,
                    s.adaptiveStep, scene);
     scene.solverState = s.solverState();
-    if (w.settingsSource != SettingsSource::Given)
-        scene.solverState->chosen = ChosenSettings{w.settings.substeps, w.settings.solverIterations};
+    scene.solverState->chosen = chosenSettings(w);
     Result<World> next = build(scene, w.switches);
     if (!next) return Error{next.error()};
     next->impl_->profiling = w.profiling;

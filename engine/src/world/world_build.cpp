@@ -295,6 +295,10 @@ std::optional<Error> chooseSolverCounts(const Scene& scene, const SystemSwitches
     const ContactSettingsChoice choice = chooseContactSettings(scene, switches);
     w.contactChoice = choice;
     const std::optional<ChosenSettings> recorded = scene.solverState ? scene.solverState->chosen : std::nullopt;
+    // The stiffness cap follows the structure the run started from (a deep
+    // column standing); a resume keeps it whatever the bodies have become.
+    w.hertzFractionRecorded = recorded && recorded->contactHertzFraction;
+    if (w.hertzFractionRecorded) w.contactChoice.hertzFraction = *recorded->contactHertzFraction;
     if (recorded && (recorded->substeps < 1 || recorded->solverIterations < 1))
         return Error{"solver_state.chosen: substeps and solver_iterations must be integers >= 1"};
     if (ws.substeps == 0) w.settings.substeps = recorded ? recorded->substeps : choice.substeps;

@@ -103,6 +103,7 @@ public:
     std::vector<std::pair<std::uint32_t, double>> breakScratch;  ///< CollisionSystem::breakJoints' output
     ContactSettingsChoice contactChoice;  ///< the scene's deepest pile (pileHint) and the engine's choice
     World::SettingsSource settingsSource = World::SettingsSource::Given;  ///< where substeps came from
+    bool hertzFractionRecorded = false;  ///< contactChoice.hertzFraction came from solver_state.chosen
     bool substepsGiven = false, iterationsGiven = false;  ///< by the level's world object
     std::vector<double> collisionAngleBackup, collisionSpinBackup;  ///< undo after a divergence
     bool profiling = true;
