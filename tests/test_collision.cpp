@@ -8,8 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 #include <random>
 
@@ -193,6 +195,41 @@ TEST(BroadPhase, StrategiesAgreeWithAFloorFirstAndASparseGrid) {
     BroadPhase(BroadPhaseKind::UniformGrid).findPairs(sparse, sparseMovable, sparseGrid);
     EXPECT_EQ(sparseBrute.size(), 40u);
     EXPECT_EQ(sparseGrid, sparseBrute);
+}
+
+// A crowded grid cell (a crowd pressed together) bounds the pairs among its
+// moving boxes, but each of its static boxes (the segments of a wall the
+// crowd presses on) must still meet every box it overlaps: a missed wall
+// pair lets a body through the wall. Swept over the crowd's size.
+TEST(BroadPhase, ACrowdedCellPairsEveryBoxWithItsStaticShapes) {
+    for (const int crowd : {65, 200, 1000}) {
+        std::mt19937 rng{std::uint32_t(crowd)};
+        std::uniform_real_distribution<double> x(0.0, 1.0);
+        std::vector<Aabb> boxes;
+        std::vector<std::uint8_t> movable;
+        for (int i = 0; i < crowd; ++i) {
+            const Vec2 p{x(rng), x(rng)};
+            boxes.push_back({p - Vec2{0.3, 0.3}, p + Vec2{0.3, 0.3}});
+            movable.push_back(1);
+        }
+        for (int k = 0; k < 4; ++k) {  // a wall of four segments through the crowd
+            boxes.push_back({{0.25 * k, 0.45}, {0.25 * (k + 1), 0.55}});
+            movable.push_back(0);
+        }
+        std::vector<ProxyPair> brute, grid;
+        BroadPhase(BroadPhaseKind::BruteForce).findPairs(boxes, movable, brute);
+        BroadPhase grids(BroadPhaseKind::UniformGrid);
+        grids.findPairs(boxes, movable, grid);
+        ASSERT_FALSE(grids.crowded().empty());
+        EXPECT_EQ(grids.crowded()[0], 1) << crowd << ": the crowd should fill one cell";
+        std::vector<ProxyPair> bruteStatic, gridStatic;
+        const auto withWall = [&](const ProxyPair& p) { return !movable[p.a] || !movable[p.b]; };
+        std::copy_if(brute.begin(), brute.end(), std::back_inserter(bruteStatic), withWall);
+        std::copy_if(grid.begin(), grid.end(), std::back_inserter(gridStatic), withWall);
+        EXPECT_GT(bruteStatic.size(), std::size_t(crowd)) << crowd;
+        EXPECT_EQ(gridStatic, bruteStatic) << crowd << " bodies in one cell";
+        EXPECT_LT(grid.size(), brute.size()) << crowd << ": the moving pairs stay bounded";
+    }
 }
 
 // ---------------------------------------------------------------- response

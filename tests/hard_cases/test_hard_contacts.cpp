@@ -285,3 +285,50 @@ TEST(HardContacts, StackOfUpToTenBoxesSinksUnderOneCentimetreAtTheDefaults) {
         EXPECT_LT(sink, 0.01) << n << " boxes, " << w->settings().substeps << " substeps";
     }
 }
+
+// A body at rest near a static wall gets a speculative margin for no motion,
+// so it has no contact with the wall when the step begins. Struck within the
+// step by a heavy ball, it leaves at up to twice the striker's speed, far
+// past that margin: it must still stop at the wall (a thin box, a one-sided
+// chain segment, a plane), never pass it or end deeper than the slop, and
+// nor may the striker. Swept over the striker's speed and the substeps.
+TEST(HardContacts, ABodyStruckWithinAStepNeverPassesAStaticWall) {
+    constexpr double r = 0.25, wall = 1.0;  // the wall's face at x = 1, solid beyond
+    for (const char* kind : {"thin box", "chain", "plane"}) {
+        for (const double speed : {20.0, 50.0, 100.0, 200.0, 400.0}) {
+            for (const int substeps : kSubsteps) {
+                Scene s = world({0.0, 0.0}, substeps);
+                const std::string what = std::string(kind) + " at " + std::to_string(int(speed)) + " m/s, substeps " +
+                                         label(substeps);
+                if (std::string(kind) == "thin box") {
+                    scenes::addStaticBox(s, {wall + 0.01, 0.0}, 0.02, 10.0);
+                } else if (std::string(kind) == "chain") {
+                    const Entity e = s.registry.create();
+                    s.registry.emplace<Position>(e, Position{{wall, 0.0}});
+                    s.registry.emplace<Static>(e, Static{true});
+                    // Downward, so the side bodies meet (its right) faces -x.
+                    s.registry.emplace<Chain>(e, Chain{{{0.0, 5.0}, {0.0, -5.0}}, false});
+                } else {
+                    const Entity e = floorPlane(s);
+                    s.registry.tryGet<Plane>(e)->normal = {-1.0, 0.0};
+                    s.registry.tryGet<Plane>(e)->offset = -wall;
+                }
+                // The target 0.5 m from the wall, the striker half a step's
+                // travel behind it: they meet within the first step.
+                disc(s, {wall - r - 0.5, 0.0}, r, 0.0);
+                const Entity striker = disc(s, {wall - 3.0 * r - 0.5 - 0.5 * speed / 60.0, 0.0}, r, 0.0);
+                s.registry.tryGet<Mass>(striker)->value = 10.0;
+                s.registry.tryGet<Velocity>(striker)->value = {speed, 0.0};
+                Result<World> w = World::build(s);
+                ASSERT_TRUE(w) << w.error();
+                double deepest = -1.0;
+                for (int i = 0; i < 40; ++i) {
+                    ASSERT_TRUE(w->step()) << what;
+                    for (const std::size_t body : {0u, 1u}) deepest = std::max(deepest, w->bodyPosition(body).x + r - wall);
+                }
+                EXPECT_LE(deepest, kSlop + kSlopTolerance) << what << ": a ball went " << deepest << " m into the wall";
+                EXPECT_LT(w->bodyPosition(0).x, wall) << what << ": the target passed the wall";
+            }
+        }
+    }
+}

@@ -1,4 +1,5 @@
 #include "collision/collision_system.hpp"
+#include "collision/static_sweep.hpp"
 
 #include "stepwise/components.hpp"
 
@@ -998,6 +999,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     }
     if (++substepsDone_ == substeps_) {
         correctStepPositions(x);
+        sweepAgainstStatic(x);
         syncShapes();
         if (anySensor_) updateSensors(x);
     }
@@ -1019,6 +1021,90 @@ void CollisionSystem::correctStepPositions(std::span<Vec2> x) {
         } else {
             x[sb.body] = stepStart_[i] + b.dp - rotate(Rot::fromAngle(angles_[i]), c.centreOfMass);
         }
+    }
+}
+
+void CollisionSystem::prepareStaticSweep() {
+    staticSweepReady_ = true;
+    std::vector<Aabb> boxes;
+    std::vector<std::uint32_t> proxies;
+    for (const std::uint32_t i : finite_) {
+        const Collider& c = colliders_[i];
+        if (c.body >= 0 || c.sensor) continue;
+        boxes.push_back(computeAabb(c.shape, c.staticPosition, Rot::fromAngle(angles_[i])));
+        proxies.push_back(i);
+    }
+    staticBoxes_.build(boxes, proxies);
+    hubShapes_.clear();
+    for (const std::uint32_t i : shapesOfHubs_) hubShapes_.push_back({std::uint32_t(colliders_[i].hub), i});
+    std::sort(hubShapes_.begin(), hubShapes_.end());
+}
+
+void CollisionSystem::sweepAgainstStatic(std::span<Vec2> x) {
+    if (!staticSweepReady_) prepareStaticSweep();
+    if (staticBoxes_.empty() && planes_.empty()) return;
+    // Within a target of the linear slop: the contact the next step finds
+    // then starts as a touching one.
+    const double target = kSpeculativeBase;
+    std::vector<SweptShape> shapes;
+    std::vector<std::uint32_t> shapeColliders;
+    for (const SolvedBody& sb : awakeSolved_) {
+        const std::uint32_t i = sb.collider;
+        const Collider& owner = colliders_[i];
+        if (owner.kinematic) continue;
+        SolverBody& b = bodies_[sb.solver];
+        // Only a body that went farther than the motion its contacts were
+        // found for can have met a static shape without a contact.
+        const double turn = angles_[i] - stepStartAngle_[i];
+        const double travel = length(b.dp) + std::abs(turn) * maxExtent_[i];
+        const double foreseen =
+            2.0 * kSpeculativeBase + dt_ * std::max(length(startV_[i]), length(endV_[i])) + spin_[i];
+        if (!(travel > foreseen)) continue;
+        shapes.clear();
+        shapeColliders.clear();
+        if (!owner.solverOnly) {
+            if (owner.sensor) continue;
+            shapes.push_back({&owner.shape, Vec2{}});
+            shapeColliders.push_back(i);
+        } else {
+            // A compound body's hub: its shapes, each about the body's centre.
+            const auto first = std::lower_bound(hubShapes_.begin(), hubShapes_.end(), std::pair{i, 0u});
+            for (auto it = first; it != hubShapes_.end() && it->first == i; ++it) {
+                const Collider& shape = colliders_[it->second];
+                if (shape.sensor) continue;
+                shapes.push_back({&shape.shape, shape.centreOfMass - owner.centreOfMass});
+                shapeColliders.push_back(it->second);
+            }
+            if (shapes.empty()) continue;
+        }
+        const BodySweep sweep{stepStart_[i], stepStart_[i] + b.dp, stepStartAngle_[i], angles_[i]};
+        double fraction = 1.0;
+        for (std::size_t k = 0; k < shapes.size(); ++k) {
+            const SweptShape& shape = shapes[k];
+            const std::uint32_t j = shapeColliders[k];
+            const auto test = [&](std::uint32_t s) {
+                const Collider& fixed = colliders_[s];
+                if (fixed.sensor || !collides(j, s) || (!noCollide_.empty() && joinedNotColliding(j, s))) return;
+                const PlacedShape placed{&fixed.shape, fixed.staticPosition, Rot::fromAngle(angles_[s])};
+                fraction = std::min(fraction, sweepFraction(sweep, shape, placed, target));
+            };
+            for (const std::uint32_t p : planes_) test(p);
+            if (staticBoxes_.empty()) continue;
+            const Rot q0 = Rot::fromAngle(sweep.a0), q1 = Rot::fromAngle(sweep.a1);
+            Aabb box = computeAabb(*shape.shape, sweep.c0 + rotate(q0, shape.offset), q0);
+            const Aabb end = computeAabb(*shape.shape, sweep.c1 + rotate(q1, shape.offset), q1);
+            box.lower = {std::min(box.lower.x, end.lower.x) - target, std::min(box.lower.y, end.lower.y) - target};
+            box.upper = {std::max(box.upper.x, end.upper.x) + target, std::max(box.upper.y, end.upper.y) + target};
+            staticBoxes_.query(box, test);
+        }
+        if (!(fraction < 1.0)) continue;
+        const Vec2 centre = sweep.centreAt(fraction);
+        angles_[i] = sweep.angleAt(fraction);
+        b.dp = centre - stepStart_[i];
+        b.dq = rotationBy(angles_[i] - stepStartAngle_[i]);
+        x[sb.body] = owner.centreOfMass.x == 0.0 && owner.centreOfMass.y == 0.0
+                         ? centre
+                         : centre - rotate(Rot::fromAngle(angles_[i]), owner.centreOfMass);
     }
 }
 

@@ -268,6 +268,14 @@ private:
     /// After the step's last substep: positions out of overlap beyond the
     /// slop (position_correction.hpp), written back to `x` and the angles.
     void correctStepPositions(std::span<Vec2> x);
+    /// After the position pass: bodies that moved farther this step than
+    /// their speculative margins allowed, swept against the static shapes
+    /// near their path and put back where their centroid would pass into
+    /// one (static_sweep.hpp), written back to `x` and the angles.
+    void sweepAgainstStatic(std::span<Vec2> x);
+    /// The static shapes' boxes and each compound body's shapes, built when
+    /// the sweep first needs them (static shapes never move).
+    void prepareStaticSweep();
     /// Adds the bodies of deeply overlapping moving pairs to crowdBodies_.
     void addDeepOverlapsToCrowd();
 
@@ -390,6 +398,9 @@ private:
     std::vector<SolvedBody> awakeSolved_;                // awakeSolverColliders_'s indices, set each step
     std::vector<std::uint32_t> awakeProxies_;            // finite_ indices of awake dynamic shapes, ascending
     FrozenBoxes frozen_;                                 // static and sleeping shapes' boxes
+    FrozenBoxes staticBoxes_;                            // static shapes' boxes, for the sweep
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> hubShapes_;  // (hub, shape), sorted, for the sweep
+    bool staticSweepReady_ = false;
     std::vector<Aabb> awakeBoxes_;
     std::vector<std::uint8_t> awakeMovable_;
     std::vector<ProxyPair> awakePairs_;

@@ -23,15 +23,16 @@ bool correctPositions(std::span<const ContactConstraint> contacts, std::span<Sol
         if (c.pointCount == 2) s = std::min(s, currentSeparation(a, b, c, c.points[1]));
         return s;
     };
-    // Moving pairs past the slop; static contacts that touch at all (the
-    // moving pass may push one of them deeper).
+    // Moving pairs past the slop; the static contacts, kept to see which
+    // touch once the moving pass has run (it may push a body squeezed
+    // against a wall into it).
     scratch.deepMoving.clear();
     scratch.touchingStatic.clear();
     bool any = false;  // a point this pass will move
     for (std::size_t k = 0; k < contacts.size(); ++k) {
         const double s = deepest(contacts[k]);
         if (contacts[k].touchesStatic) {
-            if (s < 0.0) scratch.touchingStatic.push_back(std::uint32_t(k));
+            scratch.touchingStatic.push_back(std::uint32_t(k));
             any = any || s < -settings.slop;
         } else if (s < -settings.slop &&
                    (crowd.empty() || crowd[contacts[k].bodyA] || crowd[contacts[k].bodyB])) {
@@ -84,6 +85,7 @@ bool correctPositions(std::span<const ContactConstraint> contacts, std::span<Sol
     // one jump.
     for (const std::uint32_t k : scratch.deepMoving)
         correct(contacts[k], settings.movingFraction, settings.maxCorrection);
+    std::erase_if(scratch.touchingStatic, [&](std::uint32_t k) { return !(deepest(contacts[k]) < 0.0); });
     // Against the static world the whole excess, uncapped, until every
     // point is within a micrometre of the slop: nothing else can carry the
     // load, and a point left past its step-start plane may be on the far
