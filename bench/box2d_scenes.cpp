@@ -303,7 +303,7 @@ Scene rain() {
                 at.x += 0.5;
             }
         }
-        // Copy the entity list: emplace may not move it, but creating does.
+        // Held by value: creating the emitter below grows the registry's list.
         const std::vector<Entity> members(r.entities().begin() + std::ptrdiff_t(first), r.entities().end());
         for (const Entity e : members)
             if (!r.has<Joint>(e)) r.emplace<Template>(e, Template{name});
