@@ -273,25 +273,52 @@ void human(Scene& s, const std::string& prefix, Vec2 at, int groupIndex) {
 // CreateRain: five floors 45 m apart, each a row of 501 static 0.5 m boxes;
 // above each floor, 40 columns of groups of five humans 0.5 m apart (the
 // k-th human of every group in collision group -k, as Box2D numbers them).
-// Box2D adds a column every 8 steps and then recycles the oldest; here all
-// 200 groups are there from the first step.
+// StepRain adds column j (a group on each floor) before step 8j, and once
+// all 40 are there destroys and re-creates one column every 8 steps, oldest
+// first: column j is made anew before steps 8j + 320k. Here each column is
+// a template (its five groups, at their places) with one emitter on the
+// template's first bone: interval 320 steps, one copy alive, the first at
+// the time of step 8j. An emitter adds its copy at the start of the step
+// that begins at that time, after removing the copy it replaces, as Box2D
+// does before b2World_Step. What differs: a copy's bodies and joints join
+// the solver's arrays after everything already there (Box2D reuses the
+// destroyed ids), and each is named after its copy (`rain column J#K/...`).
 Scene rain() {
     Scene s = v3World();
-    const int rows = 5, columns = 40, groupSize = 5, gridCount = 500;
+    const int rows = 5, columns = 40, groupSize = 5, gridCount = 500, delay = 8;
     const double grid = 0.5;
     for (int i = 0; i < rows; ++i)
         for (int j = 0; j <= gridCount; ++j)
             staticBox(s, label("floor ", i, j), {-0.5 * gridCount * grid + j * grid, 45.0 * i}, grid, grid);
     const double span = gridCount * grid;
     const double groupDistance = span / columns;
-    for (int row = 0; row < rows; ++row)
-        for (int column = 0; column < columns; ++column) {
+    Registry& r = s.registry;
+    for (int column = 0; column < columns; ++column) {
+        const std::string name = "rain column " + std::to_string(column);
+        const std::size_t first = r.entities().size();
+        for (int row = 0; row < rows; ++row) {
             Vec2 at{-0.5 * span + groupDistance * (column + 0.5), 40.0 + 45.0 * row};
             for (int k = 0; k < groupSize; ++k) {
                 human(s, label("human ", row, column) + "." + std::to_string(k) + " ", at, k + 1);
                 at.x += 0.5;
             }
         }
+        // Held by value: creating the emitter below grows the registry's list.
+        const std::vector<Entity> members(r.entities().begin() + std::ptrdiff_t(first), r.entities().end());
+        for (const Entity e : members)
+            if (!r.has<Joint>(e)) r.emplace<Template>(e, Template{name});
+        // The emitter sits on the template's first body, so each copy lands
+        // where the template is.
+        const Entity emitter = r.create();
+        r.emplace<Name>(emitter, Name{name + " emitter"});
+        r.emplace<Position>(emitter, Position{r.tryGet<Position>(members.front())->value});
+        Emitter em;
+        em.templateName = name;
+        em.interval = columns * delay * s.world.dt;
+        em.count = 1;
+        em.next = column * delay * s.world.dt;
+        r.emplace<Emitter>(emitter, em);
+    }
     s.view = View{{0.0, 90.0}, 2.5};
     return s;
 }

@@ -3,7 +3,7 @@
 // large pyramid, many pyramids, rain, smash, spinner, tumbler) built as
 // Stepwise scenes, as close as the scene format allows. What the format
 // lacks (capsules, chain shapes, collision filters, kinematic and compound
-// bodies, run-time spawning) is approximated; docs/performance.md, "Box2D's
+// bodies) is approximated; docs/performance.md, "Box2D's
 // benchmark scenes", lists each approximation and why. bench/levels/ holds
 // them as level files (hard_cases --write-levels).
 

@@ -42,6 +42,7 @@
 #include <string>
 #include <thread>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 using namespace stepwise;
@@ -55,7 +56,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // ---------------------------------------------------------------- bodies
 
 /// The scene's dynamic bodies in registry order, with what the measures
-/// need (both engines report their state in this order).
+/// need (both engines report their state in this order). Templates and
+/// emitters' copies are not among them: copies come and go during a run
+/// (each engine adds and removes them itself), so the per-body measures
+/// follow the level's own bodies, while contacts and joints count the
+/// copies alive.
 struct Bodies {
     std::vector<Entity> entities;
     std::vector<std::string> names;
@@ -73,8 +78,10 @@ bool hasShape(const Registry& r, Entity e) {
 Bodies bodiesOf(const Scene& scene) {
     Bodies b;
     const Registry& r = scene.registry;
+    const std::unordered_set<std::string> templates = bench::templateNames(r);
     for (Entity e : r.entities()) {
         if (!r.has<Position>(e) || isStatic(r, e) || !hasShape(r, e)) continue;
+        if (bench::inTemplate(r, e) || bench::isEmittedCopy(r, e, templates)) continue;
         double m = r.has<Mass>(e) ? r.tryGet<Mass>(e)->value : 1.0;
         double inertia = 0.0, radius = 0.0;
         if (const Shapes* shapes = r.tryGet<Shapes>(e)) {
@@ -200,9 +207,15 @@ Run runStepwise(const Scene& level, const Bodies& bodies, int steps, const Setti
     world.setProfiling(false);
     std::unordered_map<std::uint32_t, std::size_t> order;  // entity index -> Bodies index
     for (std::size_t i = 0; i < bodies.entities.size(); ++i) order.emplace(bodies.entities[i].index, i);
-    std::vector<std::size_t> slot(world.bodyCount(), std::size_t(-1));
-    for (std::size_t k = 0; k < world.bodyCount(); ++k)
-        if (auto it = order.find(world.bodyEntity(k).index); it != order.end()) slot[k] = it->second;
+    // World body k -> Bodies index; emitters add and remove bodies (and
+    // renumber the rest), so it is made again after every step that did.
+    std::vector<std::size_t> slot;
+    const auto mapBodies = [&] {
+        slot.assign(world.bodyCount(), std::size_t(-1));
+        for (std::size_t k = 0; k < world.bodyCount(); ++k)
+            if (auto it = order.find(world.bodyEntity(k).index); it != order.end()) slot[k] = it->second;
+    };
+    mapBodies();
     const Vec2 g = scene.world.gravity;
     std::vector<Vec2> p(bodies.entities.size()), v(bodies.entities.size());
     double startEnergy = 0.0;
@@ -229,6 +242,7 @@ Run runStepwise(const Scene& level, const Bodies& bodies, int steps, const Setti
             break;
         }
         ++out.steps;
+        if (!world.emitterEvents().empty()) mapBodies();
         if (const std::string why = stopReason(runStart, out); !why.empty()) {
             out.stopped = why;
             break;
@@ -271,11 +285,18 @@ Run runBox2d(const Scene& scene, const Bodies& bodies, int steps, int substeps, 
     b2Body* ground = world.CreateBody(&groundDef);
     std::unordered_map<std::uint32_t, b2Body*> bodyOf;
     for (Entity e : r.entities())
-        if (r.has<Position>(e) && (hasShape(r, e) || isStatic(r, e))) bodyOf.emplace(e.index, bench::createBox2dBody(world, r, e));
+        if (r.has<Position>(e) && (hasShape(r, e) || isStatic(r, e)) && !bench::inTemplate(r, e))
+            bodyOf.emplace(e.index, bench::createBox2dBody(world, r, e));
+    // Templates are copied by the emitters, at the steps Stepwise copies them.
+    bench::Box2dEmitters emitters;
+    if (std::string why = emitters.start(r, scene.world.time, scene.world.dt); !why.empty()) {
+        out.diverged = why;
+        return out;
+    }
     std::vector<b2Joint*> joints;
     for (Entity e : r.entities()) {
         const Joint* j = r.tryGet<Joint>(e);
-        if (!j) continue;
+        if (!j || bench::inTemplate(r, e)) continue;
         if (j->type != "hinge") {
             out.diverged = "Box2D port builds hinges only, not " + j->type;
             return out;
@@ -304,7 +325,9 @@ Run runBox2d(const Scene& scene, const Bodies& bodies, int steps, int substeps, 
     const auto runStart = std::chrono::steady_clock::now();
     for (int i = 0; i < steps; ++i) {
         const auto start = std::chrono::steady_clock::now();
+        emitters.beforeStep(world, ground, bodyOf);  // timed, as World::step times its own
         for (int s = 0; s < substeps; ++s) world.Step(h, 8, 3);
+        emitters.afterStep();
         times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         ++out.steps;
         if (const std::string why = stopReason(runStart, out); !why.empty()) {
@@ -317,7 +340,11 @@ Run runBox2d(const Scene& scene, const Bodies& bodies, int steps, int substeps, 
         }
         if (track.joints) {
             double widest = 0.0;
-            for (b2Joint* j : joints) widest = std::max(widest, double((j->GetAnchorB() - j->GetAnchorA()).Length()));
+            const auto opening = [](const b2Joint* j) { return double((j->GetAnchorB() - j->GetAnchorA()).Length()); };
+            for (b2Joint* j : joints) widest = std::max(widest, opening(j));
+            emitters.forEachCopy([&](const bench::Box2dEmitters::Copy& c) {
+                for (const b2Joint* j : c.joints) widest = std::max(widest, opening(j));
+            });
             out.maxJointOpening = std::max(out.maxJointOpening, widest);
             out.finalJointOpening = widest;
         }

@@ -15,6 +15,8 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <span>
+#include <unordered_map>
 #include <unordered_set>
 #include <sstream>
 #include <string>
@@ -618,5 +620,143 @@ TEST(Emitters, CompoundCopiesOnAChainResumeExactlyWithoutBuilds) {
             SCOPED_TRACE("split " + std::to_string(split));
             ASSERT_EQ(savedAfterResumeAt(scene, split, 300), expected);
         }
+    }
+}
+
+namespace {
+
+/// A cut-down Box2D rain (bench/box2d_scenes.cpp, rain()): `rows` floors
+/// 10 m apart, and `columns` columns, each a template holding a group of two
+/// two-bone dolls above every floor (hip and torso capsules hinged within
+/// limits, the k-th doll of a group in collision group -k), with an emitter
+/// on the template's first body: one copy alive, a new one every
+/// `columns * delay` steps, the first at step `delay * j` (counted from 0),
+/// as Box2D's StepRain makes and remakes its columns.
+std::string rainLevel(int rows, int columns, int delay) {
+    const double dt = 1.0 / 60.0;
+    std::ostringstream s;
+    s << R"({"world": {"gravity": {"x": 0, "y": -10}, "dt": )" << exactNumber(dt)
+      << R"(, "substeps": 4, "solver_iterations": 1, "sleep": false}, "entities": [)";
+    for (int row = 0; row < rows; ++row)
+        s << R"({"name": "floor )" << row << R"(", "position": )" << vectorJson(0.0, 10.0 * row)
+          << R"(, "static": true, "box": {"width": 40, "height": 0.5}},)";
+    for (int j = 0; j < columns; ++j) {
+        const std::string column = "column " + std::to_string(j);
+        Vec2 first;
+        for (int row = 0; row < rows; ++row)
+            for (int k = 0; k < 2; ++k) {
+                const std::string doll =
+                    "doll " + std::to_string(j) + "." + std::to_string(row) + "." + std::to_string(k) + " ";
+                const Vec2 at{-15.0 + 10.0 * j + 0.5 * k, 10.0 * row + 3.0};
+                if (row == 0 && k == 0) first = at;
+                const std::string filter =
+                    R"(, "filter": {"category": 2, "mask": 3, "group": )" + std::to_string(-(k + 1)) + "}";
+                s << R"({"name": ")" << doll << R"(hip", "template": ")" << column << R"(", "position": )"
+                  << vectorJson(at.x, at.y)
+                  << R"(, "capsule": {"a": {"x": 0, "y": -0.2}, "b": {"x": 0, "y": 0.2}, "radius": 0.1}, "mass": 1)"
+                  << filter << "},";
+                s << R"({"name": ")" << doll << R"(torso", "template": ")" << column << R"(", "position": )"
+                  << vectorJson(at.x, at.y + 0.6)
+                  << R"(, "capsule": {"a": {"x": 0, "y": -0.2}, "b": {"x": 0, "y": 0.2}, "radius": 0.1}, "mass": 1)"
+                  << filter << "},";
+                s << R"({"name": ")" << doll << R"(waist", "joint": {"type": "hinge", "a": ")" << doll
+                  << R"(hip", "b": ")" << doll << R"(torso", "anchor": )" << vectorJson(at.x, at.y + 0.3)
+                  << R"(, "lower": -0.5, "upper": 0.5}},)";
+            }
+        s << R"({"name": ")" << column << R"( emitter", "position": )" << vectorJson(first.x, first.y)
+          << R"(, "emitter": {"template": ")" << column << R"(", "interval": )" << exactNumber(columns * delay * dt)
+          << R"(, "count": 1, "next": )" << exactNumber(j * delay * dt) << "}}"
+          << (j + 1 < columns ? "," : "");
+    }
+    s << "]}";
+    return s.str();
+}
+
+/// What Box2D's StepRain does before step `step` (from 0) with `columns`
+/// columns remade every `delay` steps: column (step / delay) % columns is
+/// made for the (step / (columns * delay) + 1)-th time, its previous copy
+/// destroyed first; nothing between.
+std::vector<EmitterEvent> rainEventsAt(const Scene& scene, int step, int columns, int delay) {
+    if (step % delay != 0) return {};
+    const int j = (step / delay) % columns, made = step / (columns * delay);
+    const std::string column = "column " + std::to_string(j);
+    const Entity emitter = named(scene, column + " emitter");
+    std::vector<EmitterEvent> out;
+    if (made > 0) out.push_back({emitter, column + "#" + std::to_string(made), false});
+    out.push_back({emitter, column + "#" + std::to_string(made + 1), true});
+    return out;
+}
+
+} // namespace
+
+TEST(Emitters, RainColumnsAppearAndAreRemadeAtBox2dsSteps) {
+    // 3 columns remade every 4 steps over 3 rounds: column j is made before
+    // steps 4j + 12k and nowhere else, each copy's bodies on its template's
+    // places (a step's fall from rest is under 3 mm), one copy per column.
+    const int rows = 2, columns = 3, delay = 4, bodiesPerColumn = rows * 2 * 2;
+    const Scene scene = parseLevel(rainLevel(rows, columns, delay));
+    World world = buildWorld(scene);
+    ASSERT_EQ(world.emitterCount(), std::size_t(columns));
+    EXPECT_EQ(world.bodyCount(), 0u);
+    std::unordered_map<std::string, Vec2> templatePlace;  // "column J/NAME" -> where the template has it
+    for (const Entity e : scene.registry.entities())
+        if (const Template* t = scene.registry.tryGet<Template>(e))
+            templatePlace[t->value + "/" + scene.registry.tryGet<Name>(e)->value] = scene.registry.tryGet<Position>(e)->value;
+    for (int step = 0; step < 3 * columns * delay; ++step) {
+        SCOPED_TRACE("step " + std::to_string(step));
+        ASSERT_TRUE(world.step());
+        const std::span<const EmitterEvent> events = world.emitterEvents();
+        ASSERT_EQ(std::vector<EmitterEvent>(events.begin(), events.end()), rainEventsAt(scene, step, columns, delay));
+        ASSERT_EQ(world.bodyCount(), std::size_t(std::min(step / delay + 1, columns) * bodiesPerColumn));
+        if (events.empty()) continue;
+        // The copy just made: its bodies where the template's are.
+        const std::string made = events.back().copy;
+        int found = 0;
+        for (std::size_t b = 0; b < world.bodyCount(); ++b) {
+            const std::string* name = world.copyName(world.bodyEntity(b));
+            ASSERT_NE(name, nullptr);
+            if (!name->starts_with(made + "/") && *name != made) continue;
+            ++found;
+            const std::string column = made.substr(0, made.find('#'));
+            // The copy's first body is named after the copy alone: it is
+            // the template's first, "doll J.0.0 hip".
+            const std::string member =
+                *name == made ? "doll " + column.substr(7) + ".0.0 hip" : name->substr(made.size() + 1);
+            const Vec2 place = templatePlace.at(column + "/" + member);
+            const Vec2 at = world.bodyPosition(b);
+            EXPECT_EQ(at.x, place.x) << *name;
+            EXPECT_LT(std::abs(at.y - place.y), 3e-3) << *name;
+        }
+        EXPECT_EQ(found, bodiesPerColumn);
+    }
+}
+
+TEST(Emitters, RainScheduleHoldsOverManyRoundsAtSixtyHertz) {
+    // Box2D's own numbers: 40 columns, one made every 8 steps of 1/60 s, so
+    // each is remade every 320 steps; the times are sums of 1/60 and of
+    // 320/60, which need not land exactly on one another. Over 40 rounds
+    // (12,800 steps), every column is made exactly at steps 8j + 320k.
+    const int rows = 1, columns = 40, delay = 8;
+    const Scene scene = parseLevel(rainLevel(rows, columns, delay));
+    World world = buildWorld(scene);
+    for (int step = 0; step < 40 * columns * delay; ++step) {
+        ASSERT_TRUE(world.step());
+        const std::span<const EmitterEvent> events = world.emitterEvents();
+        ASSERT_EQ(std::vector<EmitterEvent>(events.begin(), events.end()), rainEventsAt(scene, step, columns, delay))
+            << "step " << step;
+    }
+}
+
+TEST(Emitters, RainSavedAndResumedRunsOnAsOneRun) {
+    // Saves before, on and after makings and remakings (steps 0, 4, 8 make,
+    // 12 remakes column 0), loaded and continued to step 40: the same text
+    // as 40 steps straight.
+    const Scene scene = parseLevel(rainLevel(2, 3, 4));
+    World straight = buildWorld(scene);
+    for (int s = 0; s < 40; ++s) ASSERT_TRUE(straight.step());
+    const std::string expected = savedRunText(straight, scene);
+    for (const int split : {1, 3, 4, 5, 12, 13, 16, 27}) {
+        SCOPED_TRACE("split " + std::to_string(split));
+        ASSERT_EQ(savedAfterResumeAt(scene, split, 40), expected);
     }
 }

@@ -8,8 +8,13 @@
 
 #include <box2d/box2d.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <deque>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace stepwise::bench {
@@ -169,5 +174,161 @@ inline b2Joint* createBox2dHinge(b2World& world, const Joint& j, b2Body* a, b2Bo
     }
     return world.CreateJoint(&def);
 }
+
+/// The template `e` is part of (a prefab that emitters copy, never a body
+/// of its own), or nullptr: its own `template`, or for a joint or spring the
+/// template of its first end (the loader keeps a template's joints within it).
+inline const std::string* templateOf(const Registry& r, Entity e) {
+    if (const Template* t = r.tryGet<Template>(e)) return &t->value;
+    Entity end;
+    if (const Joint* j = r.tryGet<Joint>(e)) end = j->a;
+    else if (const Spring* s = r.tryGet<Spring>(e)) end = s->a;
+    if (end.isNull() || !r.alive(end)) return nullptr;
+    const Template* t = r.tryGet<Template>(end);
+    return t ? &t->value : nullptr;
+}
+
+inline bool inTemplate(const Registry& r, Entity e) { return templateOf(r, e) != nullptr; }
+
+/// Whether `e` is an emitter's copy saved with a run ("TEMPLATE#N" or
+/// "TEMPLATE#N/..." with TEMPLATE a template of the scene).
+inline bool isEmittedCopy(const Registry& r, Entity e, const std::unordered_set<std::string>& templates) {
+    const Name* n = r.tryGet<Name>(e);
+    if (!n) return false;
+    const std::size_t hash = n->value.find('#');
+    return hash != std::string::npos && templates.count(n->value.substr(0, hash)) > 0;
+}
+
+/// The template names of a scene.
+inline std::unordered_set<std::string> templateNames(const Registry& r) {
+    std::unordered_set<std::string> out;
+    for (const Entity e : r.entities())
+        if (const Template* t = r.tryGet<Template>(e)) out.insert(t->value);
+    return out;
+}
+
+/// A scene's emitters in a Box2D 2.4.1 world, on Stepwise's clock: before
+/// each step, the copies whose lifetime is over leave, then every copy
+/// due (the first step that starts within half a step of `next`) is added,
+/// the oldest leaving first when `count` are alive; `next` advances by
+/// `interval`, times summed as World::step sums them, so copies come and go
+/// at the same steps in both engines. A copy is the template's bodies
+/// (createBox2dBody) moved so that its first body lands on the emitter
+/// (the emitter body's position when it has a shape), each with the
+/// emitter's velocity, and its hinges (createBox2dHinge). Not mirrored,
+/// and refused by start(): a `spread` (the engine's random turn), a run
+/// resumed with copies alive, and joints other than hinges; springs are
+/// left out as the harness leaves out every spring.
+class Box2dEmitters {
+public:
+    struct Copy {
+        std::vector<b2Body*> bodies;
+        std::vector<b2Joint*> joints;
+    };
+
+    /// Reads the emitters of `r` (world time `time`, step `dt`); an empty
+    /// string, or why the peer cannot mirror them.
+    std::string start(const Registry& r, double time, double dt) {
+        registry_ = &r;
+        time_ = time;
+        dt_ = dt;
+        for (const Entity e : r.entities()) {
+            const Emitter* em = r.tryGet<Emitter>(e);
+            if (!em) continue;
+            Run run;
+            run.entity = e;
+            run.params = *em;
+            if (!run.params.next) run.params.next = time;
+            if (em->spread != 0.0) return "the Box2D peer does not turn copies by an emitter's spread";
+            if (em->alive > 0) return "the Box2D peer does not resume an emitter with copies alive";
+            if (const Position* p = r.tryGet<Position>(e)) run.position = p->value;
+            for (const Entity m : r.entities()) {
+                const std::string* t = templateOf(r, m);
+                if (!t || *t != em->templateName) continue;
+                if (const Joint* j = r.tryGet<Joint>(m)) {
+                    if (j->type != "hinge") return "Box2D port builds hinges only, not " + j->type;
+                    run.joints.push_back(m);
+                } else if (r.has<Position>(m) && !r.has<Spring>(m)) {
+                    run.bodies.push_back(m);
+                }
+            }
+            if (run.bodies.empty()) return "emitter template \"" + em->templateName + "\" has no body";
+            runs_.push_back(std::move(run));
+        }
+        return {};
+    }
+
+    /// Before a step: removes and adds the copies due. `bodyOf` maps the
+    /// level's entities (by index) to their bodies, for an emitter that is
+    /// a body.
+    void beforeStep(b2World& world, b2Body* ground, const std::unordered_map<std::uint32_t, b2Body*>& bodyOf) {
+        const Registry& r = *registry_;
+        const double now = time_ + 0.5 * dt_;
+        for (Run& run : runs_) {
+            Emitter& p = run.params;
+            const auto removeOldest = [&] {
+                Copy& gone = run.copies.front();
+                for (b2Joint* j : gone.joints) world.DestroyJoint(j);
+                for (b2Body* b : gone.bodies) world.DestroyBody(b);
+                run.copies.pop_front();
+                --p.alive;
+                if (p.alive > 0) p.oldest = *p.oldest + p.interval;
+                else p.oldest.reset();
+            };
+            while (p.lifetime && p.alive > 0 && now >= *p.oldest + *p.lifetime) removeOldest();
+            for (int made = 0; now >= *p.next && made < kMaxEmissionsPerStep; ++made) {
+                if (p.alive >= p.count) removeOldest();
+                Vec2 at = run.position;
+                if (const auto it = bodyOf.find(run.entity.index); it != bodyOf.end())
+                    at = {it->second->GetPosition().x, it->second->GetPosition().y};
+                const Vec2 offset = at - r.tryGet<Position>(run.bodies.front())->value;
+                Copy copy;
+                std::unordered_map<std::uint32_t, b2Body*> copyOf;
+                for (const Entity m : run.bodies) {
+                    b2Body* b = createBox2dBody(world, r, m);
+                    const Vec2 q = r.tryGet<Position>(m)->value + offset;
+                    b->SetTransform(b2Vec2(float(q.x), float(q.y)), b->GetAngle());
+                    b->SetLinearVelocity(b2Vec2(float(p.velocity.x), float(p.velocity.y)));
+                    copyOf.emplace(m.index, b);
+                    copy.bodies.push_back(b);
+                }
+                for (const Entity m : run.joints) {
+                    Joint j = *r.tryGet<Joint>(m);
+                    if (j.b.isNull()) j.localB += offset;
+                    copy.joints.push_back(
+                        createBox2dHinge(world, j, copyOf.at(j.a.index), j.b.isNull() ? ground : copyOf.at(j.b.index)));
+                }
+                run.copies.push_back(std::move(copy));
+                if (p.alive == 0) p.oldest = *p.next;
+                ++p.alive;
+                ++p.emitted;
+                p.next = *p.next + p.interval;
+            }
+        }
+    }
+
+    /// After a step: the clock moves on as World::step moves it.
+    void afterStep() { time_ += dt_; }
+
+    /// Every copy alive, each emitter's oldest first.
+    template <class F> void forEachCopy(F&& f) const {
+        for (const Run& run : runs_)
+            for (const Copy& c : run.copies) f(c);
+    }
+
+private:
+    /// As the engine's cap: the rest wait for the next step.
+    static constexpr int kMaxEmissionsPerStep = 1000;
+    struct Run {
+        Entity entity;
+        Emitter params;
+        Vec2 position;
+        std::vector<Entity> bodies, joints;  ///< the template's, in scene order
+        std::deque<Copy> copies;             ///< alive, oldest first
+    };
+    const Registry* registry_ = nullptr;
+    double time_ = 0.0, dt_ = 0.0;
+    std::vector<Run> runs_;
+};
 
 } // namespace stepwise::bench
