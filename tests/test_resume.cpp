@@ -547,7 +547,9 @@ TEST(Resume, AHandEditedWarmStartIsBoundedByWhatTheStepCanNeed) {
     const double energy = plain.world->energy().total();
     EXPECT_NEAR(wild.world->energy().total(), energy, 0.001 * energy);
     EXPECT_NEAR(sideways.world->energy().total(), energy, 0.001 * energy);
-    // A friction impulse is bounded by friction times the normal one.
+    // An edited friction impulse is taken back in the first pass (the
+    // friction row clamps its accumulated impulse to the cone), and the
+    // warm start keeps it within the cone as well: a stays put.
     EXPECT_LT(widest, 0.01);
 }
 
