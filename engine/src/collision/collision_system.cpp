@@ -13,6 +13,8 @@ namespace {
 /// speculative margin. Metres (Box2D's b2_linearSlop).
 constexpr double kLinearSlop = 0.005;
 constexpr double kSpeculativeBase = 4.0 * kLinearSlop;
+/// How far past the momentum and forces that can reach one contact its
+/// warm start may be (capWarmStart): the loader's factor for its own bound.
 constexpr double kWarmStartMargin = 4.0;
 
 double msSince(std::chrono::steady_clock::time_point start) {
@@ -815,9 +817,11 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
 // external force (gravity, springs, attractors, drag: the first substep's
 // velocity change), the overlap push (pushMaxVelocity), and what the joints
 // carried last step. A contact carries a share of that sum (the bottom of a
-// stack holds the weight of the whole column, more than its two bodies),
-// never all of it more than once over, so kWarmStartMargin times the sum
-// leaves a run's own impulses alone.
+// stack holds the weight of the whole column, more than its two bodies), so
+// kWarmStartMargin times it leaves a run's own impulses alone. A wedge, or
+// a body squeezed between static and kinematic sides, can press a contact
+// harder than the sum; there the bound replaces part of the warm start, the
+// same way in a straight run and a resumed one, so a resume stays exact.
 double CollisionSystem::warmStartBound(std::span<const Vec2> firstSubstepV) const {
     const std::vector<double>& reach = impactScratch_.reach;
     // The fastest point of a kinematic body that touches something: a body
