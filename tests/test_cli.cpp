@@ -1041,8 +1041,7 @@ TEST_F(Cli, ASavedImpulseNoRunCouldWriteIsDroppedWithAWarning) {
                                 "dynamic mass x (2 x 1e9 m/s + g dt)); those contacts start cold, so the run does "
                                 "not resume exactly\n";
     EXPECT_EQ(o.err, wild.string() + warning);
-    // b, still resting on a, is where it was placed (a warm start of 1e11
-    // would have thrown it kilometres).
+    // b, still resting on a, is where it was placed.
     const std::string saved = readFile(out);
     const std::size_t b = saved.find("\"name\": \"b\"");
     ASSERT_NE(b, std::string::npos) << saved;

@@ -14,6 +14,9 @@ namespace {
 /// speculative margin. Metres (Box2D's b2_linearSlop).
 constexpr double kLinearSlop = 0.005;
 constexpr double kSpeculativeBase = 4.0 * kLinearSlop;
+/// How far past the momentum and forces that can reach one contact its
+/// warm start may be (capWarmStart): the loader's factor for its own bound.
+constexpr double kWarmStartMargin = 4.0;
 
 double msSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -797,10 +800,87 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     }
     addDeepOverlapsToCrowd();
     prepareContacts(constraints_, details_, bodies_);
-    coloured_.build(constraints_, bodies_, settings_.simd);
     indexImpacts(constraints_, bodies_.size(), impactScratch_);
+    if (settings_.warmStart && !cache_.empty()) capWarmStart(firstSubstepV);
+    coloured_.build(constraints_, bodies_, settings_.simd);
     if (!joints_.empty()) joints::prepareJoints(joints_, bodies_, centres_, angles_);
     timings_.narrowPhaseMs = msSince(narrowStart);
+}
+
+// The warm start is last substep's impulse, applied before this substep's
+// passes check it. An impulse far past what the step needs (a hand-edited
+// solver_state) is not taken back by them: a soft contact removes only part
+// of the excess per pass, and a body between two contacts hands it back and
+// forth, so the rest leaves as motion and throws the bodies it warms. What a
+// contact point can need in one substep is what passes through it: the
+// momentum of every awake body coming at it (linear, spin at its contacts'
+// lever arms, and what a kinematic body drives it at), a substep of every
+// external force (gravity, springs, attractors, drag: the first substep's
+// velocity change), the overlap push (pushMaxVelocity), and what the joints
+// carried last step. A contact carries a share of that sum (the bottom of a
+// stack holds the weight of the whole column, more than its two bodies), so
+// kWarmStartMargin times it leaves a run's own impulses alone. A wedge, or
+// a body squeezed between static and kinematic sides, can press a contact
+// harder than the sum; there the bound replaces part of the warm start, the
+// same way in a straight run and a resumed one, so a resume stays exact.
+double CollisionSystem::warmStartBound(std::span<const Vec2> firstSubstepV) const {
+    const std::vector<double>& reach = impactScratch_.reach;
+    // The fastest point of a kinematic body that touches something: a body
+    // it drives is pushed at up to that speed.
+    double driven = 0.0;
+    for (const std::uint32_t i : awakeSolverColliders_) {
+        const std::uint32_t s = solverIndex_[i];
+        if (bodies_[s].invMass == 0.0)
+            driven = std::max(driven, length(startV_[i]) + std::abs(angularVelocities_[i]) * reach[s]);
+    }
+    double bound = 0.0;
+    for (const std::uint32_t i : awakeSolverColliders_) {
+        const std::uint32_t s = solverIndex_[i];
+        const double invMass = bodies_[s].invMass;
+        if (invMass == 0.0) continue;
+        const Vec2 v0 = startV_[i];
+        const Vec2 forced = firstSubstepV[std::size_t(colliders_[i].body)] - v0;
+        bound += (length(v0) + std::abs(angularVelocities_[i]) * reach[s] + length(forced) + driven +
+                  settings_.pushMaxVelocity) /
+                 invMass;
+    }
+    // A joint presses its bodies with what its rows carry; the rows in N*s
+    // (a hinge's torque reaches a contact through its point row).
+    for (std::size_t k = 0; k < joints_.size() && k < jointImpulsesBefore_.size(); ++k) {
+        const joints::JointConstraint& j = joints_[k];
+        if (j.asleep || j.broken) continue;
+        const JointImpulse& imp = jointImpulsesBefore_[k];
+        switch (j.kind) {
+        case joints::JointKind::Hinge:
+        case joints::JointKind::Weld: bound += length(imp.linear); break;
+        case joints::JointKind::Slider:
+            bound += std::abs(imp.linear.x) + std::abs(imp.motor) + imp.lower + imp.upper;
+            break;
+        case joints::JointKind::Wheel:
+            bound += std::abs(imp.linear.x) + std::abs(imp.axial) + imp.lower + imp.upper;
+            break;
+        case joints::JointKind::Distance: bound += std::abs(imp.axial) + imp.lower + imp.upper; break;
+        case joints::JointKind::Rope: bound += imp.upper; break;
+        }
+    }
+    return kWarmStartMargin * bound;
+}
+
+// Straight and resumed runs pass here alike, so a saved state still resumes
+// bit for bit; a run's own impulses are within the bound and already
+// non-negative with friction within the cone (the solve clamps them so), so
+// they keep their bits.
+void CollisionSystem::capWarmStart(std::span<const Vec2> firstSubstepV) {
+    const double most = warmStartBound(firstSubstepV);
+    for (ContactConstraint& c : constraints_)
+        for (int i = 0; i < c.pointCount; ++i) {
+            ContactPoint& p = c.points[i];
+            if (!(p.normalImpulse >= 0.0)) p.normalImpulse = 0.0;
+            if (p.normalImpulse > most) p.normalImpulse = most;
+            const double friction = c.friction * p.normalImpulse;
+            if (p.tangentImpulse > friction) p.tangentImpulse = friction;
+            if (p.tangentImpulse < -friction) p.tangentImpulse = -friction;
+        }
 }
 
 void CollisionSystem::addDeepOverlapsToCrowd() {

@@ -292,6 +292,13 @@ private:
     /// Broad and narrow phase at the step-start positions; `firstSubstepV`
     /// is the unconstrained velocity after the first substep's forces.
     void detect(std::span<const Vec2> firstSubstepV);
+    /// The most normal impulse this step's first substep can need at one
+    /// contact point (N*s), from the awake bodies' motion and forces at the
+    /// step's start (see capWarmStart).
+    double warmStartBound(std::span<const Vec2> firstSubstepV) const;
+    /// Bounds the warm start of this step's contacts: a normal impulse in
+    /// [0, warmStartBound], a friction impulse within friction times it.
+    void capWarmStart(std::span<const Vec2> firstSubstepV);
     static Vec2 coincidentNormal(std::uint32_t a, std::uint32_t b);
 
     std::vector<Collider> colliders_;

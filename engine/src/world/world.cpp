@@ -632,8 +632,9 @@ void World::setSolverState(const SolverState& state) {
     // or stops: at most every dynamic body's mass times what the substep
     // can change of its velocity, from the fastest a level holds to the
     // fastest the other way, plus a step of gravity; four times that. A
-    // saved impulse past it would fling the bodies it warms (1e10 N*s on two
-    // 1 kg balls threw them 4.8e6 m), so it is dropped with a warning.
+    // saved impulse past it is no run's, so it is dropped with a warning;
+    // what is kept the engine bounds again at each step's start, from the
+    // bodies' motion then (CollisionSystem::capWarmStart).
     const detail::ForceModel& f = w.model;
     const bool bounded = f.springs.empty() && f.attractors.empty() && f.boids.body.empty() &&
                          w.collision->jointConstraints().empty();
