@@ -760,3 +760,34 @@ TEST(Emitters, RainSavedAndResumedRunsOnAsOneRun) {
         ASSERT_EQ(savedAfterResumeAt(scene, split, 40), expected);
     }
 }
+
+// What the engine chooses from the scene's structure (substeps, iterations,
+// the contacts' stiffness) counts a template as the bodies its copies will
+// be: a level whose tower only appears through an emitter gets what the same
+// tower standing in the level gets, not what an empty floor gets. Swept over
+// the tower's height.
+TEST(Emitters, TheEngineChoosesItsSettingsForWhatTheTemplatesWillMake) {
+    for (const int height : {3, 8, 14, 20}) {
+        const auto level = [&](bool asTemplate, bool withTower) {
+            std::ostringstream s;
+            s << R"({"world": {"gravity": {"x": 0, "y": -10}}, "entities": [)"
+              << R"({"name": "floor", "position": {"x": 0, "y": -0.5}, "box": {"width": 60, "height": 1}, "static": true})";
+            if (asTemplate && withTower)
+                s << R"(, {"name": "spawn", "position": {"x": -20, "y": 30}, "emitter": {"template": "tower", "interval": 1, "count": 1}})";
+            for (int k = 0; withTower && k < height; ++k)
+                s << R"(, {"name": "block )" << k << R"(", "position": {"x": 10, "y": )" << 0.5 + k
+                  << R"(}, "box": {"width": 1, "height": 1}, "mass": 1)" << (asTemplate ? R"(, "template": "tower"})" : "}");
+            s << "]}";
+            return parseLevel(s.str());
+        };
+        const ContactSettingsChoice templated = buildWorld(level(true, true)).settingsChoice();
+        const ContactSettingsChoice standing = buildWorld(level(false, true)).settingsChoice();
+        const ContactSettingsChoice empty = buildWorld(level(false, false)).settingsChoice();
+        EXPECT_EQ(templated.substeps, standing.substeps) << height << " blocks";
+        EXPECT_EQ(templated.iterations, standing.iterations) << height << " blocks";
+        EXPECT_EQ(templated.hertzFraction, standing.hertzFraction) << height << " blocks";
+        EXPECT_EQ(templated.stackHeight, height) << height << " blocks";
+        EXPECT_EQ(empty.stackHeight, 0) << "a floor alone";
+        if (height >= 8) EXPECT_GT(templated.substeps, empty.substeps) << height << " blocks";
+    }
+}

@@ -27,13 +27,18 @@ inline bool inTemplate(const Registry& reg, Entity e) { return templateOf(reg, e
 /// resumed run chooses what the run that saved it chose.
 bool isEmittedCopy(const Registry& reg, Entity e);
 
-/// Not a body of the scene as written: part of a template, an emitter's
-/// copy, or an emitter without a shape (a point in the world).
-inline bool emittedOrTemplate(const Registry& reg, Entity e) {
+/// An emitter without a shape: a point in the world, not a body.
+inline bool pointEmitter(const Registry& reg, Entity e) {
+    return reg.has<Emitter>(e) && !reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) &&
+           !reg.has<Capsule>(e) && !reg.has<Shapes>(e);
+}
+
+/// Left out of what the engine chooses from the scene's structure: the
+/// copies a run has made so far (they come and go) and point emitters. A
+/// template counts, standing for the copies its emitters will make.
+inline bool outsideTheChoice(const Registry& reg, Entity e) {
     if (reg.count<Template>() == 0) return false;
-    if (reg.has<Emitter>(e) && !reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) && !reg.has<Capsule>(e))
-        return true;
-    return inTemplate(reg, e) || isEmittedCopy(reg, e);
+    return pointEmitter(reg, e) || isEmittedCopy(reg, e);
 }
 
 /// The random turn of copy `number` of an emitter: a uniform angle in

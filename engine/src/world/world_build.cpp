@@ -317,10 +317,10 @@ std::optional<Error> chooseSolverCounts(const Scene& scene, const SystemSwitches
 /// when the level gives none).
 std::optional<Error> compileCollisions(const Scene& scene, const SystemSwitches& switches, const BodyIndex& bodies,
                                        WorldImpl& w) {
-    std::string jointProblem;
-    w.collision = detail::buildCollisions(scene, [&bodies](Entity e) { return bodies.of(e); }, kNoBody,
-                                          switches.collisions, &jointProblem);
-    if (!jointProblem.empty()) return Error{jointProblem};
+    Result<std::unique_ptr<collision::CollisionSystem>> built =
+        detail::buildCollisions(scene, [&bodies](Entity e) { return bodies.of(e); }, kNoBody, switches.collisions);
+    if (!built) return built.failure();
+    w.collision = std::move(*built);
     if (std::optional<Error> refused = chooseSolverCounts(scene, switches, w)) return refused;
     // Copies an emitter adds join the contact solver in place: the system
     // exists from the start, empty until the first copy.

@@ -262,9 +262,8 @@ bool fillJointParams(const Joint& joint, joints::JointConstraint& j) {
     return true;
 }
 
-std::unique_ptr<collision::CollisionSystem> buildCollisions(
-    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, bool shapes,
-    std::string* problem) {
+Result<std::unique_ptr<collision::CollisionSystem>> buildCollisions(
+    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, bool shapes) {
     const Registry& reg = scene.registry;
     std::unique_ptr<collision::CollisionSystem> system;
     std::unordered_map<std::uint32_t, std::int32_t> colliderOf;  // entity index -> collider
@@ -311,10 +310,8 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
             je.local = k == 0 ? joint->localA : joint->localB;
             if (end.isNull() && k == 1) continue;  // the world: a fixed frame at the origin
             if (end.isNull() || !reg.alive(end) || !reg.has<Position>(end)) {
-                if (problem)
-                    *problem = labelOf(reg, i) + ": joint " + (k == 0 ? "a" : "b") +
-                               ": the body it names does not exist or has no position";
-                return nullptr;
+                return Error{labelOf(reg, i) + ": joint " + (k == 0 ? "a" : "b") +
+                             ": the body it names does not exist or has no position"};
             }
             const Angle* an = reg.tryGet<Angle>(end);
             je.fixedCentre = reg.tryGet<Position>(end)->value;
@@ -347,14 +344,10 @@ std::unique_ptr<collision::CollisionSystem> buildCollisions(
             // there. (A fixed end stays about its position: fixedCentre.)
             je.local = je.local - system->collider(std::size_t(filter[k])).centreOfMass;
         }
-        if (fixed[0] && fixed[1]) {
-            if (problem) *problem = labelOf(reg, i) + ": joint joins two static bodies; at least one end must be dynamic";
-            return nullptr;
-        }
-        if (!fillJointParams(*joint, j)) {
-            if (problem) *problem = labelOf(reg, i) + ": joint axis: a slider axis needs a non-zero length";
-            return nullptr;
-        }
+        if (fixed[0] && fixed[1])
+            return Error{labelOf(reg, i) + ": joint joins two static bodies; at least one end must be dynamic"};
+        if (!fillJointParams(*joint, j))
+            return Error{labelOf(reg, i) + ": joint axis: a slider axis needs a non-zero length"};
         makeSystem();
         system->addJoint(j, filter[0], filter[1], joint->collideConnected);
     }
@@ -478,7 +471,7 @@ double springRate(const Scene& scene, const SystemSwitches& switches) {
         return 0.0;
     const Registry& reg = scene.registry;
     const auto dynamicMass = [&](Entity e) -> double {
-        if (e.isNull() || !reg.alive(e) || !reg.has<Position>(e) || detail::emittedOrTemplate(reg, e)) return 0.0;
+        if (e.isNull() || !reg.alive(e) || !reg.has<Position>(e) || detail::outsideTheChoice(reg, e)) return 0.0;
         if (const Static* st = reg.tryGet<Static>(e); st && st->value) return 0.0;
         if (const Kinematic* k = reg.tryGet<Kinematic>(e); k && k->value) return 0.0;
         if (reg.has<Mass>(e)) return reg.tryGet<Mass>(e)->value;
@@ -563,10 +556,11 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         return switches.collisions && (reg.has<Radius>(e) || reg.has<Box>(e) || reg.has<Polygon>(e) ||
                                        reg.has<Capsule>(e) || reg.has<Shapes>(e));
     };
-    // Templates, an emitter's copies and shapeless emitters are left out:
-    // the choice is the scene's as written, whatever copies a run has made.
+    // An emitter's copies and shapeless emitters are left out: the choice is
+    // the scene's as written, whatever copies a run has made. A template
+    // counts for the copies it stands for.
     const auto dynamic = [&](Entity e) {
-        return reg.alive(e) && reg.has<Position>(e) && !isStatic(e) && !detail::emittedOrTemplate(reg, e);
+        return reg.alive(e) && reg.has<Position>(e) && !isStatic(e) && !detail::outsideTheChoice(reg, e);
     };
     const auto massOf = [&](Entity e) {
         if (reg.has<Mass>(e)) return reg.tryGet<Mass>(e)->value;

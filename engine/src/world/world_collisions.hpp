@@ -4,6 +4,7 @@
 // force/integrator pipeline reads on its own.
 
 #include "collision/collision_system.hpp"
+#include "stepwise/result.hpp"
 #include "stepwise/scene.hpp"
 
 #include <cstdint>
@@ -23,11 +24,11 @@ namespace stepwise::detail {
 /// collision system even without shapes; a jointed dynamic body without a
 /// shape joins the solver as a shapeless body (kShapelessRadius). A joint
 /// the engine cannot simulate (an end that no longer exists, two fixed
-/// ends) sets `problem` ("entity N (\"name\"): joint ...") and returns null.
-/// Without `shapes` (contacts switched off) only the joints are compiled.
-std::unique_ptr<collision::CollisionSystem> buildCollisions(
-    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, bool shapes = true,
-    std::string* problem = nullptr);
+/// ends) is an Error ("entity N (\"name\"): joint ..."). Null when the scene
+/// has nothing to collide or join. Without `shapes` (contacts switched off)
+/// only the joints are compiled.
+Result<std::unique_ptr<collision::CollisionSystem>> buildCollisions(
+    const Scene& scene, const std::function<std::uint32_t(Entity)>& bodyOf, std::uint32_t noBody, bool shapes = true);
 
 /// Where the outlines and chain segments of colliders about to be added
 /// live: CollisionSystem::add copies them, so they only need to outlast that.
