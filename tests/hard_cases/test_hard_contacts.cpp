@@ -5,12 +5,14 @@
 #include "generated_scenes.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/scene.hpp"
+#include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -331,4 +333,65 @@ TEST(HardContacts, ABodyStruckWithinAStepNeverPassesAStaticWall) {
             }
         }
     }
+}
+
+namespace {
+
+/// Box2D's spinner made small: a drum of radius 8 m (a 120-point chain loop,
+/// solid outside), a 14 m bar turned at `spin` rad/s about the drum's
+/// centre by an unlimited motor (at 14 rad/s its tip runs at 98 m/s, as
+/// Box2D's spinner's at 100), and `count` discs and squares
+/// filling the drum from the bottom, 0.45 m apart (0.5 m shapes: they start
+/// overlapping, as Box2D's do).
+std::string drumLevel(int count, int substeps, double spin) {
+    constexpr double pi = 3.14159265358979323846;
+    std::ostringstream s;
+    s.precision(17);
+    s << R"({"world": {"gravity": {"x": 0, "y": -10})";
+    if (substeps > 0) s << R"(, "substeps": )" << substeps;
+    s << R"(}, "entities": [{"name": "drum", "position": {"x": 0, "y": 0}, "static": true, "friction": 0.1, "chain": {"loop": true, "points": [)";
+    for (int i = 0; i < 120; ++i) {
+        const double a = -2.0 * pi * i / 120.0;
+        s << (i ? ", " : "") << R"({"x": )" << 8.0 * std::cos(a) << R"(, "y": )" << 8.0 * std::sin(a) << "}";
+    }
+    s << R"(]}}, {"name": "bar", "position": {"x": 0, "y": 0}, "mass": 20, "friction": 0,
+        "polygon": {"vertices": [{"x": -0.2, "y": -7}, {"x": 0.2, "y": -7}, {"x": 0.2, "y": 7}, {"x": -0.2, "y": 7}], "radius": 0.1}},
+        {"name": "motor", "joint": {"type": "hinge", "a": "bar", "anchor": {"x": 0, "y": 0}, "motor_speed": )" << spin << R"(, "max_motor_torque": 1e10}})";
+    int made = 0;
+    for (double y = -7.2; made < count && y < 7.0; y += 0.45)
+        for (double x = -7.2; made < count && x < 7.2; x += 0.45) {
+            if (std::hypot(x, y) > 7.3 || std::abs(x) < 0.5) continue;  // inside, clear of the bar
+            s << R"(, {"name": "b)" << made << R"(", "position": {"x": )" << x << R"(, "y": )" << y
+              << R"(}, "mass": 0.1, "friction": 0.1, "restitution": 0.1, )"
+              << (made % 2 ? R"("radius": 0.25})" : R"("box": {"width": 0.5, "height": 0.5}})");
+            ++made;
+        }
+    s << "]}";
+    return s.str();
+}
+
+} // namespace
+
+// The bar drives the crowd round the drum at tens of m/s, presses it into
+// the one-sided chain and strikes bodies within a step: none may end a step
+// outside the drum. Swept over the crowd's size, the bar's speed and the
+// substeps.
+TEST(HardContacts, ACrowdDrivenRoundADrumStaysInsideIt) {
+    for (const int count : {60, 300, 700})
+        for (const double spin : {4.0, 14.0})
+        for (const int substeps : kSubsteps) {
+            const std::string what = std::to_string(count) + " bodies, bar at " + std::to_string(int(spin)) +
+                                     " rad/s, substeps " + label(substeps);
+            Result<Scene> scene = parseScene(drumLevel(count, substeps, spin), "drum.json");
+            ASSERT_TRUE(scene) << scene.error();
+            Result<World> w = World::build(*scene);
+            ASSERT_TRUE(w) << w.error();
+            ASSERT_EQ(w->bodyCount(), std::size_t(count) + 1);
+            double farthest = 0.0;
+            for (int step = 0; step < 100; ++step) {
+                ASSERT_TRUE(w->step()) << what;
+                for (std::size_t b = 0; b < w->bodyCount(); ++b) farthest = std::max(farthest, length(w->bodyPosition(b)));
+            }
+            EXPECT_LT(farthest, 8.0) << what << ": a body's centre left the drum";
+        }
 }

@@ -1118,6 +1118,12 @@ void CollisionSystem::prepareStaticSweep() {
     hubShapes_.clear();
     for (const std::uint32_t i : shapesOfHubs_) hubShapes_.push_back({std::uint32_t(colliders_[i].hub), i});
     std::sort(hubShapes_.begin(), hubShapes_.end());
+    // A body's smallest reach: its shape's, or a compound body's smallest
+    // shape's (a shapeless body never reaches anything: infinite).
+    minReach_.assign(colliders_.size(), std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < colliders_.size(); ++i)
+        if (colliders_[i].body >= 0 && !colliders_[i].solverOnly) minReach_[i] = smallestReach(colliders_[i].shape);
+    for (const auto& [hub, shape] : hubShapes_) minReach_[hub] = std::min(minReach_[hub], minReach_[shape]);
 }
 
 void CollisionSystem::sweepAgainstStatic(std::span<Vec2> x) {
@@ -1133,13 +1139,16 @@ void CollisionSystem::sweepAgainstStatic(std::span<Vec2> x) {
         const Collider& owner = colliders_[i];
         if (owner.kinematic) continue;
         SolverBody& b = bodies_[sb.solver];
-        // Only a body that went farther than the motion its contacts were
-        // found for can have met a static shape without a contact.
+        // A body that went farther than the motion its contacts were found
+        // for, or farther than half its smallest reach (Box2D's "fast"
+        // body): sliding fast along a curved wall, it meets segments ahead
+        // whose contacts were not found (a chain segment answers only
+        // within its own length).
         const double turn = angles_[i] - stepStartAngle_[i];
         const double travel = length(b.dp) + std::abs(turn) * maxExtent_[i];
         const double foreseen =
             2.0 * kSpeculativeBase + dt_ * std::max(length(startV_[i]), length(endV_[i])) + spin_[i];
-        if (!(travel > foreseen)) continue;
+        if (!(travel > foreseen) && !(travel > 0.5 * minReach_[i])) continue;
         shapes.clear();
         shapeColliders.clear();
         if (!owner.solverOnly) {

@@ -407,6 +407,7 @@ private:
     FrozenBoxes frozen_;                                 // static and sleeping shapes' boxes
     FrozenBoxes staticBoxes_;                            // static shapes' boxes, for the sweep
     std::vector<std::pair<std::uint32_t, std::uint32_t>> hubShapes_;  // (hub, shape), sorted, for the sweep
+    std::vector<double> minReach_;  // per collider: its smallest reach (static_sweep.hpp), for the sweep
     bool staticSweepReady_ = false;
     std::vector<Aabb> awakeBoxes_;
     std::vector<std::uint8_t> awakeMovable_;

@@ -115,7 +115,8 @@ bool convexEntry(const Outline& outline, Vec2 p0, Vec2 p1, Entry& entry) {
     return true;
 }
 
-/// The smallest distance from the centre of `shape` to its outline.
+} // namespace
+
 double smallestReach(const Shape& shape) {
     switch (shape.kind) {
     case ShapeKind::Circle:
@@ -130,8 +131,6 @@ double smallestReach(const Shape& shape) {
     default: return 0.0;
     }
 }
-
-} // namespace
 
 double supportAlong(const Shape& shape, Rot q, Vec2 d) {
     switch (shape.kind) {

@@ -49,6 +49,9 @@ struct PlacedShape {
 /// saving, and holding it back would only pin it there).
 double sweepFraction(const BodySweep& sweep, const SweptShape& moving, const PlacedShape& fixed, double target);
 
+/// The smallest distance from the centre of `shape` to its outline.
+double smallestReach(const Shape& shape);
+
 /// The largest distance from the centre of `shape` to its outline along
 /// the unit direction `d` (its support), with the shape turned by `q`.
 double supportAlong(const Shape& shape, Rot q, Vec2 d);
