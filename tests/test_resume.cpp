@@ -507,6 +507,19 @@ TEST(Resume, SavingDropsSolverStateEntriesOfEntitiesThatNoLongerCollide) {
     EXPECT_GT(expected, 0u);
 }
 
+namespace {
+/// Two 1 kg balls stacked on a floor, saved after 20 steps (warm starts
+/// between the floor and a, and a and b).
+std::string stackedBallsSaved() {
+    test::Sim first(R"({"entities": [
+        {"name": "floor", "position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 10, "height": 1}},
+        {"name": "a", "position": {"x": 0, "y": 0.5}, "radius": 0.5, "mass": 1},
+        {"name": "b", "position": {"x": 0, "y": 1.5}, "radius": 0.5, "mass": 1}]})");
+    EXPECT_TRUE(first.step(20));
+    return sceneToJsonText(first.scene);
+}
+} // namespace
+
 // A hand-edited warm start cannot change the physics: at a step's start the
 // engine bounds each contact point's warm start at what the step can need
 // (docs/format.md, "The solver_state section"). Two 1 kg balls stacked on a
@@ -514,13 +527,7 @@ TEST(Resume, SavingDropsSolverStateEntriesOfEntitiesThatNoLongerCollide) {
 // (under the loader's bound for this scene, so it is kept) must not throw
 // the top ball: without the bound it flew 2.8e8 m in a second.
 TEST(Resume, AHandEditedWarmStartIsBoundedByWhatTheStepCanNeed) {
-    const std::string level = R"({"entities": [
-        {"name": "floor", "position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 10, "height": 1}},
-        {"name": "a", "position": {"x": 0, "y": 0.5}, "radius": 0.5, "mass": 1},
-        {"name": "b", "position": {"x": 0, "y": 1.5}, "radius": 0.5, "mass": 1}]})";
-    test::Sim first(level);
-    ASSERT_TRUE(first.step(20));
-    const std::string saved = sceneToJsonText(first.scene);
+    const std::string saved = stackedBallsSaved();
     // The saved text with one entry's impulse replaced.
     const auto edited = [&](const std::string& pair, const std::string& field, const std::string& value) {
         std::string text = saved;
@@ -557,14 +564,9 @@ TEST(Resume, AHandEditedWarmStartIsBoundedByWhatTheStepCanNeed) {
 // refuses it in a file) starts the contact at zero, as a run that left
 // nothing there.
 TEST(Resume, ANegativeWarmStartGivenInCodeCountsAsZero) {
-    const std::string level = R"({"entities": [
-        {"name": "floor", "position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 10, "height": 1}},
-        {"name": "a", "position": {"x": 0, "y": 0.5}, "radius": 0.5, "mass": 1},
-        {"name": "b", "position": {"x": 0, "y": 1.5}, "radius": 0.5, "mass": 1}]})";
-    test::Sim first(level);
-    ASSERT_TRUE(first.step(20));
-    Scene negative = test::parseLevel(sceneToJsonText(first.scene));
-    Scene zero = test::parseLevel(sceneToJsonText(first.scene));
+    const std::string saved = stackedBallsSaved();
+    Scene negative = test::parseLevel(saved);
+    Scene zero = test::parseLevel(saved);
     ASSERT_TRUE(negative.solverState && negative.solverState->contacts.size() == 2);
     for (ContactImpulse& c : negative.solverState->contacts) c.normalImpulse = -100.0;
     for (ContactImpulse& c : zero.solverState->contacts) c.normalImpulse = 0.0;
