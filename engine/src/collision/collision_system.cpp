@@ -1111,7 +1111,7 @@ void CollisionSystem::prepareStaticSweep() {
     for (const std::uint32_t i : finite_) {
         const Collider& c = colliders_[i];
         if (c.body >= 0 || c.sensor) continue;
-        boxes.push_back(computeAabb(c.shape, c.staticPosition, Rot::fromAngle(angles_[i])));
+        boxes.push_back(computeAabb(c.shape, centres_[i], Rot::fromAngle(angles_[i])));
         proxies.push_back(i);
     }
     staticBoxes_.build(boxes, proxies);
@@ -1129,9 +1129,9 @@ void CollisionSystem::prepareStaticSweep() {
 void CollisionSystem::sweepAgainstStatic(std::span<Vec2> x) {
     if (!staticSweepReady_) prepareStaticSweep();
     if (staticBoxes_.empty() && planes_.empty()) return;
-    // Within a target of the linear slop: the contact the next step finds
-    // then starts as a touching one.
-    const double target = kSpeculativeBase;
+    // Stopped the linear slop short of the surface, as Box2D's sweep: the
+    // contact the next step finds then starts as a touching one.
+    const double target = kLinearSlop;
     std::vector<SweptShape> shapes;
     std::vector<std::uint32_t> shapeColliders;
     for (const SolvedBody& sb : awakeSolved_) {
@@ -1174,7 +1174,9 @@ void CollisionSystem::sweepAgainstStatic(std::span<Vec2> x) {
             const auto test = [&](std::uint32_t s) {
                 const Collider& fixed = colliders_[s];
                 if (fixed.sensor || !collides(j, s) || (!noCollide_.empty() && joinedNotColliding(j, s))) return;
-                const PlacedShape placed{&fixed.shape, fixed.staticPosition, Rot::fromAngle(angles_[s])};
+                // A static shape's centre of mass (centres_: where its
+                // outline is centred), which never moves.
+                const PlacedShape placed{&fixed.shape, centres_[s], Rot::fromAngle(angles_[s])};
                 fraction = std::min(fraction, sweepFraction(sweep, shape, placed, target));
             };
             for (const std::uint32_t p : planes_) test(p);
