@@ -42,7 +42,8 @@ std::optional<Error> polygonProblem(const std::vector<Vec2>& v) {
     // normal doubles, and the checks below would misjudge rounding as shape.
     if (!(extent >= kMinSize))
         return Error{"the polygon is " + formatNumber(extent) + " m across; the smallest shape is " +
-                     formatNumber(kMinSize) + " m"};    // Closer than a billionth of the size: the edge between them has no
+                     formatNumber(kMinSize) + " m"};
+    // Closer than a billionth of the size: the edge between them has no
     // usable direction (its normal would be rounding noise).
     const double samePoint = 1e-9 * extent;
     for (std::size_t j = 1; j < n; ++j)
