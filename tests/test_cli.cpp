@@ -140,6 +140,22 @@ TEST_F(Cli, ValidateWarnsAboutWhatAKinematicBodyIgnores) {
         << "a kinematic attractor's mass sets its pull, so it gets no warning";
 }
 
+// In range field by field, yet no step could take it: validate and run
+// refuse it alike, with exit 2 and the same words.
+TEST_F(Cli, ALevelNoStepCanTakeIsRefusedByValidateAndRun) {
+    const fs::path file = write("heavy_gravity.json", R"({"world": {"gravity": {"x": 0, "y": -1e30}},
+      "entities": [{"name": "ball", "position": {"x": 0, "y": 0}, "radius": 0.5}]})");
+    const std::string why = "world.gravity: 1e+30 m/s^2 gives a body 1.6666666666666667e+28 m/s in one step of "
+                            "0.016666666666666666 s, past the 1e+09 m/s a run holds; at this dt gravity may be at "
+                            "most 6e+10 m/s^2";
+    for (const std::string command : {"validate ", "run --steps 3 "}) {
+        Outcome o = stepwise(command + file.string());
+        EXPECT_EQ(o.exitCode, 2) << command;
+        EXPECT_EQ(o.out, "") << command;
+        EXPECT_EQ(o.err, "stepwise: error: " + file.string() + ": cannot simulate: " + why + "\n") << command;
+    }
+}
+
 TEST_F(Cli, ValidateRefusesABadFileWithExitTwoAndTheLoaderMessage) {
     const fs::path file = write("bad.json", R"({"entities": [{"name": "ball", "position": {"x": 0, "y": 0}, "mass": -1}]})");
     Outcome o = stepwise("validate " + file.string());

@@ -206,17 +206,51 @@ TEST(World, ANonFiniteEnergyNamesTheEntityAndTheTerm) {
         make(s);
         return buildOrDie(s).nonFiniteEnergyTerm();
     };
+    // A spin a step can take (its rim under 1e9 m/s) on a body heavy enough
+    // that I w^2 / 2 overflows.
     EXPECT_EQ(termOf([](Scene& s) {
-                  const Entity e = addBody(s, "spinner", {0, 10}, {0, 0});
+                  const Entity e = addBody(s, "spinner", {0, 10}, {0, 0}, 1e300);
                   s.registry.emplace<Radius>(e, {1.0});
-                  s.registry.emplace<AngularVelocity>(e, {1e300});
+                  s.registry.emplace<AngularVelocity>(e, {9e8});
               }),
-              "entity 0 (\"spinner\"): rotational energy I*w^2/2 became inf J (inertia 0.5 kg m^2, spin 1e+300 rad/s)");
+              "entity 0 (\"spinner\"): rotational energy I*w^2/2 became inf J (inertia 5e+299 kg m^2, spin 9e+08 rad/s)");
     EXPECT_EQ(termOf([](Scene& s) { addBody(s, "heavy", {0, 0.5}, {0, 0}, 1e308); }),
               "entity 0 (\"heavy\"): gravity's potential energy -m*g.x became inf J (mass 1e+308 kg at {0, 0.5} m)");
     EXPECT_EQ(termOf([](Scene& s) { addBody(s, "fast", {0, 0}, {1e200, 0}); }),
               "entity 0 (\"fast\"): kinetic energy m*v^2/2 became inf J (mass 1 kg, speed 1e+200 m/s)");
     EXPECT_EQ(termOf([](Scene& s) { addBody(s, "calm", {0, 0}, {1, 0}); }), "");
+}
+
+// Every field within its range, yet the first step would carry a body past
+// the 1e9 m/s a run holds: the build refuses it, naming the value, instead
+// of a divergence at step 1. Swept across the limit: gravity times dt, and
+// a spin times the shape's farthest point.
+TEST(World, ValuesNoStepCanTakeAreRefusedAtBuild) {
+    const double dt = 1.0 / 60.0;
+    for (const double factor : {0.5, 0.999, 1.001, 1e10}) {
+        const double g = factor * 1e9 / dt;
+        Scene s = emptyScene("semi_implicit_euler", dt, {0.0, -g});
+        addBody(s, "ball", {0, 0}, {0, 0});
+        Result<World> w = World::build(s);
+        EXPECT_EQ(bool(w), factor < 1.0) << factor;
+        if (!w)
+            EXPECT_EQ(w.error(), "world.gravity: " + formatNumber(g) + " m/s^2 gives a body " + formatNumber(g * dt) +
+                                     " m/s in one step of " + formatNumber(dt) +
+                                     " s, past the 1e+09 m/s a run holds; at this dt gravity may be at most " +
+                                     formatNumber(1e9 / dt) + " m/s^2");
+    }
+    for (const double factor : {0.5, 0.999, 1.001, 100.0}) {
+        Scene s = emptyScene("semi_implicit_euler", dt);
+        const Entity e = addBody(s, "wheel", {0, 0}, {0, 0});
+        s.registry.emplace<Box>(e, Box{6.0, 8.0});  // farthest corner 5 m from the centre
+        s.registry.emplace<AngularVelocity>(e, AngularVelocity{factor * 1e9 / 5.0});
+        Result<World> w = World::build(s);
+        EXPECT_EQ(bool(w), factor < 1.0) << factor;
+        if (!w)
+            EXPECT_EQ(w.error(), "entity 0 (\"wheel\"): angular_velocity: " + formatNumber(factor * 2e8) +
+                                     " rad/s moves its farthest point (5 m from its centre of mass) at " +
+                                     formatNumber(factor * 2e8 * 5.0) + " m/s, past the 1e+09 m/s a run holds");
+    }
 }
 
 // A step that diverges leaves the whole carried state as it was, the

@@ -111,10 +111,12 @@ void addValidateCommand(CLI::App& app, int& exitCode) {
             for (const std::string& note : ineffectiveComponents(*scene))
                 std::cerr << *level << ": warning: " << note << "\n";
         } else {
-            // The file is valid but asks for something this build cannot
-            // simulate: say so, without failing validation of the format.
-            std::cout << summary << "\n";
-            std::cerr << *level << ": warning: cannot be simulated by this build: " << world.error() << "\n";
+            // Every field is in its range, yet no step could take the level
+            // (gravity that passes the speed limit in one step): `run` would
+            // refuse it, so validation does too, in the same words.
+            reportError(*level + ": cannot simulate: " + world.error());
+            exitCode = kExitBadInput;
+            return;
         }
         exitCode = kExitOk;
     });

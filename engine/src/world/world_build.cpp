@@ -232,6 +232,36 @@ void compileBoids(const Registry& reg, WorldImpl& w) {
     if (f.boidsOn) f.boids.prepare();
 }
 
+/// Values within every field's range can still be ones no step can take:
+/// the speed they give a body in one step passes the kMaxSpeed a run holds
+/// (World::step's check), so the first step would fail with exit 3. Such a
+/// scene is refused here, naming the value: gravity over one step, and a
+/// spin at a shape's farthest point.
+std::optional<Error> checkFirstStepSpeeds(const WorldImpl& w) {
+    const double dt = w.settings.dt;
+    const double g = length(w.settings.gravity);
+    if (!w.bodyEntity.empty() && g * dt > kMaxSpeed)
+        return Error{formatNumber(g) + " m/s^2 gives a body " + formatNumber(g * dt) + " m/s in one step of " +
+                         formatNumber(dt) + " s, past the " + formatNumber(kMaxSpeed) +
+                         " m/s a run holds; at this dt gravity may be at most " + formatNumber(kMaxSpeed / dt) +
+                         " m/s^2",
+                     "world.gravity"};
+    if (!w.collision) return std::nullopt;
+    const collision::CollisionSystem& c = *w.collision;
+    for (std::size_t i = 0; i < c.colliderCount(); ++i) {
+        const std::int32_t b = c.collider(i).body;
+        if (b < 0) continue;
+        const double spin = std::abs(c.angularVelocity(i)), reach = c.maxExtent(i);
+        if (!(spin * reach > kMaxSpeed)) continue;
+        const std::size_t body = std::size_t(b);
+        return Error{detail::entityLabel(w.bodySceneIndex[body], &w.bodyName[body]) + ": angular_velocity: " +
+                     formatNumber(spin) + " rad/s moves its farthest point (" + formatNumber(reach) +
+                     " m from its centre of mass) at " + formatNumber(spin * reach) + " m/s, past the " +
+                     formatNumber(kMaxSpeed) + " m/s a run holds"};
+    }
+    return std::nullopt;
+}
+
 /// The loader refuses bad outlines (capsules without a segment, chains
 /// with too few or repeated points or on a moving body), but a
 /// scene built in code or edited in the editor reaches here unchecked.
@@ -491,6 +521,7 @@ Result<World> World::build(const Scene& scene, const SystemSwitches& switches) {
     if (std::optional<Error> refused = checkPolygons(reg)) return std::move(*refused);
     if (std::optional<Error> refused = compileCollisions(scene, switches, bodies, w)) return std::move(*refused);
     compileSpin(reg, w);
+    if (std::optional<Error> refused = checkFirstStepSpeeds(w)) return std::move(*refused);
     compileSleep(w.settings, w);
     w.listActiveSystems();
     allocateState(w, start, *kind);
