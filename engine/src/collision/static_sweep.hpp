@@ -44,7 +44,8 @@ struct PlacedShape {
 /// segment: behind it, within its length): the time its outline comes to
 /// `target` metres from the surface the centroid would cross, or, if it
 /// started closer than that, the time a core circle of a quarter of its
-/// smallest reach does. 1 when the centroid does not pass in, or when it
+/// smallest reach does (0, held where it started, if that core started
+/// closer too). 1 when the centroid does not pass in, or when it
 /// started inside or behind (Box2D's rule: such a body is already past
 /// saving, and holding it back would only pin it there).
 double sweepFraction(const BodySweep& sweep, const SweptShape& moving, const PlacedShape& fixed, double target);
