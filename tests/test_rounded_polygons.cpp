@@ -34,14 +34,9 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kG = 9.81;
-
-
-
 std::string level(const std::string& entities, const std::string& world = "") {
-    return "{\"world\": {\"gravity\": {\"x\": 0, \"y\": -9.81}" + (world.empty() ? std::string() : ", " + world) +
-           "}, \"entities\": [" + entities + "]}";
+    return test::levelUnderGravity(entities, world);
 }
-
 
 std::string polygonJson(const std::vector<Vec2>& v, double radius) {
     std::string out = "\"polygon\": {\"vertices\": [";

@@ -149,6 +149,13 @@ inline std::string vectorJson(double x, double y) {
     return "{\"x\": " + exactNumber(x) + ", \"y\": " + exactNumber(y) + "}";
 }
 
+/// A level of `entities` (JSON objects, comma-separated) under gravity
+/// 9.81 m/s^2 down, with `world` (more world keys) added when given.
+inline std::string levelUnderGravity(const std::string& entities, const std::string& world = "") {
+    return "{\"world\": {\"gravity\": {\"x\": 0, \"y\": -9.81}" + (world.empty() ? std::string() : ", " + world) +
+           "}, \"entities\": [" + entities + "]}";
+}
+
 /// The loader's refusal of `text` (as "t.json"), or "loaded".
 inline std::string loadError(const std::string& text) {
     Result<Scene> s = parseScene(text, "t.json");
