@@ -192,9 +192,16 @@ TEST(Simulation, DisabledSystemIsLeftOutOfTheWorld) {
 TEST(Simulation, DivergencePausesAndNamesEntityAndQuantity) {
     Fixture f("orbit.json");
     ASSERT_TRUE(f.ed.applyEdit("blow up", [&](Scene& s) {
-        // G so large (the most a level holds) that the pull on the planet
-        // (first body) takes it past the fastest speed a level holds.
-        s.world.G = 1e30;
+        // A spring far too stiff for the level's explicit step (h omega
+        // about 130) on the planet (first body): its swing grows about
+        // 1e4-fold a step and passes the fastest speed a level holds within
+        // a few steps, though its first step is one a run holds (a pull
+        // past that the build refuses, below).
+        const Entity planet = findByName(s.registry, "planet");
+        const Vec2 at = s.registry.tryGet<Position>(planet)->value;
+        const double mass = s.registry.has<Mass>(planet) ? s.registry.tryGet<Mass>(planet)->value : 1.0;
+        const Entity spring = s.registry.create();
+        s.registry.emplace<Spring>(spring, Spring{planet, Entity{}, at + Vec2{1.0, 0.0}, 1e9 * mass, 0.0, 0.0});
         return true;
     }));
     f.ed.togglePlay();
@@ -203,6 +210,20 @@ TEST(Simulation, DivergencePausesAndNamesEntityAndQuantity) {
     EXPECT_TRUE(f.ed.sim.diverged());
     EXPECT_NE(f.ed.sim.message().find("planet"), std::string::npos) << f.ed.sim.message();
     EXPECT_NE(f.ed.sim.message().find("became"), std::string::npos) << f.ed.sim.message();
+}
+
+TEST(Simulation, APullNoStepCanTakeIsRefusedNamingTheBody) {
+    Fixture f("orbit.json");
+    ASSERT_TRUE(f.ed.applyEdit("blow up", [&](Scene& s) {
+        s.world.G = 1e30;  // the most a level holds
+        return true;
+    }));
+    f.ed.togglePlay();
+    f.ed.update(1.0 / 60.0);
+    EXPECT_EQ(f.ed.sim.steps(), 0u);
+    EXPECT_NE(f.ed.sim.message().find("cannot simulate: entity 1 (\"planet\"): the attractors pull it at"),
+              std::string::npos)
+        << f.ed.sim.message();
 }
 
 TEST(Simulation, TimeScaleSetsStepsPerFrame) {

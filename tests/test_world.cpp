@@ -253,6 +253,51 @@ TEST(World, ValuesNoStepCanTakeAreRefusedAtBuild) {
     }
 }
 
+// The same for the pull of attractors and springs at the start: an
+// attractor heavy enough (G m / r^2 times dt past 1e9 m/s), or a stiff
+// spring stretched, is refused naming the body it pulls; swept across the
+// limit.
+TEST(World, PullsNoStepCanTakeAreRefusedAtBuild) {
+    const double dt = 1.0 / 60.0;
+    for (const double factor : {0.5, 0.999, 1.001, 1e10}) {
+        // A static sun 2 m from a ball: a = G m / r^2, G = 1.
+        Scene s = emptyScene("semi_implicit_euler", dt);
+        addBody(s, "ball", {2, 0}, {0, 0});
+        const Entity sun = addBody(s, "sun", {0, 0}, {0, 0}, factor * 4e9 / dt);
+        s.registry.emplace<Static>(sun, Static{true});
+        s.registry.emplace<Attractor>(sun, {0.0});
+        Result<World> w = World::build(s);
+        EXPECT_EQ(bool(w), factor < 1.0) << factor;
+        if (!w) {
+            const double pull = factor * 1e9 / dt;
+            EXPECT_EQ(w.error(), "entity 0 (\"ball\"): the attractors pull it at " + formatNumber(pull) +
+                                     " m/s^2 at the start: " + formatNumber(pull * dt) + " m/s in one step of " +
+                                     formatNumber(dt) + " s, past the 1e+09 m/s a run holds");
+        }
+    }
+    for (const double factor : {0.5, 0.999, 1.001, 1e10}) {
+        // A 2 kg body on a spring stretched 3 m: a = k 3 / 2.
+        Scene s = emptyScene("semi_implicit_euler", dt);
+        const Entity e = addBody(s, "bob", {3, 0}, {0, 0}, 2.0);
+        const Entity spring = s.registry.create();
+        s.registry.emplace<Spring>(spring, Spring{e, Entity{}, Vec2{0.0, 0.0}, factor * 2e9 / (3.0 * dt), 0.0, 0.0});
+        Result<World> w = World::build(s);
+        EXPECT_EQ(bool(w), factor < 1.0) << factor;
+        if (!w) {
+            EXPECT_NE(w.error().find("entity 0 (\"bob\"): the springs pull it at "), std::string::npos) << w.error();
+        }
+    }
+    // Two bodies at one point under an attractor with no softening: no
+    // direction to pull in, so no pull (and a build, not a refusal).
+    Scene s = emptyScene("semi_implicit_euler", dt);
+    const Entity a = addBody(s, "a", {1, 1}, {0, 0});
+    addBody(s, "b", {1, 1}, {0, 0});
+    s.registry.emplace<Attractor>(a, {0.0});
+    Result<World> w = World::build(s);
+    ASSERT_TRUE(w) << w.error();
+    EXPECT_EQ(w->bodyForces()[1], (Vec2{0.0, 0.0}));
+}
+
 // A step that diverges leaves the whole carried state as it was, the
 // solver's too: the failed step's contact cache and joint impulses must not
 // stay in place and warm the next step (a retry after an edit, a reload
