@@ -223,10 +223,12 @@ int run(const RunOptions& options) {
         return kExitBadInput;
     }
     World& world = built.value();
-    // Before playing: a pile the level's substeps cannot hold (stderr, so
+    // Before playing: a pile or an impact the level's substeps cannot hold (stderr, so
     // the summary on stdout stays one line).
     if (const std::optional<PileHint> pile = world.pileHint())
         std::cerr << options.level << ": warning: " << pile->message() << "\n";
+    if (const std::optional<ImpactHint> impact = world.impactHint())
+        std::cerr << options.level << ": warning: " << impact->message() << "\n";
     if (const std::optional<DroppedImpulses> dropped = world.droppedImpulses())
         std::cerr << options.level << ": warning: " << dropped->message() << "\n";
 

@@ -77,10 +77,15 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                                    world->bodyCount());
         }
         if (world) {
-            // A pile the level's substeps cannot hold: said before playing.
+            // A pile or an impact the level's substeps cannot hold: said before playing.
             if (const std::optional<PileHint> pile = world->pileHint()) {
                 ImGui::PushTextWrapPos(0.0f);
                 ImGui::TextColored(kGold, "%s", pile->message().c_str());
+                ImGui::PopTextWrapPos();
+            }
+            if (const std::optional<ImpactHint> impact = world->impactHint()) {
+                ImGui::PushTextWrapPos(0.0f);
+                ImGui::TextColored(kGold, "%s", impact->message().c_str());
                 ImGui::PopTextWrapPos();
             }
         }

@@ -194,9 +194,11 @@ struct WorldState {
 };
 
 /// What the engine runs when a level gives no `substeps` (and no
-/// `solver_iterations`), decided from the scene's structure alone (its
-/// bodies, shapes, masses, joints and gravity; never where the dynamic bodies
-/// are now), so that a run saved and resumed chooses what the long run chose.
+/// `solver_iterations`), decided from the scene's structure (its bodies,
+/// shapes, masses, joints and gravity) and, for stacks and impacts, from the
+/// level as authored (where its boxes stand, its velocities and which bodies
+/// touch). A run that saved its state records the choice, so a resumed run
+/// runs what the long run chose.
 /// The fewest substeps (1, 2, 4, 8 or 16) that hold:
 ///  * the pile: the deepest the N dynamic shapes can pile (a heap k deep,
 ///    k (k + 1) / 2 >= N, no wider than floor(W / d) bodies on ground W
@@ -205,7 +207,11 @@ struct WorldState {
 ///  * the load: the contact under the bottom body, under 1% of a diameter
 ///    and 10% of the thinnest static support's thickness (strong gravity);
 ///  * the joints: the heaviest group of jointed bodies (its mass over its
-///    lightest body's), its expected widest opening under 1% of a link.
+///    lightest body's), its expected widest opening under 1% of a link;
+///  * the impacts: a moving body (its velocity and spin as the level gives
+///    them) drives what it strikes at up to (1 + e) M / (M + m) of its
+///    speed; that body's travel per substep stays under kImpactTravel of
+///    its size (8 substeps at most).
 /// Contacts stop stiffening at 60 Hz (contactHertz): past 4 substeps, or 8
 /// for a deep column, so a contact rule that cannot hold stops where more
 /// substeps stop helping.
@@ -228,6 +234,15 @@ struct ContactSettingsChoice {
     /// implicit or adaptive integrator, which need no rule).
     double springRate = 0.0;
     int springSubsteps = 1;    ///< the fewest with h * springRate <= 1
+    /// The impact that asks the most (impactSubsteps): the striker's speed
+    /// (its fastest point, m/s), the size (m) of the body it strikes, the
+    /// striker's mass over that body's (infinite for a kinematic striker),
+    /// and the speed (m/s) the struck body is driven at.
+    double impactSpeed = 0.0;
+    double impactSize = 0.0;
+    double impactMassRatio = 1.0;
+    double impactDriven = 0.0;
+    int impactSubsteps = 1;    ///< the fewest in 1, 2, 4, 8 with driven * h <= kImpactTravel * size
     /// Contact stiffness cap as a fraction of the substep rate: 0.25, or
     /// 0.125 (with one colour order) when stackHeight > kDeepColumn under
     /// gravity (SolverSettings::hertzFraction); the rules above use the
@@ -257,6 +272,14 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
 /// alternating contacts: 4 times less overlap, and they settle and sleep
 /// sooner (docs/collisions.md, "Deep columns").
 inline constexpr int kDeepColumn = 12;
+/// The impact rule's bound: a struck body moves at most this fraction of
+/// its size per substep. Measured on Box2D's smash (a 512 kg box at 40 m/s
+/// into 0.4 m bricks of 0.16 kg): 0.83 of a brick per substep (2 substeps)
+/// ends with 382 mm of overlap, 0.42 (4 substeps) with 0.88 mm.
+inline constexpr double kImpactTravel = 0.5;
+/// The most substeps the impact rule asks for: past it a level must give
+/// its own (the rule's warning names the number).
+inline constexpr int kImpactMaxSubsteps = 8;
 /// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
 /// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
 /// compresses by load / (m_n omega^2), omega = 2 pi min(60 Hz, f / h) with
@@ -283,6 +306,19 @@ struct PileHint {
     double diameter = 0.0;         ///< metres
     int substeps = 1;              ///< the level's
     int substepsNeeded = 1;        ///< the fewest that keep it under 2% (16 at most)
+    std::string message() const;
+};
+
+/// A warning before playing: at the level's own substeps, a body struck by
+/// the level's fastest mover (the impact rule of ContactSettingsChoice) moves
+/// more than kImpactTravel of its size per substep.
+struct ImpactHint {
+    double speed = 0.0;     ///< m/s, the striker's fastest point
+    double size = 0.0;      ///< m, the struck body's size
+    double driven = 0.0;    ///< m/s, the speed the struck body is driven at
+    double travel = 0.0;    ///< m it moves per substep at the level's substeps
+    int substeps = 1;       ///< the level's
+    int substepsNeeded = 1; ///< the fewest that keep it under kImpactTravel of its size
     std::string message() const;
 };
 
@@ -409,6 +445,9 @@ public:
     /// Set when the scene's deepest pile would sink more than 2% of a
     /// diameter at the running substeps (see PileHint).
     std::optional<PileHint> pileHint() const;
+    /// An impact the level's own substeps cannot hold (ImpactHint); never
+    /// about substeps the engine chose or a run recorded.
+    std::optional<ImpactHint> impactHint() const;
     /// Set when the last setSolverState dropped impulses no run could write.
     std::optional<DroppedImpulses> droppedImpulses() const;
 

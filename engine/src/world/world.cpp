@@ -1050,6 +1050,37 @@ std::optional<PileHint> World::pileHint() const {
     return hint;
 }
 
+std::optional<ImpactHint> World::impactHint() const {
+    const WorldImpl& w = *impl_;
+    const ContactSettingsChoice& c = w.contactChoice;
+    if (!w.substepsGiven || !w.collision || !(c.impactSize > 0.0) || !(c.impactDriven > 0.0)) return std::nullopt;
+    const double dt = w.settings.dt;
+    const int substeps = w.settings.substeps;
+    const double travel = c.impactDriven * dt / double(substeps);
+    if (!(travel > kImpactTravel * c.impactSize)) return std::nullopt;
+    ImpactHint hint;
+    hint.speed = c.impactSpeed;
+    hint.size = c.impactSize;
+    hint.driven = c.impactDriven;
+    hint.travel = travel;
+    hint.substeps = substeps;
+    // Any whole number of substeps (the engine's own choice takes 1, 2, 4
+    // or 8); ceil with the ratio rounded first, as the spring rule does.
+    const double ratio = c.impactDriven * dt / (kImpactTravel * c.impactSize);
+    hint.substepsNeeded = int(std::clamp(std::ceil(ratio * (1.0 - 1e-12)), 1.0, 1e6));
+    return hint;
+}
+
+std::string ImpactHint::message() const {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "a body at %.3g m/s strikes %.2g m bodies and drives them %.0f mm per substep (%.0f%% of their "
+                  "size) at %d substep%s; substeps %d would keep it under %.0f%%",
+                  speed, size, 1e3 * travel, 100.0 * travel / size, substeps, substeps == 1 ? "" : "s",
+                  substepsNeeded, 100.0 * kImpactTravel);
+    return text;
+}
+
 std::string PileHint::message() const {
     char text[320];
     std::snprintf(text, sizeof text,
