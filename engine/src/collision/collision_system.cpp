@@ -745,9 +745,15 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     // At most one manifold a pair (and a plane against each movable shape):
     // reserving once avoids the copies and the doubled capacity of growth
     // (a crowd of 100,000 makes hundreds of thousands of manifolds).
+    // Grown by half again when short: reserving the exact count let a pile
+    // whose pair count creeps up reallocate (and fault in fresh pages for)
+    // both arrays on most steps.
     const std::size_t most = pairs_.size() + planes_.size() * finite_.size();
-    constraints_.reserve(most);
-    details_.reserve(most);
+    if (most > constraints_.capacity()) {
+        const std::size_t room = std::max(most, constraints_.capacity() + constraints_.capacity() / 2);
+        constraints_.reserve(room);
+        details_.reserve(room);
+    }
     cacheCursor_ = 0;
     // The speculative margin of a pair: how far its gap can close this
     // step, from the two bodies' relative velocity (at either end of the
@@ -800,7 +806,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     }
     addDeepOverlapsToCrowd();
     prepareContacts(constraints_, details_, bodies_);
-    indexImpacts(constraints_, bodies_.size(), impactScratch_);
+    indexImpacts(constraints_, details_, bodies_.size(), impactScratch_);
     if (settings_.warmStart && !cache_.empty()) capWarmStart(firstSubstepV);
     coloured_.build(constraints_, bodies_, settings_.simd);
     if (!joints_.empty()) joints::prepareJoints(joints_, bodies_, centres_, angles_);
@@ -987,7 +993,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     crowdSaved_.resize(crowdBodies_.size());
     for (std::size_t k = 0; k < crowdBodies_.size(); ++k)
         crowdSaved_[k] = {bodies_[crowdBodies_[k]].v, bodies_[crowdBodies_[k]].w};
-    if (!crowdBodies_.empty()) coloured_.saveImpulses(constraints_, crowdImpulses_);
+    if (!crowdBodies_.empty()) coloured_.saveImpulses(constraints_, inCrowd_, crowdImpulses_);
     // Bodies in a crowd (many on top of each other, or started deep in one
     // another) take the biased passes' push as a position correction only
     // (split impulse): their velocities and their contacts' impulses go back

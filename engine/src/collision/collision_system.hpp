@@ -420,7 +420,7 @@ private:
     double dt_ = 0.0;
     int substeps_ = 1;
     std::vector<std::uint8_t> inCrowd_;  // per solver body: in crowdBodies_
-    std::vector<double> crowdImpulses_;  // every contact's impulses after the warm start, while a crowd is solved
+    std::vector<double> crowdImpulses_;  // the crowd contacts' impulses after the warm start, while a crowd is solved
     int substepsDone_ = 0;  // of this step, counted by solveSubstep
     PositionCorrectionSettings positionCorrection_;
     PositionCorrectionScratch positionScratch_;

@@ -538,37 +538,43 @@ void ColouredContacts::solve(std::span<ContactConstraint> contacts, std::span<So
     if (!reverse) solveOverflow();
 }
 
-void ColouredContacts::saveImpulses(std::span<const ContactConstraint> contacts, std::vector<double>& out) const {
+template <class Self, class Contacts, class Visit>
+void ColouredContacts::forEachHeld(Self& self, Contacts& contacts, Visit&& visit) {
+    const auto points = [&](auto& c) {
+        for (int i = 0; i < c.pointCount; ++i)
+            visit(c.bodyA, c.bodyB, c.points[i].normalImpulse, c.points[i].tangentImpulse);
+    };
+    if (!self.simd_) {
+        for (auto& c : contacts) points(c);
+        return;
+    }
+    forEachLane<1>(self.one_, visit);
+    forEachLane<2>(self.two_, visit);
+    const std::span<const std::uint32_t> order(self.order_);
+    for (const std::uint32_t k : order.subspan(self.colourStart_[std::size_t(self.colourCount_)])) points(contacts[k]);
+}
+
+void ColouredContacts::saveImpulses(std::span<const ContactConstraint> contacts, std::span<const std::uint8_t> marked,
+                                    std::vector<double>& out) const {
     out.clear();
-    const auto save = [&](std::uint32_t, std::uint32_t, double normal, double tangent) {
+    const auto save = [&](std::uint32_t a, std::uint32_t b, double normal, double tangent) {
+        if (!marked[a] && !marked[b]) return;
         out.push_back(normal);
         out.push_back(tangent);
     };
-    if (simd_) {
-        forEachLane<1>(one_, save);
-        forEachLane<2>(two_, save);
-    }
-    for (const ContactConstraint& c : contacts)
-        for (int i = 0; i < c.pointCount; ++i) save(c.bodyA, c.bodyB, c.points[i].normalImpulse, c.points[i].tangentImpulse);
+    forEachHeld(*this, contacts, save);
 }
 
 void ColouredContacts::restoreImpulses(std::span<ContactConstraint> contacts, std::span<const std::uint8_t> marked,
                                        std::span<const double> saved) {
     std::size_t at = 0;
     const auto restore = [&](std::uint32_t a, std::uint32_t b, double& normal, double& tangent) {
-        if (marked[a] || marked[b]) {
-            normal = saved[at];
-            tangent = saved[at + 1];
-        }
+        if (!marked[a] && !marked[b]) return;
+        normal = saved[at];
+        tangent = saved[at + 1];
         at += 2;
     };
-    if (simd_) {
-        forEachLane<1>(one_, restore);
-        forEachLane<2>(two_, restore);
-    }
-    // The scalar path and the overflow keep their impulses in the contacts.
-    for (ContactConstraint& c : contacts)
-        for (int i = 0; i < c.pointCount; ++i) restore(c.bodyA, c.bodyB, c.points[i].normalImpulse, c.points[i].tangentImpulse);
+    forEachHeld(*this, contacts, restore);
 }
 
 void ColouredContacts::storeImpulses(std::span<ContactConstraint> contacts) const {

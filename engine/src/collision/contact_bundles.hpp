@@ -78,11 +78,11 @@ public:
                const Softness& staticSoft, double pushMaxVelocity, bool useBias, bool reverse);
     /// Copies the bundles' impulses back to the contacts (warm starting, records).
     void storeImpulses(std::span<ContactConstraint> contacts) const;
-    /// Every contact's accumulated (normal, tangent) impulses, in the order
-    /// the bundles and then `contacts` hold them.
-    void saveImpulses(std::span<const ContactConstraint> contacts, std::vector<double>& out) const;
-    /// Puts back what saveImpulses saved, for the contacts that have a body
-    /// with `marked[body]` set.
+    /// The accumulated (normal, tangent) impulses of every contact that has
+    /// a body with `marked[body]` set, in the order forEachHeld visits them.
+    void saveImpulses(std::span<const ContactConstraint> contacts, std::span<const std::uint8_t> marked,
+                      std::vector<double>& out) const;
+    /// Puts back what saveImpulses saved with the same `marked`.
     void restoreImpulses(std::span<ContactConstraint> contacts, std::span<const std::uint8_t> marked,
                          std::span<const double> saved);
 
@@ -93,6 +93,14 @@ public:
     std::size_t overflowCount() const { return order_.size() - colourStart_[std::size_t(colourCount_)]; }
 
 private:
+    /// Calls visit(bodyA, bodyB, normal, tangent) with references to the
+    /// impulses where the solve keeps them: the bundles' lanes and then the
+    /// overflow's contacts (SIMD), or every contact (scalar). A bundled
+    /// contact's own impulses are left alone by the passes until
+    /// storeImpulses, so they are not visited.
+    /// (`self` is *this, const or not: restoring writes through it.)
+    template <class Self, class Contacts, class Visit>
+    static void forEachHeld(Self& self, Contacts& contacts, Visit&& visit);
     bool simd_ = true;
     int colourCount_ = 0;
     std::vector<std::uint32_t> order_;

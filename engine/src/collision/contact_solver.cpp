@@ -88,7 +88,8 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
     }
 }
 
-void indexImpacts(std::span<const ContactConstraint> contacts, std::size_t bodyCount, ImpactScratch& scratch) {
+void indexImpacts(std::span<const ContactConstraint> contacts, std::span<const ContactDetail> details,
+                  std::size_t bodyCount, ImpactScratch& scratch) {
     // Counting sort of (body, contact) by body; static body 0 never changes
     // velocity, so it lists nothing.
     scratch.start.assign(bodyCount + 1, 0u);
@@ -102,12 +103,14 @@ void indexImpacts(std::span<const ContactConstraint> contacts, std::size_t bodyC
     at.assign(scratch.start.begin(), scratch.start.end() - 1);
     scratch.reach.assign(bodyCount, 0.0);
     scratch.pairBodies.resize(2 * contacts.size());
+    scratch.restitution.resize(contacts.size());
     for (std::size_t k = 0; k < contacts.size(); ++k) {
         const ContactConstraint& c = contacts[k];
         if (c.bodyA != 0) scratch.incident[at[c.bodyA]++] = std::uint32_t(k);
         if (c.bodyB != 0) scratch.incident[at[c.bodyB]++] = std::uint32_t(k);
         scratch.pairBodies[2 * k] = c.bodyA;
         scratch.pairBodies[2 * k + 1] = c.bodyB;
+        scratch.restitution[k] = details[k].restitution;
         for (int i = 0; i < c.pointCount; ++i) {
             scratch.reach[c.bodyA] = std::max(scratch.reach[c.bodyA], std::abs(c.points[i].rnA));
             scratch.reach[c.bodyB] = std::max(scratch.reach[c.bodyB], std::abs(c.points[i].rnB));
@@ -164,7 +167,6 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
                 now[word] &= now[word] - 1;
                 if (bound[scratch.pairBodies[2 * k]] + bound[scratch.pairBodies[2 * k + 1]] < quiet) continue;
                 ContactConstraint& c = contacts[k];
-                ContactDetail& detail = details[k];
                 SolverBody& a = bodies[c.bodyA];
                 SolverBody& b = bodies[c.bodyB];
                 // The approaching points that touch within this substep; the
@@ -193,13 +195,14 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
                 // Bouncy pairs leave at e times the approach speed. Inelastic ones
                 // close exactly the remaining gap this substep, so a fast body
                 // stopped by a speculative contact ends up touching, not hovering.
-                const double target = detail.restitution > 0.0 ? -detail.restitution * vn : -gap / h;
+                const double restitution = scratch.restitution[k];
+                const double target = restitution > 0.0 ? -restitution * vn : -gap / h;
                 if (vn >= target) continue;
                 const double impulse = (target - vn) * effectiveMass(a, b, rnA, rnB);
                 applyImpulse(a, b, c.normal, rnA, rnB, impulse);
                 bound[c.bodyA] = boundOf(a);
                 bound[c.bodyB] = boundOf(b);
-                for (int i = 0; i < c.pointCount; ++i) detail.restitutionImpulse[i] += impulse / double(c.pointCount);
+                for (int i = 0; i < c.pointCount; ++i) details[k].restitutionImpulse[i] += impulse / double(c.pointCount);
                 touched(c.bodyA, k);
                 touched(c.bodyB, k);
                 any = true;

@@ -160,8 +160,12 @@ struct ImpactScratch {
     /// of its points can have, |v.x| + |v.y| + |w| reach (m/s).
     std::vector<double> reach, bound;
     std::vector<std::uint32_t> pairBodies;  ///< bodyA, bodyB of each contact, packed
+    /// Each contact's restitution (ContactDetail::restitution), packed: a
+    /// crowd's approaching contacts all read it, and a detail is 88 bytes.
+    std::vector<double> restitution;
 };
-void indexImpacts(std::span<const ContactConstraint> contacts, std::size_t bodyCount, ImpactScratch& scratch);
+void indexImpacts(std::span<const ContactConstraint> contacts, std::span<const ContactDetail> details,
+                  std::size_t bodyCount, ImpactScratch& scratch);
 void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDetail> details,
                       std::span<SolverBody> bodies, double h, double threshold, int maxPasses,
                       ImpactScratch& scratch);

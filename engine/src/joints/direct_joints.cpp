@@ -188,6 +188,10 @@ void DirectJoints::factor(std::span<JointConstraint> joints, std::span<const Sol
         }
         std::fill(g.diag.begin(), g.diag.end(), 0.0);
         g.triplets.clear();
+        // A dense group sums its entries straight into the matrix, in the
+        // order the triplets would list them (so the same sums, bit for
+        // bit): a list to replay would be written and read again for nothing.
+        if (g.dense) g.denseMatrix.setZero();
         // Jacobian rows of one end: point x, point y, angle (weld).
         const auto rowsOf = [&](const Group::End& e, Row3 out[3]) {
             const double s = e.side == 0 ? -1.0 : 1.0;
@@ -218,14 +222,15 @@ void DirectJoints::factor(std::span<JointConstraint> joints, std::span<const Sol
                                 if (p != q) continue;  // both ends of one joint never meet at one body
                             }
                             const std::uint32_t row = g.offset[kp] + a, col = g.offset[kq] + c;
-                            if (row >= col) g.triplets.emplace_back(int(row), int(col), kp == kq ? diagScale * v : v);
+                            if (row < col) continue;
+                            const double entry = kp == kq ? diagScale * v : v;
+                            if (g.dense) g.denseMatrix(row, col) += entry;
+                            else g.triplets.emplace_back(int(row), int(col), entry);
                         }
                 }
             }
         }
         if (g.dense) {
-            g.denseMatrix.setZero();
-            for (const Eigen::Triplet<double>& t : g.triplets) g.denseMatrix(t.row(), t.col()) += t.value();
             g.denseLdlt.compute(g.denseMatrix);  // reads the lower triangle
             g.factored = g.denseLdlt.info() == Eigen::Success;
             continue;
