@@ -28,15 +28,15 @@ set ylabel 'sinkage of the top box, m'
 set title 'stack of 10 boxes'
 plot 'docs/measured/hard_cases.dat' index 12 using 1:2 with linespoints lc 1 pt 7 title 'Stepwise', '' index 12 using 1:2:3 with labels offset 0,0.8 font ',7' notitle, '' index 13 using 1:2 with points lc 3 pt 5 ps 1.5 title 'Stepwise defaults', '' index 14 using 1:2 with linespoints lc 2 dt 2 pt 6 title 'Box2D 2.4.1', '' index 14 using 1:2:3 with labels offset 0,-0.8 font ',7' tc lt 2 notitle
 set logscale y
-set ylabel 'fastest horizontal speed, m/s'
+set ylabel 'push-out: fastest speed relative to free fall in flight, m/s'
 set title 'crowd of 64 at one point'
 plot 'docs/measured/hard_cases.dat' index 15 using 1:2 with linespoints lc 1 pt 7 title 'Stepwise', '' index 15 using 1:2:3 with labels offset 0,0.8 font ',7' notitle, '' index 16 using 1:2 with points lc 3 pt 5 ps 1.5 title 'Stepwise defaults', '' index 17 using 1:2 with linespoints lc 2 dt 2 pt 6 title 'Box2D 2.4.1', '' index 17 using 1:2:3 with labels offset 0,-0.8 font ',7' tc lt 2 notitle
 set logscale y
-set ylabel 'fastest horizontal speed, m/s'
+set ylabel 'push-out: fastest speed relative to free fall in flight, m/s'
 set title 'crowd of 1000 at one point'
 plot 'docs/measured/hard_cases.dat' index 18 using 1:2 with linespoints lc 1 pt 7 title 'Stepwise', '' index 18 using 1:2:3 with labels offset 0,0.8 font ',7' notitle, '' index 19 using 1:2 with points lc 3 pt 5 ps 1.5 title 'Stepwise defaults', '' index 20 using 1:2 with linespoints lc 2 dt 2 pt 6 title 'Box2D 2.4.1', '' index 20 using 1:2:3 with labels offset 0,-0.8 font ',7' tc lt 2 notitle
 set logscale y
-set ylabel 'fastest horizontal speed, m/s'
+set ylabel 'push-out: fastest speed relative to free fall in flight, m/s'
 set title 'crowd of 10000 at one point'
 plot 'docs/measured/hard_cases.dat' index 21 using 1:2 with linespoints lc 1 pt 7 title 'Stepwise', '' index 21 using 1:2:3 with labels offset 0,0.8 font ',7' notitle, '' index 22 using 1:2 with points lc 3 pt 5 ps 1.5 title 'Stepwise defaults', '' index 23 using 1:2 with linespoints lc 2 dt 2 pt 6 title 'Box2D 2.4.1', '' index 23 using 1:2:3 with labels offset 0,-0.8 font ',7' tc lt 2 notitle
 set logscale y
