@@ -240,6 +240,48 @@ TEST(HardSettings, PileDepthIsRowsOfTheContainerAndSubstepsHoldItUnderOnePercent
     EXPECT_LT(deepest, 0.02 * 0.5) << "substeps " << w.settings().substeps;
 }
 
+// A floor laid as tiles is the floor it makes: 100 circles (0.5 m) above
+// open ground 8 m wide give the same choice whether the ground is one box
+// or tiles of any width, touching or with gaps no body fits through, and
+// with tops level within a quarter body. Gaps a body fits through, or steps
+// higher than that, leave separate floors (the widest one counts).
+TEST(HardSettings, ATiledFloorCountsAsTheFloorItMakes) {
+    const auto level = [](double tile, double gap, double step) {
+        std::ostringstream s;
+        s << R"({"entities": [)";
+        int k = 0;
+        for (double x = -4.0; x + tile <= 4.0 + 1e-9; x += tile + gap, ++k)
+            s << (k ? ", " : "") << R"({"position": {"x": )" << num(x + 0.5 * tile) << R"(, "y": )"
+              << num(-0.5 + (k % 2) * step) << R"(}, "static": true, "box": {"width": )" << num(tile)
+              << R"(, "height": 1}})";
+        for (int r = 0; r < 10; ++r)
+            for (int c = 0; c < 10; ++c)
+                s << R"(, {"position": {"x": )" << num(-2.3 + 0.51 * c) << R"(, "y": )" << num(0.3 + 0.52 * r)
+                  << R"(}, "radius": 0.25})";
+        s << "]}";
+        return s.str();
+    };
+    const ContactSettingsChoice whole = chooseContactSettings(parse(level(8.0, 0.0, 0.0)));
+    // 16 bodies a row on 8 m; a heap of 100 is 14 deep and no wider than 16.
+    EXPECT_EQ(whole.stackDepth, 14);
+    for (const double tile : {0.1, 0.25, 0.5, 1.0, 2.0, 4.0})
+        for (const double gap : {0.0, 0.01, 0.2})
+            for (const double step : {0.0, 0.1}) {
+                // Gaps shrink the ground a little: 8 m less the gaps.
+                const ContactSettingsChoice c = chooseContactSettings(parse(level(tile, gap, step)));
+                const int tiles = int(std::floor((8.0 + gap + 1e-9) / (tile + gap)));
+                const double width = tiles * tile + (tiles - 1) * gap;
+                const int perRow = int(std::floor(width / 0.5));
+                EXPECT_EQ(c.stackDepth, std::max((100 + perRow - 1) / perRow, std::min(14, perRow)))
+                    << "tiles " << tile << " m, gaps " << gap << " m, steps " << step << " m";
+                if (width == 8.0) EXPECT_EQ(c.substeps, whole.substeps) << tile << " " << gap << " " << step;
+            }
+    // A body fits through 0.6 m gaps, and 0.2 m steps are not level: 1 m
+    // tiles are then floors of their own, 2 bodies a row, 50 deep.
+    EXPECT_EQ(chooseContactSettings(parse(level(1.0, 0.6, 0.0))).stackDepth, 50);
+    EXPECT_EQ(chooseContactSettings(parse(level(1.0, 0.0, 0.2))).stackDepth, 50);
+}
+
 TEST(HardSettings, HeavyLoadOnAThinShelfGetsTheSubstepsThatHoldIt) {
     struct Case {
         double gravity;

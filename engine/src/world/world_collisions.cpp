@@ -833,6 +833,11 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     std::vector<Interval> walls;
     double left = -kInf, right = kInf;  // plane walls: the side bodies stay on
     double thinnest = kInf;
+    struct FloorPiece {
+        Interval span;
+        double top;  // m, against gravity
+    };
+    std::vector<FloorPiece> floorPieces;
     static const std::vector<Entity> kNoEntities;
     for (const Entity e : switches.collisions ? order : kNoEntities) {
         if (const Plane* p = reg.tryGet<Plane>(e)) {
@@ -856,9 +861,39 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         const Interval span{c - halfAcross, c + halfAcross};
         thinnest = std::min(thinnest, 2.0 * halfDown);
         if (halfAcross >= halfDown) {
-            if (!floor || span.hi - span.lo > floor->hi - floor->lo) floor = span;
+            const double top = -(dot(pos, down) + centreAlong(reg, e, down)) + halfDown;
+            floorPieces.push_back({span, top});
         } else {
             walls.push_back(span);
+        }
+    }
+    // A floor laid as tiles is one floor: pieces side by side whose tops
+    // are level within a quarter body and whose gaps no body fits through
+    // (under the median body) are joined, and the widest run is the floor.
+    // Taken one tile at a time, a floor of 0.5 m tiles would hold one body
+    // a row and every body would count as one column.
+    if (!floorPieces.empty()) {
+        const double d = median(sizes);
+        std::sort(floorPieces.begin(), floorPieces.end(), [](const FloorPiece& a, const FloorPiece& b) {
+            return a.top != b.top ? a.top > b.top : a.span.lo < b.span.lo;
+        });
+        // Level bands from the highest top down; in each, runs by position.
+        for (std::size_t i = 0; i < floorPieces.size();) {
+            std::size_t j = i + 1;
+            while (j < floorPieces.size() && floorPieces[i].top - floorPieces[j].top <= 0.25 * d) ++j;
+            std::vector<Interval> band;
+            for (std::size_t k = i; k < j; ++k) band.push_back(floorPieces[k].span);
+            std::sort(band.begin(), band.end(), [](const Interval& a, const Interval& b) { return a.lo < b.lo; });
+            Interval run = band.front();
+            for (std::size_t k = 1; k <= band.size(); ++k) {
+                if (k < band.size() && band[k].lo - run.hi < d) {
+                    run.hi = std::max(run.hi, band[k].hi);
+                    continue;
+                }
+                if (!floor || run.hi - run.lo > floor->hi - floor->lo) floor = run;
+                if (k < band.size()) run = band[k];
+            }
+            i = j;
         }
     }
     choice.support = std::isfinite(thinnest) ? thinnest : 0.0;
