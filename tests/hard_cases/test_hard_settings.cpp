@@ -240,11 +240,48 @@ TEST(HardSettings, PileDepthIsRowsOfTheContainerAndSubstepsHoldItUnderOnePercent
     EXPECT_LT(deepest, 0.02 * 0.5) << "substeps " << w.settings().substeps;
 }
 
+// A container drawn as a chain (the format's way to draw terrain and
+// containers) holds the same pile as one built of boxes: the same depth and
+// substeps for every row count, and the 20-row pile settles as deep.
+TEST(HardSettings, AChainContainerHoldsThePileABoxContainerDoes) {
+    const auto inChain = [](int rows) {
+        std::string text = pileLevel(rows, 0.0);
+        // The floor and the two walls of pileLevel, as one chain with the
+        // same inner faces: down the right wall, right to left along the
+        // floor, up the left wall (bodies on the right of each segment).
+        const std::string boxes = R"({"position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 8, "height": 1}},
+        {"position": {"x": -3.1, "y": 10}, "static": true, "box": {"width": 1, "height": 22}},
+        {"position": {"x": 3.1, "y": 10}, "static": true, "box": {"width": 1, "height": 22}})";
+        const std::size_t at = text.find(boxes);
+        EXPECT_NE(at, std::string::npos);
+        text.replace(at, boxes.size(),
+                     R"({"position": {"x": 0, "y": 0}, "static": true, "chain": {"points": [{"x": 2.6, "y": 21},
+                        {"x": 2.6, "y": 0}, {"x": -2.6, "y": 0}, {"x": -2.6, "y": 21}]}})");
+        return text;
+    };
+    for (const int rows : {1, 2, 4, 8, 12, 20, 30}) {
+        const ContactSettingsChoice boxes = chooseContactSettings(parse(pileLevel(rows, 0.0)));
+        const ContactSettingsChoice chain = chooseContactSettings(parse(inChain(rows)));
+        EXPECT_EQ(chain.stackDepth, boxes.stackDepth) << rows << " rows";
+        EXPECT_EQ(chain.substeps, boxes.substeps) << rows << " rows: " << chain.reason();
+        EXPECT_EQ(chain.iterations, boxes.iterations) << rows << " rows";
+    }
+    World w = build(parse(inChain(20)));
+    double deepest = 0.0;
+    for (int i = 0; i < 480; ++i) {
+        ASSERT_TRUE(w.step());
+        if (i >= 420)
+            for (const ContactRecord& c : w.contacts()) deepest = std::max(deepest, c.depth);
+    }
+    EXPECT_LT(deepest, 0.02 * 0.5) << "substeps " << w.settings().substeps;
+}
+
 // A floor laid as tiles is the floor it makes: 100 circles (0.5 m) above
 // open ground 8 m wide give the same choice whether the ground is one box
 // or tiles of any width, touching or with gaps no body fits through, and
 // with tops level within a quarter body. Gaps a body fits through, or steps
-// higher than that, leave separate floors (the widest one counts).
+// higher than that, leave separate floors, and each body heaps on the
+// highest one under it (or, over none, on the widest).
 TEST(HardSettings, ATiledFloorCountsAsTheFloorItMakes) {
     const auto level = [](double tile, double gap, double step) {
         std::ostringstream s;
@@ -274,12 +311,29 @@ TEST(HardSettings, ATiledFloorCountsAsTheFloorItMakes) {
                 const int perRow = int(std::floor(width / 0.5));
                 EXPECT_EQ(c.stackDepth, std::max((100 + perRow - 1) / perRow, std::min(14, perRow)))
                     << "tiles " << tile << " m, gaps " << gap << " m, steps " << step << " m";
-                if (width == 8.0) EXPECT_EQ(c.substeps, whole.substeps) << tile << " " << gap << " " << step;
+                if (width == 8.0) {
+                    EXPECT_EQ(c.substeps, whole.substeps) << tile << " " << gap << " " << step;
+                }
             }
     // A body fits through 0.6 m gaps, and 0.2 m steps are not level: 1 m
-    // tiles are then floors of their own, 2 bodies a row, 50 deep.
-    EXPECT_EQ(chooseContactSettings(parse(level(1.0, 0.6, 0.0))).stackDepth, 50);
-    EXPECT_EQ(chooseContactSettings(parse(level(1.0, 0.0, 0.2))).stackDepth, 50);
+    // tiles are then floors of their own, 2 bodies a row. The ten columns
+    // of circles (x = -2.3 + 0.51 c) put at most three columns, 30 bodies,
+    // over one tile (within half a body of its ends): 15 deep.
+    EXPECT_EQ(chooseContactSettings(parse(level(1.0, 0.6, 0.0))).stackDepth, 15);
+    EXPECT_EQ(chooseContactSettings(parse(level(1.0, 0.0, 0.2))).stackDepth, 15);
+    // Shelves: the same 100 circles over a 2 m shelf 3 m above an 8 m
+    // floor. The 40 over the shelf heap on it (4 a row: 10 deep), the other
+    // 60 on the floor (16 a row; a heap of 60 is 11 deep): 11.
+    std::ostringstream shelf;
+    shelf << R"({"entities": [
+        {"position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 8, "height": 1}},
+        {"position": {"x": 0, "y": 2.75}, "static": true, "box": {"width": 2, "height": 0.5}})";
+    for (int r = 0; r < 10; ++r)
+        for (int c = 0; c < 10; ++c)
+            shelf << R"(, {"position": {"x": )" << num(-2.3 + 0.51 * c) << R"(, "y": )" << num(3.3 + 0.52 * r)
+                  << R"(}, "radius": 0.25})";
+    shelf << "]}";
+    EXPECT_EQ(chooseContactSettings(parse(shelf.str())).stackDepth, 11);
 }
 
 TEST(HardSettings, HeavyLoadOnAThinShelfGetsTheSubstepsThatHoldIt) {

@@ -765,11 +765,14 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     // The pile: dynamic shapes that are free to come to rest on each other
     // (a group hanging from the world does not pile).
     std::vector<double> sizes;
+    std::vector<Vec2> places;  // each pile body's (across, up) coordinates, m
     double lightest = 0.0, heaviestMass = 0.0;
     for (std::uint32_t i = 0; i < bodies.size(); ++i) {
         if (!hasShape(bodies[i])) continue;
         if (jointed[i] && groupAnchored[findRoot(parent, i)]) continue;
         sizes.push_back(sizeOf(bodies[i]));
+        const Vec2 p = reg.tryGet<Position>(bodies[i])->value;
+        places.push_back({dot(p, across), -dot(p, down)});
         const double m = massOf(bodies[i]);
         lightest = sizes.size() == 1 ? m : std::min(lightest, m);
         heaviestMass = std::max(heaviestMass, m);
@@ -854,6 +857,27 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
             }
             continue;
         }
+        if (const Chain* chain = reg.tryGet<Chain>(e); chain && isStatic(e) && reg.has<Position>(e)) {
+            // Terrain and containers drawn as chains: one floor as wide as
+            // the chain (its sides, steep or curved, bound the pile it
+            // holds), resting at its lowest segment flatter than steep. A
+            // chain has no thickness to cross, so it sets no support.
+            const Vec2 pos = reg.tryGet<Position>(e)->value;
+            const collision::Rot q = collision::Rot::fromAngle(reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0);
+            const std::size_t n = chain->points.size(), segments = chain->loop ? n : n - 1;
+            Interval span{kInf, -kInf};
+            double top = kInf;
+            for (std::size_t k = 0; k < segments && n >= 2; ++k) {
+                const Vec2 a = pos + collision::rotate(q, chain->points[k]);
+                const Vec2 b = pos + collision::rotate(q, chain->points[(k + 1) % n]);
+                span = {std::min({span.lo, dot(a, across), dot(b, across)}),
+                        std::max({span.hi, dot(a, across), dot(b, across)})};
+                if (std::abs(dot(b - a, across)) >= std::abs(dot(b - a, down)))
+                    top = std::min(top, std::max(-dot(a, down), -dot(b, down)));
+            }
+            if (std::isfinite(top)) floorPieces.push_back({span, top});
+            continue;
+        }
         if (!hasShape(e) || !isStatic(e) || !reg.has<Position>(e)) continue;
         const Vec2 pos = reg.tryGet<Position>(e)->value;
         const double halfAcross = halfExtentAlong(reg, e, across), halfDown = halfExtentAlong(reg, e, down);
@@ -869,9 +893,11 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     }
     // A floor laid as tiles is one floor: pieces side by side whose tops
     // are level within a quarter body and whose gaps no body fits through
-    // (under the median body) are joined, and the widest run is the floor.
-    // Taken one tile at a time, a floor of 0.5 m tiles would hold one body
-    // a row and every body would count as one column.
+    // (under the median body) are joined into runs, and the widest run is
+    // the floor. Taken one tile at a time, a floor of 0.5 m tiles would
+    // hold one body a row and every body would count as one column.
+    std::vector<FloorPiece> runs;
+    std::size_t widestRun = std::size_t(-1);  // the run that is `floor`, if one is
     if (!floorPieces.empty()) {
         const double d = median(sizes);
         std::sort(floorPieces.begin(), floorPieces.end(), [](const FloorPiece& a, const FloorPiece& b) {
@@ -890,7 +916,11 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
                     run.hi = std::max(run.hi, band[k].hi);
                     continue;
                 }
-                if (!floor || run.hi - run.lo > floor->hi - floor->lo) floor = run;
+                if (!floor || run.hi - run.lo > floor->hi - floor->lo) {
+                    floor = run;
+                    widestRun = runs.size();
+                }
+                runs.push_back({run, floorPieces[i].top});
                 if (k < band.size()) run = band[k];
             }
             i = j;
@@ -902,34 +932,54 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         choice.diameter = median(sizes);
         choice.massRatio = heaviestMass / lightest;
         const double d = choice.diameter;
-        Interval ground = floor ? *floor : Interval{-kInf, kInf};
-        ground.lo = std::max(ground.lo, left);
-        ground.hi = std::min(ground.hi, right);
         std::sort(walls.begin(), walls.end(), [](const Interval& a, const Interval& b) { return a.lo < b.lo; });
-        double widestBay = 0.0, widestFiniteBay = 0.0, from = ground.lo;
-        for (const Interval& w : walls) {
-            if (w.hi <= ground.lo || w.lo >= ground.hi) continue;
-            const double bay = w.lo - from;
-            widestBay = std::max(widestBay, bay);
-            if (std::isfinite(bay) && bay >= d) widestFiniteBay = std::max(widestFiniteBay, bay);
-            from = std::max(from, w.hi);
+        // How deep n bodies heap on `ground`, in its widest bay.
+        const auto depthOn = [&](Interval ground, long long n) {
+            ground.lo = std::max(ground.lo, left);
+            ground.hi = std::min(ground.hi, right);
+            double widestBay = 0.0, widestFiniteBay = 0.0, from = ground.lo;
+            for (const Interval& w : walls) {
+                if (w.hi <= ground.lo || w.lo >= ground.hi) continue;
+                const double bay = w.lo - from;
+                widestBay = std::max(widestBay, bay);
+                if (std::isfinite(bay) && bay >= d) widestFiniteBay = std::max(widestFiniteBay, bay);
+                from = std::max(from, w.hi);
+            }
+            const double last = ground.hi - from;
+            widestBay = std::max(widestBay, last);
+            if (std::isfinite(last) && last >= d) widestFiniteBay = std::max(widestFiniteBay, last);
+            const double width = widestFiniteBay > 0.0 ? widestFiniteBay : widestBay;
+            // A heap on open ground: rows of 1, 2, 3 ... bodies, k deep for
+            // k (k + 1) / 2 >= n. On ground `width` wide, rows hold at most
+            // floor(width / d): the heap is no wider than that, and the
+            // bodies fill ceil(n / per row) full rows.
+            long long heap = 1;
+            while (heap * (heap + 1) / 2 < n) ++heap;
+            long long depth = heap;
+            if (std::isfinite(width) && d > 0.0) {
+                const long long perRow = std::max(1LL, (long long)std::floor(width / d));
+                depth = std::max((n + perRow - 1) / perRow, std::min(heap, perRow));
+            }
+            return depth;
+        };
+        // Each body heaps on the highest floor run below it (shelves, the
+        // levels of a building, many pyramids on their own grounds); a body
+        // above none heaps on the widest floor, or the open ground.
+        std::vector<long long> onRun(runs.size(), 0);
+        long long elsewhere = 0;
+        for (const Vec2& place : places) {
+            std::size_t best = runs.size();
+            for (std::size_t r = 0; r < runs.size(); ++r)
+                if (runs[r].top <= place.y && place.x >= runs[r].span.lo - 0.5 * d &&
+                    place.x <= runs[r].span.hi + 0.5 * d && (best == runs.size() || runs[r].top > runs[best].top))
+                    best = r;
+            if (best < runs.size()) ++onRun[best];
+            else if (widestRun < runs.size()) ++onRun[widestRun];
+            else ++elsewhere;
         }
-        const double last = ground.hi - from;
-        widestBay = std::max(widestBay, last);
-        if (std::isfinite(last) && last >= d) widestFiniteBay = std::max(widestFiniteBay, last);
-        const double width = widestFiniteBay > 0.0 ? widestFiniteBay : widestBay;
-        const long long n = (long long)sizes.size();
-        // A heap on open ground: rows of 1, 2, 3 ... bodies, k deep for
-        // k (k + 1) / 2 >= n. On ground `width` wide, rows hold at most
-        // floor(width / d): the heap is no wider than that, and the bodies
-        // fill ceil(n / per row) full rows.
-        long long heap = 1;
-        while (heap * (heap + 1) / 2 < n) ++heap;
-        long long depth = heap;
-        if (std::isfinite(width) && d > 0.0) {
-            const long long perRow = std::max(1LL, (long long)std::floor(width / d));
-            depth = std::max((n + perRow - 1) / perRow, std::min(heap, perRow));
-        }
+        long long depth = elsewhere > 0 ? depthOn(floor ? *floor : Interval{-kInf, kInf}, elsewhere) : 0;
+        for (std::size_t r = 0; r < runs.size(); ++r)
+            if (onRun[r] > 0) depth = std::max(depth, depthOn(runs[r].span, onRun[r]));
         choice.stackDepth = int(std::min<long long>(depth, 1'000'000));
     }
 
