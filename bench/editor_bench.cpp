@@ -4,6 +4,7 @@
 // of the whole scene, BM_CopyScene) and, while paused, in the live World
 // too (BM_DragOneBodyWhilePaused; the peer is a rebuild of the World from
 // the scene, BM_ReloadWorld, which an edit that is not a move still costs).
+// A mass edit goes in place as well (BM_SetMassOfOneBody).
 // Not part of ctest.
 //
 //   build/bench/editor_bench --benchmark_min_time=0.2
@@ -82,6 +83,24 @@ void BM_DragOneBodyWhilePaused(benchmark::State& state) {
     if (ed.sim.worldBuilds() != builds) state.SkipWithError("the drag rebuilt the World");
 }
 BENCHMARK(BM_DragOneBodyWhilePaused)->Arg(2000)->Arg(20000)->Arg(200000)->Unit(benchmark::kMicrosecond);
+
+/// A mass edit in place (World::setMass): one body's mass alternates by a
+/// part in a billion, which leaves the engine's choice of settings as it is.
+void BM_SetMassOfOneBody(benchmark::State& state) {
+    Scene scene = scenes::circlesInBox(int(state.range(0)));
+    const std::vector<Entity> bodies = bodiesOf(scene);
+    const Entity edited = bodies[bodies.size() / 2];
+    Result<World> world = World::build(scene);
+    bool heavier = false;
+    for (auto _ : state) {
+        heavier = !heavier;
+        scene.registry.emplace<Mass>(edited, Mass{heavier ? 1.0 + 1e-9 : 1.0});
+        Result<void> set = world->setMass(scene, {}, edited);
+        if (!set) state.SkipWithError(set.error().c_str());
+    }
+    state.counters["bodies"] = double(bodies.size());
+}
+BENCHMARK(BM_SetMassOfOneBody)->Arg(2000)->Arg(20000)->Arg(200000)->Unit(benchmark::kMicrosecond);
 
 /// The peer: the World rebuilt from the scene (World::reload).
 void BM_ReloadWorld(benchmark::State& state) {

@@ -161,20 +161,78 @@ TEST(Simulation, AMoveInPlaceWakesTheSleepingIslandAsARebuildDoes) {
         if (w.bodyEntity(b) == top) EXPECT_FALSE(w.asleep(b)) << "the moved box's island woke";
 }
 
-// Anything but a move (here a mass) rebuilds the World.
-TEST(Simulation, AnEditBeyondPositionAndVelocityRebuildsTheWorld) {
+// Anything but a move or a mass (here a radius) rebuilds the World.
+TEST(Simulation, AnEditBeyondPoseAndMassRebuildsTheWorld) {
     Fixture f("pile.json");
     f.ed.togglePlay();
     f.ed.update(1.0 / 60.0);
     f.ed.togglePlay();
     const std::uint64_t builds = f.ed.sim.worldBuilds();
     const Entity body = findByName(f.ed.doc.scene.registry, "c10");
-    ASSERT_TRUE(f.ed.applyEdit("mass", [&](Scene& s) {
-        s.registry.emplace<Mass>(body, Mass{4.0});
+    ASSERT_TRUE(f.ed.applyEdit("radius", [&](Scene& s) {
+        s.registry.tryGet<Radius>(body)->value *= 0.9;
         return true;
     }));
     f.ed.stepForward();
     EXPECT_EQ(f.ed.sim.worldBuilds(), builds + 1);
+}
+
+// A new mass goes to the live World in place and the run goes on exactly
+// as from a World rebuilt from the edited scene: circles, boxes of a
+// sleeping pyramid, compound bodies, jointed ragdoll bones, heavier and
+// lighter. A mass that changes the engine's choice of settings (a 1000:1
+// pile in a level that leaves the settings to the engine) rebuilds, and
+// still runs as the rebuild.
+TEST(Simulation, AMassEditGoesInPlaceAndRunsAsARebuild) {
+    struct Case {
+        const char* level;
+        const char* body;
+        double factor;
+        bool inPlace;
+    };
+    const Case cases[] = {{"pile.json", "c1999", 3.0, true},    {"pile.json", "c0", 0.25, true},
+                          {"pyramid.json", "", 2.0, true},      {"tumbler.json", "", 0.5, true},
+                          {"ragdoll.json", "", 4.0, true},      {"kinematic.json", "ball 3", 1.5, true},
+                          {"kinematic.json", "ball 3", 1000.0, false}};
+    for (const Case& c : cases) {
+        SCOPED_TRACE(std::string(c.level) + " " + c.body + " x" + std::to_string(c.factor));
+        Fixture inPlace(c.level), rebuilt(c.level);
+        for (Fixture* f : {&inPlace, &rebuilt}) {
+            f->ed.togglePlay();
+            for (int i = 0; i < 60; ++i) f->ed.update(1.0 / 60.0);
+            f->ed.togglePlay();
+            ASSERT_EQ(f->ed.sim.state(), SimState::Paused);
+        }
+        // The named body, else the last dynamic body with a shape.
+        const Registry& reg = inPlace.ed.doc.scene.registry;
+        Entity body = *c.body ? findByName(reg, c.body) : Entity{};
+        if (!*c.body)
+            for (Entity e : reg.entities())
+                if ((reg.has<Box>(e) || reg.has<Radius>(e) || reg.has<Polygon>(e) || reg.has<Capsule>(e) ||
+                     reg.has<Shapes>(e)) &&
+                    reg.has<Position>(e) && !(reg.has<Static>(e) && reg.tryGet<Static>(e)->value) &&
+                    !(reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value))
+                    body = e;
+        ASSERT_TRUE(reg.alive(body));
+        const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
+        for (Fixture* f : {&inPlace, &rebuilt})
+            ASSERT_TRUE(f->ed.applyEdit("mass", [&](Scene& s) {
+                const Mass* m = s.registry.tryGet<Mass>(body);
+                const double before = m ? m->value
+                                        : s.registry.has<Shapes>(body)
+                                            ? compoundMassProperties(*s.registry.tryGet<Shapes>(body), std::nullopt).mass
+                                            : 1.0;
+                s.registry.emplace<Mass>(body, Mass{before * c.factor});
+                return true;
+            }));
+        rebuilt.ed.sim.sceneChanged();
+        for (int i = 0; i < 30; ++i) {
+            inPlace.ed.stepForward();
+            rebuilt.ed.stepForward();
+        }
+        EXPECT_EQ(inPlace.ed.sim.worldBuilds(), c.inPlace ? builds : builds + 1);
+        EXPECT_EQ(textOf(inPlace.ed.doc.scene), textOf(rebuilt.ed.doc.scene));
+    }
 }
 
 TEST(Simulation, DisabledSystemIsLeftOutOfTheWorld) {

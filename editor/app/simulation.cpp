@@ -146,11 +146,18 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
         keptContacts_.assign(shown.begin(), shown.end());
     }
     contactsKept_ = keepContacts;
+    static const std::uint64_t kMass = bit("mass");
     bool inPlace = world_ && !stale_ && !edit.beyondComponents;
     for (const auto& [entity, changed] : edit.entities) {
         if (!inPlace) break;
         const Position* p = scene.registry.tryGet<Position>(entity);
         const Velocity* v = scene.registry.tryGet<Velocity>(entity);
+        if (changed == kMass) {
+            // The World checks the engine's choice against the scene it
+            // would be rebuilt from: with a mouse spring that is a copy.
+            inPlace = builtMouseSpring_.isNull() && world_->setMass(scene, switches(), entity);
+            continue;
+        }
         inPlace = (changed & ~kPose) == 0 && p && world_->moveBody(entity, p->value, v ? v->value : Vec2{});
     }
     // A partly applied edit is rebuilt whole, like any other.

@@ -84,9 +84,10 @@ public:
         contactsKept_ = false;
     }
     /// After an undoable edit: one that only moved bodies (their position
-    /// or velocity) goes to the live World in place (World::moveBody), so
-    /// the rest keeps its warm start and nothing is rebuilt; any other edit
-    /// makes the World stale.
+    /// or velocity) or changed one body's mass goes to the live World in
+    /// place (World::moveBody, World::setMass), so the rest keeps its warm
+    /// start and nothing is rebuilt; any other edit, or a mass the World
+    /// declines, makes the World stale.
     void sceneEdited(const Scene& scene, const CommandStack::EditSummary& edit);
     /// Builds the World now if it is stale (for overlays while paused).
     bool ensureWorld(const Scene& scene);

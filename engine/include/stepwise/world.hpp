@@ -408,6 +408,17 @@ public:
     /// without rebuilding the world. Fails when `body` is not a dynamic body
     /// of this world, or a value is not finite.
     Result<void> moveBody(Entity body, Vec2 position, Vec2 velocity);
+    /// Gives dynamic body `body` the mass its entity has in `scene` (what
+    /// this World was built from, with that one edit), in place: its inertia
+    /// follows, its island wakes, and every other body and every contact's
+    /// warm start stay as they are; the steps that follow are those of
+    /// reload(scene, switches). Fails, leaving the World as it was, when the
+    /// edit would change the substeps, iterations or contact stiffness the
+    /// engine chooses, when springs or attractors act (a lighter body could
+    /// be pulled past what a step can take, which a build refuses), or when
+    /// `body` is not a dynamic, non-kinematic body of this World: the caller
+    /// then reloads.
+    Result<void> setMass(const Scene& scene, const SystemSwitches& switches, Entity body);
     double time() const;
 
     /// Systems this scene needs, in pipeline order: "gravity", "drag",

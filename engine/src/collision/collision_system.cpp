@@ -150,6 +150,20 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     }
 }
 
+void CollisionSystem::setMass(std::size_t i, double mass, double inertia) {
+    Collider& c = colliders_[i];
+    const bool dynamic = c.body >= 0 && (mass > 0.0 || c.kinematic);
+    c.mass = mass;
+    invMass_[i] = dynamic && !c.kinematic ? 1.0 / mass : 0.0;
+    c.inertia = !dynamic || c.kinematic ? 0.0 : c.solverOnly ? inertia : momentOfInertia(c.shape, mass);
+    invInertia_[i] = c.inertia > 0.0 ? 1.0 / c.inertia : 0.0;
+    if (const std::uint32_t s = solverIndex_[i]; s != 0) {
+        bodies_[s].invMass = invMass_[i];
+        bodies_[s].invInertia = invInertia_[i];
+    }
+    for (std::size_t j = i + 1; j < colliders_.size() && colliders_[j].hub == std::int32_t(i); ++j) invMass_[j] = invMass_[i];
+}
+
 std::uint32_t CollisionSystem::addAll(std::span<const ColliderAdd> list) {
     const std::uint32_t base = std::uint32_t(colliders_.size());
     for (const ColliderAdd& a : list) {

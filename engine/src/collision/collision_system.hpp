@@ -244,6 +244,11 @@ public:
     /// Pairs of dynamic bodies (state-vector indices) joined by a manifold of
     /// the last step or by a joint: the island edges this system knows of.
     void bodyEdges(std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
+    /// Gives collider i (a dynamic body's own, or a compound body's hub) a
+    /// new mass, as add() would have: `inertia` is taken as given for a
+    /// solver-only collider (a hub, a shapeless body), else computed from the
+    /// shape; a hub's shapes follow it.
+    void setMass(std::size_t i, double mass, double inertia);
     /// Farthest point of collider i from its centre of mass, metres.
     double maxExtent(std::size_t i) const { return maxExtent_[i]; }
 

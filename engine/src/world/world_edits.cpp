@@ -1,0 +1,74 @@
+// Edits the World takes in place, without a rebuild: what they change is
+// exactly what a rebuild from the edited scene would (World::reload), and
+// nothing else, so every other body keeps its state and warm start.
+
+#include "world/world_collisions.hpp"
+#include "world/world_impl.hpp"
+
+#include "stepwise/components.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace stepwise {
+
+namespace {
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+} // namespace
+
+Result<void> World::setMass(const Scene& scene, const SystemSwitches& switches, Entity body) {
+    WorldImpl& w = *impl_;
+    const std::vector<Entity>& bodies = w.bodyEntity;
+    const auto it = std::find(bodies.begin(), bodies.end(), body);
+    if (it == bodies.end()) return Error{"not a dynamic body of this world"};
+    const std::size_t b = std::size_t(it - bodies.begin());
+    if (!w.isKinematic.empty() && w.isKinematic[b]) return Error{"a kinematic body has no mass in the solver"};
+    detail::ForceModel& f = w.model;
+    if (f.springsOn() || f.attractorsOn()) return Error{"springs and attractors act: a new mass is checked by a rebuild"};
+    const Registry& reg = scene.registry;
+    if (!reg.alive(body)) return Error{"the body is not in the scene"};
+    // The mass as the build reads it (compileBodies).
+    const Mass* given = reg.tryGet<Mass>(body);
+    const Shapes* compound = reg.tryGet<Shapes>(body);
+    if (compound && compound->items.empty()) compound = nullptr;  // refused by a build (checkPolygons)
+    const double mass = given ? given->value : compound ? compoundMassProperties(*compound, std::nullopt).mass : 1.0;
+    if (!(std::isfinite(mass) && mass > 0.0)) return Error{"mass must be a finite number > 0"};
+    // The settings a reload would choose from the edited scene (no solver
+    // state: chooseSolverCounts) must be the ones running.
+    const WorldSettings& ws = scene.world;
+    const ContactSettingsChoice choice = chooseContactSettings(scene, switches);
+    const int substeps = ws.substeps != 0 ? ws.substeps : choice.substeps;
+    const int iterations = ws.solverIterations != 0 ? ws.solverIterations : ws.substeps == 0 ? choice.iterations : 8;
+    if (substeps != w.settings.substeps || iterations != w.settings.solverIterations ||
+        !sameBits(choice.hertzFraction, w.contactChoice.hertzFraction))
+        return Error{"the new mass changes the settings the engine chooses"};
+    const bool changed = !sameBits(f.mass[b], mass);
+    w.contactChoice = choice;
+    w.hertzFractionRecorded = false;
+    if (w.settingsSource == SettingsSource::Recorded) w.settingsSource = SettingsSource::Chosen;
+    if (!changed) return {};
+
+    f.mass[b] = mass;
+    f.invMass[b] = 1.0 / mass;
+    if (f.dragOn) f.dragRate[b] = f.dragB[b] * f.invMass[b];
+    if (const std::int32_t c = w.colliderOfBody[b]; c >= 0 && w.collision) {
+        const collision::Collider& col = w.collision->collider(std::size_t(c));
+        // Inertia as the colliders were made (world_collisions.cpp): a
+        // compound body's from its shapes, a shapeless one's a small disc's,
+        // a shape's from the shape (setMass).
+        double inertia = 0.0;
+        if (col.part == collision::Collider::kHubPart && compound)
+            inertia = compoundMassProperties(*compound, given ? std::optional<double>(given->value) : std::nullopt).inertia;
+        else if (col.solverOnly)
+            inertia = 0.5 * mass * detail::kShapelessRadius * detail::kShapelessRadius;
+        w.collision->setMass(std::size_t(c), mass, inertia);
+    }
+    w.sleep.wake(std::uint32_t(b));  // as reload's wakeEdited: a changed mass wakes its island
+    w.sleepChanged();
+    return {};
+}
+
+} // namespace stepwise
