@@ -1266,6 +1266,10 @@ void CollisionSystem::endStep() {
         }
     }
     jointRecords_.clear();
+    if (!joints_.empty()) {
+        turns_.resize(bodies_.size());
+        for (std::size_t s = 0; s < bodies_.size(); ++s) turns_[s] = std::atan2(bodies_[s].dq.s, bodies_[s].dq.c);
+    }
     for (const joints::JointConstraint& j : joints_) {
         if (j.broken) continue;
         JointRecord r;
@@ -1278,7 +1282,7 @@ void CollisionSystem::endStep() {
         r.separation = anchors.separation;
         r.force = joints::jointForce(j, lastH_);
         r.torque = joints::jointTorque(j, lastH_);
-        r.angle = joints::jointAngle(j, bodies_);
+        r.angle = joints::jointAngle(j, std::span<const double>(turns_));
         jointRecords_.push_back(r);
     }
     // Usually already in order (constraints follow the sorted pairs); the

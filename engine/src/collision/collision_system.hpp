@@ -396,6 +396,7 @@ private:
     /// regroups the direct solve.
     void jointsBroke();
     std::vector<JointRecord> jointRecords_;
+    std::vector<double> turns_;  // endStep: each solver body's turn in the step, rad
     double lastH_ = 0.0;
     // Sleeping: see refreshSleeping(). With nothing asleep these are the
     // full lists and every stage runs exactly as without sleeping.

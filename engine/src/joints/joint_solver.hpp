@@ -182,6 +182,11 @@ struct JointAnchors {
 };
 /// Angle of b relative to a minus the reference angle, now (rad).
 double jointAngle(const JointConstraint& joint, std::span<const collision::SolverBody> bodies);
+/// The same from each solver body's turn since the step began (`turns`,
+/// atan2 of its dq, by solver body): one atan2 a body, not two a joint.
+inline double jointAngle(const JointConstraint& joint, std::span<const double> turns) {
+    return joint.deltaAngle + turns[joint.b.solverBody] - turns[joint.a.solverBody];
+}
 JointAnchors jointAnchors(const JointConstraint& joint, std::span<const collision::SolverBody> bodies);
 
 } // namespace stepwise::joints
