@@ -334,6 +334,46 @@ TEST(World, DivergenceLeavesTheWarmStartAndJointImpulsesAsTheyWere) {
     EXPECT_EQ(after.joints, before.joints);
 }
 
+// The contacts a World lists are those of its last whole step, whether
+// they were looked at before a step that diverges or only after it (they
+// are made when first asked for).
+TEST(World, AfterADivergenceTheContactsAreThoseOfTheLastWholeStep) {
+    Result<Scene> scene = parseScene(R"({"world": {"dt": 0.5, "substeps": 2},
+        "entities": [{"name": "floor", "position": {"x": 0, "y": -1}, "static": true, "box": {"width": 10, "height": 1}},
+                     {"name": "ball", "position": {"x": 0, "y": 0}, "radius": 0.5},
+                     {"name": "crate", "position": {"x": 3, "y": 0}, "box": {"width": 1, "height": 1}},
+                     {"name": "rocket", "position": {"x": 0, "y": 50}},
+                     {"name": "thrust", "spring": {"a": "rocket", "anchor": {"x": 1e12, "y": 50}, "k": 6e-4,
+                                                   "rest_length": 0}}]})",
+                                     "diverge.json");
+    ASSERT_TRUE(scene) << scene.error();
+    World looked = buildOrDie(*scene), unlooked = buildOrDie(*scene);
+    std::vector<ContactRecord> lastWhole;
+    for (int i = 0; i < 3; ++i) {
+        ASSERT_TRUE(looked.step().ok());
+        ASSERT_TRUE(unlooked.step().ok());
+        const std::span<const ContactRecord> now = looked.contacts();
+        lastWhole.assign(now.begin(), now.end());
+    }
+    ASSERT_EQ(lastWhole.size(), 3u) << "the ball's point and the crate's two";
+    ASSERT_FALSE(unlooked.step().ok());
+    ASSERT_FALSE(looked.step().ok());
+    for (const World* w : {&looked, &unlooked}) {
+        const std::span<const ContactRecord> after = w->contacts();
+        ASSERT_EQ(after.size(), lastWhole.size());
+        for (std::size_t k = 0; k < after.size(); ++k) {
+            EXPECT_EQ(after[k].a, lastWhole[k].a);
+            EXPECT_EQ(after[k].b, lastWhole[k].b);
+            EXPECT_EQ(after[k].point.x, lastWhole[k].point.x);
+            EXPECT_EQ(after[k].point.y, lastWhole[k].point.y);
+            EXPECT_EQ(after[k].depth, lastWhole[k].depth);
+            EXPECT_EQ(after[k].normalImpulse, lastWhole[k].normalImpulse);
+            EXPECT_EQ(after[k].tangentImpulse, lastWhole[k].tangentImpulse);
+        }
+        EXPECT_EQ(w->lastStats().contactCount, lastWhole.size());
+    }
+}
+
 std::string stepAndSave(Scene scene, int steps, int times) {
     // `times` rounds of: build, step `steps`, write back, save, load.
     for (int round = 0; round < times; ++round) {

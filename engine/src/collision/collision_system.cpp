@@ -347,6 +347,7 @@ void CollisionSystem::refreshSleeping(std::span<const Vec2> x) {
     // The sleeping islands' contacts stay listed (the contacts view, the
     // count, break-on-contact): recomputed once here from the frozen shapes
     // and their kept impulses, then kept at the front of records_.
+    if (recordsPending_) makeRecords();
     std::vector<ContactRecord> awakeRecords;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> awakePairs;
     for (std::size_t r = sleepingRecordCount_; r < records_.size(); ++r)
@@ -622,6 +623,14 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
 }
 
 void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v, double dt, int substeps) {
+    // The last step's manifolds, whose records nobody has asked for yet, are
+    // kept aside for contacts(): this step's detection refills the arrays
+    // (and if it diverges, the records stay those of the last whole step).
+    if (recordsPending_ && !recordsFromKept_) {
+        keptConstraints_.swap(constraints_);
+        keptDetails_.swap(details_);
+        recordsFromKept_ = true;
+    }
     dt_ = dt;
     substeps_ = substeps;
     substepsDone_ = 0;
@@ -1228,25 +1237,29 @@ void CollisionSystem::undoSolverState() {
         joints::setImpulses(joints_[k], jointImpulsesBefore_[k]);
 }
 
-void CollisionSystem::endStep() {
-    joints::restoreInertia(bodies_, stiffened_);
-    stiffened_.clear();
-    // The cache this step started from is kept (swapped, not copied) so a
-    // divergence can put it back.
-    previousCache_.swap(cache_);
-    cache_.clear();
-    coloured_.storeImpulses(constraints_);
-    records_.resize(sleepingRecordCount_);  // the sleeping islands' contacts stay
-    recordPairs_.resize(sleepingRecordCount_);
-    for (std::size_t k = 0; k < constraints_.size(); ++k) {
-        const ContactConstraint& c = constraints_[k];
-        const ContactDetail& d = details_[k];
+bool CollisionSystem::isRecord(const ContactConstraint& c, const ContactDetail& d, int i) {
+    // Speculative points that never carried load are not contacts.
+    return !(d.separation[i] > kLinearSlop && c.points[i].normalImpulse == 0.0 && d.restitutionImpulse[i] == 0.0);
+}
+
+const std::vector<ContactConstraint>& CollisionSystem::recordedConstraints() const {
+    return recordsFromKept_ ? keptConstraints_ : constraints_;
+}
+
+const std::vector<ContactDetail>& CollisionSystem::recordedDetails() const {
+    return recordsFromKept_ ? keptDetails_ : details_;
+}
+
+void CollisionSystem::makeRecords() const {
+    recordsPending_ = false;
+    const std::vector<ContactConstraint>& constraints = recordedConstraints();
+    const std::vector<ContactDetail>& details = recordedDetails();
+    for (std::size_t k = 0; k < constraints.size(); ++k) {
+        const ContactConstraint& c = constraints[k];
+        const ContactDetail& d = details[k];
         for (int i = 0; i < c.pointCount; ++i) {
+            if (!isRecord(c, d, i)) continue;
             const ContactPoint& p = c.points[i];
-            const std::uint64_t key = CachedImpulse::makeKey(d.colliderA, d.colliderB, d.id[i]);
-            cache_.push_back({key, p.normalImpulse, p.tangentImpulse});
-            // Speculative points that never carried load are not contacts.
-            if (d.separation[i] > kLinearSlop && p.normalImpulse == 0.0 && d.restitutionImpulse[i] == 0.0) continue;
             ContactRecord r;
             r.a = colliders_[d.colliderA].entity;
             r.b = colliders_[d.colliderB].entity;
@@ -1263,6 +1276,41 @@ void CollisionSystem::endStep() {
             r.tangentImpulse = p.tangentImpulse;
             records_.push_back(r);
             recordPairs_.emplace_back(d.colliderA, d.colliderB);
+        }
+    }
+}
+
+std::size_t CollisionSystem::contactPointCount() const {
+    if (!recordsPending_) return records_.size();
+    std::size_t count = records_.size();
+    const std::vector<ContactConstraint>& constraints = recordedConstraints();
+    const std::vector<ContactDetail>& details = recordedDetails();
+    for (std::size_t k = 0; k < constraints.size(); ++k)
+        for (int i = 0; i < constraints[k].pointCount; ++i) count += isRecord(constraints[k], details[k], i) ? 1 : 0;
+    return count;
+}
+
+void CollisionSystem::endStep() {
+    joints::restoreInertia(bodies_, stiffened_);
+    stiffened_.clear();
+    // The cache this step started from is kept (swapped, not copied) so a
+    // divergence can put it back.
+    previousCache_.swap(cache_);
+    cache_.clear();
+    coloured_.storeImpulses(constraints_);
+    records_.resize(sleepingRecordCount_);  // the sleeping islands' contacts stay
+    recordPairs_.resize(sleepingRecordCount_);
+    // The awake contacts' records are made when asked for (contacts()): a
+    // run that never looks at them does not pay for them.
+    recordsPending_ = true;
+    recordsFromKept_ = false;
+    for (std::size_t k = 0; k < constraints_.size(); ++k) {
+        const ContactConstraint& c = constraints_[k];
+        const ContactDetail& d = details_[k];
+        for (int i = 0; i < c.pointCount; ++i) {
+            const ContactPoint& p = c.points[i];
+            const std::uint64_t key = CachedImpulse::makeKey(d.colliderA, d.colliderB, d.id[i]);
+            cache_.push_back({key, p.normalImpulse, p.tangentImpulse});
         }
     }
     jointRecords_.clear();

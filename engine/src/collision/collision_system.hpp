@@ -178,7 +178,10 @@ public:
     /// Stores impulses for warm starting and builds the contact records.
     void endStep();
 
-    std::span<const ContactRecord> contacts() const { return records_; }
+    std::span<const ContactRecord> contacts() const {
+        if (recordsPending_) makeRecords();
+        return records_;
+    }
     /// Sensor events of the last step and the overlaps at its end.
     std::span<const SensorEvent> sensorEvents() const { return sensorEvents_; }
     std::vector<std::pair<Entity, Entity>> sensorOverlaps() const;
@@ -189,10 +192,12 @@ public:
     /// Forgets the last step's contacts (a restore replaced that step); the
     /// sleeping islands' contacts stay listed.
     void clearContactRecords() {
+        recordsPending_ = false;
         records_.resize(sleepingRecordCount_);
         recordPairs_.resize(sleepingRecordCount_);
     }
-    std::size_t contactPointCount() const { return records_.size(); }
+    /// How many records contacts() holds, without making them.
+    std::size_t contactPointCount() const;
     /// Broad-phase pairs and narrow-phase manifolds of the last detection.
     std::size_t candidatePairCount() const { return pairs_.size(); }
     std::size_t manifoldCount() const { return constraints_.size(); }
@@ -347,7 +352,18 @@ private:
     std::vector<JointImpulse> jointImpulsesBefore_;  // the joints' impulses at the last beginStep
     std::size_t cacheCursor_ = 0;  // where the previous manifold's cache search ended
     std::vector<Vec2> unconstrainedV_;
-    std::vector<ContactRecord> records_;
+    // Made from the last whole step's manifolds when first asked for
+    // (makeRecords): those are constraints_ and details_ until the next step
+    // begins, then keptConstraints_ and keptDetails_.
+    mutable std::vector<ContactRecord> records_;
+    mutable bool recordsPending_ = false;
+    bool recordsFromKept_ = false;
+    std::vector<ContactConstraint> keptConstraints_;
+    std::vector<ContactDetail> keptDetails_;
+    void makeRecords() const;
+    const std::vector<ContactConstraint>& recordedConstraints() const;
+    const std::vector<ContactDetail>& recordedDetails() const;
+    static bool isRecord(const ContactConstraint& c, const ContactDetail& d, int i);
     std::vector<Rot> rotScratch_;
     std::vector<joints::JointConstraint> joints_;
     joints::JointSettings jointSettings_;
@@ -420,7 +436,7 @@ private:
     std::vector<ProxyPair> awakePairs_;
     std::vector<CachedImpulse> sleepingCache_;           // warm start of the sleeping islands' contacts
     std::size_t sleepingRecordCount_ = 0;                // records_ starts with the sleeping contacts
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> recordPairs_;  // colliders of each record
+    mutable std::vector<std::pair<std::uint32_t, std::uint32_t>> recordPairs_;  // colliders of each record
     std::span<const Vec2> stepStartX_;                   // beginStep's positions (valid during the step)
     CollisionTimings timings_;
     double dt_ = 0.0;

@@ -322,7 +322,7 @@ Result<void> World::step() {
     w.stats.forceEvaluations = evaluations;
     w.stats.internalSteps = internalSteps;
     w.stats.rejectedSteps = rejectedSteps;
-    w.stats.contactCount = contacts ? contacts->contacts().size() : 0;
+    w.stats.contactCount = contacts ? contacts->contactPointCount() : 0;
     w.stats.stages.clear();
     w.stats.systems.clear();
     if (timed) {
