@@ -147,18 +147,26 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
     }
     contactsKept_ = keepContacts;
     static const std::uint64_t kMass = bit("mass");
+    static const std::uint64_t kTurn = bit("angle") | bit("angular_velocity");
     bool inPlace = world_ && !stale_ && !edit.beyondComponents;
     for (const auto& [entity, changed] : edit.entities) {
         if (!inPlace) break;
         const Position* p = scene.registry.tryGet<Position>(entity);
         const Velocity* v = scene.registry.tryGet<Velocity>(entity);
+        // Mass and turn edits: the World checks the engine's choice against
+        // the scene it would be rebuilt from, which with a mouse spring is a
+        // copy: those rebuild.
         if (changed == kMass) {
-            // The World checks the engine's choice against the scene it
-            // would be rebuilt from: with a mouse spring that is a copy.
             inPlace = builtMouseSpring_.isNull() && world_->setMass(scene, switches(), entity);
             continue;
         }
-        inPlace = (changed & ~kPose) == 0 && p && world_->moveBody(entity, p->value, v ? v->value : Vec2{});
+        if ((changed & ~(kPose | kTurn)) != 0 || !p) {
+            inPlace = false;
+            continue;
+        }
+        if ((changed & kPose) != 0) inPlace = world_->moveBody(entity, p->value, v ? v->value : Vec2{}).ok();
+        if (inPlace && (changed & kTurn) != 0)
+            inPlace = builtMouseSpring_.isNull() && world_->turnBody(scene, switches(), entity);
     }
     // A partly applied edit is rebuilt whole, like any other.
     if (!inPlace) stale_ = true;

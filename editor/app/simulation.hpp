@@ -83,11 +83,11 @@ public:
         stale_ = true;
         contactsKept_ = false;
     }
-    /// After an undoable edit: one that only moved bodies (their position
-    /// or velocity) or changed one body's mass goes to the live World in
-    /// place (World::moveBody, World::setMass), so the rest keeps its warm
-    /// start and nothing is rebuilt; any other edit, or a mass the World
-    /// declines, makes the World stale.
+    /// After an undoable edit: one that only moved or turned bodies (their
+    /// position, velocity, angle or angular velocity) or changed one body's
+    /// mass goes to the live World in place (World::moveBody, turnBody,
+    /// setMass), so the rest keeps its warm start and nothing is rebuilt;
+    /// any other edit, or one the World declines, makes the World stale.
     void sceneEdited(const Scene& scene, const CommandStack::EditSummary& edit);
     /// Builds the World now if it is stale (for overlays while paused).
     bool ensureWorld(const Scene& scene);

@@ -419,6 +419,14 @@ public:
     /// `body` is not a dynamic, non-kinematic body of this World: the caller
     /// then reloads.
     Result<void> setMass(const Scene& scene, const SystemSwitches& switches, Entity body);
+    /// Gives dynamic body `body` the angle and angular velocity its entity
+    /// has in `scene`, in place, as setMass gives a mass (its island wakes;
+    /// the steps that follow are reload's). Fails, leaving the World as it
+    /// was, when the edit would change the engine's choice of settings, when
+    /// `body` is kinematic or not a dynamic body of this World, or when it has
+    /// no turn of its own here (a shapeless body without both an angle and a
+    /// spin).
+    Result<void> turnBody(const Scene& scene, const SystemSwitches& switches, Entity body);
     double time() const;
 
     /// Systems this scene needs, in pipeline order: "gravity", "drag",

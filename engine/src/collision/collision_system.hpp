@@ -212,6 +212,13 @@ public:
     Vec2 centreOfMass(std::size_t i, std::span<const Vec2> x) const;
 
     /// Undoes a step's rotational change (after a divergence).
+    /// Turns collider i (a body's own, or a compound body's hub, whose
+    /// shapes follow) to `angle` with spin `angularVelocity`.
+    void setRotation(std::size_t i, double angle, double angularVelocity) {
+        angles_[i] = angle;
+        angularVelocities_[i] = angularVelocity;
+        syncShapes();
+    }
     void restoreRotation(std::span<const double> angles, std::span<const double> angularVelocities) {
         angles_.assign(angles.begin(), angles.end());
         angularVelocities_.assign(angularVelocities.begin(), angularVelocities.end());

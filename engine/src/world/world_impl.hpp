@@ -179,6 +179,9 @@ public:
     /// differ from `before` (the World this one replaces), all of them when
     /// the world settings differ, and those that touched a removed body.
     void wakeEdited(const WorldImpl& before);
+    /// For an edit taken in place (world_edits.cpp): whether a reload from
+    /// `scene` would run these settings; if so, its choice becomes this one.
+    std::optional<Error> keepChoiceFor(const Scene& scene, const SystemSwitches& switches);
 };
 
 } // namespace stepwise
