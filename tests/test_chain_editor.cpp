@@ -213,7 +213,8 @@ TEST(ChainEditor, EditsAreRefusedWithTheLoadersWords) {
     // A chain on a dynamic body.
     edited = editor::addComponentToAll(s, info, {ball});
     ASSERT_FALSE(edited);
-    EXPECT_NE(edited.error().find("a chain must be on a static body"), std::string::npos) << edited.error();
+    EXPECT_NE(edited.error().find("a chain must be on a static or kinematic body"), std::string::npos)
+        << edited.error();
     EXPECT_FALSE(s.registry.has<Chain>(ball));
     // Three points and a loop: accepted.
     edited = editor::setFieldOnAll(s, info, points, std::vector<Vec2>{{2.0, 0.0}, {0.0, 1.0}, {-2.0, 0.0}}, {chain});
@@ -223,4 +224,39 @@ TEST(ChainEditor, EditsAreRefusedWithTheLoadersWords) {
     ASSERT_TRUE(edited) << edited.error();
     EXPECT_EQ(*edited, 1u);
     EXPECT_TRUE(s.registry.tryGet<Chain>(chain)->loop);
+}
+
+// Static and kinematic turn each other off in one edit, so a static chain
+// becomes a moving one (and back) from the inspector: in two edits either
+// order passes through a level the loader refuses (a chain on a dynamic
+// body, or a body both static and kinematic).
+TEST(ChainEditor, TickingKinematicOnAStaticChainUnticksStatic) {
+    Scene s;
+    const Entity chain = s.registry.create();
+    s.registry.emplace<Name>(chain, {"belt"});
+    s.registry.emplace<Position>(chain, {{0.0, 0.0}});
+    s.registry.emplace<Static>(chain, {true});
+    s.registry.emplace<Chain>(chain, {{{2.0, 0.0}, {-2.0, 0.0}}, false});
+    const ComponentInfo& kinematic = *findComponent("kinematic");
+    const ComponentInfo& still = *findComponent("static");
+    // Unticking static alone is refused, with the loader's words.
+    Result<std::size_t> edited = editor::setFieldOnAll(s, still, still.fields[0], false, {chain});
+    ASSERT_FALSE(edited);
+    EXPECT_NE(edited.error().find("a chain must be on a static or kinematic body"), std::string::npos)
+        << edited.error();
+    EXPECT_TRUE(s.registry.tryGet<Static>(chain)->value);
+    // Adding kinematic turns static off.
+    edited = editor::addComponentToAll(s, kinematic, {chain});
+    ASSERT_TRUE(edited) << edited.error();
+    EXPECT_TRUE(s.registry.tryGet<Kinematic>(chain)->value);
+    EXPECT_FALSE(s.registry.tryGet<Static>(chain)->value);
+    // And ticking static again turns kinematic off.
+    edited = editor::setFieldOnAll(s, still, still.fields[0], true, {chain});
+    ASSERT_TRUE(edited) << edited.error();
+    EXPECT_TRUE(s.registry.tryGet<Static>(chain)->value);
+    EXPECT_FALSE(s.registry.tryGet<Kinematic>(chain)->value);
+    edited = editor::setFieldOnAll(s, kinematic, kinematic.fields[0], true, {chain});
+    ASSERT_TRUE(edited) << edited.error();
+    EXPECT_TRUE(s.registry.tryGet<Kinematic>(chain)->value);
+    EXPECT_FALSE(s.registry.tryGet<Static>(chain)->value);
 }

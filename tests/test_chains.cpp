@@ -109,11 +109,11 @@ TEST(ChainFormat, BadChainsAreRefusedNamingTheEntityAndPoint) {
     EXPECT_EQ(loadError(chainOn("{\"points\": [{\"x\": 0, \"y\": 0}, {\"x\": 1, \"y\": 0}], \"loop\": 1}")),
               "t.json: error: /entities/0/chain/loop: expected true or false, got 1");
     EXPECT_EQ(loadError(chainOn("{\"points\": [{\"x\": 0, \"y\": 0}, {\"x\": 1, \"y\": 0}]}", "")),
-              "t.json: error: /entities/0/chain: entity 0 (\"ground\"): a chain must be on a static body "
-              "(\"static\": true); chains on dynamic and kinematic bodies are not supported");
+              "t.json: error: /entities/0/chain: entity 0 (\"ground\"): a chain must be on a static or kinematic "
+              "body (\"static\": true or \"kinematic\": true); a chain has no area, so it gives a dynamic body no "
+              "mass or inertia to move by");
     EXPECT_EQ(loadError(chainOn("{\"points\": [{\"x\": 0, \"y\": 0}, {\"x\": 1, \"y\": 0}]}", "\"kinematic\": true, ")),
-              "t.json: error: /entities/0/chain: entity 0 (\"ground\"): a chain must be on a static body "
-              "(\"static\": true); chains on dynamic and kinematic bodies are not supported");
+              "loaded");
     EXPECT_EQ(loadError(chainOn("{\"points\": [{\"x\": 0, \"y\": 0}, {\"x\": 1, \"y\": 0}]}",
                                 "\"static\": true, \"radius\": 1, ")),
               "t.json: error: /entities/0: an entity has at most one shape (radius, box, polygon, capsule, chain or "
@@ -132,8 +132,9 @@ TEST(ChainFormat, TheWorldRefusesBadChainsMadeInCode) {
     s.registry.emplace<Chain>(e, {{{0.0, 0.0}, {1.0, 0.0}}, false});
     Result<World> dynamic = World::build(s);
     ASSERT_FALSE(dynamic);
-    EXPECT_EQ(dynamic.error(), "entity 0 (\"rail\"): chain: a chain must be on a static body (\"static\": true); "
-                               "chains on dynamic and kinematic bodies are not supported");
+    EXPECT_EQ(dynamic.error(), "entity 0 (\"rail\"): chain: a chain must be on a static or kinematic body "
+                               "(\"static\": true or \"kinematic\": true); a chain has no area, so it gives a "
+                               "dynamic body no mass or inertia to move by");
     s.registry.emplace<Static>(e, {true});
     s.registry.emplace<Chain>(e, {{{0.0, 0.0}, {1.0, 0.0}, {1.0, 0.0}}, false});
     Result<World> repeated = World::build(s);
@@ -625,3 +626,94 @@ TEST(ChainWorld, ABallRollsOverBentJointsKeepingItsEnergy) {
                 "from r %.3g m\n",
                 worstLoss, worstGap);
 }
+
+// ---- chains on kinematic bodies: moving terrain ----------------------------
+
+/// A kinematic chain entity named `name` at `at`, moving with `velocity`
+/// and spinning at `spin`.
+std::string movingChain(const std::string& name, const std::vector<Vec2>& points, bool loop, Vec2 velocity,
+                        double spin, const std::string& extra = "", Vec2 at = {}) {
+    return "{\"name\": \"" + name + "\", \"kinematic\": true, \"position\": " + vectorJson(at.x, at.y) +
+           ", \"velocity\": " +
+           vectorJson(velocity.x, velocity.y) + ", \"angular_velocity\": " + exactNumber(spin) + ", " +
+           (extra.empty() ? "" : extra + ", ") + chainJson(points, loop) + "}";
+}
+
+// A conveyor: a flat kinematic chain moving at u carries a crate set on it
+// at rest. Friction (mu g) brings it to u after slipping u^2 / (2 mu g)
+// behind the belt, and a disc set on it ends rolling at u / 3 (its contact
+// point moving with the belt). Swept over belt speeds and substeps.
+TEST(ChainKinematic, AConveyorCarriesACrateAndRollsADisc) {
+    for (const double u : {0.5, 2.0, 6.0})
+        for (const std::string substeps : {"1", "2", "4", "8", ""}) {
+            SCOPED_TRACE("belt " + exactNumber(u) + " m/s, substeps " + (substeps.empty() ? "default" : substeps));
+            const std::string world = substeps.empty() ? "" : "\"substeps\": " + substeps;
+            const std::string text =
+                level(movingChain("belt", flatFloor(40.0, -40.0, 2.0), false, {u, 0.0}, 0.0, "\"friction\": 0.8") +
+                          ", {\"name\": \"crate\", \"position\": {\"x\": 0, \"y\": 0.5}, \"box\": {\"width\": 1, "
+                          "\"height\": 1}, \"friction\": 0.8}, {\"name\": \"disc\", \"position\": {\"x\": -4, \"y\": "
+                          "0.3}, \"radius\": 0.3, \"friction\": 0.8}",
+                      world);
+            Sim sim(text);
+            ASSERT_TRUE(sim.step(120));  // 2 s: both settle well within it
+            const Registry& reg = sim.scene.registry;
+            const Entity crate = named(sim.scene, "crate"), disc = named(sim.scene, "disc"), belt = named(sim.scene, "belt");
+            const double beltX = reg.tryGet<Position>(belt)->value.x;
+            EXPECT_NEAR(beltX, 2.0 * u, 1e-9) << "contacts never move a kinematic body";
+            EXPECT_NEAR(reg.tryGet<Velocity>(crate)->value.x, u, 1e-3 * u);
+            const double slip = u * u / (2.0 * 0.8 * kG);
+            EXPECT_NEAR(beltX - reg.tryGet<Position>(crate)->value.x, slip, 0.1 * slip + 0.01);
+            EXPECT_NEAR(reg.tryGet<Position>(crate)->value.y, 0.5, 0.005) << "resting on the belt";
+            EXPECT_NEAR(reg.tryGet<Velocity>(disc)->value.x, u / 3.0, 0.01 * u);
+            EXPECT_NEAR(reg.tryGet<Position>(disc)->value.y, 0.3, 0.005);
+        }
+}
+
+// A drum: a clockwise loop chain on a kinematic body spinning about its
+// centre keeps a disc and a box inside (one-sided, turning with the body)
+// at every speed, and the chain carries them up the rising side.
+TEST(ChainKinematic, ASpinningDrumKeepsItsLoadInside) {
+    const double R = 3.0;
+    for (const double spin : {0.5, 2.0, 6.0, -3.0}) {
+        SCOPED_TRACE("spin " + exactNumber(spin) + " rad/s");
+        const std::string text =
+            level(movingChain("drum", circlePoints(R, 48, true), true, {0.0, 0.0}, spin, "\"friction\": 0.9") +
+                  ", {\"name\": \"disc\", \"position\": {\"x\": 0, \"y\": -2.4}, \"radius\": 0.5, \"friction\": "
+                  "0.9}, {\"name\": \"crate\", \"position\": {\"x\": 1, \"y\": -2.3}, \"box\": {\"width\": 0.6, "
+                  "\"height\": 0.6}, \"friction\": 0.9}");
+        Sim sim(text);
+        double farthest = 0.0, sideways = 0.0;
+        ASSERT_TRUE(sim.step(600, [&] {
+            sim.world->writeBack(sim.scene);
+            for (const char* name : {"disc", "crate"}) {
+                const Vec2 p = sim.scene.registry.tryGet<Position>(named(sim.scene, name))->value;
+                farthest = std::max(farthest, length(p));
+                if (std::string(name) == "disc") sideways = std::max(sideways, std::abs(p.x));
+            }
+        }));
+        // The disc's centre stays 0.5 m in from the 48-gon's flats (2.995 m
+        // from the centre), the box's corners in too (its centre within
+        // R - 0.3 and a little for the soft contact).
+        EXPECT_LT(farthest, R - 0.29);
+        EXPECT_NEAR(sim.scene.registry.tryGet<Angle>(named(sim.scene, "drum"))->value, spin * 10.0, 1e-9);
+        EXPECT_GT(sideways, 0.3) << "the turning drum carries the disc up its side";
+    }
+}
+
+// A run with bodies on a moving chain resumes bit for bit from a save.
+TEST(ChainKinematic, ResumesBitForBitFromAMidRunSave) {
+    const std::string text = level(
+        movingChain("belt", flatFloor(20.0, -20.0, 1.0), false, {1.5, 0.0}, 0.0, "\"friction\": 0.6") + ", " +
+        movingChain("drum", circlePoints(2.0, 40, true), true, {0.0, 0.0}, 1.5, "\"friction\": 0.6", {-30.0, 5.0}) +
+        ", {\"name\": \"crate\", \"position\": {\"x\": 3, \"y\": 0.3}, \"box\": {\"width\": 0.6, \"height\": 0.6}}"
+        ", {\"name\": \"ball\", \"position\": {\"x\": -30, \"y\": 3.5}, \"radius\": 0.3}");
+    Sim whole(text);
+    ASSERT_TRUE(whole.step(200));
+    Sim first(text);
+    ASSERT_TRUE(first.step(100));
+    ASSERT_TRUE(first.scene.solverState.has_value());
+    Sim second(sceneToJsonText(first.scene));
+    ASSERT_TRUE(second.step(100));
+    EXPECT_EQ(sceneToJsonText(second.scene), sceneToJsonText(whole.scene));
+}
+

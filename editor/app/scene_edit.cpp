@@ -155,6 +155,39 @@ std::optional<Error> checkEdited(Scene& scene, const std::vector<Entity>& entiti
     return std::nullopt;
 }
 
+namespace {
+
+/// Static and kinematic exclude each other: turning one on for `entities`
+/// turns the other off in the same edit, and returns the entities it turned
+/// off (for a rollback). Two edits in either order would not do: a static
+/// chain unticked first is a chain on a dynamic body, ticked kinematic
+/// first is both, and the loader refuses each.
+std::vector<Entity> turnOffOtherBodyKind(Scene& scene, std::string_view turnedOn, const std::vector<Entity>& entities) {
+    std::vector<Entity> off;
+    Registry& reg = scene.registry;
+    for (Entity e : entities) {
+        if (turnedOn == "kinematic" && reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value && reg.has<Static>(e) &&
+            reg.tryGet<Static>(e)->value) {
+            reg.tryGet<Static>(e)->value = false;
+            off.push_back(e);
+        } else if (turnedOn == "static" && reg.has<Static>(e) && reg.tryGet<Static>(e)->value && reg.has<Kinematic>(e) &&
+                   reg.tryGet<Kinematic>(e)->value) {
+            reg.tryGet<Kinematic>(e)->value = false;
+            off.push_back(e);
+        }
+    }
+    return off;
+}
+
+void turnBackOn(Scene& scene, std::string_view turnedOn, const std::vector<Entity>& off) {
+    for (Entity e : off) {
+        if (turnedOn == "kinematic") scene.registry.tryGet<Static>(e)->value = true;
+        else scene.registry.tryGet<Kinematic>(e)->value = true;
+    }
+}
+
+} // namespace
+
 Result<std::size_t> setFieldOnAll(Scene& scene, const ComponentInfo& component, const FieldInfo& field,
                                   const FieldValue& value, const std::vector<Entity>& entities) {
     // Write, check the way the loader would, and put the old values back
@@ -169,6 +202,7 @@ Result<std::size_t> setFieldOnAll(Scene& scene, const ComponentInfo& component, 
     if (old.empty()) return 0;
     std::vector<Entity> touched;
     for (const auto& [e, v] : old) touched.push_back(e);
+    const std::vector<Entity> off = turnOffOtherBodyKind(scene, component.name, touched);
     // Springs and joints that point at a touched entity are checked too.
     for (Entity s : attachedTo(scene.registry, touched)) touched.push_back(s);
     if (std::optional<Error> why = checkEdited(scene, touched, fieldPath(component, field.key))) {
@@ -186,6 +220,7 @@ Result<std::size_t> setFieldOnAll(Scene& scene, const ComponentInfo& component, 
                     break;
                 }
         for (const auto& [e, v] : old) writeField(field, component.get(scene.registry, e), v);
+        turnBackOn(scene, component.name, off);
         return Error{message};
     }
     return old.size();
@@ -199,8 +234,10 @@ Result<std::size_t> addComponentToAll(Scene& scene, const ComponentInfo& compone
             component.emplaceDefault(scene.registry, e);
             added.push_back(e);
         }
+    const std::vector<Entity> off = turnOffOtherBodyKind(scene, component.name, added);
     if (std::optional<Error> why = checkEdited(scene, added, std::string(component.name))) {
         for (Entity e : added) component.remove(scene.registry, e);
+        turnBackOn(scene, component.name, off);
         return *why;
     }
     return added.size();

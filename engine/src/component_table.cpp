@@ -205,7 +205,7 @@ std::vector<ComponentInfo> buildTable() {
     {
         ComponentInfo chain = row<Chain>(
             "chain",
-            "chain shape on a static body: a smooth one-sided polyline, solid on the right of each segment's "
+            "chain shape on a static or kinematic body: a smooth one-sided polyline, solid on the right of each segment's "
             "direction; rotated by angle about position",
             false, needsPosition,
             {field<&Chain::points>("points", NumberRange{2.0, double(kMaxChainPoints)}, "m",

@@ -971,12 +971,11 @@ std::string relationsProblem(const Scene& scene) {
             return child("/entities", i) +
                    ": an entity has at most one shape (radius, box, polygon, capsule, chain or plane), got " +
                    std::to_string(shapes);
-        // Each segment is a collider of its own; a moving body has one
-        // collider that turns and takes impulses, so chains stay still.
-        if (registry.has<Chain>(e) && !(registry.has<Static>(e) && registry.tryGet<Static>(e)->value))
-            return child("/entities", i) + "/chain: " + entityLabelOf(registry, i) +
-                   ": a chain must be on a static body (\"static\": true); chains on dynamic and kinematic bodies "
-                   "are not supported";
+        // A chain has no area: no mass or inertia for a dynamic body to move
+        // by. Static and kinematic bodies need none.
+        if (registry.has<Chain>(e) && !(registry.has<Static>(e) && registry.tryGet<Static>(e)->value) &&
+            !(registry.has<Kinematic>(e) && registry.tryGet<Kinematic>(e)->value))
+            return child("/entities", i) + "/chain: " + entityLabelOf(registry, i) + ": " + kChainOnDynamicBody;
         if (registry.has<Static>(e) && registry.tryGet<Static>(e)->value && registry.has<Kinematic>(e) &&
             registry.tryGet<Kinematic>(e)->value)
             return child("/entities", i) + "/kinematic: a body is static or kinematic, not both";

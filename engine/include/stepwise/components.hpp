@@ -120,6 +120,10 @@ inline constexpr std::size_t kMaxChainPoints = 1024;
 /// error's `where` is the offending point's index, or empty for the whole
 /// list. The loader, the world and the editor all ask this one function.
 std::optional<Error> chainProblem(const std::vector<Vec2>& points, bool loop);
+/// Why a chain is refused on a dynamic body (the loader's and the World's words).
+inline constexpr const char* kChainOnDynamicBody =
+    "a chain must be on a static or kinematic body (\"static\": true or \"kinematic\": true); a chain has no "
+    "area, so it gives a dynamic body no mass or inertia to move by";
 
 /// Orientation, radians, counter-clockwise.
 struct Angle { double value = 0.0; };

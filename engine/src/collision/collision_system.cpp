@@ -31,7 +31,7 @@ double momentOfInertia(const Shape& shape, double mass) {
         return mass * (w * w + h * h) / 12.0;
     }
     case ShapeKind::Plane:
-    case ShapeKind::ChainSegment: return 0.0;  // only on static bodies
+    case ShapeKind::ChainSegment: return 0.0;  // no area; only on static and kinematic bodies
     case ShapeKind::Capsule:
         return mass * capsuleMassProperties(2.0 * length(shape.halfExtents), shape.radius).inertiaPerMass;
     case ShapeKind::Polygon: {
@@ -99,7 +99,9 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
         const double own = c.shape.kind == ShapeKind::Circle    ? c.shape.radius
                            : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius + c.shape.polygon->cornerRadius
                            : c.shape.kind == ShapeKind::Capsule ? length(c.shape.halfExtents) + c.shape.radius
-                                                                : length(c.shape.halfExtents);
+                           : c.shape.kind == ShapeKind::ChainSegment
+                               ? std::max(length(c.shape.segment->p1), length(c.shape.segment->p2))
+                               : length(c.shape.halfExtents);
         maxExtent_.push_back(own + length(c.centreOfMass - colliders_[hub].centreOfMass));
         finite_.push_back(index);
         solverIndex_.push_back(solverIndex_[hub]);

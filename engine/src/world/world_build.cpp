@@ -321,10 +321,9 @@ std::optional<Error> checkPolygons(const Registry& reg) {
             if (std::optional<Error> problem = chainProblem(chain->points, chain->loop))
                 return Error{problem->message,
                              label + ": chain.points" + (problem->where.empty() ? "" : "[" + problem->where + "]")};
-            if (!(reg.has<Static>(order[i]) && reg.tryGet<Static>(order[i])->value))
-                return Error{"a chain must be on a static body (\"static\": true); chains on dynamic and kinematic "
-                             "bodies are not supported",
-                             label + ": chain"};
+            if (!(reg.has<Static>(order[i]) && reg.tryGet<Static>(order[i])->value) &&
+                !(reg.has<Kinematic>(order[i]) && reg.tryGet<Kinematic>(order[i])->value))
+                return Error{kChainOnDynamicBody, label + ": chain"};
         }
         const Polygon* poly = reg.tryGet<Polygon>(order[i]);
         if (!poly) continue;

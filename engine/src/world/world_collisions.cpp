@@ -209,7 +209,21 @@ void collidersFor(const Registry& reg, Entity e, const std::function<std::uint32
     }
     // Each segment is a collider and a broad-phase proxy of its own (a long
     // terrain is not one huge box), in order, so segment k is the chain's
-    // first collider plus k.
+    // first collider plus k. On a kinematic body the segments are shapes of
+    // one moving body, as a compound body's are: a hub (the solver body,
+    // with the body's angle and spin) comes first and they follow it.
+    if (c.body >= 0) {
+        collision::CollisionSystem::ColliderAdd h;
+        h.collider.body = c.body;
+        h.collider.part = collision::Collider::kHubPart;
+        h.collider.kinematic = c.kinematic;
+        h.collider.entity = e;
+        h.collider.solverOnly = true;
+        h.angle = add.angle;
+        h.angularVelocity = add.angularVelocity;
+        c.hub = std::int32_t(out.size());
+        out.push_back(h);
+    }
     const Chain& chain = *reg.tryGet<Chain>(e);
     const std::vector<Vec2>& pts = chain.points;
     const std::size_t n = pts.size(), segments = chain.loop ? n : n - 1;

@@ -178,7 +178,12 @@ void WorldImpl::wakeEdited(const WorldImpl& before) {
         const auto oldColliderOf = [&](const collision::Collider& col) {
             std::uint32_t o = oldFirst.find(col.entity);
             if (o == EntitySlots::kNone) return o;
-            if (col.shape.segment) o += col.shape.segment->index;  // a chain's segments follow its first in order
+            // A chain's segments follow its first in order (after its hub on
+            // a kinematic body).
+            if (col.shape.segment) {
+                if (before.collision->collider(o).part == collision::Collider::kHubPart) ++o;
+                o += col.shape.segment->index;
+            }
             for (; o < before.collision->colliderCount() && before.collision->collider(o).entity == col.entity; ++o)
                 if (before.collision->collider(o).part == col.part) return o;
             return EntitySlots::kNone;
