@@ -92,6 +92,26 @@ TEST(Simulation, AMouseSpringDragBuildsTheWorldOnceAndPullsTheBody) {
 // edited scene (which carries the same warm start): the same bits after 20
 // more steps, for a body on top of the pile, one inside it and one at the
 // floor, each moved and given a velocity.
+namespace {
+
+/// Applies the same `edit` to both fixtures, has `rebuilt` build its World
+/// again from its edited scene, steps both `steps` times, and expects the
+/// same bytes from both and no World build on `inPlace` (one if `rebuilds`).
+void expectRunsAsARebuild(Fixture& inPlace, Fixture& rebuilt, const std::string& label,
+                          const std::function<bool(Scene&)>& edit, int steps, bool rebuilds = false) {
+    const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
+    for (Fixture* f : {&inPlace, &rebuilt}) ASSERT_TRUE(f->ed.applyEdit(label, edit));
+    rebuilt.ed.sim.sceneChanged();
+    for (int i = 0; i < steps; ++i) {
+        inPlace.ed.stepForward();
+        rebuilt.ed.stepForward();
+    }
+    EXPECT_EQ(inPlace.ed.sim.worldBuilds(), rebuilds ? builds + 1 : builds);
+    EXPECT_EQ(textOf(inPlace.ed.doc.scene), textOf(rebuilt.ed.doc.scene));
+}
+
+} // namespace
+
 TEST(Simulation, AMoveWhilePausedGoesToTheWorldInPlaceAndRunsAsARebuild) {
     for (const char* name : {"c1999", "c1000", "c0"}) {
         SCOPED_TRACE(name);
@@ -143,19 +163,10 @@ TEST(Simulation, AMoveInPlaceWakesTheSleepingIslandAsARebuildDoes) {
                 top = e;
             }
     }
-    const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
-    for (Fixture* f : {&inPlace, &rebuilt})
-        ASSERT_TRUE(f->ed.applyEdit("move", [&](Scene& s) {
-            s.registry.tryGet<Position>(top)->value.x += 0.3;
-            return true;
-        }));
-    rebuilt.ed.sim.sceneChanged();
-    for (int i = 0; i < 20; ++i) {
-        inPlace.ed.stepForward();
-        rebuilt.ed.stepForward();
-    }
-    EXPECT_EQ(inPlace.ed.sim.worldBuilds(), builds);
-    EXPECT_EQ(textOf(inPlace.ed.doc.scene), textOf(rebuilt.ed.doc.scene));
+    expectRunsAsARebuild(inPlace, rebuilt, "move", [&](Scene& s) {
+        s.registry.tryGet<Position>(top)->value.x += 0.3;
+        return true;
+    }, 20);
     const World& w = *inPlace.ed.sim.world();
     for (std::size_t b = 0; b < w.bodyCount(); ++b)
         if (w.bodyEntity(b) == top) EXPECT_FALSE(w.asleep(b)) << "the moved box's island woke";
@@ -214,24 +225,15 @@ TEST(Simulation, AMassEditGoesInPlaceAndRunsAsARebuild) {
                     !(reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value))
                     body = e;
         ASSERT_TRUE(reg.alive(body));
-        const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
-        for (Fixture* f : {&inPlace, &rebuilt})
-            ASSERT_TRUE(f->ed.applyEdit("mass", [&](Scene& s) {
-                const Mass* m = s.registry.tryGet<Mass>(body);
-                const double before = m ? m->value
-                                        : s.registry.has<Shapes>(body)
-                                            ? compoundMassProperties(*s.registry.tryGet<Shapes>(body), std::nullopt).mass
-                                            : 1.0;
-                s.registry.emplace<Mass>(body, Mass{before * c.factor});
-                return true;
-            }));
-        rebuilt.ed.sim.sceneChanged();
-        for (int i = 0; i < 30; ++i) {
-            inPlace.ed.stepForward();
-            rebuilt.ed.stepForward();
-        }
-        EXPECT_EQ(inPlace.ed.sim.worldBuilds(), c.inPlace ? builds : builds + 1);
-        EXPECT_EQ(textOf(inPlace.ed.doc.scene), textOf(rebuilt.ed.doc.scene));
+        expectRunsAsARebuild(inPlace, rebuilt, "mass", [&](Scene& s) {
+            const Mass* m = s.registry.tryGet<Mass>(body);
+            const double before = m ? m->value
+                                    : s.registry.has<Shapes>(body)
+                                        ? compoundMassProperties(*s.registry.tryGet<Shapes>(body), std::nullopt).mass
+                                        : 1.0;
+            s.registry.emplace<Mass>(body, Mass{before * c.factor});
+            return true;
+        }, 30, !c.inPlace);
     }
 }
 
@@ -263,22 +265,13 @@ TEST(Simulation, ATurnGoesInPlaceAndRunsAsARebuild) {
                 !(reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value))
                 body = e;
         ASSERT_TRUE(reg.alive(body));
-        const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
-        for (Fixture* f : {&inPlace, &rebuilt})
-            ASSERT_TRUE(f->ed.applyEdit("rotate", [&](Scene& s) {
-                const double angle = s.registry.has<Angle>(body) ? s.registry.tryGet<Angle>(body)->value : 0.0;
-                s.registry.emplace<Angle>(body, Angle{angle + c.turn});
-                if (c.spin != 0.0) s.registry.emplace<AngularVelocity>(body, AngularVelocity{c.spin});
-                s.registry.tryGet<Position>(body)->value.x += c.shift;
-                return true;
-            }));
-        rebuilt.ed.sim.sceneChanged();
-        for (int i = 0; i < 30; ++i) {
-            inPlace.ed.stepForward();
-            rebuilt.ed.stepForward();
-        }
-        EXPECT_EQ(inPlace.ed.sim.worldBuilds(), builds);
-        EXPECT_EQ(textOf(inPlace.ed.doc.scene), textOf(rebuilt.ed.doc.scene));
+        expectRunsAsARebuild(inPlace, rebuilt, "rotate", [&](Scene& s) {
+            const double angle = s.registry.has<Angle>(body) ? s.registry.tryGet<Angle>(body)->value : 0.0;
+            s.registry.emplace<Angle>(body, Angle{angle + c.turn});
+            if (c.spin != 0.0) s.registry.emplace<AngularVelocity>(body, AngularVelocity{c.spin});
+            s.registry.tryGet<Position>(body)->value.x += c.shift;
+            return true;
+        }, 30);
     }
 }
 

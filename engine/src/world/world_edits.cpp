@@ -17,6 +17,17 @@ namespace {
 
 bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
+/// The state index of `body`, a dynamic, non-kinematic body of the World
+/// that is alive in `scene`; else why an edit of it cannot go in place.
+Result<std::size_t> editableBody(const WorldImpl& w, const Scene& scene, Entity body) {
+    const auto it = std::find(w.bodyEntity.begin(), w.bodyEntity.end(), body);
+    if (it == w.bodyEntity.end()) return Error{"not a dynamic body of this world"};
+    const std::size_t b = std::size_t(it - w.bodyEntity.begin());
+    if (!w.isKinematic.empty() && w.isKinematic[b]) return Error{"a kinematic body moves as its level says"};
+    if (!scene.registry.alive(body)) return Error{"the body is not in the scene"};
+    return b;
+}
+
 } // namespace
 
 /// Whether a reload from `scene` (no solver state: chooseSolverCounts) would
@@ -38,15 +49,12 @@ std::optional<Error> WorldImpl::keepChoiceFor(const Scene& scene, const SystemSw
 
 Result<void> World::setMass(const Scene& scene, const SystemSwitches& switches, Entity body) {
     WorldImpl& w = *impl_;
-    const std::vector<Entity>& bodies = w.bodyEntity;
-    const auto it = std::find(bodies.begin(), bodies.end(), body);
-    if (it == bodies.end()) return Error{"not a dynamic body of this world"};
-    const std::size_t b = std::size_t(it - bodies.begin());
-    if (!w.isKinematic.empty() && w.isKinematic[b]) return Error{"a kinematic body has no mass in the solver"};
+    const Result<std::size_t> index = editableBody(w, scene, body);
+    if (!index) return index.failure();
+    const std::size_t b = *index;
     detail::ForceModel& f = w.model;
     if (f.springsOn() || f.attractorsOn()) return Error{"springs and attractors act: a new mass is checked by a rebuild"};
     const Registry& reg = scene.registry;
-    if (!reg.alive(body)) return Error{"the body is not in the scene"};
     // The mass as the build reads it (compileBodies).
     const Mass* given = reg.tryGet<Mass>(body);
     const Shapes* compound = reg.tryGet<Shapes>(body);
@@ -78,13 +86,10 @@ Result<void> World::setMass(const Scene& scene, const SystemSwitches& switches, 
 
 Result<void> World::turnBody(const Scene& scene, const SystemSwitches& switches, Entity body) {
     WorldImpl& w = *impl_;
-    const std::vector<Entity>& bodies = w.bodyEntity;
-    const auto it = std::find(bodies.begin(), bodies.end(), body);
-    if (it == bodies.end()) return Error{"not a dynamic body of this world"};
-    const std::size_t b = std::size_t(it - bodies.begin());
-    if (!w.isKinematic.empty() && w.isKinematic[b]) return Error{"a kinematic body turns as its level says"};
+    const Result<std::size_t> index = editableBody(w, scene, body);
+    if (!index) return index.failure();
+    const std::size_t b = *index;
     const Registry& reg = scene.registry;
-    if (!reg.alive(body)) return Error{"the body is not in the scene"};
     const double angle = reg.has<Angle>(body) ? reg.tryGet<Angle>(body)->value : 0.0;
     const double spin = reg.has<AngularVelocity>(body) ? reg.tryGet<AngularVelocity>(body)->value : 0.0;
     if (!std::isfinite(angle) || !std::isfinite(spin)) return Error{"an angle and a spin must be finite"};
