@@ -175,7 +175,8 @@ public:
     /// constrained one (positions move by h times the contact velocity change).
     /// The first call of a step also runs the broad and narrow phases.
     void solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double h);
-    /// Stores impulses for warm starting and builds the contact records.
+    /// Stores impulses for warm starting and the joint records; the contact
+    /// records are made when first asked for (contacts()).
     void endStep();
 
     std::span<const ContactRecord> contacts() const {
@@ -211,7 +212,6 @@ public:
     /// rotated offset), metres, at the given body positions.
     Vec2 centreOfMass(std::size_t i, std::span<const Vec2> x) const;
 
-    /// Undoes a step's rotational change (after a divergence).
     /// Turns collider i (a body's own, or a compound body's hub, whose
     /// shapes follow) to `angle` with spin `angularVelocity`.
     void setRotation(std::size_t i, double angle, double angularVelocity) {
@@ -219,6 +219,7 @@ public:
         angularVelocities_[i] = angularVelocity;
         syncShapes();
     }
+    /// Undoes a step's rotational change (after a divergence).
     void restoreRotation(std::span<const double> angles, std::span<const double> angularVelocities) {
         angles_.assign(angles.begin(), angles.end());
         angularVelocities_.assign(angularVelocities.begin(), angularVelocities.end());
