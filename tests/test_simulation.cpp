@@ -275,6 +275,30 @@ TEST(Simulation, ATurnGoesInPlaceAndRunsAsARebuild) {
     }
 }
 
+// A kinematic body's new velocity (a platform sped up while paused) goes
+// in place and holds: each substep sets a kinematic body's velocity again,
+// from the edited value, as a rebuilt World's would.
+TEST(Simulation, AKinematicBodysNewVelocityGoesInPlaceAndHolds) {
+    for (const char* level : {"kinematic.json", "conveyor.json"}) {
+        SCOPED_TRACE(level);
+        Fixture inPlace(level), rebuilt(level);
+        for (Fixture* f : {&inPlace, &rebuilt}) {
+            f->ed.togglePlay();
+            for (int i = 0; i < 20; ++i) f->ed.update(1.0 / 60.0);
+            f->ed.togglePlay();
+        }
+        const Registry& reg = inPlace.ed.doc.scene.registry;
+        Entity platform;
+        for (Entity e : reg.entities())
+            if (reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value && reg.has<Velocity>(e)) platform = e;
+        ASSERT_TRUE(reg.alive(platform));
+        expectRunsAsARebuild(inPlace, rebuilt, "speed up", [&](Scene& s) {
+            s.registry.tryGet<Velocity>(platform)->value.x += 0.75;
+            return true;
+        }, 30);
+    }
+}
+
 TEST(Simulation, DisabledSystemIsLeftOutOfTheWorld) {
     Fixture f("spring_chain.json");
     f.ed.sim.disabledSystems.insert("springs");

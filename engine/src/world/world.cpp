@@ -863,6 +863,13 @@ Result<void> World::moveBody(Entity body, Vec2 position, Vec2 velocity) {
     x[2 * b + 1] = position.y;
     v[2 * b] = velocity.x;
     v[2 * b + 1] = velocity.y;
+    // A kinematic body moves at its own velocity, which each substep sets
+    // again (WorldImpl::kinematicVelocity): the edit goes there too.
+    for (std::size_t k = 0; k < impl_->kinematicBody.size(); ++k)
+        if (impl_->kinematicBody[k] == b) {
+            impl_->kinematicVelocity[2 * k] = velocity.x;
+            impl_->kinematicVelocity[2 * k + 1] = velocity.y;
+        }
     impl_->sleep.wake(std::uint32_t(b));
     impl_->sleepChanged();
     return {};
