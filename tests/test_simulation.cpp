@@ -299,6 +299,35 @@ TEST(Simulation, AKinematicBodysNewVelocityGoesInPlaceAndHolds) {
     }
 }
 
+// Moves in place of bodies whose centre of mass is off their position
+// (polygons, compound bodies, capsule bones) run as a rebuild too.
+TEST(Simulation, AMoveOfAnOffCentreBodyGoesInPlaceAndRunsAsARebuild) {
+    for (const char* level : {"polygons.json", "tumbler.json", "terrain.json", "capsules.json"}) {
+        SCOPED_TRACE(level);
+        Fixture inPlace(level), rebuilt(level);
+        for (Fixture* f : {&inPlace, &rebuilt}) {
+            f->ed.togglePlay();
+            for (int i = 0; i < 30; ++i) f->ed.update(1.0 / 60.0);
+            f->ed.togglePlay();
+        }
+        const Registry& reg = inPlace.ed.doc.scene.registry;
+        std::vector<Entity> moved;
+        for (Entity e : reg.entities())
+            if ((reg.has<Polygon>(e) || reg.has<Shapes>(e) || reg.has<Capsule>(e)) && reg.has<Position>(e) &&
+                !(reg.has<Static>(e) && reg.tryGet<Static>(e)->value) &&
+                !(reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value))
+                moved.push_back(e);
+        ASSERT_FALSE(moved.empty());
+        expectRunsAsARebuild(inPlace, rebuilt, "move", [&](Scene& s) {
+            for (Entity e : moved) {
+                s.registry.tryGet<Position>(e)->value += Vec2{0.05, 0.4};
+                s.registry.emplace<Velocity>(e, Velocity{{0.5, 1.0}});
+            }
+            return true;
+        }, 30);
+    }
+}
+
 TEST(Simulation, DisabledSystemIsLeftOutOfTheWorld) {
     Fixture f("spring_chain.json");
     f.ed.sim.disabledSystems.insert("springs");
