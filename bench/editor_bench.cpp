@@ -100,7 +100,7 @@ void BM_SetMassOfOneBody(benchmark::State& state) {
     }
     state.counters["bodies"] = double(bodies.size());
 }
-BENCHMARK(BM_SetMassOfOneBody)->Arg(2000)->Arg(20000)->Arg(200000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SetMassOfOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
 
 /// The peer: the World rebuilt from the scene (World::reload).
 void BM_ReloadWorld(benchmark::State& state) {

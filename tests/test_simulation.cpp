@@ -110,6 +110,19 @@ void expectRunsAsARebuild(Fixture& inPlace, Fixture& rebuilt, const std::string&
     EXPECT_EQ(textOf(inPlace.ed.doc.scene), textOf(rebuilt.ed.doc.scene));
 }
 
+/// Plays `f` for `frames` frames of 1/60 s, then pauses it.
+void playThenPause(Fixture& f, int frames) {
+    f.ed.togglePlay();
+    for (int i = 0; i < frames; ++i) f.ed.update(1.0 / 60.0);
+    f.ed.togglePlay();
+}
+
+/// A body contacts and forces move: a position, neither static nor kinematic.
+bool isFreeBody(const Registry& reg, Entity e) {
+    return reg.has<Position>(e) && !(reg.has<Static>(e) && reg.tryGet<Static>(e)->value) &&
+           !(reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value);
+}
+
 } // namespace
 
 TEST(Simulation, AMoveWhilePausedGoesToTheWorldInPlaceAndRunsAsARebuild) {
@@ -209,9 +222,7 @@ TEST(Simulation, AMassEditGoesInPlaceAndRunsAsARebuild) {
         SCOPED_TRACE(std::string(c.level) + " " + c.body + " x" + std::to_string(c.factor));
         Fixture inPlace(c.level), rebuilt(c.level);
         for (Fixture* f : {&inPlace, &rebuilt}) {
-            f->ed.togglePlay();
-            for (int i = 0; i < 60; ++i) f->ed.update(1.0 / 60.0);
-            f->ed.togglePlay();
+            playThenPause(*f, 60);
             ASSERT_EQ(f->ed.sim.state(), SimState::Paused);
         }
         // The named body, else the last dynamic body with a shape.
@@ -221,8 +232,7 @@ TEST(Simulation, AMassEditGoesInPlaceAndRunsAsARebuild) {
             for (Entity e : reg.entities())
                 if ((reg.has<Box>(e) || reg.has<Radius>(e) || reg.has<Polygon>(e) || reg.has<Capsule>(e) ||
                      reg.has<Shapes>(e)) &&
-                    reg.has<Position>(e) && !(reg.has<Static>(e) && reg.tryGet<Static>(e)->value) &&
-                    !(reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value))
+                    isFreeBody(reg, e))
                     body = e;
         ASSERT_TRUE(reg.alive(body));
         expectRunsAsARebuild(inPlace, rebuilt, "mass", [&](Scene& s) {
@@ -252,17 +262,12 @@ TEST(Simulation, ATurnGoesInPlaceAndRunsAsARebuild) {
     for (const Case& c : cases) {
         SCOPED_TRACE(std::string(c.level) + " turn " + std::to_string(c.turn));
         Fixture inPlace(c.level), rebuilt(c.level);
-        for (Fixture* f : {&inPlace, &rebuilt}) {
-            f->ed.togglePlay();
-            for (int i = 0; i < 45; ++i) f->ed.update(1.0 / 60.0);
-            f->ed.togglePlay();
-        }
+        for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, 45);
         const Registry& reg = inPlace.ed.doc.scene.registry;
         Entity body;
         for (Entity e : reg.entities())
             if ((reg.has<Box>(e) || reg.has<Polygon>(e) || reg.has<Capsule>(e) || reg.has<Shapes>(e)) &&
-                reg.has<Position>(e) && !(reg.has<Static>(e) && reg.tryGet<Static>(e)->value) &&
-                !(reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value))
+                isFreeBody(reg, e))
                 body = e;
         ASSERT_TRUE(reg.alive(body));
         expectRunsAsARebuild(inPlace, rebuilt, "rotate", [&](Scene& s) {
@@ -282,11 +287,7 @@ TEST(Simulation, AKinematicBodysNewVelocityGoesInPlaceAndHolds) {
     for (const char* level : {"kinematic.json", "conveyor.json"}) {
         SCOPED_TRACE(level);
         Fixture inPlace(level), rebuilt(level);
-        for (Fixture* f : {&inPlace, &rebuilt}) {
-            f->ed.togglePlay();
-            for (int i = 0; i < 20; ++i) f->ed.update(1.0 / 60.0);
-            f->ed.togglePlay();
-        }
+        for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, 20);
         const Registry& reg = inPlace.ed.doc.scene.registry;
         Entity platform;
         for (Entity e : reg.entities())
@@ -305,17 +306,11 @@ TEST(Simulation, AMoveOfAnOffCentreBodyGoesInPlaceAndRunsAsARebuild) {
     for (const char* level : {"polygons.json", "tumbler.json", "terrain.json", "capsules.json"}) {
         SCOPED_TRACE(level);
         Fixture inPlace(level), rebuilt(level);
-        for (Fixture* f : {&inPlace, &rebuilt}) {
-            f->ed.togglePlay();
-            for (int i = 0; i < 30; ++i) f->ed.update(1.0 / 60.0);
-            f->ed.togglePlay();
-        }
+        for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, 30);
         const Registry& reg = inPlace.ed.doc.scene.registry;
         std::vector<Entity> moved;
         for (Entity e : reg.entities())
-            if ((reg.has<Polygon>(e) || reg.has<Shapes>(e) || reg.has<Capsule>(e)) && reg.has<Position>(e) &&
-                !(reg.has<Static>(e) && reg.tryGet<Static>(e)->value) &&
-                !(reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value))
+            if ((reg.has<Polygon>(e) || reg.has<Shapes>(e) || reg.has<Capsule>(e)) && isFreeBody(reg, e))
                 moved.push_back(e);
         ASSERT_FALSE(moved.empty());
         expectRunsAsARebuild(inPlace, rebuilt, "move", [&](Scene& s) {
