@@ -4,7 +4,8 @@
 // of the whole scene, BM_CopyScene) and, while paused, in the live World
 // too (BM_DragOneBodyWhilePaused; the peer is a rebuild of the World from
 // the scene, BM_ReloadWorld, which an edit that is not a move still costs).
-// A mass edit goes in place as well (BM_SetMassOfOneBody).
+// A mass edit goes in place as well (BM_SetMassOfOneBody), and so do a
+// body added and deleted (BM_AddAndDeleteOneBody, two edits an iteration).
 // Not part of ctest.
 //
 //   build/bench/editor_bench --benchmark_min_time=0.2
@@ -101,6 +102,26 @@ void BM_SetMassOfOneBody(benchmark::State& state) {
     state.counters["bodies"] = double(bodies.size());
 }
 BENCHMARK(BM_SetMassOfOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
+
+/// A ball added above the box and deleted again, each in place
+/// (World::changeEntities): two edits per iteration, against two reloads.
+void BM_AddAndDeleteOneBody(benchmark::State& state) {
+    Scene scene = scenes::circlesInBox(int(state.range(0)));
+    const std::vector<Entity> bodies = bodiesOf(scene);
+    Result<World> world = World::build(scene);
+    const Vec2 above = scene.registry.tryGet<Position>(bodies.back())->value + Vec2{0.0, 2.0};
+    for (auto _ : state) {
+        const Entity e = scene.registry.create();
+        scene.registry.emplace<Position>(e, Position{above});
+        scene.registry.emplace<Radius>(e, Radius{0.1});
+        const Result<void> added = world->changeEntities(scene, {}, {}, std::vector<Entity>{e});
+        (void)scene.registry.destroy(e);
+        const Result<void> removed = world->changeEntities(scene, {}, std::vector<Entity>{e}, {});
+        if (!added || !removed) state.SkipWithError((added ? removed : added).error().c_str());
+    }
+    state.counters["bodies"] = double(bodies.size());
+}
+BENCHMARK(BM_AddAndDeleteOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
 
 /// The peer: the World rebuilt from the scene (World::reload).
 void BM_ReloadWorld(benchmark::State& state) {

@@ -323,6 +323,258 @@ TEST(Simulation, AMoveOfAnOffCentreBodyGoesInPlaceAndRunsAsARebuild) {
     }
 }
 
+namespace {
+
+/// Where a new body can go in a level: above everything in it, over the
+/// middle of its dynamic bodies.
+Vec2 dropPoint(const Registry& reg) {
+    double top = -1e300, sum = 0.0;
+    int count = 0;
+    for (Entity e : reg.entities()) {
+        const Position* p = reg.tryGet<Position>(e);
+        if (!p || !isFreeBody(reg, e)) continue;
+        top = std::max(top, p->value.y);
+        sum += p->value.x;
+        ++count;
+    }
+    return {count ? sum / count : 0.0, top + 2.0};
+}
+
+/// Adds, at `at`, one body of each shape kind (a ball with a filter, a
+/// turned box, a triangle, a capsule, a compound body) and a pair of boxes
+/// hinged together, each with a velocity: what the editor's tools and a
+/// paste add.
+void addOneOfEach(Scene& s, Vec2 at) {
+    Registry& reg = s.registry;
+    const auto body = [&](const std::string& name, Vec2 offset, Vec2 velocity) {
+        const Entity e = reg.create();
+        reg.emplace<Name>(e, Name{name});
+        reg.emplace<Position>(e, Position{at + offset});
+        reg.emplace<Velocity>(e, Velocity{velocity});
+        reg.emplace<Mass>(e, Mass{1.5});
+        return e;
+    };
+    reg.emplace<Radius>(body("new ball", {-2.0, 0.0}, {0.5, -1.0}), Radius{0.3});
+    reg.emplace<Filter>(reg.entities().back(), Filter{2, 0xFFFFFFFFu, 0});
+    const Entity box = body("new box", {-1.0, 0.5}, {0.0, -2.0});
+    reg.emplace<Box>(box, Box{0.6, 0.4});
+    reg.emplace<Angle>(box, Angle{0.4});
+    reg.emplace<Polygon>(body("new triangle", {0.0, 0.0}, {-0.5, 0.0}), Polygon{});
+    reg.emplace<Capsule>(body("new capsule", {1.0, 0.5}, {0.0, 1.0}), Capsule{{-0.3, 0.0}, {0.3, 0.0}, 0.15});
+    Shapes compound;
+    compound.items.resize(2);
+    compound.items[0].center = {-0.3, 0.0};
+    compound.items[0].radius = 0.2;
+    compound.items[1].kind = CompoundShape::Kind::Box;
+    compound.items[1].center = {0.3, 0.0};
+    compound.items[1].width = compound.items[1].height = 0.4;
+    reg.emplace<Shapes>(body("new compound", {2.0, 0.0}, {0.0, 0.0}), std::move(compound));
+    const Entity left = body("new link a", {-1.0, 2.0}, {0.0, 0.0});
+    const Entity right = body("new link b", {0.0, 2.0}, {1.0, 0.0});
+    for (Entity e : {left, right}) reg.emplace<Box>(e, Box{0.8, 0.2});
+    const Entity hinge = reg.create();
+    reg.emplace<Name>(hinge, Name{"new hinge"});
+    Joint joint;
+    joint.type = "hinge";
+    joint.a = left;
+    joint.b = right;
+    joint.localA = {0.5, 0.0};
+    joint.localB = {-0.5, 0.0};
+    reg.emplace<Joint>(hinge, std::move(joint));
+}
+
+} // namespace
+
+// Bodies added while paused (one of each shape kind, a hinged pair) go to
+// the live World in place, and the run goes on exactly as from a World
+// rebuilt from the edited scene: in a pile, a sleeping pyramid (the new
+// bodies land on it), ragdolls, compound bodies and filtered shapes.
+TEST(Simulation, AddedBodiesGoInPlaceAndRunAsARebuild) {
+    for (const char* level : {"pile.json", "pyramid.json", "ragdoll.json", "tumbler.json", "filters.json"}) {
+        SCOPED_TRACE(level);
+        Fixture inPlace(level), rebuilt(level);
+        for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, 60);
+        const Vec2 at = dropPoint(inPlace.ed.doc.scene.registry);
+        expectRunsAsARebuild(inPlace, rebuilt, "add", [&](Scene& s) {
+            addOneOfEach(s, at);
+            return true;
+        }, 60);
+        const World& w = *inPlace.ed.sim.world();
+        const Entity ball = findByName(inPlace.ed.doc.scene.registry, "new ball");
+        bool found = false;
+        for (std::size_t b = 0; b < w.bodyCount(); ++b) found = found || w.bodyEntity(b) == ball;
+        EXPECT_TRUE(found) << "the new ball is a body of the World";
+        // The new bodies fell: gravity and contacts act on them.
+        EXPECT_LT(inPlace.ed.doc.scene.registry.tryGet<Position>(ball)->value.y, at.y - 0.5);
+    }
+}
+
+// Deleting bodies (with the joints on them) while paused goes in place as
+// well: a circle inside the pile, a box of a sleeping pyramid (its island
+// wakes and the boxes above it fall), a whole ragdoll, one joint of it.
+TEST(Simulation, DeletedBodiesLeaveInPlaceAndRunAsARebuild) {
+    struct Case {
+        const char* level;
+        std::function<std::vector<Entity>(const Registry&)> pick;
+    };
+    const auto named = [](const char* name) {
+        return [name](const Registry& reg) { return std::vector<Entity>{findByName(reg, name)}; };
+    };
+    // The dynamic box nearest the middle of the level's lowest row.
+    const auto lowBox = [](const Registry& reg) {
+        Entity best;
+        double lowest = 1e300;
+        for (Entity e : reg.entities())
+            if (reg.has<Box>(e) && isFreeBody(reg, e) && reg.tryGet<Position>(e)->value.y < lowest - 1e-3) {
+                lowest = reg.tryGet<Position>(e)->value.y;
+                best = e;
+            }
+        return std::vector<Entity>{best};
+    };
+    // Every dynamic body (the ragdoll's bones; its joints go with them).
+    const auto everyBody = [](const Registry& reg) {
+        std::vector<Entity> out;
+        for (Entity e : reg.entities())
+            if (isFreeBody(reg, e)) out.push_back(e);
+        return out;
+    };
+    const auto firstJoint = [](const Registry& reg) {
+        for (Entity e : reg.entities())
+            if (reg.has<Joint>(e)) return std::vector<Entity>{e};
+        return std::vector<Entity>{};
+    };
+    const Case cases[] = {{"pile.json", named("c1000")},
+                          {"pile.json", named("c0")},
+                          {"pyramid.json", lowBox},
+                          {"ragdoll.json", everyBody},
+                          {"ragdoll.json", firstJoint}};
+    for (const Case& c : cases) {
+        Fixture inPlace(c.level), rebuilt(c.level);
+        for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, c.level == std::string("pyramid.json") ? 600 : 60);
+        const std::vector<Entity> doomed = c.pick(inPlace.ed.doc.scene.registry);
+        SCOPED_TRACE(std::string(c.level) + ", " + std::to_string(doomed.size()) + " deleted");
+        ASSERT_FALSE(doomed.empty());
+        for (Entity e : doomed) ASSERT_TRUE(inPlace.ed.doc.scene.registry.alive(e));
+        const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
+        for (Fixture* f : {&inPlace, &rebuilt}) {
+            f->ed.select(doomed);
+            ASSERT_TRUE(f->ed.deleteSelection());
+        }
+        rebuilt.ed.sim.sceneChanged();
+        for (int i = 0; i < 60; ++i) {
+            inPlace.ed.stepForward();
+            rebuilt.ed.stepForward();
+        }
+        EXPECT_EQ(inPlace.ed.sim.worldBuilds(), builds) << "deleted in place, never rebuilt";
+        EXPECT_EQ(textOf(inPlace.ed.doc.scene), textOf(rebuilt.ed.doc.scene));
+    }
+}
+
+// Step back after an edit made in place returns the scene as the steps
+// after the edit left it (the new body there, the new mass kept), and
+// stepping on again repeats them bit for bit; stepping back past the edit
+// returns the state from before it.
+TEST(Simulation, StepBackAfterAnEditInPlaceRestoresTheEditedScene) {
+    struct Case {
+        const char* what;
+        std::function<void(Scene&, Vec2)> edit;
+    };
+    const Case cases[] = {
+        {"add", [](Scene& s, Vec2 at) { addOneOfEach(s, at); }},
+        {"delete", [](Scene& s, Vec2) { (void)s.registry.destroy(findByName(s.registry, "c1000")); }},
+        {"mass", [](Scene& s, Vec2) { s.registry.emplace<Mass>(findByName(s.registry, "c1999"), Mass{3.0}); }},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        Fixture f("pile.json");
+        playThenPause(f, 30);
+        const std::string before = textOf(f.ed.doc.scene);
+        const Vec2 at = dropPoint(f.ed.doc.scene.registry);
+        const std::uint64_t builds = f.ed.sim.worldBuilds();
+        ASSERT_TRUE(f.ed.applyEdit(c.what, [&](Scene& s) {
+            c.edit(s, at);
+            return true;
+        }));
+        std::vector<std::string> pass;
+        for (int i = 0; i < 6; ++i) {
+            f.ed.stepForward();
+            pass.push_back(textOf(f.ed.doc.scene));
+        }
+        EXPECT_EQ(f.ed.sim.worldBuilds(), builds) << "the edit went in place";
+        for (int i = 0; i < 3; ++i) f.ed.stepBack();
+        // (Compared as booleans: a level's text is too long to print.)
+        EXPECT_TRUE(textOf(f.ed.doc.scene) == pass[2]);
+        for (int i = 3; i < 6; ++i) {
+            f.ed.stepForward();
+            EXPECT_TRUE(textOf(f.ed.doc.scene) == pass[std::size_t(i)]) << "step " << i + 1 << " after the edit";
+        }
+        for (int i = 0; i < 6; ++i) f.ed.stepBack();
+        EXPECT_EQ(f.ed.sim.steps(), 30u);
+        EXPECT_TRUE(textOf(f.ed.doc.scene) != before) << "back to the step the edit was made at, with the edit";
+        f.ed.stepBack();
+        EXPECT_EQ(f.ed.sim.steps(), 29u);
+    }
+}
+
+// What the World does not take in place rebuilds, and still runs as the
+// rebuild: a static wall, a spring, a spinning body, a body joined to one
+// already there, a heavy body that changes the engine's choice of settings.
+TEST(Simulation, AddsTheWorldCannotTakeInPlaceRebuild) {
+    struct Case {
+        const char* what;
+        const char* level;
+        std::function<void(Scene&, Vec2)> add;
+    };
+    const auto ball = [](Scene& s, Vec2 at, double mass) {
+        const Entity e = s.registry.create();
+        s.registry.emplace<Position>(e, Position{at});
+        s.registry.emplace<Radius>(e, Radius{0.3});
+        s.registry.emplace<Mass>(e, Mass{mass});
+        return e;
+    };
+    const Case cases[] = {
+        {"static wall", "pile.json",
+         [&](Scene& s, Vec2 at) { s.registry.emplace<Static>(ball(s, at, 1.0), Static{true}); }},
+        {"spring", "pile.json",
+         [&](Scene& s, Vec2 at) {
+             const Entity e = ball(s, at, 1.0);
+             const Entity spring = s.registry.create();
+             Spring sp;
+             sp.a = e;
+             sp.anchor = at + Vec2{0.0, 1.0};
+             sp.k = 50.0;
+             s.registry.emplace<Spring>(spring, std::move(sp));
+         }},
+        {"spin", "pile.json",
+         [&](Scene& s, Vec2 at) { s.registry.emplace<AngularVelocity>(ball(s, at, 1.0), AngularVelocity{3.0}); }},
+        {"joint to an old body", "ragdoll.json",
+         [&](Scene& s, Vec2 at) {
+             Entity old;
+             for (Entity e : s.registry.entities())
+                 if (isFreeBody(s.registry, e)) old = e;
+             const Entity e = ball(s, at, 1.0);
+             const Entity j = s.registry.create();
+             Joint joint;
+             joint.type = "distance";
+             joint.a = e;
+             joint.b = old;
+             joint.length = 3.0;
+             s.registry.emplace<Joint>(j, std::move(joint));
+         }},
+        {"heavy", "kinematic.json", [&](Scene& s, Vec2 at) { ball(s, at, 1000.0); }},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        Fixture inPlace(c.level), rebuilt(c.level);
+        for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, 30);
+        const Vec2 at = dropPoint(inPlace.ed.doc.scene.registry);
+        expectRunsAsARebuild(inPlace, rebuilt, "add", [&](Scene& s) {
+            c.add(s, at);
+            return true;
+        }, 30, true);
+    }
+}
+
 TEST(Simulation, DisabledSystemIsLeftOutOfTheWorld) {
     Fixture f("spring_chain.json");
     f.ed.sim.disabledSystems.insert("springs");

@@ -271,6 +271,7 @@ public:
                     std::string encoded = encodeEntity(registry_, e, &after);
                     keep({e, std::string(), std::move(encoded)}, {});
                 }
+            summarizeSlots(*slots_, now, summary);
             if (!(now == *slots_)) d.slots.emplace(std::move(*slots_), std::move(now));
         }
         d.entities.shrink_to_fit();
@@ -279,6 +280,15 @@ public:
 
 private:
     static std::uint64_t key(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
+    /// The entities that came and went between two slot tables, and whether
+    /// those in both kept their order.
+    static void summarizeSlots(const Registry::Slots& before, const Registry::Slots& now,
+                               CommandStack::EditSummary& summary) {
+        std::vector<Entity> stayedBefore, stayedNow;
+        for (const Entity e : now.order) (aliveIn(before, e) ? stayedNow : summary.created).push_back(e);
+        for (const Entity e : before.order) (aliveIn(now, e) ? stayedBefore : summary.destroyed).push_back(e);
+        if (stayedBefore != stayedNow) summary.beyondComponents = true;
+    }
     Registry& registry_;
     struct Touched {
         CommandStack::Delta::EntityChange change;  ///< `before` filled now, `after` by finish()
@@ -341,7 +351,7 @@ bool CommandStack::apply(Scene& scene, std::string label, const std::function<bo
         apply(scene, change, false);  // an edit that gave up must leave no trace
         return false;
     }
-    summary.beyondComponents = change.slots || change.world || change.solver || change.version;
+    summary.beyondComponents = summary.beyondComponents || change.world || change.solver || change.version;
     lastEdit_ = std::move(summary);
     if (merging) {
         // The command keeps its original "before"; only "after" moves on.

@@ -61,12 +61,15 @@ public:
 
     /// What the last successful apply() changed, that edit alone (merged
     /// into the command before it or not): each entity it changed, with the
-    /// component-table indices of its changed components as bits, and
-    /// whether anything else changed (entities created or destroyed, the
-    /// world settings, the solver state). The simulation applies an edit
-    /// that only moved bodies to its World in place.
+    /// component-table indices of its changed components as bits (created
+    /// and destroyed ones included), the entities it created (in scene
+    /// order) and destroyed, and whether anything else changed (the world
+    /// settings, the solver state, the order of the entities that stayed).
+    /// The simulation applies to its World in place an edit that moved,
+    /// turned or re-massed bodies, or added or deleted some.
     struct EditSummary {
         std::vector<std::pair<Entity, std::uint64_t>> entities;
+        std::vector<Entity> created, destroyed;
         bool beyondComponents = false;
     };
     const EditSummary& lastEdit() const { return lastEdit_; }

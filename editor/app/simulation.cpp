@@ -5,6 +5,7 @@
 #include "stepwise/components.hpp"
 
 #include <algorithm>
+#include <unordered_set>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -139,7 +140,8 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
     // one that adds or removes entities) makes the last step's contacts stale.
     static const std::uint64_t kContactShape = bit("position") | bit("angle") | bit("static") | bit("radius") |
                                                bit("box") | bit("polygon") | bit("chain") | bit("plane");
-    bool keepContacts = world_ && running() && !edit.beyondComponents;
+    const bool cameOrWent = !edit.created.empty() || !edit.destroyed.empty();
+    bool keepContacts = world_ && running() && !edit.beyondComponents && !cameOrWent;
     for (const auto& [entity, changed] : edit.entities) keepContacts = keepContacts && (changed & kContactShape) == 0;
     if (keepContacts && !contactsKept_) {
         const std::span<const ContactRecord> shown = world_->contacts();
@@ -149,8 +151,18 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
     static const std::uint64_t kMass = bit("mass");
     static const std::uint64_t kTurn = bit("angle") | bit("angular_velocity");
     bool inPlace = world_ && !stale_ && !edit.beyondComponents;
+    // Bodies added or deleted (with a mouse spring the World was built from
+    // a copy of the scene: those rebuild).
+    if (inPlace && cameOrWent)
+        inPlace = builtMouseSpring_.isNull() && world_->changeEntities(scene, switches(), edit.destroyed, edit.created);
+    std::unordered_set<Entity> newOrGone;
+    if (cameOrWent) {
+        newOrGone.insert(edit.created.begin(), edit.created.end());
+        newOrGone.insert(edit.destroyed.begin(), edit.destroyed.end());
+    }
     for (const auto& [entity, changed] : edit.entities) {
         if (!inPlace) break;
+        if (newOrGone.count(entity) != 0) continue;
         const Position* p = scene.registry.tryGet<Position>(entity);
         const Velocity* v = scene.registry.tryGet<Velocity>(entity);
         // Mass and turn edits: the World checks the engine's choice against
@@ -170,6 +182,13 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
     }
     // A partly applied edit is rebuilt whole, like any other.
     if (!inPlace) stale_ = true;
+    // The steps from here on are taken from the edited scene: those that
+    // step back restores it from a copy of it, not of the scene the World
+    // was built from. A move or a turn needs none (the state holds it); a
+    // mass or a body that came or went does.
+    bool beyondState = cameOrWent;
+    for (const auto& [entity, changed] : edit.entities) beyondState = beyondState || (changed & kMass) != 0;
+    if (inPlace && beyondState) sceneAtBuild_.reset();
 }
 
 void Simulation::beforeEdit(std::size_t cursor) {

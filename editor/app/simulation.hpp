@@ -84,10 +84,11 @@ public:
         contactsKept_ = false;
     }
     /// After an undoable edit: one that only moved or turned bodies (their
-    /// position, velocity, angle or angular velocity) or changed one body's
-    /// mass goes to the live World in place (World::moveBody, turnBody,
-    /// setMass), so the rest keeps its warm start and nothing is rebuilt;
-    /// any other edit, or one the World declines, makes the World stale.
+    /// position, velocity, angle or angular velocity), changed one body's
+    /// mass, or added or deleted bodies goes to the live World in place
+    /// (World::moveBody, turnBody, setMass, changeEntities), so the rest
+    /// keeps its warm start and nothing is rebuilt; any other edit, or one
+    /// the World declines, makes the World stale.
     void sceneEdited(const Scene& scene, const CommandStack::EditSummary& edit);
     /// Builds the World now if it is stale (for overlays while paused).
     bool ensureWorld(const Scene& scene);

@@ -427,6 +427,18 @@ public:
     /// no turn of its own here (a shapeless body without both an angle and a
     /// spin).
     Result<void> turnBody(const Scene& scene, const SystemSwitches& switches, Entity body);
+    /// Takes the entities of `removed` (no longer in `scene`) out of the
+    /// World and adds those of `added` (the last entities of `scene`, in its
+    /// order), in place: the islands of removed bodies wake, every other
+    /// body and every contact's warm start stay, and the steps that follow
+    /// are those of reload(scene, switches). The editor adds and deletes
+    /// bodies this way. Fails, leaving the World as it was, for anything but
+    /// dynamic bodies with a shape and no spin and the joints among them
+    /// (added) or dynamic bodies and joints (removed), when springs,
+    /// attractors, boids or emitters act, or when the edit would change the
+    /// engine's choice of settings: the caller then reloads.
+    Result<void> changeEntities(const Scene& scene, const SystemSwitches& switches, std::span<const Entity> removed,
+                                std::span<const Entity> added);
     double time() const;
 
     /// Systems this scene needs, in pipeline order: "gravity", "drag",

@@ -295,51 +295,8 @@ std::optional<Error> checkFirstStepForces(const WorldImpl& w, detail::Integrator
 /// with too few or repeated points or on a moving body), but a
 /// scene built in code or edited in the editor reaches here unchecked.
 std::optional<Error> checkPolygons(const Registry& reg) {
-    const std::vector<Entity>& order = reg.entities();
-    for (std::size_t i = 0; i < order.size(); ++i) {
-        if (const Shapes* compound = reg.tryGet<Shapes>(order[i])) {
-            for (std::size_t k = 0; k < compound->items.size(); ++k)
-                if (std::optional<Error> problem = compoundShapeProblem(compound->items[k])) {
-                    const Name* name = reg.tryGet<Name>(order[i]);
-                    return Error{problem->message, entityLabel(i, name ? &name->value : nullptr) + ": shapes/" +
-                                                       std::to_string(k) + "/" + problem->where};
-                }
-            if (compound->items.empty() || compound->items.size() > 256) {
-                const Name* name = reg.tryGet<Name>(order[i]);
-                return Error{"expected 1 to 256 shapes, got " + std::to_string(compound->items.size()),
-                             entityLabel(i, name ? &name->value : nullptr) + ": shapes"};
-            }
-        }
-        if (const Capsule* capsule = reg.tryGet<Capsule>(order[i]); capsule && capsule->a == capsule->b) {
-            const Name* name = reg.tryGet<Name>(order[i]);
-            return Error{"a and b are the same point; a capsule needs a segment of non-zero length",
-                         entityLabel(i, name ? &name->value : nullptr) + ": capsule.b"};
-        }
-        if (const Chain* chain = reg.tryGet<Chain>(order[i])) {
-            const Name* name = reg.tryGet<Name>(order[i]);
-            const std::string label = entityLabel(i, name ? &name->value : nullptr);
-            if (std::optional<Error> problem = chainProblem(chain->points, chain->loop))
-                return Error{problem->message,
-                             label + ": chain.points" + (problem->where.empty() ? "" : "[" + problem->where + "]")};
-            if (!(reg.has<Static>(order[i]) && reg.tryGet<Static>(order[i])->value) &&
-                !(reg.has<Kinematic>(order[i]) && reg.tryGet<Kinematic>(order[i])->value))
-                return Error{kChainOnDynamicBody, label + ": chain"};
-        }
-        const Polygon* poly = reg.tryGet<Polygon>(order[i]);
-        if (!poly) continue;
-        if (poly->radius && !(*poly->radius >= 0.0 && *poly->radius <= kMaxMagnitude)) {
-            const Name* name = reg.tryGet<Name>(order[i]);
-            return Error{"expected a number in [0, " + formatNumber(kMaxMagnitude) + "], got " +
-                             formatNumber(*poly->radius),
-                         entityLabel(i, name ? &name->value : nullptr) + ": polygon.radius"};
-        }
-        if (std::optional<Error> problem = polygonProblem(poly->vertices)) {
-            // Vertex 3 is named "polygon.vertices[3]".
-            const Name* name = reg.tryGet<Name>(order[i]);
-            return Error{problem->message, entityLabel(i, name ? &name->value : nullptr) + ": polygon.vertices" +
-                                               (problem->where.empty() ? "" : "[" + problem->where + "]")};
-        }
-    }
+    for (std::size_t i = 0; i < reg.entities().size(); ++i)
+        if (std::optional<Error> problem = detail::shapeProblem(reg, i)) return problem;
     return std::nullopt;
 }
 
@@ -563,6 +520,41 @@ Result<World> World::build(const Scene& scene, const SystemSwitches& switches) {
     World world(std::move(impl));
     if (scene.solverState) world.setSolverState(*scene.solverState);
     return world;
+}
+
+std::optional<Error> detail::shapeProblem(const Registry& reg, std::size_t i) {
+    const Entity e = reg.entities()[i];
+    const auto label = [&] {
+        const Name* name = reg.tryGet<Name>(e);
+        return entityLabel(i, name ? &name->value : nullptr);
+    };
+    if (const Shapes* compound = reg.tryGet<Shapes>(e)) {
+        for (std::size_t k = 0; k < compound->items.size(); ++k)
+            if (std::optional<Error> problem = compoundShapeProblem(compound->items[k]))
+                return Error{problem->message, label() + ": shapes/" + std::to_string(k) + "/" + problem->where};
+        if (compound->items.empty() || compound->items.size() > 256)
+            return Error{"expected 1 to 256 shapes, got " + std::to_string(compound->items.size()), label() + ": shapes"};
+    }
+    if (const Capsule* capsule = reg.tryGet<Capsule>(e); capsule && capsule->a == capsule->b)
+        return Error{"a and b are the same point; a capsule needs a segment of non-zero length", label() + ": capsule.b"};
+    if (const Chain* chain = reg.tryGet<Chain>(e)) {
+        if (std::optional<Error> problem = chainProblem(chain->points, chain->loop))
+            return Error{problem->message,
+                         label() + ": chain.points" + (problem->where.empty() ? "" : "[" + problem->where + "]")};
+        if (!(reg.has<Static>(e) && reg.tryGet<Static>(e)->value) &&
+            !(reg.has<Kinematic>(e) && reg.tryGet<Kinematic>(e)->value))
+            return Error{kChainOnDynamicBody, label() + ": chain"};
+    }
+    const Polygon* poly = reg.tryGet<Polygon>(e);
+    if (!poly) return std::nullopt;
+    if (poly->radius && !(*poly->radius >= 0.0 && *poly->radius <= kMaxMagnitude))
+        return Error{"expected a number in [0, " + formatNumber(kMaxMagnitude) + "], got " + formatNumber(*poly->radius),
+                     label() + ": polygon.radius"};
+    // Vertex 3 is named "polygon.vertices[3]".
+    if (std::optional<Error> problem = polygonProblem(poly->vertices))
+        return Error{problem->message,
+                     label() + ": polygon.vertices" + (problem->where.empty() ? "" : "[" + problem->where + "]")};
+    return std::nullopt;
 }
 
 } // namespace stepwise

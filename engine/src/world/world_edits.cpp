@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <unordered_set>
 
 namespace stepwise {
 
@@ -116,6 +117,80 @@ Result<void> World::turnBody(const Scene& scene, const SystemSwitches& switches,
     }
     w.sleep.wake(std::uint32_t(b));  // as reload's wakeEdited: a turned body wakes its island
     w.sleepChanged();
+    return {};
+}
+
+
+namespace {
+
+bool isOn(const Static* s) { return s && s->value; }
+bool isOn(const Kinematic* k) { return k && k->value; }
+
+std::uint64_t keyOf(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
+
+/// Why `e`, the scene's entity number `index`, cannot join the World in
+/// place (what changeBodies adds: a dynamic body with a shape and no turn,
+/// or a joint whose ends are added with it); nothing when it can.
+std::optional<Error> addableProblem(const Registry& reg, std::size_t index, const std::unordered_set<std::uint64_t>& added) {
+    const Entity e = reg.entities()[index];
+    if (const Joint* joint = reg.tryGet<Joint>(e)) {
+        for (const Entity end : {joint->a, joint->b})
+            if (!end.isNull() && !added.count(keyOf(end))) return Error{"a joint to a body that was already there"};
+        return std::nullopt;
+    }
+    if (reg.has<Spring>(e)) return Error{"a spring is checked by a rebuild"};
+    if (!reg.has<Position>(e)) return std::nullopt;  // not simulated (World::build skips it too)
+    if (isOn(reg.tryGet<Static>(e)) || isOn(reg.tryGet<Kinematic>(e)) || reg.has<Plane>(e) || reg.has<Attractor>(e) ||
+        reg.has<Boid>(e) || reg.has<Emitter>(e) || reg.has<Template>(e))
+        return Error{"only dynamic bodies are added in place"};
+    if (!reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) && !reg.has<Capsule>(e) && !reg.has<Shapes>(e))
+        return Error{"a body without a shape is added by a rebuild"};
+    // A build checks that a spin is one a step can hold.
+    if (const AngularVelocity* w = reg.tryGet<AngularVelocity>(e); w && w->value != 0.0)
+        return Error{"a spinning body is added by a rebuild"};
+    const Mass* m = reg.tryGet<Mass>(e);
+    if (m && !(std::isfinite(m->value) && m->value > 0.0)) return Error{"mass must be a finite number > 0"};
+    return detail::shapeProblem(reg, index);
+}
+
+} // namespace
+
+Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& switches, std::span<const Entity> removed,
+                                   std::span<const Entity> added) {
+    WorldImpl& w = *impl_;
+    const Registry& reg = scene.registry;
+    if (!w.emitters.empty()) return Error{"a level with emitters changes its bodies as it runs: a rebuild"};
+    if (!w.collision || !switches.collisions) return Error{"no contact solver to add shapes to"};
+    if (w.model.springsOn() || w.model.attractorsOn() || w.model.boidsOn)
+        return Error{"springs, attractors and boids act on every body: a rebuild checks them"};
+    // The removed: dynamic bodies and joints of this World, gone from the
+    // scene, that nothing kept holds.
+    std::unordered_set<std::uint64_t> gone;
+    for (const Entity e : removed) {
+        if (reg.alive(e)) return Error{"a removed entity is still in the scene"};
+        gone.insert(keyOf(e));
+    }
+    const auto isGone = [&gone](Entity e) { return !e.isNull() && gone.count(keyOf(e)) != 0; };
+    for (std::size_t b = 0; b < w.bodyEntity.size(); ++b)
+        if (isGone(w.bodyEntity[b]) && !w.isKinematic.empty() && w.isKinematic[b])
+            return Error{"a kinematic body is removed by a rebuild"};
+    for (std::size_t c = 0; c < w.collision->colliderCount(); ++c)
+        if (w.collision->collider(c).body < 0 && isGone(w.collision->collider(c).entity))
+            return Error{"a static shape is removed by a rebuild"};
+    for (const joints::JointConstraint& j : w.collision->jointConstraints())
+        if (!isGone(j.entity) && (isGone(j.entityA) || isGone(j.entityB)))
+            return Error{"a joint stays while a body it holds is removed"};
+    // The added: the scene's last entities, in its order, as a build would
+    // append them.
+    const std::vector<Entity>& order = reg.entities();
+    if (added.size() > order.size() || !std::equal(added.begin(), added.end(), order.end() - std::ptrdiff_t(added.size())))
+        return Error{"added entities are not the scene's last"};
+    std::unordered_set<std::uint64_t> fresh;
+    for (const Entity e : added) fresh.insert(keyOf(e));
+    for (std::size_t i = order.size() - added.size(); i < order.size(); ++i)
+        if (std::optional<Error> problem = addableProblem(reg, i, fresh)) return std::move(*problem);
+    if (std::optional<Error> other = w.keepChoiceFor(scene, switches)) return std::move(*other);
+    w.changeBodies(reg, removed, added);
     return {};
 }
 

@@ -206,11 +206,10 @@ void WorldImpl::runEmitters() {
             p.next = *p.next + p.interval;
         }
     }
-    changeBodies(removed, added);
+    changeBodies(reg, removed, added);
 }
 
-void WorldImpl::changeBodies(const std::vector<Entity>& removed, const std::vector<Entity>& added) {
-    const Registry& reg = *registry;
+void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> removed, std::span<const Entity> added) {
     // Flags by entity slot: a removed entity's slot may be reused by an
     // added one, which is told apart by its generation.
     const std::size_t slots = std::max(reg.slotCount(), bodyOfSlot.size());

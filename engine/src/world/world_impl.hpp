@@ -12,6 +12,7 @@
 #include <deque>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -22,6 +23,10 @@ namespace detail {
 /// "entity 3", or "entity 3 (\"ball\")" when it has a name: how the World's
 /// messages name an entity, by its place in the scene's order.
 std::string entityLabel(std::size_t index, const std::string* name);
+/// What World::build refuses in the shapes of the scene's entity number
+/// `index` (a capsule without a segment, a bad outline, a chain on a
+/// dynamic body, an empty compound), naming it; nothing when they are fine.
+std::optional<Error> shapeProblem(const Registry& reg, std::size_t index);
 } // namespace detail
 
 /// How many Worlds World::build has made in this process: the tests check
@@ -129,10 +134,12 @@ public:
     void runEmitters();
     /// Takes the bodies of `removed` (with their shapes, joints and springs)
     /// out of every array in place and appends those of `added` (entities
-    /// of `registry`, scene order), so the arrays are what World::build would
-    /// make of the scene as it now is; every other body's state and warm
-    /// start stay.
-    void changeBodies(const std::vector<Entity>& removed, const std::vector<Entity>& added);
+    /// of `reg`, the scene as it now is, in its order), so the arrays are
+    /// what World::build would make of that scene; every other body's state
+    /// and warm start stay. An added entity is a dynamic body with a shape,
+    /// or a joint or spring among such bodies (a spring may also hold one to
+    /// a body already here): emitters' copies and the editor's additions.
+    void changeBodies(const Registry& reg, std::span<const Entity> removed, std::span<const Entity> added);
     /// The layout of the arrays as they are now.
     std::shared_ptr<const WorldLayout> makeLayout() const;
     /// The names activeSystems() reports, in pipeline order.
