@@ -341,7 +341,7 @@ Vec2 dropPoint(const Registry& reg) {
 }
 
 /// Adds, at `at`, one body of each shape kind (a ball with a filter, a
-/// turned box, a triangle, a capsule, a compound body) and a pair of boxes
+/// turned box, a spinning triangle, a capsule, a compound body) and a pair of boxes
 /// hinged together, each with a velocity: what the editor's tools and a
 /// paste add.
 void addOneOfEach(Scene& s, Vec2 at) {
@@ -359,7 +359,9 @@ void addOneOfEach(Scene& s, Vec2 at) {
     const Entity box = body("new box", {-1.0, 0.5}, {0.0, -2.0});
     reg.emplace<Box>(box, Box{0.6, 0.4});
     reg.emplace<Angle>(box, Angle{0.4});
-    reg.emplace<Polygon>(body("new triangle", {0.0, 0.0}, {-0.5, 0.0}), Polygon{});
+    const Entity triangle = body("new triangle", {0.0, 0.0}, {-0.5, 0.0});
+    reg.emplace<Polygon>(triangle, Polygon{});
+    reg.emplace<AngularVelocity>(triangle, AngularVelocity{3.0});
     reg.emplace<Capsule>(body("new capsule", {1.0, 0.5}, {0.0, 1.0}), Capsule{{-0.3, 0.0}, {0.3, 0.0}, 0.15});
     Shapes compound;
     compound.items.resize(2);
@@ -406,6 +408,39 @@ TEST(Simulation, AddedBodiesGoInPlaceAndRunAsARebuild) {
         EXPECT_TRUE(found) << "the new ball is a body of the World";
         // The new bodies fell: gravity and contacts act on them.
         EXPECT_LT(inPlace.ed.doc.scene.registry.tryGet<Position>(ball)->value.y, at.y - 0.5);
+    }
+}
+
+// The editor's own Duplicate and Paste add in place: a ragdoll (bones and
+// joints) duplicated, a pyramid's boxes copied and pasted.
+TEST(Simulation, DuplicateAndPasteAddInPlaceAndRunAsARebuild) {
+    for (const char* level : {"ragdoll.json", "pyramid.json"}) {
+        SCOPED_TRACE(level);
+        Fixture inPlace(level), rebuilt(level);
+        for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, 30);
+        std::vector<Entity> bodies;
+        const Registry& reg = inPlace.ed.doc.scene.registry;
+        for (Entity e : reg.entities())
+            if (isFreeBody(reg, e) && bodies.size() < 12) bodies.push_back(e);
+        const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
+        const std::size_t before = reg.size();
+        for (Fixture* f : {&inPlace, &rebuilt}) {
+            f->ed.select(bodies);
+            if (level == std::string("ragdoll.json")) {
+                ASSERT_TRUE(f->ed.duplicateSelection());
+            } else {
+                f->ed.copySelection();
+                ASSERT_TRUE(f->ed.paste());
+            }
+        }
+        EXPECT_GE(inPlace.ed.doc.scene.registry.size(), before + bodies.size());
+        rebuilt.ed.sim.sceneChanged();
+        for (int i = 0; i < 60; ++i) {
+            inPlace.ed.stepForward();
+            rebuilt.ed.stepForward();
+        }
+        EXPECT_EQ(inPlace.ed.sim.worldBuilds(), builds) << "added in place, never rebuilt";
+        EXPECT_TRUE(textOf(inPlace.ed.doc.scene) == textOf(rebuilt.ed.doc.scene));
     }
 }
 
@@ -517,8 +552,9 @@ TEST(Simulation, StepBackAfterAnEditInPlaceRestoresTheEditedScene) {
 }
 
 // What the World does not take in place rebuilds, and still runs as the
-// rebuild: a static wall, a spring, a spinning body, a body joined to one
-// already there, a heavy body that changes the engine's choice of settings.
+// rebuild: a static wall, a spring, a body spinning near the speed limit,
+// a body joined to one already there, a heavy body that changes the
+// engine's choice of settings.
 TEST(Simulation, AddsTheWorldCannotTakeInPlaceRebuild) {
     struct Case {
         const char* what;
@@ -545,8 +581,10 @@ TEST(Simulation, AddsTheWorldCannotTakeInPlaceRebuild) {
              sp.k = 50.0;
              s.registry.emplace<Spring>(spring, std::move(sp));
          }},
+        // A spin near the speed limit a build checks (it falls clear of
+        // the pile in these steps).
         {"spin", "pile.json",
-         [&](Scene& s, Vec2 at) { s.registry.emplace<AngularVelocity>(ball(s, at, 1.0), AngularVelocity{3.0}); }},
+         [&](Scene& s, Vec2 at) { s.registry.emplace<AngularVelocity>(ball(s, at, 1.0), AngularVelocity{2e9}); }},
         {"joint to an old body", "ragdoll.json",
          [&](Scene& s, Vec2 at) {
              Entity old;

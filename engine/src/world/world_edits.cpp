@@ -5,6 +5,7 @@
 #include "world/world_collisions.hpp"
 #include "world/world_impl.hpp"
 
+#include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
 
 #include <algorithm>
@@ -128,6 +129,22 @@ bool isOn(const Kinematic* k) { return k && k->value; }
 
 std::uint64_t keyOf(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
 
+/// How far a body's shapes reach from its position, metres.
+double reachFromPosition(const Registry& reg, Entity e) {
+    double reach = 0.0;
+    if (const Radius* r = reg.tryGet<Radius>(e)) reach = std::max(reach, r->value);
+    if (const Box* b = reg.tryGet<Box>(e)) reach = std::max(reach, 0.5 * std::hypot(b->width, b->height));
+    if (const Polygon* p = reg.tryGet<Polygon>(e))
+        for (const Vec2& v : p->vertices) reach = std::max(reach, length(v) + p->radius.value_or(0.0));
+    if (const Capsule* c = reg.tryGet<Capsule>(e)) reach = std::max(reach, std::max(length(c->a), length(c->b)) + c->radius);
+    if (const Shapes* shapes = reg.tryGet<Shapes>(e))
+        for (const CompoundShape& item : shapes->items) {
+            const ShapeOutline outline = compoundShapeOutline(item);
+            for (const Vec2& v : outline.points) reach = std::max(reach, length(v) + outline.radius);
+        }
+    return reach;
+}
+
 /// Why `e`, the scene's entity number `index`, cannot join the World in
 /// place (what changeBodies adds: a dynamic body with a shape and no turn,
 /// or a joint whose ends are added with it); nothing when it can.
@@ -145,9 +162,13 @@ std::optional<Error> addableProblem(const Registry& reg, std::size_t index, cons
         return Error{"only dynamic bodies are added in place"};
     if (!reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) && !reg.has<Capsule>(e) && !reg.has<Shapes>(e))
         return Error{"a body without a shape is added by a rebuild"};
-    // A build checks that a spin is one a step can hold.
-    if (const AngularVelocity* w = reg.tryGet<AngularVelocity>(e); w && w->value != 0.0)
-        return Error{"a spinning body is added by a rebuild"};
+    // A build refuses a spin that moves a point faster than a run holds.
+    // The centre of mass lies within the shapes, so no point is farther
+    // from it than twice the reach from the position: a spin under that
+    // bound passes the build's check, and one over it is left to a build.
+    if (const AngularVelocity* w = reg.tryGet<AngularVelocity>(e);
+        w && !(std::abs(w->value) * 2.0 * reachFromPosition(reg, e) <= kMaxSpeed))
+        return Error{"a body spinning this fast is checked by a rebuild"};
     const Mass* m = reg.tryGet<Mass>(e);
     if (m && !(std::isfinite(m->value) && m->value > 0.0)) return Error{"mass must be a finite number > 0"};
     return detail::shapeProblem(reg, index);
