@@ -551,6 +551,29 @@ TEST(Simulation, StepBackAfterAnEditInPlaceRestoresTheEditedScene) {
     }
 }
 
+// Undo of an add or a delete made in place, with no step between, goes
+// back to the run as it was: the steps that follow are those of a run
+// never edited, bit for bit.
+TEST(Simulation, UndoOfAnAddOrDeleteInPlaceRunsAsIfNeverEdited) {
+    for (const bool add : {true, false}) {
+        SCOPED_TRACE(add ? "add" : "delete");
+        Fixture edited("pile.json"), untouched("pile.json");
+        for (Fixture* f : {&edited, &untouched}) playThenPause(*f, 30);
+        const Vec2 at = dropPoint(edited.ed.doc.scene.registry);
+        ASSERT_TRUE(edited.ed.applyEdit(add ? "add" : "delete", [&](Scene& s) {
+            if (add) addOneOfEach(s, at);
+            else (void)s.registry.destroy(findByName(s.registry, "c1000"));
+            return true;
+        }));
+        ASSERT_TRUE(edited.ed.undo());
+        for (int i = 0; i < 30; ++i) {
+            edited.ed.stepForward();
+            untouched.ed.stepForward();
+        }
+        EXPECT_TRUE(textOf(edited.ed.doc.scene) == textOf(untouched.ed.doc.scene));
+    }
+}
+
 // What the World does not take in place rebuilds, and still runs as the
 // rebuild: a static wall, a spring, a body spinning near the speed limit,
 // a body joined to one already there, a heavy body that changes the
