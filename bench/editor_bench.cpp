@@ -5,7 +5,8 @@
 // too (BM_DragOneBodyWhilePaused; the peer is a rebuild of the World from
 // the scene, BM_ReloadWorld, which an edit that is not a move still costs).
 // A mass edit goes in place as well (BM_SetMassOfOneBody), and so do a
-// body added and deleted (BM_AddAndDeleteOneBody, two edits an iteration).
+// radius (BM_ReshapeOneBody) and a body added and deleted
+// (BM_AddAndDeleteOneBody, two edits an iteration).
 // Not part of ctest.
 //
 //   build/bench/editor_bench --benchmark_min_time=0.2
@@ -102,6 +103,25 @@ void BM_SetMassOfOneBody(benchmark::State& state) {
     state.counters["bodies"] = double(bodies.size());
 }
 BENCHMARK(BM_SetMassOfOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
+
+/// A radius edit in place (World::reshapeBody): one circle alternates
+/// between two sizes a part in a billion apart.
+void BM_ReshapeOneBody(benchmark::State& state) {
+    Scene scene = scenes::circlesInBox(int(state.range(0)));
+    const std::vector<Entity> bodies = bodiesOf(scene);
+    const Entity edited = bodies[bodies.size() / 2];
+    const double radius = scene.registry.tryGet<Radius>(edited)->value;
+    Result<World> world = World::build(scene);
+    bool larger = false;
+    for (auto _ : state) {
+        larger = !larger;
+        scene.registry.tryGet<Radius>(edited)->value = larger ? radius * (1.0 + 1e-9) : radius;
+        Result<void> set = world->reshapeBody(scene, {}, edited);
+        if (!set) state.SkipWithError(set.error().c_str());
+    }
+    state.counters["bodies"] = double(bodies.size());
+}
+BENCHMARK(BM_ReshapeOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
 
 /// A ball added above the box and deleted again, each in place
 /// (World::changeEntities): two edits per iteration, against two reloads.

@@ -185,16 +185,17 @@ TEST(Simulation, AMoveInPlaceWakesTheSleepingIslandAsARebuildDoes) {
         if (w.bodyEntity(b) == top) EXPECT_FALSE(w.asleep(b)) << "the moved box's island woke";
 }
 
-// Anything but a move or a mass (here a radius) rebuilds the World.
-TEST(Simulation, AnEditBeyondPoseAndMassRebuildsTheWorld) {
+// An edit beyond a body's pose, mass and shape (here its drag) rebuilds
+// the World.
+TEST(Simulation, AnEditBeyondPoseMassAndShapeRebuildsTheWorld) {
     Fixture f("pile.json");
     f.ed.togglePlay();
     f.ed.update(1.0 / 60.0);
     f.ed.togglePlay();
     const std::uint64_t builds = f.ed.sim.worldBuilds();
     const Entity body = findByName(f.ed.doc.scene.registry, "c10");
-    ASSERT_TRUE(f.ed.applyEdit("radius", [&](Scene& s) {
-        s.registry.tryGet<Radius>(body)->value *= 0.9;
+    ASSERT_TRUE(f.ed.applyEdit("drag", [&](Scene& s) {
+        s.registry.emplace<Drag>(body, Drag{0.5});
         return true;
     }));
     f.ed.stepForward();
@@ -277,6 +278,48 @@ TEST(Simulation, ATurnGoesInPlaceAndRunsAsARebuild) {
             s.registry.tryGet<Position>(body)->value.x += c.shift;
             return true;
         }, 30);
+    }
+}
+
+// A new shape, friction, restitution or filter goes to the live World in
+// place and the run goes on as from a rebuilt World: a circle shrunk and
+// grown in a pile, a box of a pyramid widened, a capsule thickened, a
+// filter changed, a bone made bouncy. An outline whose centroid moves (a
+// polygon's) rebuilds, and still runs as the rebuild.
+TEST(Simulation, AShapeEditGoesInPlaceAndRunsAsARebuild) {
+    struct Case {
+        const char* what;
+        const char* level;
+        const char* body;  // "" = the level's last dynamic body with this shape
+        std::function<void(Registry&, Entity)> edit;
+        bool inPlace;
+    };
+    const Case cases[] = {
+        {"smaller circle", "pile.json", "c1000", [](Registry& r, Entity e) { r.tryGet<Radius>(e)->value *= 0.8; }, true},
+        {"larger circle", "pile.json", "c1999", [](Registry& r, Entity e) { r.tryGet<Radius>(e)->value *= 1.3; }, true},
+        {"friction", "pile.json", "c10", [](Registry& r, Entity e) { r.emplace<Friction>(e, Friction{0.05}); }, true},
+        {"wider box", "pyramid.json", "", [](Registry& r, Entity e) { r.tryGet<Box>(e)->width *= 1.1; }, true},
+        {"thicker capsule", "capsules.json", "ramp capsule 0",
+         [](Registry& r, Entity e) { r.tryGet<Capsule>(e)->radius *= 1.25; }, true},
+        {"filter", "filters.json", "ghost ball 0", [](Registry& r, Entity e) { r.emplace<Filter>(e, Filter{}); }, true},
+        {"bouncy", "ragdoll.json", "head", [](Registry& r, Entity e) { r.emplace<Restitution>(e, Restitution{0.8}); }, true},
+        {"polygon outline", "polygons.json", "slider",
+         [](Registry& r, Entity e) { r.tryGet<Polygon>(e)->vertices[2].x = 0.35; }, false},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        Fixture inPlace(c.level), rebuilt(c.level);
+        for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, 45);
+        const Registry& reg = inPlace.ed.doc.scene.registry;
+        Entity body = *c.body ? findByName(reg, c.body) : Entity{};
+        if (!*c.body)
+            for (Entity e : reg.entities())
+                if (reg.has<Box>(e) && isFreeBody(reg, e)) body = e;
+        ASSERT_TRUE(reg.alive(body));
+        expectRunsAsARebuild(inPlace, rebuilt, c.what, [&](Scene& s) {
+            c.edit(s.registry, body);
+            return true;
+        }, 45, !c.inPlace);
     }
 }
 
@@ -518,6 +561,7 @@ TEST(Simulation, StepBackAfterAnEditInPlaceRestoresTheEditedScene) {
         {"add", [](Scene& s, Vec2 at) { addOneOfEach(s, at); }},
         {"delete", [](Scene& s, Vec2) { (void)s.registry.destroy(findByName(s.registry, "c1000")); }},
         {"mass", [](Scene& s, Vec2) { s.registry.emplace<Mass>(findByName(s.registry, "c1999"), Mass{3.0}); }},
+        {"radius", [](Scene& s, Vec2) { s.registry.tryGet<Radius>(findByName(s.registry, "c1500"))->value = 0.4; }},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.what);

@@ -138,8 +138,10 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
     static const std::uint64_t kPose = bit("position") | bit("velocity");
     // What decides which pairs touch and where: an edit of any of these (or
     // one that adds or removes entities) makes the last step's contacts stale.
-    static const std::uint64_t kContactShape = bit("position") | bit("angle") | bit("static") | bit("radius") |
-                                               bit("box") | bit("polygon") | bit("chain") | bit("plane");
+    static const std::uint64_t kContactShape = bit("position") | bit("angle") | bit("static") | bit("kinematic") |
+                                               bit("radius") | bit("box") | bit("polygon") | bit("capsule") |
+                                               bit("shapes") | bit("chain") | bit("plane") | bit("filter") |
+                                               bit("sensor");
     const bool cameOrWent = !edit.created.empty() || !edit.destroyed.empty();
     bool keepContacts = world_ && running() && !edit.beyondComponents && !cameOrWent;
     for (const auto& [entity, changed] : edit.entities) keepContacts = keepContacts && (changed & kContactShape) == 0;
@@ -150,6 +152,8 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
     contactsKept_ = keepContacts;
     static const std::uint64_t kMass = bit("mass");
     static const std::uint64_t kTurn = bit("angle") | bit("angular_velocity");
+    static const std::uint64_t kShape = bit("radius") | bit("box") | bit("polygon") | bit("capsule") |
+                                        bit("friction") | bit("restitution") | bit("filter");
     bool inPlace = world_ && !stale_ && !edit.beyondComponents;
     // Bodies added or deleted (with a mouse spring the World was built from
     // a copy of the scene: those rebuild).
@@ -172,11 +176,12 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
             inPlace = builtMouseSpring_.isNull() && world_->setMass(scene, switches(), entity);
             continue;
         }
-        if ((changed & ~(kPose | kTurn)) != 0 || !p) {
+        if ((changed & ~(kPose | kTurn | kShape)) != 0 || !p) {
             inPlace = false;
             continue;
         }
-        if ((changed & kPose) != 0) inPlace = world_->moveBody(entity, p->value, v ? v->value : Vec2{}).ok();
+        if ((changed & kShape) != 0) inPlace = builtMouseSpring_.isNull() && world_->reshapeBody(scene, switches(), entity);
+        if (inPlace && (changed & kPose) != 0) inPlace = world_->moveBody(entity, p->value, v ? v->value : Vec2{}).ok();
         if (inPlace && (changed & kTurn) != 0)
             inPlace = builtMouseSpring_.isNull() && world_->turnBody(scene, switches(), entity);
     }
@@ -185,9 +190,9 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
     // The steps from here on are taken from the edited scene: those that
     // step back restores it from a copy of it, not of the scene the World
     // was built from. A move or a turn needs none (the state holds it); a
-    // mass or a body that came or went does.
+    // mass, a shape or a body that came or went does.
     bool beyondState = cameOrWent;
-    for (const auto& [entity, changed] : edit.entities) beyondState = beyondState || (changed & kMass) != 0;
+    for (const auto& [entity, changed] : edit.entities) beyondState = beyondState || (changed & ~(kPose | kTurn)) != 0;
     if (inPlace && beyondState) sceneAtBuild_.reset();
 }
 

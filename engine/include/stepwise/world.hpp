@@ -427,6 +427,14 @@ public:
     /// no turn of its own here (a shapeless body without both an angle and a
     /// spin).
     Result<void> turnBody(const Scene& scene, const SystemSwitches& switches, Entity body);
+    /// Gives dynamic body `body` the shape, friction, restitution and filter
+    /// its entity has in `scene`, in place (its inertia follows; its island
+    /// wakes; the steps that follow are reload's). Fails, leaving the World
+    /// as it was, for a compound body or a chain, an edit that moves the
+    /// body's centre of mass (a polygon's outline, a capsule's ends off
+    /// centre) or makes it a sensor or not, a shape a build refuses, or one
+    /// that changes the engine's choice of settings.
+    Result<void> reshapeBody(const Scene& scene, const SystemSwitches& switches, Entity body);
     /// Takes the entities of `removed` (no longer in `scene`) out of the
     /// World and adds those of `added` (the last entities of `scene`, in its
     /// order), in place: the islands of removed bodies wake, every other

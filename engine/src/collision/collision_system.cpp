@@ -67,6 +67,22 @@ Vec2 CollisionSystem::centreOfMass(std::size_t i, std::span<const Vec2> x) const
     return p + rotate(Rot::fromAngle(angles_[i]), c.centreOfMass);
 }
 
+namespace {
+
+/// Farthest point of a shape from its own centre (the collider's centre of
+/// mass for a body's one shape), metres; planes and shapeless colliders 0.
+double shapeReach(const Shape& s) {
+    switch (s.kind) {
+    case ShapeKind::Circle: return s.radius;
+    case ShapeKind::Polygon: return s.polygon->radius + s.polygon->cornerRadius;
+    case ShapeKind::Capsule: return length(s.halfExtents) + s.radius;
+    case ShapeKind::ChainSegment: return std::max(length(s.segment->p1), length(s.segment->p2));
+    default: return length(s.halfExtents);
+    }
+}
+
+} // namespace
+
 void CollisionSystem::add(const Collider& c, double angle, double angularVelocity, const Filter& filter) {
     const std::uint32_t index = std::uint32_t(colliders_.size());
     colliders_.push_back(c);
@@ -96,13 +112,7 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
         invInertia_.push_back(0.0);
         // Reach about the body's centre of mass: the shape's own plus how
         // far its centre sits from the body's.
-        const double own = c.shape.kind == ShapeKind::Circle    ? c.shape.radius
-                           : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius + c.shape.polygon->cornerRadius
-                           : c.shape.kind == ShapeKind::Capsule ? length(c.shape.halfExtents) + c.shape.radius
-                           : c.shape.kind == ShapeKind::ChainSegment
-                               ? std::max(length(c.shape.segment->p1), length(c.shape.segment->p2))
-                               : length(c.shape.halfExtents);
-        maxExtent_.push_back(own + length(c.centreOfMass - colliders_[hub].centreOfMass));
+        maxExtent_.push_back(shapeReach(c.shape) + length(c.centreOfMass - colliders_[hub].centreOfMass));
         finite_.push_back(index);
         solverIndex_.push_back(solverIndex_[hub]);
         return;
@@ -124,13 +134,7 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
                                                   : momentOfInertia(c.shape, c.mass);
     colliders_.back().inertia = inertia;
     invInertia_.push_back(inertia > 0.0 ? 1.0 / inertia : 0.0);
-    maxExtent_.push_back(c.solverOnly                          ? 0.0
-                         : c.shape.kind == ShapeKind::Circle    ? c.shape.radius
-                         : c.shape.kind == ShapeKind::Polygon ? c.shape.polygon->radius + c.shape.polygon->cornerRadius
-                         : c.shape.kind == ShapeKind::Capsule ? length(c.shape.halfExtents) + c.shape.radius
-                         : c.shape.kind == ShapeKind::ChainSegment
-                             ? std::max(length(c.shape.segment->p1), length(c.shape.segment->p2))
-                                                              : length(c.shape.halfExtents));
+    maxExtent_.push_back(c.solverOnly ? 0.0 : shapeReach(c.shape));
     if (dynamic && (c.centreOfMass.x != 0.0 || c.centreOfMass.y != 0.0)) offsetBodies_.push_back(index);
     if (c.solverOnly) {
         // in the solver only: no broad phase, no narrow phase
@@ -164,6 +168,28 @@ void CollisionSystem::setMass(std::size_t i, double mass, double inertia) {
         bodies_[s].invInertia = invInertia_[i];
     }
     for (std::size_t j = i + 1; j < colliders_.size() && colliders_[j].hub == std::int32_t(i); ++j) invMass_[j] = invMass_[i];
+}
+
+void CollisionSystem::reshape(std::size_t i, const Collider& fresh, const Filter& filter) {
+    Collider& c = colliders_[i];
+    const ConvexPolygon* kept = c.shape.kind == ShapeKind::Polygon ? c.shape.polygon : nullptr;
+    c.shape = fresh.shape;
+    if (fresh.shape.kind == ShapeKind::Polygon) {
+        // The outline lives here: over the old one when there was one.
+        if (kept) {
+            *const_cast<ConvexPolygon*>(kept) = *fresh.shape.polygon;
+            c.shape.polygon = kept;
+        } else {
+            polygons_.push_back(*fresh.shape.polygon);
+            c.shape.polygon = &polygons_.back();
+        }
+    }
+    c.friction = fresh.friction;
+    c.restitution = fresh.restitution;
+    filters_[i] = filter;
+    filtered_ = filtered_ || !(filter == Filter{});
+    maxExtent_[i] = shapeReach(c.shape);
+    setMass(i, c.mass, c.inertia);  // the inertia of the new shape
 }
 
 std::uint32_t CollisionSystem::addAll(std::span<const ColliderAdd> list) {

@@ -262,6 +262,11 @@ public:
     /// solver-only collider (a hub, a shapeless body), else computed from the
     /// shape; a hub's shapes follow it.
     void setMass(std::size_t i, double mass, double inertia);
+    /// Gives collider i, a dynamic body's only shape, the shape, friction,
+    /// restitution and filter of `fresh` (made as add() takes it, with the
+    /// same centre of mass and sensor flag), and the inertia and reach that
+    /// follow, as add() would have; its contacts' warm start stays.
+    void reshape(std::size_t i, const Collider& fresh, const Filter& filter);
     /// Farthest point of collider i from its centre of mass, metres.
     double maxExtent(std::size_t i) const { return maxExtent_[i]; }
 

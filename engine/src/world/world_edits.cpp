@@ -122,6 +122,38 @@ Result<void> World::turnBody(const Scene& scene, const SystemSwitches& switches,
 }
 
 
+Result<void> World::reshapeBody(const Scene& scene, const SystemSwitches& switches, Entity body) {
+    WorldImpl& w = *impl_;
+    const Result<std::size_t> index = editableBody(w, scene, body);
+    if (!index) return index.failure();
+    const std::size_t b = *index;
+    const Registry& reg = scene.registry;
+    if (!w.collision || !switches.collisions) return Error{"no contact solver holds the shape"};
+    const std::int32_t c = w.colliderOfBody[b];
+    if (c < 0 || reg.has<Shapes>(body) || reg.has<Chain>(body)) return Error{"only a body's one shape is reshaped in place"};
+    const collision::Collider& old = w.collision->collider(std::size_t(c));
+    if (old.solverOnly || old.hub >= 0) return Error{"only a body's one shape is reshaped in place"};
+    if (std::optional<Error> problem = detail::shapeProblem(reg, w.bodySceneIndex[b])) return std::move(*problem);
+    // The collider as a build would make it now.
+    detail::ShapeStorage storage;
+    std::vector<collision::CollisionSystem::ColliderAdd> made;
+    detail::collidersFor(reg, body, [b](Entity) { return std::uint32_t(b); }, detail::kNoBody, storage, made);
+    if (made.size() != 1) return Error{"the body's shape is not one a build gives a collider"};
+    const collision::Collider& fresh = made.front().collider;
+    // A shape whose centre of mass moved (a polygon's outline, a capsule's
+    // ends off centre) moves the body's centre, and a sensor is another
+    // kind of shape: a rebuild.
+    if (fresh.shape.kind == collision::ShapeKind::Plane || fresh.sensor != old.sensor ||
+        !sameBits(fresh.centreOfMass.x, old.centreOfMass.x) || !sameBits(fresh.centreOfMass.y, old.centreOfMass.y))
+        return Error{"the edit moves the body's centre of mass or changes its kind of shape"};
+    if (std::optional<Error> other = w.keepChoiceFor(scene, switches)) return std::move(*other);
+    w.collision->reshape(std::size_t(c), fresh, made.front().filter);
+    w.sleep.extent[b] = w.collision->maxExtent(std::size_t(c));
+    w.sleep.wake(std::uint32_t(b));  // as reload's wakeEdited: a changed shape wakes its island
+    w.sleepChanged();
+    return {};
+}
+
 namespace {
 
 bool isOn(const Static* s) { return s && s->value; }
