@@ -618,6 +618,51 @@ TEST(Simulation, UndoOfAnAddOrDeleteInPlaceRunsAsIfNeverEdited) {
     }
 }
 
+// Undo and redo of edits taken in place (with steps between, so the run
+// goes on from where it is) go in place too, and run as a rebuild: a move,
+// a mass, a radius, an add and a delete, each undone then redone. Undoing
+// a delete brings the body back at its place in the scene's order, not
+// last, which takes a rebuild.
+TEST(Simulation, UndoAndRedoOfEditsInPlaceGoInPlaceAndRunAsARebuild) {
+    struct Case {
+        const char* what;
+        std::function<void(Scene&, Vec2)> edit;
+    };
+    const Case cases[] = {
+        {"move", [](Scene& s, Vec2) { s.registry.tryGet<Position>(findByName(s.registry, "c1999"))->value.y += 1.0; }},
+        {"mass", [](Scene& s, Vec2) { s.registry.emplace<Mass>(findByName(s.registry, "c1999"), Mass{3.0}); }},
+        {"radius", [](Scene& s, Vec2) { s.registry.tryGet<Radius>(findByName(s.registry, "c1500"))->value = 0.4; }},
+        {"add", [](Scene& s, Vec2 at) { addOneOfEach(s, at); }},
+        {"delete", [](Scene& s, Vec2) { (void)s.registry.destroy(findByName(s.registry, "c1000")); }},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        Fixture inPlace("pile.json"), rebuilt("pile.json");
+        for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, 30);
+        const Vec2 at = dropPoint(inPlace.ed.doc.scene.registry);
+        for (Fixture* f : {&inPlace, &rebuilt}) {
+            ASSERT_TRUE(f->ed.applyEdit(c.what, [&](Scene& s) {
+                c.edit(s, at);
+                return true;
+            }));
+            for (int i = 0; i < 5; ++i) f->ed.stepForward();
+        }
+        const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
+        for (const bool undo : {true, false}) {
+            for (Fixture* f : {&inPlace, &rebuilt}) ASSERT_TRUE(undo ? f->ed.undo() : f->ed.redo());
+            rebuilt.ed.sim.sceneChanged();
+            for (int i = 0; i < 15; ++i) {
+                inPlace.ed.stepForward();
+                rebuilt.ed.stepForward();
+            }
+            const bool restoresDeleted = std::string(c.what) == "delete";
+            EXPECT_EQ(inPlace.ed.sim.worldBuilds(), builds + (restoresDeleted ? 1 : 0))
+                << (undo ? "undo" : "redo") << " went in place";
+            EXPECT_TRUE(textOf(inPlace.ed.doc.scene) == textOf(rebuilt.ed.doc.scene)) << (undo ? "undo" : "redo");
+        }
+    }
+}
+
 // What the World does not take in place rebuilds, and still runs as the
 // rebuild: a static wall, a spring, a body spinning near the speed limit,
 // a body joined to one already there, a heavy body that changes the

@@ -224,6 +224,15 @@ bool aliveIn(const Registry::Slots& slots, Entity e) {
     return e.index < slots.generations.size() && slots.alive[e.index] && slots.generations[e.index] == e.generation;
 }
 
+/// The entities that came and went between two slot tables; a change in
+/// the order of those in both is beyond components.
+void summarizeSlots(const Registry::Slots& before, const Registry::Slots& now, CommandStack::EditSummary& summary) {
+    std::vector<Entity> stayedBefore, stayedNow;
+    for (const Entity e : now.order) (aliveIn(before, e) ? stayedNow : summary.created).push_back(e);
+    for (const Entity e : before.order) (aliveIn(now, e) ? stayedBefore : summary.destroyed).push_back(e);
+    if (stayedBefore != stayedNow) summary.beyondComponents = true;
+}
+
 /// Keeps, while one edit runs, each entity's components as they were when
 /// the edit first reached for them, and the slot table before its first
 /// change: what the undo record needs, and all that is copied. An edit that
@@ -280,15 +289,6 @@ public:
 
 private:
     static std::uint64_t key(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
-    /// The entities that came and went between two slot tables, and whether
-    /// those in both kept their order.
-    static void summarizeSlots(const Registry::Slots& before, const Registry::Slots& now,
-                               CommandStack::EditSummary& summary) {
-        std::vector<Entity> stayedBefore, stayedNow;
-        for (const Entity e : now.order) (aliveIn(before, e) ? stayedNow : summary.created).push_back(e);
-        for (const Entity e : before.order) (aliveIn(now, e) ? stayedBefore : summary.destroyed).push_back(e);
-        if (stayedBefore != stayedNow) summary.beyondComponents = true;
-    }
     Registry& registry_;
     struct Touched {
         CommandStack::Delta::EntityChange change;  ///< `before` filled now, `after` by finish()
@@ -315,14 +315,34 @@ std::size_t CommandStack::Delta::bytes() const {
     return n;
 }
 
-void CommandStack::apply(Scene& scene, const Delta& d, bool forward) {
+void CommandStack::apply(Scene& scene, const Delta& d, bool forward, EditSummary* summary) {
     Registry& reg = scene.registry;
+    // What each entity held before, to tell which components changed.
+    std::vector<std::pair<std::string, ComponentStarts>> was;
+    if (summary) {
+        *summary = EditSummary{};
+        was.resize(d.entities.size());
+        for (std::size_t k = 0; k < d.entities.size(); ++k)
+            was[k].first = encodeEntity(reg, d.entities[k].entity, &was[k].second);
+    }
     for (const Delta::EntityChange& c : d.entities) removeAllComponents(reg, c.entity);
-    if (d.slots) reg.setSlots(forward ? d.slots->second : d.slots->first);
-    for (const Delta::EntityChange& c : d.entities) {
+    if (d.slots) {
+        const Registry::Slots& from = forward ? d.slots->first : d.slots->second;
+        const Registry::Slots& to = forward ? d.slots->second : d.slots->first;
+        if (summary) summarizeSlots(from, to, *summary);
+        reg.setSlots(to);
+    }
+    ComponentStarts now;
+    for (std::size_t k = 0; k < d.entities.size(); ++k) {
+        const Delta::EntityChange& c = d.entities[k];
         const std::string& target = forward ? c.after : c.before;
         if (!target.empty()) decodeEntity(target, reg, c.entity);
+        if (summary) {
+            const std::string encoded = encodeEntity(reg, c.entity, &now);
+            summary->entities.emplace_back(c.entity, changedComponents(was[k].first, was[k].second, encoded, now));
+        }
     }
+    if (summary) summary->beyondComponents = summary->beyondComponents || d.world || d.solver || d.version;
     if (d.world) scene.world = forward ? d.world->second : d.world->first;
     if (d.view) scene.view = forward ? d.view->second : d.view->first;
     if (d.solver) scene.solverState = forward ? d.solver->second : d.solver->first;
@@ -394,7 +414,7 @@ std::string CommandStack::undo(Scene& scene) {
     open_ = false;
     if (!canUndo()) return {};
     --cursor_;
-    apply(scene, commands_[cursor_].delta, false);
+    apply(scene, commands_[cursor_].delta, false, &lastEdit_);
     ++revision_;
     return commands_[cursor_].label;
 }
@@ -402,7 +422,7 @@ std::string CommandStack::undo(Scene& scene) {
 std::string CommandStack::redo(Scene& scene) {
     open_ = false;
     if (!canRedo()) return {};
-    apply(scene, commands_[cursor_].delta, true);
+    apply(scene, commands_[cursor_].delta, true, &lastEdit_);
     ++cursor_;
     ++revision_;
     return commands_[cursor_ - 1].label;

@@ -59,14 +59,15 @@ public:
     void truncate(std::size_t n);
     void clear();
 
-    /// What the last successful apply() changed, that edit alone (merged
-    /// into the command before it or not): each entity it changed, with the
-    /// component-table indices of its changed components as bits (created
-    /// and destroyed ones included), the entities it created (in scene
-    /// order) and destroyed, and whether anything else changed (the world
-    /// settings, the solver state, the order of the entities that stayed).
-    /// The simulation applies to its World in place an edit that moved,
-    /// turned or re-massed bodies, or added or deleted some.
+    /// What the last successful apply(), undo() or redo() changed, that
+    /// edit alone (merged into the command before it or not): each entity
+    /// it changed, with the component-table indices of its changed
+    /// components as bits (created and destroyed ones included), the
+    /// entities it created (in scene order) and destroyed, and whether
+    /// anything else changed (the world settings, the solver state, the
+    /// order of the entities that stayed). The simulation applies to its
+    /// World in place an edit that moved, turned, re-massed or reshaped
+    /// bodies, or added or deleted some.
     struct EditSummary {
         std::vector<std::pair<Entity, std::uint64_t>> entities;
         std::vector<Entity> created, destroyed;
@@ -97,8 +98,8 @@ public:
         std::size_t bytes() const;
     };
     /// Turns the scene on one side of `delta` into the other (forward:
-    /// before -> after).
-    static void apply(Scene& scene, const Delta& delta, bool forward);
+    /// before -> after); `summary`, when given, gets what that changed.
+    static void apply(Scene& scene, const Delta& delta, bool forward, EditSummary* summary = nullptr);
 
 private:
     struct Command {

@@ -25,6 +25,13 @@ void Editor::afterSceneReplaced() {
     ++revisionExtra_;
 }
 
+void Editor::afterUndoOrRedo() {
+    // The World takes the reverted edit in place as it took the edit.
+    sim.sceneEdited(doc.scene, commands.lastEdit());
+    pruneSelection();
+    ++revisionExtra_;
+}
+
 void Editor::note(std::string text) {
     status = text;
     log.push_back(std::move(text));
@@ -197,7 +204,7 @@ bool Editor::undo() {
     }
     const std::string label = commands.undo(doc.scene);
     if (label.empty()) return false;
-    afterSceneReplaced();
+    afterUndoOrRedo();
     // Back to the state before the run's edits with no step between: the
     // islands they woke sleep again and the contacts are those of before.
     if (sim.running()) sim.undoneTo(doc.scene, commands.cursor());
@@ -209,7 +216,7 @@ bool Editor::undo() {
 bool Editor::redo() {
     const std::string label = commands.redo(doc.scene);
     if (label.empty()) return false;
-    afterSceneReplaced();
+    afterUndoOrRedo();
     forgetRecoveryWhenClean();
     note("redo: " + label);
     return true;

@@ -198,6 +198,7 @@ public:
 
 private:
     void afterSceneReplaced();
+    void afterUndoOrRedo();
     void forgetRecoveryWhenClean();
     /// Open and New: the new document replaces the old one with a fresh
     /// undo history, selection, trails and view.

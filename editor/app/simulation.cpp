@@ -169,18 +169,17 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
         if (newOrGone.count(entity) != 0) continue;
         const Position* p = scene.registry.tryGet<Position>(entity);
         const Velocity* v = scene.registry.tryGet<Velocity>(entity);
-        // Mass and turn edits: the World checks the engine's choice against
-        // the scene it would be rebuilt from, which with a mouse spring is a
-        // copy: those rebuild.
-        if (changed == kMass) {
-            inPlace = builtMouseSpring_.isNull() && world_->setMass(scene, switches(), entity);
-            continue;
-        }
-        if ((changed & ~(kPose | kTurn | kShape)) != 0 || !p) {
+        if ((changed & ~(kPose | kTurn | kShape | kMass)) != 0 || !p) {
             inPlace = false;
             continue;
         }
-        if ((changed & kShape) != 0) inPlace = builtMouseSpring_.isNull() && world_->reshapeBody(scene, switches(), entity);
+        // Mass, shape and turn edits: the World checks the engine's choice
+        // against the scene it would be rebuilt from, which with a mouse
+        // spring is a copy: those rebuild. (An undo after steps brings back
+        // an entity's mass or shape with its pose of the time.)
+        if ((changed & kMass) != 0) inPlace = builtMouseSpring_.isNull() && world_->setMass(scene, switches(), entity);
+        if (inPlace && (changed & kShape) != 0)
+            inPlace = builtMouseSpring_.isNull() && world_->reshapeBody(scene, switches(), entity);
         if (inPlace && (changed & kPose) != 0) inPlace = world_->moveBody(entity, p->value, v ? v->value : Vec2{}).ok();
         if (inPlace && (changed & kTurn) != 0)
             inPlace = builtMouseSpring_.isNull() && world_->turnBody(scene, switches(), entity);
