@@ -206,17 +206,17 @@ void removeAllComponents(Registry& reg, Entity e) {
 }
 
 template <class T>
-void setIfChanged(std::optional<std::pair<T, T>>& slot, const T& before, const T& after) {
+void setIfChanged(CommandStack::Change<T>& slot, const T& before, const T& after) {
     if (!(before == after)) slot.emplace(before, after);
 }
 
 /// Merging: `later` follows `earlier`; the pair becomes (earlier's before,
 /// later's after).
 template <class T>
-void compose(std::optional<std::pair<T, T>>& earlier, const std::optional<std::pair<T, T>>& later) {
+void compose(CommandStack::Change<T>& earlier, const CommandStack::Change<T>& later) {
     if (!later) return;
     if (earlier) earlier->second = later->second;
-    else earlier = later;
+    else earlier.emplace(later->first, later->second);
 }
 
 /// Whether `e` is alive in a slot table taken earlier.
@@ -308,6 +308,7 @@ std::size_t CommandStack::Delta::bytes() const {
         if (c.before.capacity() > 15) n += c.before.capacity() + 1;
         if (c.after.capacity() > 15) n += c.after.capacity() + 1;
     }
+    n += slots.heapBytes() + world.heapBytes() + view.heapBytes() + solver.heapBytes() + version.heapBytes();
     if (slots) n += slots->first.bytes() + slots->second.bytes();
     if (solver)
         for (const std::optional<SolverState>* s : {&solver->first, &solver->second})

@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <string>
@@ -83,6 +84,23 @@ public:
     /// Heap bytes the recorded commands hold (labels and changes).
     std::size_t bytes() const { return bytes_; }
 
+    /// A value before and after an edit, kept on the heap: most commands
+    /// change none of these, and then one costs a pointer (held inline,
+    /// the slot table, world settings and solver state on both sides made
+    /// every one-body command nearly a kilobyte).
+    template <class T>
+    class Change {
+    public:
+        explicit operator bool() const { return bool(pair_); }
+        const std::pair<T, T>* operator->() const { return pair_.get(); }
+        std::pair<T, T>* operator->() { return pair_.get(); }
+        void emplace(T before, T after) { pair_ = std::make_unique<std::pair<T, T>>(std::move(before), std::move(after)); }
+        std::size_t heapBytes() const { return pair_ ? sizeof(std::pair<T, T>) : 0; }
+
+    private:
+        std::unique_ptr<std::pair<T, T>> pair_;
+    };
+
     /// What one command changed; each pair is (before, after).
     struct Delta {
         struct EntityChange {
@@ -90,11 +108,11 @@ public:
             std::string before, after;  ///< encoded components; "" = not alive on that side
         };
         std::vector<EntityChange> entities;
-        std::optional<std::pair<Registry::Slots, Registry::Slots>> slots;
-        std::optional<std::pair<WorldSettings, WorldSettings>> world;
-        std::optional<std::pair<std::optional<View>, std::optional<View>>> view;
-        std::optional<std::pair<std::optional<SolverState>, std::optional<SolverState>>> solver;
-        std::optional<std::pair<int, int>> version;
+        Change<Registry::Slots> slots;
+        Change<WorldSettings> world;
+        Change<std::optional<View>> view;
+        Change<std::optional<SolverState>> solver;
+        Change<int> version;
         std::size_t bytes() const;
     };
     /// Turns the scene on one side of `delta` into the other (forward:
