@@ -663,6 +663,114 @@ TEST(Simulation, UndoAndRedoOfEditsInPlaceGoInPlaceAndRunAsARebuild) {
     }
 }
 
+// While editing, the panels' World takes adds, deletes and their undos in
+// place or rebuilt, in any order, and ends as a World built from the
+// scene: a box added, three circles deleted, both undone, then redone.
+TEST(Simulation, TheEditingWorldFollowsAddsDeletesAndTheirUndos) {
+    Fixture f("pile.json");
+    const auto frame = [&f] { ASSERT_NE(f.ed.sim.editingWorld(f.ed.doc.scene), nullptr) << f.ed.sim.editingWorldError(); };
+    frame();
+    ASSERT_TRUE(f.ed.applyEdit("add", [](Scene& s) {
+        const Entity e = s.registry.create();
+        s.registry.emplace<Position>(e, Position{{-2.0, 20.0}});
+        s.registry.emplace<Box>(e, Box{1.0, 1.0});
+        return true;
+    }));
+    frame();
+    f.ed.select({findByName(f.ed.doc.scene.registry, "c100"), findByName(f.ed.doc.scene.registry, "c101"),
+                 findByName(f.ed.doc.scene.registry, "c102")});
+    ASSERT_TRUE(f.ed.deleteSelection());
+    frame();
+    for (const bool undo : {true, true, false, false}) {
+        ASSERT_TRUE(undo ? f.ed.undo() : f.ed.redo());
+        frame();
+        Result<World> built = World::build(f.ed.doc.scene);
+        ASSERT_TRUE(built) << built.error();
+        const World& live = *f.ed.sim.editingWorld(f.ed.doc.scene);
+        ASSERT_EQ(live.bodyCount(), built->bodyCount());
+        for (std::size_t b = 0; b < built->bodyCount(); ++b) EXPECT_EQ(live.bodyEntity(b), built->bodyEntity(b));
+    }
+}
+
+// A stranger's session: 60 actions drawn from adds, deletes, duplicates,
+// moves, masses, radii, undos, redos, steps and steps back, in an order
+// from a fixed seed. After each, the run with edits in place and one that
+// rebuilds its World after every action hold the same bytes.
+TEST(Simulation, ARandomSessionOfEditsInPlaceRunsAsRebuilds) {
+    Fixture inPlace("pile.json"), rebuilt("pile.json");
+    for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, 20);
+    std::uint64_t state = 12345;
+    const auto next = [&state](std::uint64_t n) {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return (state >> 33) % n;
+    };
+    const auto someBody = [](const Registry& reg, std::uint64_t pick) {
+        std::vector<Entity> free;
+        for (Entity e : reg.entities())
+            if (isFreeBody(reg, e) && reg.has<Radius>(e)) free.push_back(e);
+        return free.empty() ? Entity{} : free[pick % free.size()];
+    };
+    int added = 0;
+    for (int action = 0; action < 60; ++action) {
+        const std::uint64_t kind = next(10), pick = next(1u << 20);
+        const Entity body = someBody(inPlace.ed.doc.scene.registry, pick);
+        SCOPED_TRACE("action " + std::to_string(action) + " kind " + std::to_string(kind));
+        for (Fixture* f : {&inPlace, &rebuilt}) {
+            Editor& ed = f->ed;
+            switch (kind) {
+            case 0:
+                (void)ed.applyEdit("add", [&](Scene& s) {
+                    const Entity e = s.registry.create();
+                    s.registry.emplace<Name>(e, Name{"added " + std::to_string(added)});
+                    s.registry.emplace<Position>(e, Position{{-10.0 + double(pick % 20), 24.0}});
+                    if (pick % 2) s.registry.emplace<Radius>(e, Radius{0.3});
+                    else s.registry.emplace<Box>(e, Box{0.5, 0.4});
+                    return true;
+                });
+                break;
+            case 1:
+                ed.select({body});
+                (void)ed.deleteSelection();
+                break;
+            case 2:
+                ed.select({body});
+                (void)ed.duplicateSelection();
+                break;
+            case 3:
+                (void)ed.applyEdit("move", [&](Scene& s) {
+                    s.registry.tryGet<Position>(body)->value.y += 0.5;
+                    return true;
+                });
+                break;
+            case 4:
+                (void)ed.applyEdit("mass", [&](Scene& s) {
+                    s.registry.emplace<Mass>(body, Mass{0.5 + double(pick % 4)});
+                    return true;
+                });
+                break;
+            case 5:
+                (void)ed.applyEdit("radius", [&](Scene& s) {
+                    s.registry.tryGet<Radius>(body)->value = 0.2 + 0.02 * double(pick % 5);
+                    return true;
+                });
+                break;
+            case 6: (void)ed.undo(); break;
+            case 7: (void)ed.redo(); break;
+            case 8:
+                for (int i = 0; i < 3; ++i) ed.stepForward();
+                break;
+            default: ed.stepBack(); break;
+            }
+        }
+        added += kind == 0 ? 1 : 0;
+        rebuilt.ed.sim.sceneChanged();
+        inPlace.ed.stepForward();
+        rebuilt.ed.stepForward();
+        ASSERT_TRUE(textOf(inPlace.ed.doc.scene) == textOf(rebuilt.ed.doc.scene));
+    }
+    EXPECT_LT(inPlace.ed.sim.worldBuilds(), rebuilt.ed.sim.worldBuilds() / 2) << "most actions went in place";
+}
+
 // What the World does not take in place rebuilds, and still runs as the
 // rebuild: a static wall, a spring, a body spinning near the speed limit,
 // a body joined to one already there, a heavy body that changes the

@@ -211,8 +211,12 @@ void WorldImpl::runEmitters() {
 
 void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> removed, std::span<const Entity> added) {
     // Flags by entity slot: a removed entity's slot may be reused by an
-    // added one, which is told apart by its generation.
-    const std::size_t slots = std::max(reg.slotCount(), bodyOfSlot.size());
+    // added one, which is told apart by its generation. An undone add
+    // takes its slot out of the registry's table with it, so the removed
+    // and this World's own bodies count too.
+    std::size_t slots = std::max(reg.slotCount(), bodyOfSlot.size());
+    for (const Entity e : removed) slots = std::max(slots, std::size_t(e.index) + 1);
+    for (const Entity e : bodyEntity) slots = std::max(slots, std::size_t(e.index) + 1);
     std::vector<Entity> goneAt(slots);
     for (const Entity e : removed) goneAt[e.index] = e;
     const auto isGone = [&goneAt](Entity e) { return e.index < goneAt.size() && goneAt[e.index] == e; };
