@@ -5,11 +5,11 @@
 #include "stepwise/components.hpp"
 
 #include <algorithm>
-#include <unordered_set>
 #include <array>
 #include <chrono>
 #include <cstdio>
 #include <functional>
+#include <unordered_set>
 #include <cmath>
 
 namespace stepwise::editor {

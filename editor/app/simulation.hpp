@@ -83,12 +83,13 @@ public:
         stale_ = true;
         contactsKept_ = false;
     }
-    /// After an undoable edit: one that only moved or turned bodies (their
-    /// position, velocity, angle or angular velocity), changed one body's
-    /// mass, or added or deleted bodies goes to the live World in place
-    /// (World::moveBody, turnBody, setMass, changeEntities), so the rest
-    /// keeps its warm start and nothing is rebuilt; any other edit, or one
-    /// the World declines, makes the World stale.
+    /// After an undoable edit, undo or redo: one that only moved, turned,
+    /// re-massed or reshaped bodies (their position, velocity, angle,
+    /// angular velocity, mass, shape, friction, restitution or filter), or
+    /// added or deleted bodies, goes to the live World in place
+    /// (World::moveBody, turnBody, setMass, reshapeBody, changeEntities), so
+    /// the rest keeps its warm start and nothing is rebuilt; any other edit,
+    /// or one the World declines, makes the World stale.
     void sceneEdited(const Scene& scene, const CommandStack::EditSummary& edit);
     /// Builds the World now if it is stale (for overlays while paused).
     bool ensureWorld(const Scene& scene);

@@ -121,7 +121,6 @@ Result<void> World::turnBody(const Scene& scene, const SystemSwitches& switches,
     return {};
 }
 
-
 Result<void> World::reshapeBody(const Scene& scene, const SystemSwitches& switches, Entity body) {
     WorldImpl& w = *impl_;
     const Result<std::size_t> index = editableBody(w, scene, body);
@@ -133,7 +132,9 @@ Result<void> World::reshapeBody(const Scene& scene, const SystemSwitches& switch
     if (c < 0 || reg.has<Shapes>(body) || reg.has<Chain>(body)) return Error{"only a body's one shape is reshaped in place"};
     const collision::Collider& old = w.collision->collider(std::size_t(c));
     if (old.solverOnly || old.hub >= 0) return Error{"only a body's one shape is reshaped in place"};
-    if (std::optional<Error> problem = detail::shapeProblem(reg, w.bodySceneIndex[b])) return std::move(*problem);
+    const std::size_t at = w.bodySceneIndex[b];
+    if (at >= reg.entities().size() || reg.entities()[at] != body) return Error{"the scene's order changed"};
+    if (std::optional<Error> problem = detail::shapeProblem(reg, at)) return std::move(*problem);
     // The collider as a build would make it now.
     detail::ShapeStorage storage;
     std::vector<collision::CollisionSystem::ColliderAdd> made;
@@ -178,8 +179,8 @@ double reachFromPosition(const Registry& reg, Entity e) {
 }
 
 /// Why `e`, the scene's entity number `index`, cannot join the World in
-/// place (what changeBodies adds: a dynamic body with a shape and no turn,
-/// or a joint whose ends are added with it); nothing when it can.
+/// place (what changeBodies adds: a dynamic body with a shape, or a joint
+/// whose ends are added with it); nothing when it can.
 std::optional<Error> addableProblem(const Registry& reg, std::size_t index, const std::unordered_set<std::uint64_t>& added) {
     const Entity e = reg.entities()[index];
     if (const Joint* joint = reg.tryGet<Joint>(e)) {
