@@ -440,11 +440,13 @@ public:
     /// order), in place: the islands of removed bodies wake, every other
     /// body and every contact's warm start stay, and the steps that follow
     /// are those of reload(scene, switches). The editor adds and deletes
-    /// bodies this way. Fails, leaving the World as it was, for anything but
-    /// dynamic bodies with a shape and the joints among them (added) or
-    /// dynamic bodies and joints (removed), when springs, attractors, boids
-    /// or emitters act, or when the edit would change the engine's choice of
-    /// settings: the caller then reloads.
+    /// bodies this way; a static shape that comes or goes wakes every
+    /// island. Fails, leaving the World as it was, for anything but dynamic
+    /// and static bodies with a shape and the joints among dynamic ones
+    /// (added) or bodies and joints other than planes and kinematic bodies
+    /// (removed), when springs, attractors, boids or emitters act, or when
+    /// the edit would change the engine's choice of settings: the caller
+    /// then reloads.
     Result<void> changeEntities(const Scene& scene, const SystemSwitches& switches, std::span<const Entity> removed,
                                 std::span<const Entity> added);
     double time() const;

@@ -179,22 +179,27 @@ double reachFromPosition(const Registry& reg, Entity e) {
 }
 
 /// Why `e`, the scene's entity number `index`, cannot join the World in
-/// place (what changeBodies adds: a dynamic body with a shape, or a joint
-/// whose ends are added with it); nothing when it can.
+/// place (what changeBodies adds: a dynamic or static body with a shape,
+/// or a joint whose ends are added with it); nothing when it can.
 std::optional<Error> addableProblem(const Registry& reg, std::size_t index, const std::unordered_set<std::uint64_t>& added) {
     const Entity e = reg.entities()[index];
     if (const Joint* joint = reg.tryGet<Joint>(e)) {
-        for (const Entity end : {joint->a, joint->b})
+        for (const Entity end : {joint->a, joint->b}) {
             if (!end.isNull() && !added.count(keyOf(end))) return Error{"a joint to a body that was already there"};
+            if (!end.isNull() && isOn(reg.tryGet<Static>(end))) return Error{"a joint to a static body is added by a rebuild"};
+        }
         return std::nullopt;
     }
     if (reg.has<Spring>(e)) return Error{"a spring is checked by a rebuild"};
     if (!reg.has<Position>(e)) return std::nullopt;  // not simulated (World::build skips it too)
-    if (isOn(reg.tryGet<Static>(e)) || isOn(reg.tryGet<Kinematic>(e)) || reg.has<Plane>(e) || reg.has<Attractor>(e) ||
-        reg.has<Boid>(e) || reg.has<Emitter>(e) || reg.has<Template>(e))
-        return Error{"only dynamic bodies are added in place"};
-    if (!reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) && !reg.has<Capsule>(e) && !reg.has<Shapes>(e))
+    if (isOn(reg.tryGet<Kinematic>(e)) || reg.has<Plane>(e) || reg.has<Attractor>(e) || reg.has<Boid>(e) ||
+        reg.has<Emitter>(e) || reg.has<Template>(e))
+        return Error{"only dynamic and static bodies are added in place"};
+    const bool fixed = isOn(reg.tryGet<Static>(e));
+    if (!reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) && !reg.has<Capsule>(e) && !reg.has<Shapes>(e) &&
+        !(fixed && reg.has<Chain>(e)))
         return Error{"a body without a shape is added by a rebuild"};
+    if (fixed) return detail::shapeProblem(reg, index);
     // A build refuses a spin that moves a point faster than a run holds.
     // The centre of mass lies within the shapes, so no point is farther
     // from it than twice the reach from the position: a spin under that
@@ -229,8 +234,8 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
         if (isGone(w.bodyEntity[b]) && !w.isKinematic.empty() && w.isKinematic[b])
             return Error{"a kinematic body is removed by a rebuild"};
     for (std::size_t c = 0; c < w.collision->colliderCount(); ++c)
-        if (w.collision->collider(c).body < 0 && isGone(w.collision->collider(c).entity))
-            return Error{"a static shape is removed by a rebuild"};
+        if (w.collision->collider(c).shape.kind == collision::ShapeKind::Plane && isGone(w.collision->collider(c).entity))
+            return Error{"a plane is removed by a rebuild"};
     for (const joints::JointConstraint& j : w.collision->jointConstraints())
         if (!isGone(j.entity) && (isGone(j.entityA) || isGone(j.entityB)))
             return Error{"a joint stays while a body it holds is removed"};

@@ -278,10 +278,16 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
         springName.resize(out);
     }
 
-    // The copies' bodies, at the end in scene order.
+    // The copies' bodies, at the end in scene order (a static entity is
+    // shapes only, as World::build has it).
+    bool staticChanged = false;
     for (const Entity e : added) {
         const Position* p = reg.tryGet<Position>(e);
         if (!p || reg.has<Joint>(e) || reg.has<Spring>(e)) continue;
+        if (const Static* st = reg.tryGet<Static>(e); st && st->value) {
+            staticChanged = true;
+            continue;
+        }
         const Velocity* vel = reg.tryGet<Velocity>(e);
         const Shapes* compound = reg.tryGet<Shapes>(e);
         const double mass = reg.has<Mass>(e) ? reg.tryGet<Mass>(e)->value
@@ -359,7 +365,10 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
     // Shapes and joints.
     if (collision) {
         std::vector<std::uint8_t> dropCollider(collision->colliderCount(), 0);
-        for (std::size_t c = 0; c < dropCollider.size(); ++c) dropCollider[c] = isGone(collision->collider(c).entity) ? 1 : 0;
+        for (std::size_t c = 0; c < dropCollider.size(); ++c) {
+            dropCollider[c] = isGone(collision->collider(c).entity) ? 1 : 0;
+            staticChanged = staticChanged || (dropCollider[c] && collision->collider(c).body < 0);
+        }
         const std::span<const joints::JointConstraint> oldJoints = collision->jointConstraints();
         std::vector<std::uint8_t> dropJoint(oldJoints.size(), 0);
         for (std::size_t k = 0; k < oldJoints.size(); ++k) dropJoint[k] = isGone(oldJoints[k].entity) ? 1 : 0;
@@ -443,6 +452,8 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
         backupV.assign(2 * n, 0.0);
     }
     stepStartKnown = false;
+    // A static shape that came or went may have held up any island.
+    if (staticChanged) sleep.wakeAll();
     sleep.refresh();
     sleep.changed = true;
     sleepChanged();
