@@ -938,6 +938,12 @@ TEST(Simulation, APullNoStepCanTakeIsRefusedNamingTheBody) {
     EXPECT_NE(f.ed.sim.message().find("cannot simulate: entity 1 (\"planet\"): the attractors pull it at"),
               std::string::npos)
         << f.ed.sim.message();
+    EXPECT_TRUE(f.ed.sim.cannotSimulate());
+    // Undone, the level builds again and the refusal is over.
+    ASSERT_TRUE(f.ed.undo());
+    f.ed.stepForward();
+    EXPECT_EQ(f.ed.sim.steps(), 1u) << f.ed.sim.message();
+    EXPECT_FALSE(f.ed.sim.cannotSimulate());
 }
 
 TEST(Simulation, TimeScaleSetsStepsPerFrame) {

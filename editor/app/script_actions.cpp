@@ -65,7 +65,7 @@ void step(ScriptActionRun& r) {
     for (int i = 0; i < c.count && r.ok(); ++i) {
         ed.stepForward();
         // A diverged step, or a level that cannot be simulated.
-        if (ed.sim.diverged() || ed.sim.message().rfind("cannot simulate", 0) == 0)
+        if (ed.sim.diverged() || ed.sim.cannotSimulate())
             r.failLine("step " + std::to_string(i + 1) + " of " + std::to_string(c.count) + ": " + ed.sim.message());
     }
 }

@@ -99,13 +99,19 @@ bool Simulation::rebuild(const Scene& scene) {
     builtMouseBody_ = builtMouseSpring_.isNull() ? Entity{} : mouseSpring->first;
     sceneAtBuild_.reset();
     if (!built) {
-        world_.reset();
-        message_ = "cannot simulate: " + built.error();
+        refuse(built.error());
         return false;
     }
     world_.emplace(std::move(*built));
+    refusal_.clear();
     stale_ = false;
     return true;
+}
+
+void Simulation::refuse(std::string why) {
+    world_.reset();
+    refusal_ = std::move(why);
+    message_ = "cannot simulate: " + refusal_;
 }
 
 bool Simulation::reload(const Scene& scene) {
@@ -121,10 +127,10 @@ bool Simulation::reload(const Scene& scene) {
     ++worldBuilds_;
     sceneAtBuild_.reset();
     if (!reloaded) {
-        world_.reset();
-        message_ = "cannot simulate: " + reloaded.error();
+        refuse(reloaded.error());
         return false;
     }
+    refusal_.clear();
     builtMouseSpring_ = springEntity;
     builtMouseBody_ = springEntity.isNull() ? Entity{} : mouseSpring->first;
     stale_ = false;
@@ -228,7 +234,7 @@ const World* Simulation::editingWorld(const Scene& scene) {
     if (stale_ || !world_) {
         const std::string kept = message_;
         editingError_.clear();
-        if (!reload(scene)) editingError_ = message_.substr(std::string_view("cannot simulate: ").size());
+        if (!reload(scene)) editingError_ = refusal_;
         message_ = kept;  // a refusal while editing is shown in the panel, not as a run's message
     }
     return world_ ? &*world_ : nullptr;
@@ -494,10 +500,10 @@ bool Simulation::stepBack(Scene& scene) {
         if (!r) {
             Result<World> built = World::build(sim, on);
             if (!built) {
-                world_.reset();
-                message_ = "cannot simulate: " + built.error();
+                refuse(built.error());
             } else {
                 world_.emplace(std::move(*built));
+                refusal_.clear();
             }
         }
         ++worldBuilds_;
@@ -537,6 +543,7 @@ bool Simulation::reset(Scene& scene) {
     steps_ = 0;  // the step counter belongs to the run that ended
     stale_ = true;
     message_.clear();
+    refusal_.clear();
     diverged_ = false;
     contactPair.reset();
     mouseSpring.reset();

@@ -153,6 +153,9 @@ public:
     /// max_force 4000 N"); the joint is already gone from the scene.
     std::vector<std::string> takeBreakNotes() { return std::exchange(breakNotes_, {}); }
     bool diverged() const { return diverged_; }
+    /// The last build of the World from the scene was refused (message()
+    /// says why); false once one succeeds.
+    bool cannotSimulate() const { return !refusal_.empty(); }
     /// The contacts the panels and the overlay show: the last step's. An edit
     /// that leaves the contacts as they were (a mass, a colour, a name, a
     /// velocity: not a position, angle, shape, wall or static flag, and no
@@ -245,6 +248,9 @@ private:
     std::uint64_t steps_ = 0;
     double frameStepMs_ = 0.0;
     std::string message_;
+    std::string refusal_;  ///< why the last build or reload was refused; empty after one succeeds
+    /// Drops the World that could not be built, keeping why.
+    void refuse(std::string why);
     std::vector<std::string> breakNotes_;
     bool diverged_ = false;
     struct BeforeEdits {

@@ -69,7 +69,8 @@ public:
                     // lost to rounding next to h^2 k (k >= ~1e20 for 1 kg at
                     // 60 Hz). Keeping v1 = v0 froze every body, the free
                     // ones too: refuse the step instead.
-                    fail("the linear system is singular in double precision (the factorisation failed)");
+                    fail("the linear system is singular in double precision (the factorisation failed)",
+                         Failure::Factorisation);
                     break;
                 }
                 factored = true;
@@ -232,11 +233,15 @@ private:
                       "the linear solve lost its accuracy (residual %.2g of the right-hand side; the system is too "
                       "stiff for doubles at this dt)",
                       rhsSize > 0.0 ? size / rhsSize : size);
-        fail(text);
+        fail(text, Failure::Solve);
         return false;
     }
 
-    void fail(const std::string& what) {
+    /// Which part of the Newton step failed: the factorisation of the
+    /// system, or the solve that followed it (then the residual names the
+    /// bodies whose rows went wrong).
+    enum class Failure { Factorisation, Solve };
+    void fail(const std::string& what, Failure where) {
         failed_ = true;
         failure_.what = what;
         failure_.bodies.clear();
@@ -244,7 +249,7 @@ private:
         const bool solved = residual_.size() == rhs_.size() && residual_.allFinite();
         for (std::size_t b = 0; b < n_; ++b) {
             bool bad;
-            if (solved && failure_.what.rfind("the linear solve", 0) == 0) {
+            if (solved && where == Failure::Solve) {
                 const double r = std::max(std::abs(residual_[Eigen::Index(2 * b)]),
                                           std::abs(residual_[Eigen::Index(2 * b + 1)]));
                 bad = !(r <= kSolveRelativeResidual * rhsSize);
