@@ -296,7 +296,7 @@ TEST(Simulation, AShapeEditGoesInPlaceAndRunsAsARebuild) {
     };
     const Case cases[] = {
         {"smaller circle", "pile.json", "c1000", [](Registry& r, Entity e) { r.tryGet<Radius>(e)->value *= 0.8; }, true},
-        {"larger circle", "pile.json", "c1999", [](Registry& r, Entity e) { r.tryGet<Radius>(e)->value *= 1.3; }, true},
+        {"larger circle", "pile.json", "c1899", [](Registry& r, Entity e) { r.tryGet<Radius>(e)->value *= 1.3; }, true},
         {"friction", "pile.json", "c10", [](Registry& r, Entity e) { r.emplace<Friction>(e, Friction{0.05}); }, true},
         {"wider box", "pyramid.json", "", [](Registry& r, Entity e) { r.tryGet<Box>(e)->width *= 1.1; }, true},
         {"thicker capsule", "capsules.json", "ramp capsule 0",
@@ -620,7 +620,7 @@ TEST(Simulation, StepBackAfterAnEditInPlaceRestoresTheEditedScene) {
     const Case cases[] = {
         {"add", [](Scene& s, Vec2 at) { addOneOfEach(s, at); }},
         {"delete", [](Scene& s, Vec2) { (void)s.registry.destroy(findByName(s.registry, "c1000")); }},
-        {"mass", [](Scene& s, Vec2) { s.registry.emplace<Mass>(findByName(s.registry, "c1999"), Mass{3.0}); }},
+        {"mass", [](Scene& s, Vec2) { s.registry.emplace<Mass>(findByName(s.registry, "c1899"), Mass{3.0}); }},
         {"radius", [](Scene& s, Vec2) { s.registry.tryGet<Radius>(findByName(s.registry, "c1500"))->value = 0.4; }},
     };
     for (const Case& c : cases) {
@@ -689,8 +689,8 @@ TEST(Simulation, UndoAndRedoOfEditsInPlaceGoInPlaceAndRunAsARebuild) {
         std::function<void(Scene&, Vec2)> edit;
     };
     const Case cases[] = {
-        {"move", [](Scene& s, Vec2) { s.registry.tryGet<Position>(findByName(s.registry, "c1999"))->value.y += 1.0; }},
-        {"mass", [](Scene& s, Vec2) { s.registry.emplace<Mass>(findByName(s.registry, "c1999"), Mass{3.0}); }},
+        {"move", [](Scene& s, Vec2) { s.registry.tryGet<Position>(findByName(s.registry, "c1899"))->value.y += 1.0; }},
+        {"mass", [](Scene& s, Vec2) { s.registry.emplace<Mass>(findByName(s.registry, "c1899"), Mass{3.0}); }},
         {"radius", [](Scene& s, Vec2) { s.registry.tryGet<Radius>(findByName(s.registry, "c1500"))->value = 0.4; }},
         {"add", [](Scene& s, Vec2 at) { addOneOfEach(s, at); }},
         {"delete", [](Scene& s, Vec2) { (void)s.registry.destroy(findByName(s.registry, "c1000")); }},

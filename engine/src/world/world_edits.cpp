@@ -160,8 +160,6 @@ namespace {
 bool isOn(const Static* s) { return s && s->value; }
 bool isOn(const Kinematic* k) { return k && k->value; }
 
-std::uint64_t keyOf(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
-
 /// How far a body's shapes reach from its position, metres.
 double reachFromPosition(const Registry& reg, Entity e) {
     double reach = 0.0;
@@ -181,11 +179,11 @@ double reachFromPosition(const Registry& reg, Entity e) {
 /// Why `e`, the scene's entity number `index`, cannot join the World in
 /// place (what changeBodies adds: a dynamic or static body with a shape,
 /// or a joint whose ends are added with it); nothing when it can.
-std::optional<Error> addableProblem(const Registry& reg, std::size_t index, const std::unordered_set<std::uint64_t>& added) {
+std::optional<Error> addableProblem(const Registry& reg, std::size_t index, const std::unordered_set<Entity>& added) {
     const Entity e = reg.entities()[index];
     if (const Joint* joint = reg.tryGet<Joint>(e)) {
         for (const Entity end : {joint->a, joint->b}) {
-            if (!end.isNull() && !added.count(keyOf(end))) return Error{"a joint to a body that was already there"};
+            if (!end.isNull() && !added.count(end)) return Error{"a joint to a body that was already there"};
             if (!end.isNull() && isOn(reg.tryGet<Static>(end))) return Error{"a joint to a static body is added by a rebuild"};
         }
         return std::nullopt;
@@ -224,12 +222,10 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
         return Error{"springs, attractors and boids act on every body: a rebuild checks them"};
     // The removed: dynamic bodies and joints of this World, gone from the
     // scene, that nothing kept holds.
-    std::unordered_set<std::uint64_t> gone;
-    for (const Entity e : removed) {
+    const std::unordered_set<Entity> gone(removed.begin(), removed.end());
+    for (const Entity e : removed)
         if (reg.alive(e)) return Error{"a removed entity is still in the scene"};
-        gone.insert(keyOf(e));
-    }
-    const auto isGone = [&gone](Entity e) { return !e.isNull() && gone.count(keyOf(e)) != 0; };
+    const auto isGone = [&gone](Entity e) { return !e.isNull() && gone.count(e) != 0; };
     for (std::size_t b = 0; b < w.bodyEntity.size(); ++b)
         if (isGone(w.bodyEntity[b]) && !w.isKinematic.empty() && w.isKinematic[b])
             return Error{"a kinematic body is removed by a rebuild"};
@@ -244,8 +240,7 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
     const std::vector<Entity>& order = reg.entities();
     if (added.size() > order.size() || !std::equal(added.begin(), added.end(), order.end() - std::ptrdiff_t(added.size())))
         return Error{"added entities are not the scene's last"};
-    std::unordered_set<std::uint64_t> fresh;
-    for (const Entity e : added) fresh.insert(keyOf(e));
+    const std::unordered_set<Entity> fresh(added.begin(), added.end());
     for (std::size_t i = order.size() - added.size(); i < order.size(); ++i)
         if (std::optional<Error> problem = addableProblem(reg, i, fresh)) return std::move(*problem);
     if (std::optional<Error> other = w.keepChoiceFor(scene, switches)) return std::move(*other);
