@@ -381,6 +381,26 @@ TEST(Springs, EndsArePickedInTheViewportOrTheEntityList) {
     EXPECT_FALSE(f.ed.referencePick.has_value());
 }
 
+// The inspector shows a refusal in red by the flag the refusal set, not
+// by the text: a status that merely begins "refused" is not one.
+TEST(Springs, ARefusedPickMarksTheStatusAsARefusal) {
+    Fixture f("default.json");
+    const Entity spring = f.named("pendulum spring");
+    const ComponentInfo* info = findComponent("spring");
+    // Both ends on the bob: a spring from a body to itself.
+    f.ed.startReferencePick(*info, info->fields[1], {spring});
+    EXPECT_FALSE(f.ed.finishReferencePick(f.named("bob")));
+    EXPECT_EQ(f.ed.status.rfind("refused: ", 0), 0u) << f.ed.status;
+    EXPECT_TRUE(f.ed.statusRefused);
+    f.ed.startReferencePick(*info, info->fields[0], {spring});
+    EXPECT_FALSE(f.ed.statusRefused);
+    f.ed.note("refused-looking text of a plain note");
+    EXPECT_FALSE(f.ed.statusRefused);
+    f.ed.select({f.named("bob")});
+    ASSERT_TRUE(f.ed.deleteSelection());
+    EXPECT_FALSE(f.ed.statusRefused);
+}
+
 TEST(Editing, DeletingABodyWithASpringSaysWhatGoes) {
     Fixture f("default.json");
     f.ed.select({f.named("bob")});

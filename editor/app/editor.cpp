@@ -32,8 +32,9 @@ void Editor::afterUndoOrRedo() {
     ++revisionExtra_;
 }
 
-void Editor::note(std::string text) {
+void Editor::note(std::string text, bool refused) {
     status = text;
+    statusRefused = refused;
     log.push_back(std::move(text));
     if (log.size() > 200) log.erase(log.begin());
 }
@@ -175,6 +176,11 @@ void Editor::resolvePending(Resolution r) {
 
 // ---- editing ---------------------------------------------------------------------
 
+void Editor::refuse(const std::string& why) {
+    status = "refused: " + why;
+    statusRefused = true;
+}
+
 bool Editor::applyEdit(const std::string& label, const std::function<bool(Scene&)>& edit, std::uint64_t mergeKey) {
     if (commands.absoluteCursor() < savedCursor_) savedReachable_ = false;  // the saved state leaves the redo branch
     sim.beforeEdit(commands.cursor());
@@ -182,6 +188,7 @@ bool Editor::applyEdit(const std::string& label, const std::function<bool(Scene&
     sim.sceneEdited(doc.scene, commands.lastEdit());
     pruneSelection();
     status = label;
+    statusRefused = false;
     return true;
 }
 
@@ -253,7 +260,12 @@ bool Editor::finishReferencePick(Entity target) {
     const Result<bool> edited =
         tryEdit(what, [&](Scene& s) { return changedAny(setFieldOnAll(s, *p.component, *p.field, target, p.entities)); });
     if (edited && *edited) return true;
-    status = edited ? "nothing changed" : "refused: " + edited.error();
+    if (edited) {
+        status = "nothing changed";
+        statusRefused = false;
+    } else {
+        refuse(edited.error());
+    }
     return false;
 }
 

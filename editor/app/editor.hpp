@@ -170,10 +170,17 @@ public:
 
     // ---- messages -------------------------------------------------------
     std::string status;          ///< one line, bottom of the window
+    /// Whether `status` says an edit was refused (the inspector shows it in
+    /// red); set with the text by note and refuse, never read from it.
+    bool statusRefused = false;
     std::string errorModal;      ///< non-empty: shown as a modal until dismissed
     UiRequest uiRequest = UiRequest::None;
     std::vector<std::string> log;  ///< newest last
-    void note(std::string text);
+    /// Sets the status line and logs it; `refused` marks a refusal.
+    void note(std::string text, bool refused = false);
+    /// Status "refused: why", not logged: a slider held past its range
+    /// refuses every frame.
+    void refuse(const std::string& why);
 
     // ---- autosave -------------------------------------------------------
     std::filesystem::path configDir;

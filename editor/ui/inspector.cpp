@@ -311,7 +311,7 @@ void reportRefusedTyping(UiState& ui, Editor& ed, const std::string& who, std::s
     if (ui.refusedTypingFor == 0 || !ImGui::IsItemActive() || GImGui->LastItemData.ID != ui.refusedTypingFor) return;
     const std::string text = "refused: " + who + std::string(field) + ": \"" + ui.refusedTyping +
                              "\" is not a number (digits, '.', 'e', '+', '-', '*' and '/' can be typed)";
-    if (ed.status != text) ed.note(text);
+    if (ed.status != text) ed.note(text, true);
 }
 
 bool worldFieldWidget(UiState& ui, Editor& ed, std::string_view key) {
@@ -342,7 +342,7 @@ bool worldFieldWidget(UiState& ui, Editor& ed, std::string_view key) {
                 return !problem;
             }, ui.activeKey) &&
             problem)
-            ed.status = "refused: " + problem->message;
+            ed.refuse(problem->message);
     }
     if (ImGui::IsItemDeactivated()) ed.endEdit();
     return changed;
@@ -454,7 +454,7 @@ void drawInspector(UiState& ui, Editor& ed) {
                     const Result<bool> edited = ed.tryEdit(what, [&](Scene& s) {
                         return editor::changedAny(editor::setFieldOnAll(s, info, f, value, selection));
                     }, ui.activeKey);
-                    if (!edited) ed.status = "refused: " + edited.error();
+                    if (!edited) ed.refuse(edited.error());
                 }
                 if (ImGui::IsItemDeactivated()) ed.endEdit();
                 ImGui::PopID();
@@ -469,7 +469,7 @@ void drawInspector(UiState& ui, Editor& ed) {
         const Result<bool> edited = ed.tryEdit("remove " + std::string(info.name), [&](Scene& s) {
             return editor::changedAny(editor::removeComponentFromAll(s, info, selection));
         });
-        if (!edited) ed.status = "refused: " + edited.error();
+        if (!edited) ed.refuse(edited.error());
     }
 
     ImGui::Separator();
@@ -482,14 +482,14 @@ void drawInspector(UiState& ui, Editor& ed) {
                 const Result<bool> edited = ed.tryEdit("add " + std::string(info.name), [&](Scene& s) {
                     return editor::changedAny(editor::addComponentToAll(s, info, selection));
                 });
-                if (!edited) ed.status = "refused: " + edited.error();
+                if (!edited) ed.refuse(edited.error());
             }
             if (ImGui::IsItemHovered() && !info.description.empty())
                 ImGui::SetTooltip("%.*s", int(info.description.size()), info.description.data());
         }
         ImGui::EndCombo();
     }
-    if (!ed.status.empty() && ed.status.rfind("refused", 0) == 0) ImGui::TextColored(kRed, "%s", ed.status.c_str());
+    if (ed.statusRefused) ImGui::TextColored(kRed, "%s", ed.status.c_str());
     ImGui::End();
 }
 

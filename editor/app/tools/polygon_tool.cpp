@@ -46,7 +46,7 @@ void Editor::releaseRegularPolygon() {
     const Result<bool> placed =
         tryEdit("place polygon", [&](Scene& s) { return createdInto(addPolygon(s, outline), created); });
     if (placed && *placed) selection = {created};
-    else if (!placed) note("refused: " + placed.error());
+    else if (!placed) note("refused: " + placed.error(), true);
 }
 
 std::vector<Vec2> Editor::polygonPreview() const {
@@ -82,7 +82,7 @@ bool Editor::finishPolygon() {
     const Result<bool> placed =
         tryEdit("place polygon", [&](Scene& s) { return createdInto(addPolygon(s, hull), created); });
     if (!placed || !*placed) {
-        note(placed ? "nothing changed" : "refused: " + placed.error());
+        note(placed ? "nothing changed" : "refused: " + placed.error(), !placed);
         return false;
     }
     selection = {created};
