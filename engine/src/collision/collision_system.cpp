@@ -624,6 +624,14 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
         p.dnA = dot(anchorA, m.normal);
         p.dnB = dot(anchorB, m.normal);
     }
+    // Noted here, where the separations are at hand, rather than by a pass
+    // over every contact (addDeepOverlapsToCrowd).
+    if (!c.touchesStatic) {
+        double deepest = m.points[0].separation;
+        if (m.pointCount == 2) deepest = std::min(deepest, m.points[1].separation);
+        if (deepest < -0.25 * std::min(maxExtent_[a], maxExtent_[b]))
+            deepContacts_.push_back(std::uint32_t(constraints_.size() - 1));
+    }
     if (settings_.warmStart && !cache_.empty()) {
         // The cache is sorted by key, and pairs arrive sorted by (a, b), so
         // the search for this pair starts where the last pair's ended (a
@@ -792,6 +800,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     const auto narrowStart = std::chrono::steady_clock::now();
     constraints_.clear();
     details_.clear();
+    deepContacts_.clear();
     sensorCandidates_.clear();
     // At most one manifold a pair (and a plane against each movable shape):
     // reserving once avoids the copies and the doubled capacity of growth
@@ -951,13 +960,8 @@ void CollisionSystem::addDeepOverlapsToCrowd() {
     // Box2D's smash scene would keep 0.3 m overlaps that never open.)
     inCrowd_.assign(bodies_.size(), 0);
     for (const std::uint32_t b : crowdBodies_) inCrowd_[b] = 1;
-    for (std::size_t k = 0; k < constraints_.size(); ++k) {
+    for (const std::uint32_t k : deepContacts_) {
         const ContactConstraint& c = constraints_[k];
-        if (c.touchesStatic) continue;
-        const ContactDetail& d = details_[k];
-        double deepest = d.separation[0];
-        if (c.pointCount == 2) deepest = std::min(deepest, d.separation[1]);
-        if (!(deepest < -0.25 * std::min(maxExtent_[d.colliderA], maxExtent_[d.colliderB]))) continue;
         for (const std::uint32_t b : {c.bodyA, c.bodyB}) {
             if (inCrowd_[b]) continue;
             inCrowd_[b] = 1;

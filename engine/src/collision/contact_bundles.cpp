@@ -396,9 +396,13 @@ void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32
             for (std::size_t at = 0; at < sizeof(ContactConstraint); at += 64) __builtin_prefetch(line + at);
         }
         if (k + kBodiesAhead < order.size()) {
+            // Both lines of each body: the inverse inertia sits on the
+            // second (the iterations' fields fill the first).
             const ContactConstraint& ahead = contacts[order[k + kBodiesAhead]];
             __builtin_prefetch(&bodies[ahead.bodyA]);
+            __builtin_prefetch(&bodies[ahead.bodyA].invInertia);
             __builtin_prefetch(&bodies[ahead.bodyB]);
+            __builtin_prefetch(&bodies[ahead.bodyB].invInertia);
         }
         fillLane(out[first + k / kContactLanes], int(k % kContactLanes), contacts[order[k]], order[k], bodies);
     }

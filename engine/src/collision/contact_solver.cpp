@@ -90,24 +90,12 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
 
 void indexImpacts(std::span<const ContactConstraint> contacts, std::span<const ContactDetail> details,
                   std::size_t bodyCount, ImpactScratch& scratch) {
-    // Counting sort of (body, contact) by body; static body 0 never changes
-    // velocity, so it lists nothing.
-    scratch.start.assign(bodyCount + 1, 0u);
-    for (const ContactConstraint& c : contacts) {
-        if (c.bodyA != 0) ++scratch.start[c.bodyA + 1];
-        if (c.bodyB != 0) ++scratch.start[c.bodyB + 1];
-    }
-    for (std::size_t b = 0; b < bodyCount; ++b) scratch.start[b + 1] += scratch.start[b];
-    scratch.incident.resize(scratch.start[bodyCount]);
-    std::vector<std::uint32_t>& at = scratch.now32;  // next free slot per body
-    at.assign(scratch.start.begin(), scratch.start.end() - 1);
     scratch.reach.assign(bodyCount, 0.0);
     scratch.pairBodies.resize(2 * contacts.size());
     scratch.restitution.resize(contacts.size());
+    scratch.incidentReady = false;
     for (std::size_t k = 0; k < contacts.size(); ++k) {
         const ContactConstraint& c = contacts[k];
-        if (c.bodyA != 0) scratch.incident[at[c.bodyA]++] = std::uint32_t(k);
-        if (c.bodyB != 0) scratch.incident[at[c.bodyB]++] = std::uint32_t(k);
         scratch.pairBodies[2 * k] = c.bodyA;
         scratch.pairBodies[2 * k + 1] = c.bodyB;
         scratch.restitution[k] = details[k].restitution;
@@ -117,6 +105,26 @@ void indexImpacts(std::span<const ContactConstraint> contacts, std::span<const C
         }
     }
 }
+
+namespace {
+
+/// Which contacts touch which body, from the packed pairs: a counting sort
+/// of (body, contact) by body. Static body 0 never changes velocity, so it
+/// lists nothing.
+void indexIncident(std::size_t contactCount, std::size_t bodyCount, ImpactScratch& scratch) {
+    scratch.start.assign(bodyCount + 1, 0u);
+    for (std::size_t k = 0; k < 2 * contactCount; ++k)
+        if (const std::uint32_t b = scratch.pairBodies[k]; b != 0) ++scratch.start[b + 1];
+    for (std::size_t b = 0; b < bodyCount; ++b) scratch.start[b + 1] += scratch.start[b];
+    scratch.incident.resize(scratch.start[bodyCount]);
+    std::vector<std::uint32_t>& at = scratch.now32;  // next free slot per body
+    at.assign(scratch.start.begin(), scratch.start.end() - 1);
+    for (std::size_t k = 0; k < 2 * contactCount; ++k)
+        if (const std::uint32_t b = scratch.pairBodies[k]; b != 0) scratch.incident[at[b]++] = std::uint32_t(k / 2);
+    scratch.incidentReady = true;
+}
+
+} // namespace
 
 void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDetail> details,
                       std::span<SolverBody> bodies, double h, double threshold, int maxPasses,
@@ -153,6 +161,7 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
     // in this pass if it comes after k, else in the next pass (k included).
     const auto touched = [&](std::uint32_t body, std::size_t k) {
         if (body == 0) return;
+        if (!scratch.incidentReady) indexIncident(contacts.size(), bodies.size(), scratch);
         for (std::uint32_t i = scratch.start[body]; i < scratch.start[body + 1]; ++i) {
             const std::uint32_t m = scratch.incident[i];
             (m > k ? now : next)[m / 64] |= std::uint64_t(1) << (m % 64);

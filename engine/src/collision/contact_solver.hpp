@@ -149,12 +149,15 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
 /// contact was last looked at (or that fired then): the others would find
 /// what they found before and do nothing, so the result is that of passes
 /// over every contact, at the cost of the contacts that move. `scratch` holds
-/// which contacts touch which body; build it with indexImpacts once a step.
+/// which contacts touch which body; indexImpacts resets it once a step, and
+/// the first impulse of the step lists them (most steps of a resting scene
+/// have none).
 struct ImpactScratch {
+    bool incidentReady = false;           ///< start and incident list this step's contacts
     std::vector<std::uint32_t> start;     ///< solver body b's contacts: incident[start[b], start[b + 1])
     std::vector<std::uint32_t> incident;  ///< contact indices, ascending per body
     std::vector<std::uint64_t> now, next;  ///< contacts to look at in this pass and the next (bit sets)
-    std::vector<std::uint32_t> now32;      ///< indexImpacts' cursor per body
+    std::vector<std::uint32_t> now32;      ///< the listing's cursor per body
     /// Per solver body: the largest |rn| of its contact points this step
     /// (m), and at the start of a substep a bound on the normal speed any
     /// of its points can have, |v.x| + |v.y| + |w| reach (m/s).
