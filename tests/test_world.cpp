@@ -446,6 +446,31 @@ TEST(World, StiffnessHintsNameSpringAndLargestStableDt) {
     EXPECT_TRUE(buildOrDie(scene).stiffnessHints().empty());
 }
 
+// A spring with no name is called by its place in the scene's order; a
+// body deleted before it in place moves it up, as a rebuild would count.
+TEST(World, AnUnnamedSpringIsCalledByItsNewPlaceAfterADeleteInPlace) {
+    Scene s = emptyScene("semi_implicit_euler", 1.0 / 60.0, {0.0, -10.0});
+    s.world.substeps = 1;
+    const Entity first = addBody(s, "first", {0.0, 5.0}, {0.0, 0.0});
+    const Entity second = addBody(s, "second", {3.0, 5.0}, {0.0, 0.0});
+    for (const Entity e : {first, second}) s.registry.emplace<Radius>(e, Radius{0.2});
+    const Entity spring = s.registry.create();
+    Spring sp;
+    sp.a = second;
+    sp.anchor = Vec2{3.0, 6.0};
+    sp.k = 1e6;  // h omega = 1000 / 60, far past 2: a hint names it
+    s.registry.emplace<Spring>(spring, std::move(sp));
+    World w = buildOrDie(s);
+    ASSERT_EQ(w.stiffnessHints().size(), 1u);
+    EXPECT_EQ(w.stiffnessHints()[0].springName, "entity 2");
+    ASSERT_TRUE(s.registry.destroy(first));
+    const Result<void> changed = w.changeEntities(s, {}, std::vector<Entity>{first}, {});
+    ASSERT_TRUE(changed.ok()) << changed.error();
+    ASSERT_EQ(w.stiffnessHints().size(), 1u);
+    EXPECT_EQ(w.stiffnessHints()[0].springName, "entity 1");
+    EXPECT_EQ(w.stiffnessHints()[0].springName, buildOrDie(s).stiffnessHints()[0].springName);
+}
+
 TEST(World, StiffChainStaysBoundedUnderImplicitEuler) {
     // k = 1e5 N/m, m = 0.01 kg, dt = 1/60: h w = 53 per spring.
     Result<Scene> loaded = loadSceneFile(std::string(STEPWISE_SOURCE_DIR) + "/levels/stiff_spring.json");

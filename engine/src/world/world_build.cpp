@@ -262,35 +262,6 @@ std::optional<Error> checkFirstStepSpeeds(const WorldImpl& w) {
     return std::nullopt;
 }
 
-/// As checkFirstStepSpeeds, for the springs and attractors at the start:
-/// a body pulled at a value no step can take (an attractor of 1e300 kg, two
-/// bodies at one point under an unsoftened attractor, a spring of 1e300
-/// N/m stretched) is refused, naming it. Needs the state allocated; one
-/// force evaluation, only when the scene has springs or attractors. Only
-/// for fixed explicit steps: an implicit step solves for the velocity the
-/// pull leaves (a stiff spring holds its length), and dopri5 shortens its
-/// steps to the pull.
-std::optional<Error> checkFirstStepForces(const WorldImpl& w, detail::IntegratorKind kind) {
-    if (!w.model.springsOn() && !w.model.attractorsOn()) return std::nullopt;
-    if (detail::isImplicit(kind) || kind == detail::IntegratorKind::Dopri5) return std::nullopt;
-    const std::size_t n = w.model.n;
-    std::vector<double> a(2 * n);
-    w.model.accelerations(w.xs(), w.vs(), a.data());
-    const double dt = w.settings.dt;
-    for (std::size_t b = 0; b < n && b < w.bodyName.size(); ++b) {
-        const double pull = std::hypot(a[2 * b], a[2 * b + 1]);
-        if (pull * dt <= kMaxSpeed) continue;
-        const std::string by = w.model.springsOn() && w.model.attractorsOn() ? "springs and attractors"
-                               : w.model.springsOn()                         ? "springs"
-                                                                             : "attractors";
-        return Error{"the " + by + " pull it at " + formatNumber(pull) + " m/s^2 at the start: " +
-                         formatNumber(pull * dt) + " m/s in one step of " + formatNumber(dt) + " s, past the " +
-                         formatNumber(kMaxSpeed) + " m/s a run holds",
-                     detail::entityLabel(w.bodySceneIndex[b], &w.bodyName[b])};
-    }
-    return std::nullopt;
-}
-
 /// The loader refuses bad outlines (capsules without a segment, chains
 /// with too few or repeated points or on a moving body), but a
 /// scene built in code or edited in the editor reaches here unchecked.
@@ -510,7 +481,7 @@ Result<World> World::build(const Scene& scene, const SystemSwitches& switches) {
     compileSleep(w.settings, w);
     w.listActiveSystems();
     allocateState(w, start, *kind);
-    if (std::optional<Error> refused = checkFirstStepForces(w, *kind)) return std::move(*refused);
+    if (std::optional<Error> refused = detail::checkFirstStepForces(w, *kind)) return std::move(*refused);
     if (std::optional<Error> refused = compileEmitters(scene, w)) return std::move(*refused);
     if (w.registry) w.run = ++runCount;
     w.layout = w.makeLayout();
@@ -521,6 +492,36 @@ Result<World> World::build(const Scene& scene, const SystemSwitches& switches) {
     if (scene.solverState) world.setSolverState(*scene.solverState);
     return world;
 }
+
+/// As checkFirstStepSpeeds, for the springs and attractors at the start:
+/// a body pulled at a value no step can take (an attractor of 1e300 kg, two
+/// bodies at one point under an unsoftened attractor, a spring of 1e300
+/// N/m stretched) is refused, naming it. Needs the state allocated; one
+/// force evaluation, only when the scene has springs or attractors. Only
+/// for fixed explicit steps: an implicit step solves for the velocity the
+/// pull leaves (a stiff spring holds its length), and dopri5 shortens its
+/// steps to the pull.
+std::optional<Error> detail::checkFirstStepForces(const WorldImpl& w, IntegratorKind kind) {
+    if (!w.model.springsOn() && !w.model.attractorsOn()) return std::nullopt;
+    if (isImplicit(kind) || kind == IntegratorKind::Dopri5) return std::nullopt;
+    const std::size_t n = w.model.n;
+    std::vector<double> a(2 * n);
+    w.model.accelerations(w.xs(), w.vs(), a.data());
+    const double dt = w.settings.dt;
+    for (std::size_t b = 0; b < n && b < w.bodyName.size(); ++b) {
+        const double pull = std::hypot(a[2 * b], a[2 * b + 1]);
+        if (pull * dt <= kMaxSpeed) continue;
+        const std::string by = w.model.springsOn() && w.model.attractorsOn() ? "springs and attractors"
+                               : w.model.springsOn()                         ? "springs"
+                                                                             : "attractors";
+        return Error{"the " + by + " pull it at " + formatNumber(pull) + " m/s^2 at the start: " +
+                         formatNumber(pull * dt) + " m/s in one step of " + formatNumber(dt) + " s, past the " +
+                         formatNumber(kMaxSpeed) + " m/s a run holds",
+                     entityLabel(w.bodySceneIndex[b], &w.bodyName[b])};
+    }
+    return std::nullopt;
+}
+
 
 std::optional<Error> detail::shapeProblem(const Registry& reg, std::size_t i) {
     const Entity e = reg.entities()[i];

@@ -218,8 +218,8 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
     const Registry& reg = scene.registry;
     if (!w.emitters.empty()) return Error{"a level with emitters changes its bodies as it runs: a rebuild"};
     if (!w.collision || !switches.collisions) return Error{"no contact solver to add shapes to"};
-    if (w.model.springsOn() || w.model.attractorsOn() || w.model.boidsOn)
-        return Error{"springs, attractors and boids act on every body: a rebuild checks them"};
+    if (w.model.attractorsOn() || w.model.boidsOn)
+        return Error{"attractors and boids act on every body: a rebuild checks them"};
     // The removed: dynamic bodies and joints of this World, gone from the
     // scene, that nothing kept holds.
     const std::unordered_set<Entity> gone(removed.begin(), removed.end());
@@ -235,6 +235,10 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
     for (const joints::JointConstraint& j : w.collision->jointConstraints())
         if (!isGone(j.entity) && (isGone(j.entityA) || isGone(j.entityB)))
             return Error{"a joint stays while a body it holds is removed"};
+    const auto bodyGone = [&](std::uint32_t b) { return b != detail::kNoBody && isGone(w.bodyEntity[b]); };
+    for (const detail::SpringData& s : w.model.springs)
+        if (!isGone(s.entity) && (bodyGone(s.a) || bodyGone(s.b)))
+            return Error{"a spring stays while a body it holds is removed"};
     // The added: the scene's last entities, in its order, as a build would
     // append them.
     const std::vector<Entity>& order = reg.entities();
@@ -245,6 +249,9 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
         if (std::optional<Error> problem = addableProblem(reg, i, fresh)) return std::move(*problem);
     if (std::optional<Error> other = w.keepChoiceFor(scene, switches)) return std::move(*other);
     w.changeBodies(reg, removed, added);
+    // The springs' pull on the bodies at this state, as a build checks it:
+    // refused, the caller's rebuild says why.
+    if (std::optional<Error> refused = detail::checkFirstStepForces(w, w.kind)) return std::move(*refused);
     return {};
 }
 

@@ -321,6 +321,14 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
     for (std::size_t i = 0; i < reg.entities().size(); ++i) sceneIndex[reg.entities()[i].index] = std::uint32_t(i);
     bodySceneIndex.resize(n);
     for (std::size_t b = 0; b < n; ++b) bodySceneIndex[b] = sceneIndex[bodyEntity[b].index];
+    // The kept springs' places moved with the removed entities; an unnamed
+    // one is called by its place.
+    for (std::size_t s = 0; s < model.springs.size(); ++s) {
+        detail::SpringData& d = model.springs[s];
+        d.sceneIndex = sceneIndex[d.entity.index];
+        const Name* name = reg.tryGet<Name>(d.entity);
+        if (!name || name->value.empty()) springName[s] = "entity " + std::to_string(d.sceneIndex);
+    }
 
     // Forces: gravity pulls once there is a body; drag as World::build sets it.
     model.gravityOn = n > 0 && (model.gx != 0.0 || model.gy != 0.0);

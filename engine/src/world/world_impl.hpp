@@ -191,4 +191,11 @@ public:
     std::optional<Error> keepChoiceFor(const Scene& scene, const SystemSwitches& switches);
 };
 
+namespace detail {
+/// World::build's refusal of a body that the springs or attractors pull
+/// past what one step holds, at the state `w` holds now; the in-place adds
+/// run it as a rebuild would.
+std::optional<Error> checkFirstStepForces(const WorldImpl& w, IntegratorKind kind);
+} // namespace detail
+
 } // namespace stepwise
