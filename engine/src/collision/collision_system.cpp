@@ -189,6 +189,9 @@ void CollisionSystem::reshape(std::size_t i, const Collider& fresh, const Filter
     filters_[i] = filter;
     filtered_ = filtered_ || !(filter == Filter{});
     maxExtent_[i] = shapeReach(c.shape);
+    // The sweep's test of a fast body reads the smallest reach it noted
+    // when it first ran (one shape: compound bodies are not reshaped).
+    if (staticSweepReady_ && c.body >= 0 && !c.solverOnly) minReach_[i] = smallestReach(c.shape);
     setMass(i, c.mass, c.inertia);  // the inertia of the new shape
 }
 
@@ -1169,12 +1172,15 @@ void CollisionSystem::prepareStaticSweep() {
     staticSweepReady_ = true;
     std::vector<Aabb> boxes;
     std::vector<std::uint32_t> proxies;
+    staticRots_.assign(colliders_.size(), Rot{});
     for (const std::uint32_t i : finite_) {
         const Collider& c = colliders_[i];
         if (c.body >= 0 || c.sensor) continue;
-        boxes.push_back(computeAabb(c.shape, centres_[i], Rot::fromAngle(angles_[i])));
+        staticRots_[i] = Rot::fromAngle(angles_[i]);
+        boxes.push_back(computeAabb(c.shape, centres_[i], staticRots_[i]));
         proxies.push_back(i);
     }
+    for (const std::uint32_t p : planes_) staticRots_[p] = Rot::fromAngle(angles_[p]);
     staticBoxes_.build(boxes, proxies);
     hubShapes_.clear();
     for (const std::uint32_t i : shapesOfHubs_) hubShapes_.push_back({std::uint32_t(colliders_[i].hub), i});
@@ -1236,8 +1242,8 @@ void CollisionSystem::sweepAgainstStatic(std::span<Vec2> x) {
                 const Collider& fixed = colliders_[s];
                 if (fixed.sensor || !collides(j, s) || (!noCollide_.empty() && joinedNotColliding(j, s))) return;
                 // A static shape's centre of mass (centres_: where its
-                // outline is centred), which never moves.
-                const PlacedShape placed{&fixed.shape, centres_[s], Rot::fromAngle(angles_[s])};
+                // outline is centred) and rotation, which never change.
+                const PlacedShape placed{&fixed.shape, centres_[s], staticRots_[s]};
                 fraction = std::min(fraction, sweepFraction(sweep, shape, placed, target));
             };
             for (const std::uint32_t p : planes_) test(p);

@@ -441,6 +441,7 @@ private:
     std::vector<std::uint32_t> awakeProxies_;            // finite_ indices of awake dynamic shapes, ascending
     FrozenBoxes frozen_;                                 // static and sleeping shapes' boxes
     FrozenBoxes staticBoxes_;                            // static shapes' boxes, for the sweep
+    std::vector<Rot> staticRots_;  // per collider: a static shape's rotation, for the sweep (others unset)
     std::vector<std::pair<std::uint32_t, std::uint32_t>> hubShapes_;  // (hub, shape), sorted, for the sweep
     std::vector<double> minReach_;  // per collider: its smallest reach (static_sweep.hpp), for the sweep
     bool staticSweepReady_ = false;
