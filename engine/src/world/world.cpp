@@ -400,10 +400,17 @@ void writeStateBack(const WorldLayout& layout, const double* x, const double* v,
     for (std::size_t b = 0; b < layout.bodies.size(); ++b) {
         const Entity e = layout.bodies[b];
         if (!reg.alive(e)) continue;  // stale: the scene is not the one built from
-        reg.emplace<Position>(e, Position{{x[2 * b], x[2 * b + 1]}});
+        const Vec2 position{x[2 * b], x[2 * b + 1]};
+        const Position* before = reg.tryGet<Position>(e);
+        const bool moved = before && !(before->value == position);
+        reg.emplace<Position>(e, Position{position});
         const Vec2 vel{v[2 * b], v[2 * b + 1]};
-        // A body that had no velocity component gets one only once it moves.
-        if (reg.has<Velocity>(e) || vel.x != 0.0 || vel.y != 0.0) reg.emplace<Velocity>(e, Velocity{vel});
+        // A body that had no velocity component gets one once it moves,
+        // whatever its velocity then: a body that fell and came to rest
+        // (asleep, v exactly 0) is written with one, as it is when a run
+        // saved while it fell is resumed. So a run saved at any step and
+        // resumed writes the bytes one long run does.
+        if (reg.has<Velocity>(e) || vel.x != 0.0 || vel.y != 0.0 || moved) reg.emplace<Velocity>(e, Velocity{vel});
     }
     for (std::size_t s = 0; s < layout.spinBodies.size(); ++s) {
         const Entity e = layout.spinBodies[s];
@@ -415,8 +422,11 @@ void writeStateBack(const WorldLayout& layout, const double* x, const double* v,
         // Like velocity: written once the body turns, so a resumed run
         // starts from the same rotation.
         const double angle = colliderAngle[c], spin = colliderSpin[c];
+        const Angle* before = reg.tryGet<Angle>(e);
+        const bool turned = (before ? before->value : 0.0) != angle;
         if (reg.has<Angle>(e) || angle != 0.0) reg.emplace<Angle>(e, Angle{angle});
-        if (reg.has<AngularVelocity>(e) || spin != 0.0) reg.emplace<AngularVelocity>(e, AngularVelocity{spin});
+        if (reg.has<AngularVelocity>(e) || spin != 0.0 || turned)
+            reg.emplace<AngularVelocity>(e, AngularVelocity{spin});
     }
     scene.world.time = time;
     scene.world.adaptiveStep = adaptiveStep;
