@@ -756,6 +756,71 @@ TEST(Simulation, TheEditingWorldFollowsAddsDeletesAndTheirUndos) {
     }
 }
 
+// Step back past an edit restores a scene without it: the undo history
+// past the restored step goes with it, else an undo would restore a body
+// the scene does not have (a stranger's script: a ball added, moved,
+// stepped back past, undone). Stepping back over an undo clears it all (a
+// redo would add the ball a second time); stepping back between edits
+// keeps it.
+TEST(Simulation, StepBackPastAnEditDropsTheUndoHistoryPastTheStep) {
+    const auto addBall = [](Editor& ed) {
+        return ed.applyEdit("add ball", [](Scene& s) {
+            const Entity e = s.registry.create();
+            s.registry.emplace<Name>(e, Name{"late ball"});
+            s.registry.emplace<Position>(e, Position{{0.0, 8.0}});
+            s.registry.emplace<Radius>(e, Radius{0.3});
+            return true;
+        });
+    };
+    const auto moveBall = [](Editor& ed) {
+        return ed.applyEdit("move ball", [](Scene& s) {
+            s.registry.tryGet<Position>(findByName(s.registry, "late ball"))->value.x += 1.0;
+            return true;
+        });
+    };
+    {
+        Fixture f("ragdoll.json");
+        for (int i = 0; i < 2; ++i) f.ed.stepForward();
+        ASSERT_TRUE(addBall(f.ed));
+        ASSERT_TRUE(moveBall(f.ed));
+        ASSERT_EQ(f.ed.commands.size(), 2u);
+        f.ed.stepBack();  // to the state before step 2: before both edits
+        EXPECT_TRUE(findByName(f.ed.doc.scene.registry, "late ball").isNull());
+        EXPECT_EQ(f.ed.commands.size(), 0u);
+        EXPECT_NE(f.ed.status.find("the undo history past that step is cleared (2 edits)"), std::string::npos)
+            << f.ed.status;
+        EXPECT_FALSE(f.ed.undo());
+        for (int i = 0; i < 3; ++i) f.ed.stepForward();
+        EXPECT_TRUE(f.ed.sim.message().empty()) << f.ed.sim.message();
+    }
+    {
+        Fixture f("ragdoll.json");
+        f.ed.stepForward();
+        ASSERT_TRUE(addBall(f.ed));
+        for (int i = 0; i < 3; ++i) f.ed.stepForward();
+        ASSERT_TRUE(f.ed.undo());
+        EXPECT_TRUE(findByName(f.ed.doc.scene.registry, "late ball").isNull());
+        f.ed.stepBack();  // to a step the ball took
+        EXPECT_FALSE(findByName(f.ed.doc.scene.registry, "late ball").isNull());
+        EXPECT_EQ(f.ed.commands.size(), 0u);
+        EXPECT_FALSE(f.ed.redo());
+        EXPECT_FALSE(f.ed.undo());
+        for (int i = 0; i < 3; ++i) f.ed.stepForward();
+        EXPECT_TRUE(f.ed.sim.message().empty()) << f.ed.sim.message();
+    }
+    {
+        Fixture f("ragdoll.json");
+        f.ed.stepForward();
+        ASSERT_TRUE(addBall(f.ed));
+        for (int i = 0; i < 5; ++i) f.ed.stepForward();
+        f.ed.stepBack();
+        f.ed.stepBack();
+        EXPECT_EQ(f.ed.commands.size(), 1u) << "no edit was stepped back past";
+        ASSERT_TRUE(f.ed.undo());
+        EXPECT_TRUE(findByName(f.ed.doc.scene.registry, "late ball").isNull());
+    }
+}
+
 // A stranger's session: 60 actions drawn from adds, deletes, duplicates,
 // moves, masses, radii, undos, redos, steps and steps back, in an order
 // from a fixed seed. After each, the run with edits in place and one that
@@ -1065,6 +1130,45 @@ TEST(Simulation, StepBackAcrossEmissionsIsExact) {
         f.ed.stepForward();
         ASSERT_EQ(textOf(f.ed.doc.scene), pass[std::size_t(i)]) << "on to step " << i;
     }
+}
+
+// Select all, copy, paste in a run with copies alive: the pasted template
+// is a template of its own with its own emitter, which starts from
+// nothing; the pasted copies are the designer's bodies (no '#' in their
+// names); the run goes on with both emitters. (Pasted into the original
+// template, the new parts were missing from the copies alive, and the run
+// refused to go on.) One part duplicated joins its template.
+TEST(Simulation, APastedTemplateAndEmitterRunBesideTheOriginal) {
+    Fixture f("emitter_rain.json");
+    for (int i = 0; i < 40; ++i) f.ed.stepForward();
+    ASSERT_FALSE(f.named("doll#2/head").isNull());
+    f.ed.selectAll();
+    f.ed.copySelection();
+    ASSERT_TRUE(f.ed.paste());
+    const Registry& reg = f.ed.doc.scene.registry;
+    int parts = 0, newParts = 0;
+    for (const Entity e : f.ed.selection) {
+        if (const Name* n = reg.tryGet<Name>(e)) EXPECT_EQ(n->value.find('#'), std::string::npos) << n->value;
+        if (const Template* t = reg.tryGet<Template>(e)) newParts += t->value == "doll_2" ? 1 : 0;
+        if (const Emitter* em = reg.tryGet<Emitter>(e)) {
+            EXPECT_EQ(em->templateName, "doll_2");
+            EXPECT_EQ(em->emitted, 0);
+            EXPECT_EQ(em->alive, 0);
+        }
+    }
+    for (const Entity e : reg.entities())
+        if (const Template* t = reg.tryGet<Template>(e)) parts += t->value == "doll" ? 1 : 0;
+    EXPECT_GT(newParts, 0);
+    EXPECT_EQ(newParts, parts);
+    for (int i = 0; i < 40; ++i) {
+        f.ed.stepForward();
+        ASSERT_TRUE(f.ed.sim.message().empty()) << f.ed.sim.message();
+    }
+    EXPECT_FALSE(f.named("doll_2#1/head_2").isNull()) << "the pasted emitter copies its own template";
+    EXPECT_FALSE(f.named("doll#3/head").isNull()) << "the original goes on";
+    f.ed.select({f.named("head")});
+    ASSERT_TRUE(f.ed.duplicateSelection());
+    EXPECT_EQ(reg.tryGet<Template>(f.ed.selection.front())->value, "doll");
 }
 
 TEST(Simulation, AnEditUndoneBetweenEmissionsLeavesTheRunExact) {

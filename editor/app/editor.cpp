@@ -411,6 +411,7 @@ void Editor::stepForward() {
         playMark_ = commands.cursor();
         trails = render::TrailRecorder(trails.capacity());
     }
+    sim.setCommandCursor(commands.absoluteCursor());
     if (!sim.step(doc.scene) && !sim.message().empty()) note(sim.message());
     for (std::string& line : sim.takeBreakNotes()) note(std::move(line));
     if (const World* w = sim.world()) trails.record(*w);
@@ -419,12 +420,38 @@ void Editor::stepForward() {
 
 void Editor::stepBack() {
     if (sim.stepBack(doc.scene)) {
-        note("stepped back to t = " + std::to_string(doc.scene.world.time) + " s");
+        note("stepped back to t = " + std::to_string(doc.scene.world.time) + " s" + forgetEditsPastStepBack());
         ++revisionExtra_;
         pruneSelection();
     } else {
         note(sim.running() ? "no earlier state in the history" : "step back works while the simulation runs");
     }
+}
+
+std::string Editor::forgetEditsPastStepBack() {
+    // The restored scene is the one of that step's time: an edit made
+    // after it is not in it, and one undone since is. The undo history past
+    // that point no longer describes the scene (an undo would restore a body
+    // the scene does not have), so it goes, as reset drops the edits made
+    // while running.
+    const std::uint64_t restored = sim.restoredCommandCursor(), here = commands.absoluteCursor();
+    if (restored == here) return {};
+    // Edits made after the step, since play: the history up to the step
+    // stays. Otherwise (an edit undone since, or one from before play that
+    // Reset would bring back) none of it matches both the restored scene
+    // and the level Reset returns to: all of it goes.
+    const std::uint64_t dropped = here - commands.cursor();
+    const std::size_t before = commands.size();
+    if (restored < here && restored >= dropped + playMark_) {
+        commands.truncate(std::size_t(restored - dropped));
+    } else {
+        commands.clear();
+        playMark_ = 0;
+    }
+    if (commands.absoluteCursor() < savedCursor_) savedReachable_ = false;
+    const std::size_t forgotten = before - commands.size();
+    return "; the undo history past that step is cleared (" + std::to_string(forgotten) +
+           (forgotten == 1 ? " edit)" : " edits)");
 }
 
 void Editor::resetSimulation() {
@@ -443,6 +470,7 @@ void Editor::resetSimulation() {
 void Editor::update(double frameSeconds) {
     const std::uint64_t before = sim.steps();
     const bool wasPlaying = sim.state() == SimState::Playing;
+    sim.setCommandCursor(commands.absoluteCursor());
     sim.advance(doc.scene, frameSeconds);
     for (std::string& line : sim.takeBreakNotes()) note(std::move(line));
     if (sim.steps() != before) {

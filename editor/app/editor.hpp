@@ -206,6 +206,9 @@ public:
 private:
     void afterSceneReplaced();
     void afterUndoOrRedo();
+    /// After a step back: drops the undo history past the restored step
+    /// when it no longer matches the scene; what to add to the note.
+    std::string forgetEditsPastStepBack();
     void forgetRecoveryWhenClean();
     /// Open and New: the new document replaces the old one with a fresh
     /// undo history, selection, trails and view.

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <type_traits>
 #include <unordered_map>
@@ -472,11 +473,46 @@ std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>
     std::vector<Entity> created;
     std::unordered_map<Entity, Entity> copyOf;  // source handle -> its copy
     NameAllocator names(dst.registry);  // before the copies exist, so they do not see themselves
+    // A whole template pasted (every body of it) is a template of its own,
+    // named like an entity ("doll_2"), and a pasted emitter of it copies
+    // the new one: else the pasted bodies would join the template and the
+    // copies alive, made without them, would no longer match it. Some of a
+    // template's bodies pasted join it (a designer adding a part).
+    std::unordered_map<std::string, std::size_t> partsOf;
+    std::map<std::string, std::size_t> partsCloned;  // in name order: the new names do not hang on hashing
+    for (Entity e : src.entities())
+        if (const Template* t = src.tryGet<Template>(e)) ++partsOf[t->value];
+    const std::unordered_set<Entity> cloned(entities.begin(), entities.end());
+    for (Entity e : cloned)
+        if (const Template* t = src.alive(e) ? src.tryGet<Template>(e) : nullptr) ++partsCloned[t->value];
+    Registry templateNames;
+    for (Entity e : dst.registry.entities())
+        if (const Template* t = dst.registry.tryGet<Template>(e))
+            templateNames.emplace<Name>(templateNames.create(), Name{t->value});
+    NameAllocator templates(templateNames);
+    std::unordered_map<std::string, std::string> templateOf;  // source template name -> the copies'
+    for (const auto& [name, count] : partsCloned)
+        templateOf.emplace(name, count == partsOf[name] ? templates.take(name) : name);
     for (Entity e : entities) {
         if (!src.alive(e)) continue;
         const Entity c = dst.registry.create();
         copyComponents(src, e, dst.registry, c);
-        if (Name* n = dst.registry.tryGet<Name>(c)) n->value = names.take(n->value.empty() ? std::string("entity") : n->value);
+        if (Name* n = dst.registry.tryGet<Name>(c)) {
+            // '#' marks what an emitter made ("doll#3/head"): a pasted or
+            // duplicated copy is the designer's own body, which the run would
+            // otherwise take for one of the emitter's and drop.
+            std::string base = n->value.empty() ? std::string("entity") : n->value;
+            std::replace(base.begin(), base.end(), '#', ' ');
+            n->value = names.take(base);
+        }
+        if (Template* t = dst.registry.tryGet<Template>(c)) t->value = templateOf.at(t->value);
+        if (Emitter* em = dst.registry.tryGet<Emitter>(c)) {
+            if (auto it = templateOf.find(em->templateName); it != templateOf.end()) em->templateName = it->second;
+            // A new emitter: it has made nothing yet.
+            em->next.reset();
+            em->emitted = em->alive = 0;
+            em->oldest.reset();
+        }
         if (Position* p = dst.registry.tryGet<Position>(c)) p->value += offset;
         if (Plane* pl = dst.registry.tryGet<Plane>(c)) pl->offset += dot(pl->normal, offset);
         if (Spring* s = dst.registry.tryGet<Spring>(c); s && s->anchor) *s->anchor += offset;  // moves with the copy

@@ -350,7 +350,7 @@ void Simulation::pushHistory(const Scene& scene) {
         gained_.reset();
         sceneCounts_ = counts;
     }
-    HistoryEntry entry{sceneAtBuild_, gained_, world_->saveState()};
+    HistoryEntry entry{sceneAtBuild_, gained_, world_->saveState(), commandCursor_};
     historyStateBytes_ += entry.state.bytes();
     history_.push_back(std::move(entry));
     while (!history_.empty() && (history_.size() > historyCapacity_ ||
@@ -482,6 +482,7 @@ bool Simulation::stepBack(Scene& scene) {
     state_ = SimState::Paused;
     HistoryEntry entry = std::move(history_.back());
     popHistory();
+    restoredCommandCursor_ = entry.commandCursor;
     contactsKept_ = false;  // the restored step's contacts are replayed below
     beforeEdits_.reset();
     scene = entry.restore();

@@ -71,6 +71,12 @@ public:
     bool step(Scene& scene);
     /// Restores the state before the last step. False when there is none.
     bool stepBack(Scene& scene);
+    /// The undo position (CommandStack::absoluteCursor) each step records
+    /// with its state; the editor sets it before stepping.
+    void setCommandCursor(std::uint64_t cursor) { commandCursor_ = cursor; }
+    /// The undo position of the state the last stepBack restored: edits
+    /// past it are not in the restored scene.
+    std::uint64_t restoredCommandCursor() const { return restoredCommandCursor_; }
     /// Back to the edited scene and editing. False when not running.
     bool reset(Scene& scene);
     /// Called once per displayed frame: takes timeScale * frameSeconds / dt
@@ -207,6 +213,7 @@ private:
         std::shared_ptr<const Scene> scene;
         std::shared_ptr<const std::vector<Gained>> gained;  ///< null: none
         WorldState state;
+        std::uint64_t commandCursor = 0;  ///< the undo position at this step
         /// The scene this entry stands for: `scene`, the gained components,
         /// then the state written back.
         Scene restore() const;
@@ -260,6 +267,7 @@ private:
         std::vector<ContactRecord> contacts;
     };
     std::optional<BeforeEdits> beforeEdits_;
+    std::uint64_t commandCursor_ = 0, restoredCommandCursor_ = 0;
     std::vector<ContactRecord> keptContacts_;  ///< the last step's, while contactsKept_
     bool contactsKept_ = false;
     int contactStageBefore_ = 0;  ///< break on contact: 0 none, 1 speculative, 2 touching, last step

@@ -109,7 +109,9 @@ std::optional<Error> compileEmitters(const Scene& scene, WorldImpl& w) {
                 const auto it = byName.find(copyName(base, reg, run.members[m], anchor, m));
                 if (it == byName.end())
                     return Error{label + ": emitter: copy \"" + base + "\" is alive in its run state but \"" +
-                                 copyName(base, reg, run.members[m], anchor, m) + "\" is not in the scene"};
+                                 copyName(base, reg, run.members[m], anchor, m) +
+                                 "\" is not in the scene (a copy alive keeps the parts of the template it was made "
+                                 "from: undo the edit, or reset the run)"};
                 copy.push_back(it->second);
             }
             run.copies.push_back(std::move(copy));
