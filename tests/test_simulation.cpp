@@ -1171,6 +1171,42 @@ TEST(Simulation, APastedTemplateAndEmitterRunBesideTheOriginal) {
     EXPECT_EQ(reg.tryGet<Template>(f.ed.selection.front())->value, "doll");
 }
 
+// A copy alive is whatever bears its name: a part deleted from it, or a
+// part added to its template, leaves the run going (it refused to step
+// on). An add or delete cannot be undone or redone once the run has added
+// entities since (the emitter's copies): the undo would put back the
+// entity table of its time and drop them. It is refused, saying why.
+TEST(Simulation, EditsToALiveCopyOrItsTemplateLeaveTheRunGoing) {
+    Fixture f("emitter_rain.json");
+    f.ed.select({f.named("arm right")});
+    ASSERT_TRUE(f.ed.deleteSelection());
+    ASSERT_TRUE(f.ed.undo());
+    for (int i = 0; i < 40; ++i) f.ed.stepForward();
+    ASSERT_FALSE(f.named("doll#2/head").isNull());
+    const std::string before = textOf(f.ed.doc.scene);
+    EXPECT_FALSE(f.ed.redo());
+    EXPECT_TRUE(f.ed.statusRefused);
+    EXPECT_EQ(f.ed.status.rfind("redo refused: the run added or removed entities", 0), 0u) << f.ed.status;
+    EXPECT_EQ(textOf(f.ed.doc.scene), before);
+    f.ed.select({f.named("doll#2/head")});
+    ASSERT_TRUE(f.ed.deleteSelection());
+    ASSERT_TRUE(f.ed.applyEdit("one more part", [](Scene& s) {
+        const Entity e = s.registry.create();
+        s.registry.emplace<Name>(e, Name{"hat"});
+        s.registry.emplace<Position>(e, Position{{8.0, 7.2}});
+        s.registry.emplace<Radius>(e, Radius{0.1});
+        s.registry.emplace<Template>(e, Template{"doll"});
+        return true;
+    }));
+    for (int i = 0; i < 400; ++i) {
+        f.ed.stepForward();
+        ASSERT_TRUE(f.ed.sim.message().empty()) << "step " << i << ": " << f.ed.sim.message();
+    }
+    EXPECT_FALSE(f.named("doll#14/hat").isNull()) << "copies made since have the new part";
+    EXPECT_TRUE(f.named("doll#2/arm left").isNull()) << "the edited copy was removed whole in its turn";
+    EXPECT_TRUE(f.named("doll#2").isNull());
+}
+
 TEST(Simulation, AnEditUndoneBetweenEmissionsLeavesTheRunExact) {
     // Paused after the second doll appeared: a copy's mass and the
     // emitter's interval are edited and undone; the run then goes on as if

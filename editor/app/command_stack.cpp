@@ -420,6 +420,12 @@ std::string CommandStack::undo(Scene& scene) {
     return commands_[cursor_].label;
 }
 
+bool CommandStack::entitiesAsLeft(const Scene& scene, bool redo) const {
+    if (redo ? !canRedo() : !canUndo()) return true;
+    const Delta& d = commands_[redo ? cursor_ : cursor_ - 1].delta;
+    return !d.slots || scene.registry.slots() == (redo ? d.slots->first : d.slots->second);
+}
+
 std::string CommandStack::redo(Scene& scene) {
     open_ = false;
     if (!canRedo()) return {};

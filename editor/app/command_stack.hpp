@@ -45,6 +45,12 @@ public:
 
     bool canUndo() const { return cursor_ > 0; }
     bool canRedo() const { return cursor_ < commands_.size(); }
+    /// Whether the command the next undo (false) or redo (true) applies
+    /// finds the scene's entity table as it left it: a run that added or
+    /// removed entities since (an emitter's copies, a broken joint) leaves
+    /// an add or delete that cannot be undone exactly; every other command
+    /// can.
+    bool entitiesAsLeft(const Scene& scene, bool redo) const;
     /// Restores the scene before the last command. Returns its label ("" if none).
     std::string undo(Scene& scene);
     std::string redo(Scene& scene);

@@ -209,6 +209,12 @@ bool Editor::undo() {
         note("nothing to undo since Play (R resets to the edited level)");
         return false;
     }
+    if (!commands.entitiesAsLeft(doc.scene, false)) {
+        note("undo refused: the run added or removed entities since that edit (an emitter's copies, a broken joint); "
+             "R resets to the edited level",
+             true);
+        return false;
+    }
     const std::string label = commands.undo(doc.scene);
     if (label.empty()) return false;
     afterUndoOrRedo();
@@ -221,6 +227,12 @@ bool Editor::undo() {
 }
 
 bool Editor::redo() {
+    if (!commands.entitiesAsLeft(doc.scene, true)) {
+        note("redo refused: the run added or removed entities since that edit was undone (an emitter's copies, a "
+             "broken joint)",
+             true);
+        return false;
+    }
     const std::string label = commands.redo(doc.scene);
     if (label.empty()) return false;
     afterUndoOrRedo();

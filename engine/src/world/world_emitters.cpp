@@ -66,9 +66,14 @@ std::optional<Error> compileEmitters(const Scene& scene, WorldImpl& w) {
     w.registry = std::make_shared<Registry>(reg);
     w.bodyOfSlot.assign(reg.slotCount(), kNoBody);
     for (std::size_t b = 0; b < w.bodyEntity.size(); ++b) w.bodyOfSlot[w.bodyEntity[b].index] = std::uint32_t(b);
-    std::unordered_map<std::string, Entity> byName;
+    // A copy is every entity named TEMPLATE#N or TEMPLATE#N/..., in scene
+    // order: the bodies and joints it was made with (made in that order),
+    // whatever has become of the template since (a body added to it or
+    // deleted from it, or from the copy, while the copy is alive).
+    std::unordered_map<std::string, std::vector<Entity>> copyParts;
     for (const Entity e : reg.entities())
-        if (const Name* n = reg.tryGet<Name>(e); n && !n->value.empty()) byName.emplace(n->value, e);
+        if (const Name* n = reg.tryGet<Name>(e); n && n->value.find('#') != std::string::npos)
+            copyParts[n->value.substr(0, n->value.find('/'))].push_back(e);
     const std::vector<Entity>& order = reg.entities();
     for (std::size_t i = 0; i < order.size(); ++i) {
         const Entity e = order[i];
@@ -101,20 +106,12 @@ std::optional<Error> compileEmitters(const Scene& scene, WorldImpl& w) {
             }
         }
         run.key = detail::emitterKey(reg, e, i);
-        const Entity anchor = anchorOf(reg, run.members);
         for (int k = em->emitted - em->alive + 1; k <= em->emitted; ++k) {
             const std::string base = em->templateName + "#" + std::to_string(k);
-            std::vector<Entity> copy;
-            for (std::size_t m = 0; m < run.members.size(); ++m) {
-                const auto it = byName.find(copyName(base, reg, run.members[m], anchor, m));
-                if (it == byName.end())
-                    return Error{label + ": emitter: copy \"" + base + "\" is alive in its run state but \"" +
-                                 copyName(base, reg, run.members[m], anchor, m) +
-                                 "\" is not in the scene (a copy alive keeps the parts of the template it was made "
-                                 "from: undo the edit, or reset the run)"};
-                copy.push_back(it->second);
-            }
-            run.copies.push_back(std::move(copy));
+            const auto it = copyParts.find(base);
+            if (it == copyParts.end())
+                return Error{label + ": emitter: copy \"" + base + "\" is alive in its run state but not in the scene"};
+            run.copies.push_back(it->second);
         }
         w.emitters.push_back(std::move(run));
     }
@@ -142,8 +139,10 @@ void WorldImpl::runEmitters() {
     for (EmitterRun& em : emitters) {
         Emitter& p = em.params;
         const auto removeOldest = [&] {
+            // The copy's name is its first entity's up to the '/' (the
+            // anchor's, unless the designer deleted that one).
             if (const Name* name = reg.tryGet<Name>(em.copies.front().front()))
-                emitterEvents.push_back({em.entity, name->value, false});
+                emitterEvents.push_back({em.entity, name->value.substr(0, name->value.find('/')), false});
             for (const Entity e : em.copies.front()) {
                 const auto it = std::find(added.begin(), added.end(), e);
                 if (it != added.end()) added.erase(it);
