@@ -793,11 +793,16 @@ TEST(Simulation, StepBackPastAnEditDropsTheUndoHistoryPastTheStep) {
         for (int i = 0; i < 3; ++i) f.ed.stepForward();
         EXPECT_TRUE(f.ed.sim.message().empty()) << f.ed.sim.message();
     }
+    // One step, the ball added, `steps` more.
+    const auto ballInARun = [&](Fixture& f, int steps) {
+        f.ed.stepForward();
+        const bool added = addBall(f.ed);
+        for (int i = 0; i < steps; ++i) f.ed.stepForward();
+        return added;
+    };
     {
         Fixture f("ragdoll.json");
-        f.ed.stepForward();
-        ASSERT_TRUE(addBall(f.ed));
-        for (int i = 0; i < 3; ++i) f.ed.stepForward();
+        ASSERT_TRUE(ballInARun(f, 3));
         ASSERT_TRUE(f.ed.undo());
         EXPECT_TRUE(findByName(f.ed.doc.scene.registry, "late ball").isNull());
         f.ed.stepBack();  // to a step the ball took
@@ -810,9 +815,7 @@ TEST(Simulation, StepBackPastAnEditDropsTheUndoHistoryPastTheStep) {
     }
     {
         Fixture f("ragdoll.json");
-        f.ed.stepForward();
-        ASSERT_TRUE(addBall(f.ed));
-        for (int i = 0; i < 5; ++i) f.ed.stepForward();
+        ASSERT_TRUE(ballInARun(f, 5));
         f.ed.stepBack();
         f.ed.stepBack();
         EXPECT_EQ(f.ed.commands.size(), 1u) << "no edit was stepped back past";
