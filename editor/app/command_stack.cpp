@@ -423,7 +423,7 @@ std::string CommandStack::undo(Scene& scene) {
 bool CommandStack::entitiesAsLeft(const Scene& scene, bool redo) const {
     if (redo ? !canRedo() : !canUndo()) return true;
     const Delta& d = commands_[redo ? cursor_ : cursor_ - 1].delta;
-    return !d.slots || scene.registry.slots() == (redo ? d.slots->first : d.slots->second);
+    return !d.slots || scene.registry.hasSlots(redo ? d.slots->first : d.slots->second);
 }
 
 std::string CommandStack::redo(Scene& scene) {

@@ -485,11 +485,11 @@ std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>
     const std::unordered_set<Entity> cloned(entities.begin(), entities.end());
     for (Entity e : cloned)
         if (const Template* t = src.alive(e) ? src.tryGet<Template>(e) : nullptr) ++partsCloned[t->value];
-    Registry templateNames;
-    for (Entity e : dst.registry.entities())
-        if (const Template* t = dst.registry.tryGet<Template>(e))
-            templateNames.emplace<Name>(templateNames.create(), Name{t->value});
-    NameAllocator templates(templateNames);
+    std::unordered_set<std::string> templateNames;
+    const Registry& existing = dst.registry;  // read only: nothing there changes
+    for (Entity e : existing.entities())
+        if (const Template* t = existing.tryGet<Template>(e)) templateNames.insert(t->value);
+    NameAllocator templates(std::move(templateNames));
     std::unordered_map<std::string, std::string> templateOf;  // source template name -> the copies'
     for (const auto& [name, count] : partsCloned)
         templateOf.emplace(name, count == partsOf[name] ? templates.take(name) : name);

@@ -85,6 +85,8 @@ inline Result<bool> createdInto(const Result<Entity>& made, Entity& out) {
 class NameAllocator {
 public:
     explicit NameAllocator(const Registry& registry);
+    /// Over a set of names in use that are not entities' (template names).
+    explicit NameAllocator(std::unordered_set<std::string> used) : used_(std::move(used)) {}
     /// `base` if unused, else base_2, base_3, ... (the first free one); the
     /// name returned counts as used from then on.
     std::string take(const std::string& base);

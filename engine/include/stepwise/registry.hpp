@@ -311,6 +311,10 @@ public:
         }
     };
     Slots slots() const { return {generations_, alive_, freeList_, order_}; }
+    /// Whether the slot table is `s` (slots() == s, without the copy).
+    bool hasSlots(const Slots& s) const {
+        return generations_ == s.generations && alive_ == s.alive && freeList_ == s.freeList && order_ == s.order;
+    }
     /// Replaces the slot table. Remove the components of every entity that
     /// `s` does not keep alive first: pools are not touched here.
     void setSlots(Slots s) {

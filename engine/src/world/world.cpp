@@ -401,9 +401,13 @@ void writeStateBack(const WorldLayout& layout, const double* x, const double* v,
         const Entity e = layout.bodies[b];
         if (!reg.alive(e)) continue;  // stale: the scene is not the one built from
         const Vec2 position{x[2 * b], x[2 * b + 1]};
-        const Position* before = reg.tryGet<Position>(e);
-        const bool moved = before && !(before->value == position);
-        reg.emplace<Position>(e, Position{position});
+        bool moved = false;
+        if (Position* p = reg.tryGet<Position>(e)) {
+            moved = !(p->value == position);
+            p->value = position;
+        } else {
+            reg.emplace<Position>(e, Position{position});
+        }
         const Vec2 vel{v[2 * b], v[2 * b + 1]};
         // A body that had no velocity component gets one once it moves,
         // whatever its velocity then: a body that fell and came to rest
