@@ -232,6 +232,54 @@ TEST(BroadPhase, ACrowdedCellPairsEveryBoxWithItsStaticShapes) {
     }
 }
 
+// A pile of shapes side by side, moving fast: each box is fattened by its
+// motion to several times its shape, so a grid cell holds far more boxes
+// than a crowd's threshold count, yet no two shapes overlap. Every pair is
+// a contact the step may need, so the grid finds them all once it is told
+// the boxes' cores; told nothing, it takes the cell for a crowd and drops
+// most of them. Shapes piled on top of each other are still a crowd.
+// Swept over the margin (shapes 0.7 m wide, 0.75 m apart; past a margin
+// of a metre the cells hold more boxes than the crowd count).
+TEST(BroadPhase, AFastPileSideBySideKeepsEveryPairAndACrowdStaysBounded) {
+    for (const double margin : {0.05, 0.3, 0.6, 1.2, 2.4}) {
+        std::vector<Aabb> boxes;
+        std::vector<std::uint8_t> movable;
+        std::vector<double> cores;
+        for (int row = 0; row < 30; ++row)
+            for (int col = 0; col < 60; ++col) {
+                const Vec2 p{0.75 * col, 0.75 * row}, h{0.35 + margin, 0.35 + margin};
+                boxes.push_back({p - h, p + h});
+                movable.push_back(1);
+                cores.push_back(0.7 * 0.7);
+            }
+        std::vector<ProxyPair> brute, told, untold;
+        BroadPhase(BroadPhaseKind::BruteForce).findPairs(boxes, movable, brute);
+        BroadPhase grid(BroadPhaseKind::UniformGrid);
+        grid.findPairs(boxes, movable, told, cores);
+        EXPECT_EQ(told, brute) << "margin " << margin;
+        EXPECT_EQ(std::count(grid.crowded().begin(), grid.crowded().end(), 1), 0) << "margin " << margin;
+        BroadPhase(BroadPhaseKind::UniformGrid).findPairs(boxes, movable, untold);
+        if (margin >= 1.2) EXPECT_LT(untold.size(), brute.size() / 2) << "margin " << margin << ": cores decide";
+    }
+    for (const int crowd : {200, 1000}) {  // on top of each other: cores cover the cell many times
+        std::mt19937 rng{std::uint32_t(crowd)};
+        std::uniform_real_distribution<double> x(0.0, 1.0);
+        std::vector<Aabb> boxes;
+        std::vector<std::uint8_t> movable(std::size_t(crowd), 1);
+        std::vector<double> cores(std::size_t(crowd), 0.5 * 0.5);
+        for (int i = 0; i < crowd; ++i) {
+            const Vec2 p{x(rng), x(rng)};
+            boxes.push_back({p - Vec2{0.3, 0.3}, p + Vec2{0.3, 0.3}});
+        }
+        std::vector<ProxyPair> brute, grid;
+        BroadPhase(BroadPhaseKind::BruteForce).findPairs(boxes, movable, brute);
+        BroadPhase phase(BroadPhaseKind::UniformGrid);
+        phase.findPairs(boxes, movable, grid, cores);
+        EXPECT_EQ(phase.crowded()[0], 1) << crowd;
+        EXPECT_LT(grid.size(), brute.size() / 10) << crowd << ": the pairs stay bounded";
+    }
+}
+
 // ---------------------------------------------------------------- response
 
 TEST(Collision, HeadOnElasticUnequalMassesMatchTheCourseNotesFormula) {

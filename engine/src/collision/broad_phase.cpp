@@ -70,7 +70,7 @@ void bucketSort(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& sc
 } // namespace
 
 void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
-                           std::vector<ProxyPair>& pairs) {
+                           std::vector<ProxyPair>& pairs, std::span<const double> coreArea) {
     pairs.clear();
     crowded_.clear();
     switch (kind_) {
@@ -81,10 +81,10 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uin
         // far above any ordinary scene's few).
         if (pairs.size() > 16 * boxes.size() + 4096) {
             pairs.clear();
-            uniformGrid(boxes, movable, pairs);
+            uniformGrid(boxes, movable, pairs, coreArea);
         }
         break;
-    case BroadPhaseKind::UniformGrid: uniformGrid(boxes, movable, pairs); break;
+    case BroadPhaseKind::UniformGrid: uniformGrid(boxes, movable, pairs, coreArea); break;
     case BroadPhaseKind::BruteForce:
         for (std::uint32_t i = 0; i < boxes.size(); ++i)
             for (std::uint32_t j = i + 1; j < boxes.size(); ++j)
@@ -148,7 +148,7 @@ void BroadPhase::sweepAndPrune(std::span<const Aabb> boxes, std::span<const std:
 }
 
 void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
-                             std::vector<ProxyPair>& pairs) {
+                             std::vector<ProxyPair>& pairs, std::span<const double> coreArea) {
     const std::uint32_t n = std::uint32_t(boxes.size());
     overlapTests_ = 0;
     crowded_.assign(n, 0);
@@ -237,9 +237,19 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
         // in both directions (an order by x alone pairs a spread crowd
         // across thin vertical strips). The contacts push the crowd apart
         // until the cells thin out. An ordinary scene never has such a cell
-        // (a cell is two typical boxes wide).
+        // (a cell is two typical boxes wide), but a dense pile moving fast
+        // can, its boxes fattened by their motion to several times their
+        // shapes: there the cores tell a crowd (shapes on top of each
+        // other) from a pile (shapes side by side, every pair a contact the
+        // window would drop).
+        const auto coresCoverCell = [&] {
+            if (coreArea.empty()) return true;
+            double covered = 0.0;
+            for (std::size_t i = begin; i < end; ++i) covered += coreArea[std::uint32_t(cellKeys_[i])];
+            return covered > kCrowdedCover * cell * cell;
+        };
         std::size_t reach = end - begin;
-        if (end - begin > kDenseCell) {
+        if (end - begin > kDenseCell && coresCoverCell()) {
             const double originX = lo.x + double(cx) * cell, originY = lo.y + double(cy) * cell;
             const auto morton = [&](std::uint64_t entry) {
                 const Aabb& b = boxes[std::uint32_t(entry)];

@@ -4,7 +4,8 @@
 // prune on x, and a uniform grid. Both return the same pairs in the same
 // order (sorted by (a, b)), so the solver's result does not depend on which
 // one ran; the one exception is a crowd (a grid cell with more than
-// kDenseCell boxes), where the grid bounds the pairs per box.
+// kDenseCell boxes whose shapes cover it kCrowdedCover times over), where
+// the grid bounds the pairs per box.
 
 #include "collision/collision_types.hpp"
 
@@ -34,23 +35,37 @@ public:
     void setKind(BroadPhaseKind kind) { kind_ = kind; }
     BroadPhaseKind kind() const { return kind_; }
 
-    void findPairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
+    /// `coreArea[i]`, when given, is the area of box i before any margin
+    /// fattened it (m^2): a grid cell is then a crowd only when its boxes'
+    /// cores cover it several times over, not merely when fat margins make
+    /// many boxes reach into it.
+    void findPairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs,
+                   std::span<const double> coreArea = {});
     /// Box-against-box tests the last uniform-grid call made (its cost, for
     /// tests: it must not grow with one huge shape or a crowd).
     std::size_t lastGridOverlapTests() const { return overlapTests_; }
-    /// Per box of the last call: 1 when it sat in a crowded grid cell (more
-    /// than kDenseCell boxes); empty when no grid ran.
+    /// Per box of the last call: 1 when it sat in a crowded grid cell;
+    /// empty when no grid ran.
     std::span<const std::uint8_t> crowded() const { return crowded_; }
 
 private:
     void sweepAndPrune(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
-    void uniformGrid(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
+    void uniformGrid(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs,
+                     std::span<const double> coreArea);
 
     BroadPhaseKind kind_;
     /// Grid cells with more entries than this are a crowd: each box there
     /// pairs only with its next kDenseNeighbours boxes (in Z-order of the
     /// centres), so it has about twice that many pairs.
     static constexpr std::size_t kDenseCell = 64;
+    /// With core areas given, a cell is a crowd only when its boxes' cores
+    /// sum to more than this many times the cell's area. Cores side by side
+    /// stay under 4 (a box reaching into a cell lies within the cell grown
+    /// by its fat extent, at most half a cell for a median box, so their
+    /// cores fit in twice the cell's width); bodies started overlapping
+    /// their neighbours by half (Box2D's spinner) reach 8; only shapes on
+    /// top of each other reach this.
+    static constexpr double kCrowdedCover = 16.0;
     static constexpr std::size_t kDenseNeighbours = 4;
     struct SortedBox {
         double lowerX, upperX, lowerY, upperY;

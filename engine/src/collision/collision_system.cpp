@@ -460,10 +460,12 @@ void CollisionSystem::bodyEdges(std::vector<std::pair<std::uint32_t, std::uint32
 
 bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, Vec2 ref1) {
     awakeBoxes_.resize(awakeProxies_.size());
+    awakeCores_.resize(awakeProxies_.size());
     awakeMovable_.assign(awakeProxies_.size(), 1);
     for (std::size_t j = 0; j < awakeProxies_.size(); ++j) {
         const std::uint32_t i = finite_[awakeProxies_[j]];
         Aabb box = computeAabb(colliders_[i].shape, centres_[i], rots[i]);
+        awakeCores_[j] = (box.upper.x - box.lower.x) * (box.upper.y - box.lower.y);
         const Vec2 fat{margins_[i], margins_[i]};
         box.lower -= fat;
         box.upper += fat;
@@ -471,7 +473,7 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
     }
     if (autoBroadPhase_)
         broadPhase_.setKind(awakeProxies_.size() > 512 ? BroadPhaseKind::UniformGrid : BroadPhaseKind::SweepAndPrune);
-    broadPhase_.findPairs(awakeBoxes_, awakeMovable_, awakePairs_);
+    broadPhase_.findPairs(awakeBoxes_, awakeMovable_, awakePairs_, awakeCores_);
     // awakeProxies_ ascends, so the mapped pairs keep (a, b) order.
     pairs_.clear();
     for (const ProxyPair& p : awakePairs_) pairs_.push_back({awakeProxies_[p.a], awakeProxies_[p.b]});
@@ -772,10 +774,12 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
         }
     } else {
     boxes_.resize(finite_.size());
+    cores_.resize(finite_.size());
     movable_.resize(finite_.size());
     for (std::size_t k = 0; k < finite_.size(); ++k) {
         const std::uint32_t i = finite_[k];
         Aabb box = computeAabb(colliders_[i].shape, centres_[i], rots[i]);
+        cores_[k] = (box.upper.x - box.lower.x) * (box.upper.y - box.lower.y);
         const Vec2 fat{margins_[i], margins_[i]};
         box.lower -= fat;
         box.upper += fat;
@@ -789,7 +793,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     // return the same sorted pairs, so the choice never changes a result.
     if (autoBroadPhase_)
         broadPhase_.setKind(finite_.size() > 512 ? BroadPhaseKind::UniformGrid : BroadPhaseKind::SweepAndPrune);
-    broadPhase_.findPairs(boxes_, movable_, pairs_);
+    broadPhase_.findPairs(boxes_, movable_, pairs_, cores_);
     crowdBodies_.clear();
     const std::span<const std::uint8_t> crowded = broadPhase_.crowded();
     for (std::size_t k = 0; k < crowded.size(); ++k)

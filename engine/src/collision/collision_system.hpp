@@ -343,6 +343,7 @@ private:
     BroadPhase broadPhase_;
     bool autoBroadPhase_ = true;
     std::vector<Aabb> boxes_;
+    std::vector<double> cores_;  // per box: its area before the margin (m^2), for the grid's crowd test
     std::vector<std::uint8_t> movable_;
     std::vector<ProxyPair> pairs_;
     std::vector<Vec2> centres_, stepStart_;
@@ -446,6 +447,7 @@ private:
     std::vector<double> minReach_;  // per collider: its smallest reach (static_sweep.hpp), for the sweep
     bool staticSweepReady_ = false;
     std::vector<Aabb> awakeBoxes_;
+    std::vector<double> awakeCores_;
     std::vector<std::uint8_t> awakeMovable_;
     std::vector<ProxyPair> awakePairs_;
     std::vector<CachedImpulse> sleepingCache_;           // warm start of the sleeping islands' contacts
