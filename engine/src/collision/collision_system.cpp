@@ -855,7 +855,18 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
             addManifold(a, b, m, centres_);
             continue;
         }
-        const Manifold m = collide(shapeA, centres_[a], rots[a], shapeB, centres_[b], rots[b], pairMargin(a, b));
+        const double margin = pairMargin(a, b);
+        // Each shape lies within its reach of its centre, so shapes whose
+        // reach circles are farther apart than the margin cannot make a
+        // point: most of a fast pile's pairs, whose boxes the motion
+        // fattened (the spinner: four in five), are passed over without the
+        // narrow phase. The slack covers the rounding of the three terms.
+        // (A chain segment's separation is not measured from a centre.)
+        if (shapeA.kind != ShapeKind::ChainSegment && shapeB.kind != ShapeKind::ChainSegment) {
+            const double apart = length(centres_[b] - centres_[a]) - maxExtent_[a] - maxExtent_[b];
+            if (apart - 1e-9 * (apart + 2.0 * (maxExtent_[a] + maxExtent_[b])) > margin) continue;
+        }
+        const Manifold m = collide(shapeA, centres_[a], rots[a], shapeB, centres_[b], rots[b], margin);
         addManifold(a, b, m, centres_);
     }
     // Planes against every movable finite shape: planes are few and infinite,
