@@ -1174,6 +1174,35 @@ TEST(Simulation, APastedTemplateAndEmitterRunBesideTheOriginal) {
     EXPECT_EQ(reg.tryGet<Template>(f.ed.selection.front())->value, "doll");
 }
 
+// An emitter duplicated or pasted without its template would be a second
+// emitter of one template: both would name their copies "doll#1", and the
+// scene could no longer be saved. Refused as the loader refuses it, naming
+// the template and its emitter, before and during a run; the scene and the
+// undo history stay as they were, and the emitter with its whole template
+// still duplicates.
+TEST(Simulation, AnEmitterCopiedWithoutItsTemplateIsRefused) {
+    for (const int steps : {0, 35}) {
+        Fixture f("emitter_rain.json");
+        for (int i = 0; i < steps; ++i) f.ed.stepForward();
+        const std::string before = textOf(f.ed.doc.scene);
+        const std::size_t history = f.ed.commands.cursor();
+        f.ed.select({f.named("hatch")});
+        EXPECT_FALSE(f.ed.duplicateSelection()) << steps;
+        EXPECT_TRUE(f.ed.statusRefused) << f.ed.status;
+        EXPECT_NE(f.ed.status.find("template \"doll\" is copied by"), std::string::npos) << f.ed.status;
+        EXPECT_NE(f.ed.status.find("\"hatch\""), std::string::npos) << f.ed.status;
+        f.ed.copySelection();
+        EXPECT_FALSE(f.ed.paste()) << steps;
+        EXPECT_EQ(f.ed.status.rfind("refused: paste: ", 0), 0u) << f.ed.status;
+        EXPECT_EQ(textOf(f.ed.doc.scene), before) << steps;
+        EXPECT_EQ(f.ed.commands.cursor(), history) << steps;
+        for (int i = 0; i < 5; ++i) f.ed.stepForward();
+        EXPECT_TRUE(f.ed.sim.message().empty()) << f.ed.sim.message();
+        const Result<Scene> reloaded = parseScene(textOf(f.ed.doc.scene), "after.json");
+        EXPECT_TRUE(reloaded) << (reloaded ? "" : reloaded.error());
+    }
+}
+
 // A copy alive is whatever bears its name: a part deleted from it, or a
 // part added to its template, leaves the run going (it refused to step
 // on). An add or delete cannot be undone or redone once the run has added

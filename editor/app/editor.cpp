@@ -340,17 +340,32 @@ bool Editor::deleteSelection() {
     return done;
 }
 
+bool Editor::addCopies(const std::string& label, const std::function<std::vector<Entity>(Scene&)>& clone) {
+    // Copies are checked as a loaded file is: an emitter copied without its
+    // template would be a second emitter of one template, whose copies
+    // would share names and make the scene one that cannot be saved.
+    std::vector<Entity> created;
+    const Result<bool> edited = tryEdit(label, [&](Scene& s) -> Result<bool> {
+        created = clone(s);
+        if (created.empty()) return false;
+        if (std::optional<Error> problem = checkEdited(s, created, label)) return *problem;
+        return true;
+    });
+    if (!edited) {
+        refuse(label + ": " + edited.error());
+        return false;
+    }
+    if (*edited) selection = created;
+    return *edited;
+}
+
 bool Editor::duplicateSelection() {
     if (selection.empty()) return false;
-    std::vector<Entity> created;
     const std::vector<Entity> source = selection;
-    const bool done = applyEdit("duplicate", [&](Scene& s) {
+    return addCopies("duplicate", [&](Scene& s) {
         const Registry copy = s.registry;  // read from a stable copy while creating
-        created = cloneEntities(copy, source, s, placementOffset(copy, source, 1));
-        return !created.empty();
+        return cloneEntities(copy, source, s, placementOffset(copy, source, 1));
     });
-    if (done) selection = created;
-    return done;
 }
 
 void Editor::copySelection() {
@@ -364,17 +379,13 @@ void Editor::copySelection() {
 bool Editor::paste() {
     if (clipboardEntities_.empty()) return false;
     ++pasteCount_;
-    std::vector<Entity> created;
     const Vec2 offset = placementOffset(clipboard_.registry, clipboardEntities_, pasteCount_);
-    const bool done = applyEdit("paste", [&](Scene& s) {
+    return addCopies("paste", [&](Scene& s) {
         // Handles to bodies outside the copy mean something only in the
         // document they were copied from.
-        created = cloneEntities(clipboard_.registry, clipboardEntities_, s, offset,
-                                clipboardDocument_ == documentSerial_ ? OutsideRefs::Keep : OutsideRefs::Drop);
-        return !created.empty();
+        return cloneEntities(clipboard_.registry, clipboardEntities_, s, offset,
+                             clipboardDocument_ == documentSerial_ ? OutsideRefs::Keep : OutsideRefs::Drop);
     });
-    if (done) selection = created;
-    return done;
 }
 
 // ---- simulation ------------------------------------------------------------------

@@ -204,6 +204,9 @@ public:
     std::uint64_t revision() const { return commands.revision() + revisionExtra_; }
 
 private:
+    /// Duplicate and paste: adds what `clone` creates as one edit, checked as
+    /// the loader checks a file; selects the copies, or refuses, saying why.
+    bool addCopies(const std::string& label, const std::function<std::vector<Entity>(Scene&)>& clone);
     void afterSceneReplaced();
     void afterUndoOrRedo();
     /// After a step back: drops the undo history past the restored step
