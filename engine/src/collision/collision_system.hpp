@@ -309,6 +309,9 @@ private:
     /// island (an awake body has a manifold with a sleeping one): then the
     /// detection starts over with that island awake.
     bool sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, Vec2 ref1);
+    /// Replaces margins_ by margins in a frame that turns with the bodies,
+    /// when those add up to less than meanFrameSum (all colliders awake).
+    void rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFrameSum);
     /// Moves cache entries that touch a sleeping collider to sleepingCache_
     /// and the others back to cache_ (each stays sorted).
     void splitCache();
@@ -348,6 +351,7 @@ private:
     std::vector<ProxyPair> pairs_;
     std::vector<Vec2> centres_, stepStart_;
     std::vector<double> stepStartAngle_, margins_, spin_;
+    std::vector<double> rotatedMargins_;  ///< rotatingFrameMargins' candidates
     std::vector<Vec2> startV_, endV_;  // per collider: velocity at step start, predicted at step end (m/s)
     bool detected_ = false;
     struct SavedVelocity {
