@@ -223,12 +223,14 @@ int run(const RunOptions& options) {
         return kExitBadInput;
     }
     World& world = built.value();
-    // Before playing: a pile or an impact the level's substeps cannot hold (stderr, so
+    // Before playing: a pile, an impact or joint loops the level's substeps cannot hold (stderr, so
     // the summary on stdout stays one line).
     if (const std::optional<PileHint> pile = world.pileHint())
         std::cerr << options.level << ": warning: " << pile->message() << "\n";
     if (const std::optional<ImpactHint> impact = world.impactHint())
         std::cerr << options.level << ": warning: " << impact->message() << "\n";
+    if (const std::optional<JointLoopHint> loops = world.jointLoopHint())
+        std::cerr << options.level << ": warning: " << loops->message() << "\n";
     if (const std::optional<DroppedImpulses> dropped = world.droppedImpulses())
         std::cerr << options.level << ": warning: " << dropped->message() << "\n";
 

@@ -77,7 +77,7 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                                    world->bodyCount());
         }
         if (world) {
-            // A pile or an impact the level's substeps cannot hold: said before playing.
+            // A pile, an impact or joint loops the level's substeps cannot hold: said before playing.
             if (const std::optional<PileHint> pile = world->pileHint()) {
                 ImGui::PushTextWrapPos(0.0f);
                 ImGui::TextColored(kGold, "%s", pile->message().c_str());
@@ -86,6 +86,11 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
             if (const std::optional<ImpactHint> impact = world->impactHint()) {
                 ImGui::PushTextWrapPos(0.0f);
                 ImGui::TextColored(kGold, "%s", impact->message().c_str());
+                ImGui::PopTextWrapPos();
+            }
+            if (const std::optional<JointLoopHint> loops = world->jointLoopHint()) {
+                ImGui::PushTextWrapPos(0.0f);
+                ImGui::TextColored(kGold, "%s", loops->message().c_str());
                 ImGui::PopTextWrapPos();
             }
         }

@@ -1092,6 +1092,29 @@ std::optional<ImpactHint> World::impactHint() const {
     return hint;
 }
 
+std::optional<JointLoopHint> World::jointLoopHint() const {
+    const WorldImpl& w = *impl_;
+    const ContactSettingsChoice& c = w.contactChoice;
+    if (!w.substepsGiven || c.jointLoops == 0 || !(c.jointLoopHertz > 0.0)) return std::nullopt;
+    const double perStep = w.settings.dt * c.jointLoopHertz / kLoopJointHertzFraction;
+    if (!(perStep > double(w.settings.substeps) * (1.0 + 1e-12))) return std::nullopt;
+    JointLoopHint hint;
+    hint.loops = c.jointLoops;
+    hint.hertz = c.jointLoopHertz;
+    hint.substeps = w.settings.substeps;
+    hint.substepsNeeded = int(std::clamp(std::ceil(perStep * (1.0 - 1e-12)), 1.0, 1e6));
+    return hint;
+}
+
+std::string JointLoopHint::message() const {
+    char text[360];
+    std::snprintf(text, sizeof text,
+                  "%d joint%s close loops among moving bodies, corrected at %.3g Hz: past a quarter of the substep "
+                  "rate at %d substep%s, where a net of joints can swing open or diverge; substeps %d would hold it",
+                  loops, loops == 1 ? "" : "s", hertz, substeps, substeps == 1 ? "" : "s", substepsNeeded);
+    return text;
+}
+
 std::string ImpactHint::message() const {
     char text[320];
     std::snprintf(text, sizeof text,

@@ -708,6 +708,9 @@ std::string ContactSettingsChoice::reason() const {
             (impactMassRatio > 1.0 ? ", mass ratio " + (std::isinf(impactMassRatio) ? std::string("kinematic")
                                                                                     : number(impactMassRatio) + ":1")
                                    : std::string()));
+    if (jointLoopSubsteps > 1 && jointLoopSubsteps == substeps)
+        add(std::to_string(jointLoops) + " joint" + (jointLoops == 1 ? "" : "s") + " in loops at " +
+            number(jointLoopHertz) + " Hz");
     if (substeps == 1) add(out.empty() ? "nothing in the scene needs more" : "nothing needs more");
     return out;
 }
@@ -760,6 +763,9 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     std::vector<std::uint32_t> parent(bodies.size());
     for (std::uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
     std::vector<std::uint8_t> jointed(bodies.size(), 0), anchored(bodies.size(), 0);
+    // The rigid joints alone, for the loops they close (a joint with its
+    // own stiffness is a spring, not corrected at the loop stiffness).
+    std::vector<std::uint32_t> rigidParent = parent;
     for (const Entity e : order) {
         const Joint* j = reg.tryGet<Joint>(e);
         if (!j) continue;
@@ -769,6 +775,13 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         if (da && db) {
             const std::uint32_t ra = findRoot(parent, slot[j->a.index]), rb = findRoot(parent, slot[j->b.index]);
             if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+            const bool sprung = (j->type == "weld" || j->type == "distance") && j->stiffnessHz.value_or(0.0) > 0.0;
+            if (!sprung) {
+                const std::uint32_t qa = findRoot(rigidParent, slot[j->a.index]);
+                const std::uint32_t qb = findRoot(rigidParent, slot[j->b.index]);
+                if (qa == qb) ++choice.jointLoops;
+                else rigidParent[std::max(qa, qb)] = std::min(qa, qb);
+            }
         } else if (da || db) {
             anchored[slot[da ? j->a.index : j->b.index]] = 1;
         }
@@ -1036,8 +1049,14 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     };
     choice.pileSubsteps = std::max(fewest(pileHolds, true), fewest(columnHolds, true));
     choice.loadSubsteps = fewest(loadHolds, true);
-    // Joints add no rule: the joint solver holds chains and other trees
-    // exactly at any substep count (direct_joints.hpp).
+    // Chains and other trees of joints add no rule: the joint solver holds
+    // them exactly at any substep count (direct_joints.hpp). Joints in loops
+    // are iterated at their loop stiffness (kLoopJointHertzFraction).
+    if (choice.jointLoops > 0) {
+        choice.jointLoopHertz = scene.world.jointHz.value_or(joints::JointSettings::kLoopHertz);
+        const double perStep = dt * choice.jointLoopHertz / kLoopJointHertzFraction;
+        if (perStep > 0.0) choice.jointLoopSubsteps = int(std::clamp(std::ceil(perStep * (1.0 - 1e-12)), 1.0, 16.0));
+    }
     choice.springRate = springRate(scene, switches);
     // ceil(dt * rate) with the product rounded first, so a rate that sits
     // exactly on a whole number of substeps does not ask for one more.
@@ -1045,7 +1064,8 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     choice.springSubsteps = int(std::clamp(std::ceil(perStep * (1.0 - 1e-12)), 1.0, 1000.0));
     impactRule(scene, switches, dt, choice);
     choice.substeps =
-        std::max({choice.pileSubsteps, choice.loadSubsteps, choice.springSubsteps, choice.impactSubsteps});
+        std::max({choice.pileSubsteps, choice.loadSubsteps, choice.springSubsteps, choice.impactSubsteps,
+                  choice.jointLoopSubsteps});
     choice.iterations = choice.substeps == 1 ? 8 : 2;
     return choice;
 }
