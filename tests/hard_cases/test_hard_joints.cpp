@@ -428,6 +428,31 @@ TEST(HardJointsGrid, TooFewSubstepsForJointLoopsAreNamed) {
     Result<World> four = World::build(hingeGrid(6, 4, 1));
     ASSERT_TRUE(four);
     EXPECT_FALSE(four->jointLoopHint());
+    // One loop, in the singular: a ring of three bodies, each pinned to the next.
+    Scene ring;
+    ring.world.gravity = {0.0, -10.0};
+    ring.world.substeps = 2;
+    Registry& r = ring.registry;
+    Entity corners[3];
+    for (int k = 0; k < 3; ++k) {
+        corners[k] = r.create();
+        r.emplace<Position>(corners[k], Position{{std::cos(2.1 * k), std::sin(2.1 * k)}});
+        r.emplace<Radius>(corners[k], Radius{0.1});
+        r.emplace<Mass>(corners[k], Mass{1.0});
+    }
+    for (int k = 0; k < 3; ++k) {
+        Joint j;
+        j.type = "hinge";
+        j.a = corners[k];
+        j.b = corners[(k + 1) % 3];
+        r.emplace<Joint>(r.create(), j);
+    }
+    Result<World> ringWorld = World::build(ring);
+    ASSERT_TRUE(ringWorld) << ringWorld.error();
+    ASSERT_TRUE(ringWorld->jointLoopHint());
+    EXPECT_EQ(ringWorld->jointLoopHint()->message(),
+              "1 joint closes a loop among moving bodies, corrected at 60 Hz: past a quarter of the substep rate at "
+              "2 substeps, where a net of joints can swing open or diverge; substeps 4 would hold it");
     Scene soft = hingeGrid(6, 1, 8);
     soft.world.jointHz = 15.0;
     Result<World> softWorld = World::build(soft);

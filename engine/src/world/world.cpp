@@ -1109,9 +1109,10 @@ std::optional<JointLoopHint> World::jointLoopHint() const {
 std::string JointLoopHint::message() const {
     char text[360];
     std::snprintf(text, sizeof text,
-                  "%d joint%s close loops among moving bodies, corrected at %.3g Hz: past a quarter of the substep "
-                  "rate at %d substep%s, where a net of joints can swing open or diverge; substeps %d would hold it",
-                  loops, loops == 1 ? "" : "s", hertz, substeps, substeps == 1 ? "" : "s", substepsNeeded);
+                  "%d %s among moving bodies, corrected at %.3g Hz: past a quarter of the substep rate at %d "
+                  "substep%s, where a net of joints can swing open or diverge; substeps %d would hold it",
+                  loops, loops == 1 ? "joint closes a loop" : "joints close loops", hertz, substeps,
+                  substeps == 1 ? "" : "s", substepsNeeded);
     return text;
 }
 
