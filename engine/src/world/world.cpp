@@ -1086,9 +1086,8 @@ std::optional<ImpactHint> World::impactHint() const {
     hint.travel = travel;
     hint.substeps = substeps;
     // Any whole number of substeps (the engine's own choice takes 1, 2, 4
-    // or 8); ceil with the ratio rounded first, as the spring rule does.
-    const double ratio = c.impactDriven * dt / (kImpactTravel * c.impactSize);
-    hint.substepsNeeded = int(std::clamp(std::ceil(ratio * (1.0 - 1e-12)), 1.0, 1e6));
+    // or 8).
+    hint.substepsNeeded = detail::wholeSubsteps(c.impactDriven * dt / (kImpactTravel * c.impactSize), 1e6);
     return hint;
 }
 
@@ -1102,7 +1101,7 @@ std::optional<JointLoopHint> World::jointLoopHint() const {
     hint.loops = c.jointLoops;
     hint.hertz = c.jointLoopHertz;
     hint.substeps = w.settings.substeps;
-    hint.substepsNeeded = int(std::clamp(std::ceil(perStep * (1.0 - 1e-12)), 1.0, 1e6));
+    hint.substepsNeeded = detail::wholeSubsteps(perStep, 1e6);
     return hint;
 }
 

@@ -1055,13 +1055,10 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     if (choice.jointLoops > 0) {
         choice.jointLoopHertz = scene.world.jointHz.value_or(joints::JointSettings::kLoopHertz);
         const double perStep = dt * choice.jointLoopHertz / kLoopJointHertzFraction;
-        if (perStep > 0.0) choice.jointLoopSubsteps = int(std::clamp(std::ceil(perStep * (1.0 - 1e-12)), 1.0, 16.0));
+        if (perStep > 0.0) choice.jointLoopSubsteps = detail::wholeSubsteps(perStep, 16.0);
     }
     choice.springRate = springRate(scene, switches);
-    // ceil(dt * rate) with the product rounded first, so a rate that sits
-    // exactly on a whole number of substeps does not ask for one more.
-    const double perStep = dt * choice.springRate;
-    choice.springSubsteps = int(std::clamp(std::ceil(perStep * (1.0 - 1e-12)), 1.0, 1000.0));
+    choice.springSubsteps = detail::wholeSubsteps(dt * choice.springRate, 1000.0);
     impactRule(scene, switches, dt, choice);
     choice.substeps =
         std::max({choice.pileSubsteps, choice.loadSubsteps, choice.springSubsteps, choice.impactSubsteps,

@@ -7,6 +7,8 @@
 #include "stepwise/result.hpp"
 #include "stepwise/scene.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -52,6 +54,14 @@ bool fillJointParams(const Joint& joint, joints::JointConstraint& j);
 /// not be welded or driven by a motor, and a small disc changes nothing for
 /// a hinge at its centre.
 inline constexpr double kShapelessRadius = 0.1;
+
+/// The fewest whole substeps, from 1 to `most`, that split a step into
+/// parts of at most 1 / `perStep` of it: ceil(perStep), with the ratio
+/// rounded first so one that sits on a whole number does not ask for one
+/// more.
+inline int wholeSubsteps(double perStep, double most) {
+    return int(std::clamp(std::ceil(perStep * (1.0 - 1e-12)), 1.0, most));
+}
 
 /// Views an interleaved (x0, y0, x1, y1, ...) state array as Vec2s. Vec2 is
 /// exactly two doubles (asserted), the layout the integrators use.
