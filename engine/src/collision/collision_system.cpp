@@ -807,7 +807,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
         margins_[i] = kSpeculativeBase + dt * drift + spin_[i];
         meanFrameSum += margins_[i];
     });
-    if (!anySleeping_ && moving > 1) rotatingFrameMargins(ref0, ref1, meanFrameSum);
+    if (turningFrame_ && !anySleeping_ && moving > 1) rotatingFrameMargins(ref0, ref1, meanFrameSum);
 
     // One sincos per collider per step, shared by the boxes and the narrow phase.
     std::vector<Rot>& rots = rotScratch_;

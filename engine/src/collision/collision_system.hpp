@@ -164,6 +164,9 @@ public:
         broadPhase_.setKind(kind);
     }
     const BroadPhase& broadPhase() const { return broadPhase_; }
+    /// Off: boxes are fattened in the mean-velocity frame only, never in
+    /// the frame that turns with the bodies (tests compare the two).
+    void setTurningFrame(bool on) { turningFrame_ = on; }
 
     /// Records the step-start state. Detection for the whole step runs in
     /// the first solveSubstep, once the forces of the step are known: margins
@@ -345,6 +348,7 @@ private:
     SolverSettings settings_;
     BroadPhase broadPhase_;
     bool autoBroadPhase_ = true;
+    bool turningFrame_ = true;
     std::vector<Aabb> boxes_;
     std::vector<double> cores_;  // per box: its area before the margin (m^2), for the grid's crowd test
     std::vector<std::uint8_t> movable_;
