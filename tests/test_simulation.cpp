@@ -1175,11 +1175,11 @@ TEST(Simulation, APastedTemplateAndEmitterRunBesideTheOriginal) {
 }
 
 // An emitter duplicated or pasted without its template would be a second
-// emitter of one template: both would name their copies "doll#1", and the
-// scene could no longer be saved. Refused as the loader refuses it, naming
-// the template and its emitter, before and during a run; the scene and the
-// undo history stay as they were, and the emitter with its whole template
-// still duplicates.
+// emitter of one template: both would give their copies the same names,
+// and the scene could no longer be saved. Refused as the loader refuses
+// it, naming the template and its emitter, before and during a run; the
+// scene and the undo history stay as they were, and the emitter with its
+// whole template still duplicates.
 TEST(Simulation, AnEmitterCopiedWithoutItsTemplateIsRefused) {
     for (const int steps : {0, 35}) {
         Fixture f("emitter_rain.json");
