@@ -33,6 +33,7 @@ void setDistinct(const FieldInfo& field, void* component, int salt, Entity targe
     case FieldKind::VectorList:  // a convex, counter-clockwise quadrilateral off its origin
         *static_cast<std::vector<Vec2>*>(m) = {{0.1 * salt + 1.0 / 3.0, -2.0 / 7.0}, {2.0, -0.5}, {2.5, 1e-3}, {0.2, 1.0}};
         break;
+    case FieldKind::IntegerList: *static_cast<std::vector<int>*>(m) = {salt + 1, salt + 4}; break;
     case FieldKind::ShapeList: {  // one of each kind, with every optional field set somewhere
         CompoundShape circle;
         circle.center = {0.1 * salt + 1.0 / 3.0, -2.0 / 7.0};
@@ -84,6 +85,7 @@ bool fieldEquals(const FieldInfo& field, const void* a, const void* b, const Reg
     case FieldKind::Bool: return *static_cast<const bool*>(ma) == *static_cast<const bool*>(mb);
     case FieldKind::VectorList:
         return *static_cast<const std::vector<Vec2>*>(ma) == *static_cast<const std::vector<Vec2>*>(mb);
+    case FieldKind::IntegerList: return *static_cast<const std::vector<int>*>(ma) == *static_cast<const std::vector<int>*>(mb);
     case FieldKind::ShapeList:
         return *static_cast<const std::vector<CompoundShape>*>(ma) == *static_cast<const std::vector<CompoundShape>*>(mb);
     case FieldKind::String: return *static_cast<const std::string*>(ma) == *static_cast<const std::string*>(mb);
@@ -167,6 +169,7 @@ TEST_P(ComponentRoundTrip, EveryFieldSurvivesSaveAndLoad) {
         // entities of their own).
         auto* em = static_cast<Emitter*>(component);
         em->alive = 0;
+        em->copies.clear();
         r.emplace<Template>(target, Template{em->templateName});
         r.emplace<Radius>(target, Radius{0.25});
     }

@@ -11,6 +11,10 @@
 
 #include <gtest/gtest.h>
 
+#include <deque>
+#include <map>
+#include <tuple>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -406,17 +410,30 @@ TEST(Emitters, RefusalsNameTheEmitterOrTemplate) {
               "t.json: error: /entities/2/emitter/spread: expected a number in [0, 3.14159], got -0.1");
     EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2, "lifetime": -1})")),
               "t.json: error: /entities/2/emitter/lifetime: expected a number in (0, 1e+30], got -1");
-    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2})",
-                            R"(, {"name": "spout2", "position": {"x": 0, "y": 5}, "emitter": {"template": "drop"}})")),
-              "t.json: error: /entities/3/emitter/template: emitter on entity 3 (\"spout\"): template \"drop\" is "
-              "copied by entity 2 (\"spout2\") already; give each emitter its own template");
+    // Two emitters of one template share its copy numbers; each says which
+    // of them it has alive when they are not its newest.
+    const std::string spout2 =
+        R"(, {"name": "drop#3", "position": {"x": 0, "y": 5}, "radius": 0.1}, {"name": "drop#1", "position": {"x": 1, "y": 5},
+           "radius": 0.1}, {"name": "spout2", "position": {"x": 0, "y": 5}, "emitter": {"template": "drop", "emitted": 2,
+           "alive": 2, "next": 5, "oldest": 3, )";
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2})", spout2 + R"("copies": [1]}})")),
+              "t.json: error: /entities/4/emitter/copies: emitter on entity 4 (\"spout2\"): 1 copy numbers for 2 "
+              "copies alive");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2})", spout2 + R"("copies": [3, 1]}})")),
+              "t.json: error: /entities/4/emitter/copies/1: emitter on entity 4 (\"spout2\"): copy numbers go up, "
+              "oldest first; 1 follows 3");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2})", spout2 + R"("copies": [0, 3]}})")),
+              "t.json: error: /entities/4/emitter/copies/0: expected an integer in [1, 2147483647], got 0");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2, "emitted": 1, "alive": 1, "next": 5,
+                                "oldest": 4, "copies": [3]})",
+                            spout2 + R"("copies": [1, 3]}})")),
+              "t.json: error: /entities/5/emitter/copies: emitter on entity 5 (\"spout\"): copy \"drop#3\" is alive in "
+              "the run state of entity 4 (\"spout2\") already");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2})", spout2 + R"("copies": [1, 3]}})")),
+              "(loaded)");
     EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2, "emitted": 4, "alive": 1, "next": 5, "oldest": 4})")),
               "t.json: error: /entities/2/emitter/alive: emitter on entity 2 (\"spout\"): copy \"drop#4\" is alive in "
               "its run state but not in the scene");
-    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2})",
-                            R"(, {"name": "drop#3", "position": {"x": 0, "y": 5}})")),
-              "t.json: error: /entities/2/name: \"drop#3\" is a name the emitter on entity 3 (\"spout\") gives its "
-              "copies, and that copy is not alive in its run state (0 alive of 0 emitted)");
     EXPECT_EQ(refusal(R"({"entities": [{"name": "p", "template": "t", "position": {"x": 0, "y": 0}, "static": true,
                           "radius": 1}]})"),
               "t.json: error: /entities/0/template: entity 0 (\"p\"): a template entity is a dynamic body with a "
@@ -790,4 +807,130 @@ TEST(Emitters, TheEngineChoosesItsSettingsForWhatTheTemplatesWillMake) {
         EXPECT_EQ(empty.stackHeight, 0) << "a floor alone";
         if (height >= 8) EXPECT_GT(templated.substeps, empty.substeps) << height << " blocks";
     }
+}
+
+namespace {
+
+/// `level` with a second emitter of its template `name` added last: `fields`
+/// are its emitter's fields after "template".
+std::string withSecondEmitter(std::string level, const std::string& name, const std::string& templateName,
+                              const std::string& fields) {
+    const std::string entity = R"(, {"name": ")" + name + R"(", "position": {"x": -2, "y": 6}, "emitter": {"template": ")" +
+                               templateName + R"(", )" + fields + "}}";
+    level.insert(level.rfind(']'), entity);
+    return level;
+}
+
+} // namespace
+
+// Two emitters of one template, at different intervals and counts (one with
+// a lifetime): every copy has its own name, numbered in the order the
+// copies appear (the emitters in scene order within a step), and each
+// emitter removes only its own oldest copies.
+TEST(Emitters, TwoEmittersOfOneTemplateNumberItsCopiesInTheOrderTheyAppear) {
+    const double dt = 1.0 / 60.0;
+    for (const auto& [every, count, lifetime] : {std::tuple{3, 2, std::string()}, std::tuple{5, 4, std::string()},
+                                                 std::tuple{2, 3, std::string(R"(, "lifetime": 0.1)")}}) {
+        SCOPED_TRACE("second emitter every " + std::to_string(every) + " steps, count " + std::to_string(count) +
+                     lifetime);
+        const Scene scene = parseLevel(withSecondEmitter(
+            ballLevel(R"("interval": )" + exactNumber(3 * dt) + R"(, "count": 2, "velocity": {"x": 3, "y": 0})"),
+            "spout2", "drop",
+            R"("interval": )" + exactNumber(every * dt) + R"(, "count": )" + std::to_string(count) + lifetime));
+        World world = buildWorld(scene);
+        const Entity spout = named(scene, "spout"), spout2 = named(scene, "spout2");
+        std::unordered_map<Entity, std::deque<std::string>> own;  // each emitter's copies alive, from its events
+        int appeared = 0;
+        for (int step = 1; step <= 90; ++step) {
+            ASSERT_TRUE(world.step());
+            for (const EmitterEvent& event : world.emitterEvents()) {
+                std::deque<std::string>& mine = own[event.emitter];
+                if (event.added) {
+                    ASSERT_EQ(event.copy, "drop#" + std::to_string(++appeared)) << "step " << step;
+                    mine.push_back(event.copy);
+                } else {
+                    ASSERT_FALSE(mine.empty()) << "step " << step;
+                    ASSERT_EQ(event.copy, mine.front()) << "an emitter removes its own oldest copy, step " << step;
+                    mine.pop_front();
+                }
+            }
+            ASSERT_LE(own[spout].size(), 2u);
+            ASSERT_LE(own[spout2].size(), std::size_t(count));
+            std::vector<std::string> expected(own[spout].begin(), own[spout].end());
+            expected.insert(expected.end(), own[spout2].begin(), own[spout2].end());
+            std::sort(expected.begin(), expected.end());
+            std::vector<std::string> alive = copiesAlive(world, scene);
+            std::sort(alive.begin(), alive.end());
+            ASSERT_EQ(alive, expected) << "step " << step;
+            ASSERT_EQ(world.bodyCount(), alive.size()) << "step " << step;
+        }
+        EXPECT_EQ(appeared, 30 + 90 / every);
+    }
+}
+
+// Save, load and continue equals running on with two emitters of one
+// ragdoll template, whose copies alive are then not each emitter's newest
+// numbers (the save lists them), over split points on and around both
+// emitters' copies, at 1 and 4 substeps and the engine's choice.
+TEST(Emitters, TwoEmittersOfOneTemplateResumeExactly) {
+    for (const int substeps : {1, 4, 0}) {
+        SCOPED_TRACE("substeps " + std::to_string(substeps));
+        const Scene scene = parseLevel(withSecondEmitter(ragdollLevel(substeps, 3, R"(, "lifetime": 1.2)"), "chute",
+                                                         "doll", R"("interval": 0.3, "count": 2, "spread": 0.4)"));
+        World straight = buildWorld(scene);
+        for (int s = 0; s < 240; ++s) ASSERT_TRUE(straight.step());
+        const std::string expected = savedRunText(straight, scene);
+        EXPECT_NE(expected.find("\"copies\""), std::string::npos) << "the interleaved numbers are listed";
+        for (const int split : {1, 17, 18, 19, 30, 31, 72, 163}) {
+            SCOPED_TRACE("split " + std::to_string(split));
+            ASSERT_EQ(savedAfterResumeAt(scene, split, 240), expected);
+        }
+    }
+}
+
+// One of two emitters deleted while copies are alive, as the editor
+// deletes it (its copies stay, renamed without the '#'): the other emitter
+// numbers its copies past every copy alive, so no name is given twice, and
+// a save of that scene resumes exactly. A body named like a copy that no
+// emitter has alive is refused, naming the template's emitters.
+TEST(Emitters, CopiesOfADeletedEmitterStayAndLaterCopiesNumberPastTheOthers) {
+    const double dt = 1.0 / 60.0;
+    const Scene scene = parseLevel(withSecondEmitter(
+        ballLevel(R"("interval": )" + exactNumber(4 * dt) + R"(, "count": 1)"), "spout2", "drop",
+        R"("interval": )" + exactNumber(2 * dt) + R"(, "count": 3)"));
+    World world = buildWorld(scene);
+    for (int s = 0; s < 20; ++s) ASSERT_TRUE(world.step());
+    // Copies 1 to 15 came in turn (spout every 4 steps, spout2 every 2);
+    // spout2's three newest stay, and spout's newest.
+    EXPECT_EQ(copiesAlive(world, scene), (std::vector<std::string>{"drop#12", "drop#13", "drop#14", "drop#15"}));
+    Scene edited = parseLevel(savedRunText(world, scene));
+    Scene handNamed = edited;
+    edited.registry.destroy(named(edited, "spout"));
+    edited.registry.tryGet<Name>(named(edited, "drop#13"))->value = "drop 13";  // as the editor renames it
+    const Scene reloaded = parseLevel(sceneToJsonText(edited));
+    EXPECT_FALSE(named(reloaded, "drop 13").isNull()) << "the deleted emitter's copy stays, renamed";
+    World after = buildWorld(reloaded);
+    std::vector<std::string> added;
+    for (int s = 0; s < 8; ++s) {
+        ASSERT_TRUE(after.step());
+        for (const EmitterEvent& event : after.emitterEvents())
+            if (event.added) added.push_back(event.copy);
+    }
+    // spout2 alone has made 10: numbered past its newest alive, 15.
+    EXPECT_EQ(added, (std::vector<std::string>{"drop#16", "drop#17", "drop#18", "drop#19"}));
+    World straight = buildWorld(reloaded);
+    for (int s = 0; s < 40; ++s) ASSERT_TRUE(straight.step());
+    const std::string expected = savedRunText(straight, reloaded);
+    for (const int split : {1, 2, 3, 13})
+        EXPECT_EQ(savedAfterResumeAt(reloaded, split, 40), expected) << "split " << split;
+
+    const Entity hand = handNamed.registry.create();
+    handNamed.registry.emplace<Name>(hand, Name{"drop#40"});
+    handNamed.registry.emplace<Position>(hand, Position{{3.0, 3.0}});
+    handNamed.registry.emplace<Radius>(hand, Radius{0.1});
+    const std::string text = sceneToJsonText(handNamed);
+    EXPECT_EQ(refusal(text).substr(refusal(text).find("error:")),
+              "error: /entities/" + std::to_string(handNamed.registry.entities().size() - 1) +
+                  "/name: \"drop#40\" is a name the emitters of template \"drop\" give their copies, and no emitter "
+                  "has that copy alive in its run state");
 }

@@ -103,6 +103,12 @@ void encodeComponent(std::string& out, std::size_t c, const void* component) {
             break;
         }
         case FieldKind::ShapeList: putShapes(out, field); break;
+        case FieldKind::IntegerList: {
+            const auto& list = *static_cast<const std::vector<int>*>(field);
+            put(out, std::uint32_t(list.size()));
+            for (const int n : list) put(out, n);
+            break;
+        }
         case FieldKind::OptionalNumber: putOptional<double>(out, field); break;
         case FieldKind::Vector: put(out, *static_cast<const Vec2*>(field)); break;
         case FieldKind::OptionalVector: putOptional<Vec2>(out, field); break;
@@ -183,6 +189,12 @@ void decodeEntity(const std::string& in, Registry& reg, Entity e) {
                 break;
             }
             case FieldKind::ShapeList: takeShapes(in, at, field); break;
+            case FieldKind::IntegerList: {
+                auto& list = *static_cast<std::vector<int>*>(field);
+                list.resize(take<std::uint32_t>(in, at));
+                for (int& n : list) n = take<int>(in, at);
+                break;
+            }
             case FieldKind::OptionalNumber: takeOptional<double>(in, at, field); break;
             case FieldKind::Vector: *static_cast<Vec2*>(field) = take<Vec2>(in, at); break;
             case FieldKind::OptionalVector: takeOptional<Vec2>(in, at, field); break;

@@ -341,9 +341,8 @@ bool Editor::deleteSelection() {
 }
 
 bool Editor::addCopies(const std::string& label, const std::function<std::vector<Entity>(Scene&)>& clone) {
-    // Copies are checked as a loaded file is: an emitter copied without its
-    // template would be a second emitter of one template, whose copies
-    // would share names and make the scene one that cannot be saved.
+    // Copies are checked as a loaded file is, so that what the editor makes
+    // always saves and loads.
     std::vector<Entity> created;
     const Result<bool> edited = tryEdit(label, [&](Scene& s) -> Result<bool> {
         created = clone(s);

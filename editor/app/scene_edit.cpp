@@ -28,6 +28,7 @@ FieldValue readField(const FieldInfo& field, const void* component) {
     case FieldKind::Bool: return *static_cast<const bool*>(at);
     case FieldKind::VectorList: return *static_cast<const std::vector<Vec2>*>(at);
     case FieldKind::ShapeList: return *static_cast<const std::vector<CompoundShape>*>(at);
+    case FieldKind::IntegerList: return *static_cast<const std::vector<int>*>(at);
     case FieldKind::String: return *static_cast<const std::string*>(at);
     case FieldKind::EntityRef: return *static_cast<const Entity*>(at);
     }
@@ -52,6 +53,7 @@ void writeField(const FieldInfo& field, void* component, const FieldValue& value
                 (std::is_same_v<V, bool> && field.kind == FieldKind::Bool) ||
                 (std::is_same_v<V, std::vector<Vec2>> && field.kind == FieldKind::VectorList) ||
                 (std::is_same_v<V, std::vector<CompoundShape>> && field.kind == FieldKind::ShapeList) ||
+                (std::is_same_v<V, std::vector<int>> && field.kind == FieldKind::IntegerList) ||
                 (std::is_same_v<V, std::string> && field.kind == FieldKind::String) ||
                 (std::is_same_v<V, Entity> && field.kind == FieldKind::EntityRef);
             if (matches) *static_cast<V*>(at) = v;
@@ -74,6 +76,7 @@ bool valueFitsKind(const FieldInfo& field, const FieldValue& value) {
             case FieldKind::Bool: return std::is_same_v<V, bool>;
             case FieldKind::VectorList: return std::is_same_v<V, std::vector<Vec2>>;
             case FieldKind::ShapeList: return std::is_same_v<V, std::vector<CompoundShape>>;
+            case FieldKind::IntegerList: return std::is_same_v<V, std::vector<int>>;
             case FieldKind::String: return std::is_same_v<V, std::string>;
             case FieldKind::EntityRef: return std::is_same_v<V, Entity>;
             }
@@ -461,6 +464,23 @@ std::vector<Entity> attachedTo(const Registry& registry, const std::vector<Entit
 }
 
 std::size_t destroyWithSprings(Scene& scene, const std::vector<Entity>& entities) {
+    // A deleted emitter's copies alive stay, as the designer's own bodies:
+    // their names lose the '#' (as a pasted copy's do), or another emitter
+    // of the template would find names it gives that no run has alive.
+    std::unordered_set<std::string> orphaned;
+    for (const Entity e : entities)
+        if (const Emitter* em = scene.registry.alive(e) ? scene.registry.tryGet<Emitter>(e) : nullptr)
+            for (const int k : copyNumbers(*em)) orphaned.insert(em->templateName + "#" + std::to_string(k));
+    if (!orphaned.empty()) {
+        NameAllocator names(scene.registry);
+        for (const Entity e : scene.registry.entities()) {
+            Name* n = scene.registry.tryGet<Name>(e);
+            if (!n || !orphaned.contains(n->value.substr(0, n->value.find('/')))) continue;
+            std::string base = n->value;
+            std::replace(base.begin(), base.end(), '#', ' ');
+            n->value = names.take(base);
+        }
+    }
     std::vector<Entity> doomed = entities;
     for (Entity s : attachedTo(scene.registry, entities)) doomed.push_back(s);
     std::size_t count = 0;

@@ -23,7 +23,7 @@ namespace stepwise::editor {
 
 /// A field's value, by kind (FieldKind -> alternative).
 using FieldValue = std::variant<double, std::optional<double>, Vec2, std::optional<Vec2>, Rgb, bool, std::string, Entity,
-                                std::vector<Vec2>, int, std::uint32_t, std::vector<CompoundShape>>;
+                                std::vector<Vec2>, int, std::uint32_t, std::vector<CompoundShape>, std::vector<int>>;
 FieldValue readField(const FieldInfo& field, const void* component);
 void writeField(const FieldInfo& field, void* component, const FieldValue& value);
 /// True when `value` holds the C++ type of `field`'s kind.
@@ -127,7 +127,8 @@ std::vector<Entity> springsAttachedTo(const Registry& registry, Entity e);
 std::vector<Entity> attachedTo(const Registry& registry, const std::vector<Entity>& entities);
 
 /// Destroys the entities and everything attached to them (a spring whose
-/// end disappears would make the level invalid). Returns how many went.
+/// end disappears would make the level invalid). A deleted emitter's
+/// copies alive stay, renamed without their '#'. Returns how many went.
 std::size_t destroyWithSprings(Scene& scene, const std::vector<Entity>& entities);
 
 /// Copies `entities` (and their components) into `dst` with fresh unique

@@ -170,6 +170,15 @@ bool fieldWidget(UiState& ui, const FieldInfo& f, FieldValue& value, const char*
         ImGui::EndGroup();
         return changed;
     }
+    case FieldKind::IntegerList: {
+        // Run state the engine keeps (an emitter's copies alive): shown,
+        // not edited, as the names of the copies follow from it.
+        const auto& list = std::get<std::vector<int>>(value);
+        std::string text;
+        for (const int n : list) text += (text.empty() ? "" : " ") + std::to_string(n);
+        ImGui::TextColored(kDim, "%s: %s", label, text.empty() ? "-" : text.c_str());
+        return false;
+    }
     case FieldKind::ShapeList: {
         // One tree node per shape with its geometry and material; the whole
         // list is one value, so a drag is one undo step and the component's

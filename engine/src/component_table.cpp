@@ -291,7 +291,10 @@ std::vector<ComponentInfo> buildTable() {
          field<&Emitter::next>("next", kAny, "s", "run state: world time of the next copy; absent: the time at load"),
          field<&Emitter::emitted>("emitted", NumberRange{0.0, 2147483647.0}, "", "run state: copies made so far"),
          field<&Emitter::alive>("alive", NumberRange{0.0, 100000.0}, "", "run state: the newest this many are alive"),
-         field<&Emitter::oldest>("oldest", kAny, "s", "run state: when the oldest copy alive appeared")}));
+         field<&Emitter::oldest>("oldest", kAny, "s", "run state: when the oldest copy alive appeared"),
+         field<&Emitter::copies>("copies", NumberRange{1.0, 2147483647.0}, "",
+                                 "run state: the numbers of its copies alive, oldest first; absent: the alive "
+                                 "numbers up to emitted")}));
     {
         FieldInfo type = field<&Joint::type>("type", kAny, "", "hinge, slider, weld, distance, rope or wheel");
         type.choices = kJointTypes;
@@ -399,6 +402,10 @@ std::optional<Error> fieldValueProblem(const FieldInfo& field, const void* membe
         for (const Vec2 p : *static_cast<const std::vector<Vec2>*>(member))
             if (auto problem = vector(p, kAnyMagnitude)) return problem;
         return std::nullopt;
+    case FieldKind::IntegerList:
+        for (const int n : *static_cast<const std::vector<int>*>(member))
+            if (auto problem = number(n, true)) return problem;
+        return std::nullopt;
     case FieldKind::ShapeList:
         for (const CompoundShape& s : *static_cast<const std::vector<CompoundShape>*>(member)) {
             for (const Vec2 p : {s.center, s.a, s.b})
@@ -493,6 +500,7 @@ void copyField(const FieldInfo& field, const void* src, void* dst) {
     case FieldKind::ShapeList:
         *static_cast<std::vector<CompoundShape>*>(to) = *static_cast<const std::vector<CompoundShape>*>(from);
         break;
+    case FieldKind::IntegerList: *static_cast<std::vector<int>*>(to) = *static_cast<const std::vector<int>*>(from); break;
     case FieldKind::String: *static_cast<std::string*>(to) = *static_cast<const std::string*>(from); break;
     case FieldKind::EntityRef: *static_cast<Entity*>(to) = *static_cast<const Entity*>(from); break;
     }

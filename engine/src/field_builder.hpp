@@ -43,6 +43,7 @@ constexpr FieldKind kindOf() {
     else if constexpr (std::is_same_v<M, Entity>) return FieldKind::EntityRef;
     else if constexpr (std::is_same_v<M, std::vector<Vec2>>) return FieldKind::VectorList;
     else if constexpr (std::is_same_v<M, std::vector<CompoundShape>>) return FieldKind::ShapeList;
+    else if constexpr (std::is_same_v<M, std::vector<int>>) return FieldKind::IntegerList;
     else {
         static_assert(std::is_same_v<M, std::string>, "unsupported field type");
         return FieldKind::String;

@@ -9,6 +9,7 @@
 #include "stepwise/world_fields.hpp"
 
 #include "json_reader.hpp"
+#include "templates.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -309,6 +310,19 @@ void readField(const FieldInfo& field, const Json& v, void* component, const std
         for (std::size_t i = 0; i < v.size(); ++i) list.push_back(readVector(v[i], child(pointer, i)));
         break;
     }
+    case FieldKind::IntegerList: {
+        if (!v.is_array()) refuse(pointer, "expected an array of integers, got " + describeFound(v));
+        auto& list = *static_cast<std::vector<int>*>(member);
+        list.clear();
+        for (std::size_t i = 0; i < v.size(); ++i) {
+            const std::string at = child(pointer, i);
+            const double d = readNumber(v[i], at, NumberRange{}, field.range, true);
+            if (d != std::floor(d) || !field.range.contains(d) || std::abs(d) > double(std::numeric_limits<int>::max()))
+                refuse(at, "expected " + field.range.describe(true) + ", got " + formatNumber(d));
+            list.push_back(int(d));
+        }
+        break;
+    }
     case FieldKind::ShapeList: {
         if (!v.is_array()) refuse(pointer, "expected an array of shapes, got " + describeFound(v));
         auto& list = *static_cast<std::vector<CompoundShape>*>(member);
@@ -372,6 +386,13 @@ Json fieldJson(const FieldInfo& field, const void* component, const Registry& re
     case FieldKind::VectorList: {
         Json list = Json::array();
         for (const Vec2 p : *static_cast<const std::vector<Vec2>*>(member)) list.push_back(vectorJson(p));
+        return list;
+    }
+    case FieldKind::IntegerList: {
+        const auto& values = *static_cast<const std::vector<int>*>(member);
+        if (values.empty()) return Json(Json::value_t::discarded);
+        Json list = Json::array();
+        for (const int n : values) list.push_back(n);
         return list;
     }
     case FieldKind::ShapeList: {
@@ -895,7 +916,12 @@ std::string templatesProblem(const Registry& registry) {
                        "; a template's joints and springs stay within it";
         }
     }
-    std::map<std::string, std::size_t> emitterOf;  // template value -> its emitter
+    // Copy names already claimed by an emitter's run state: by whom.
+    std::map<std::string, std::size_t> claimedBy;
+    std::unordered_set<std::string> names;
+    if (registry.count<Emitter>() > 0)
+        for (const Entity e : entities)
+            if (const Name* n = registry.tryGet<Name>(e)) names.insert(n->value);
     for (std::size_t i = 0; i < entities.size(); ++i) {
         const Emitter* em = registry.tryGet<Emitter>(entities[i]);
         if (!em) continue;
@@ -903,9 +929,6 @@ std::string templatesProblem(const Registry& registry) {
         const std::string who = "emitter on " + entityLabelOf(registry, i);
         if (firstOf.find(em->templateName) == firstOf.end())
             return at + "/template: " + who + ": no entity has \"template\": \"" + em->templateName + "\"";
-        if (const auto [it, inserted] = emitterOf.emplace(em->templateName, i); !inserted)
-            return at + "/template: " + who + ": template \"" + em->templateName + "\" is copied by " +
-                   entityLabelOf(registry, it->second) + " already; give each emitter its own template";
         if (em->alive > em->count)
             return at + "/alive: " + who + ": " + std::to_string(em->alive) + " copies alive, more than count " +
                    std::to_string(em->count);
@@ -914,29 +937,45 @@ std::string templatesProblem(const Registry& registry) {
                    std::to_string(em->emitted) + " emitted";
         if (em->alive > 0 && (!em->oldest || !em->next))
             return at + "/oldest: " + who + ": with copies alive the run state needs \"next\" and \"oldest\"";
+        if (!em->copies.empty()) {
+            if (int(em->copies.size()) != em->alive)
+                return at + "/copies: " + who + ": " + std::to_string(em->copies.size()) + " copy numbers for " +
+                       std::to_string(em->alive) + " copies alive";
+            for (std::size_t k = 1; k < em->copies.size(); ++k)
+                if (em->copies[k] <= em->copies[k - 1])
+                    return child(at + "/copies", k) + ": " + who + ": copy numbers go up, oldest first; " +
+                           std::to_string(em->copies[k]) + " follows " + std::to_string(em->copies[k - 1]);
+        }
         // The copies alive, by the names they were given.
-        // Names of its copies belong to the run: only those alive may be in
-        // the scene, or a later copy would take a name that is in use.
-        const std::string prefix = em->templateName + "#";
-        for (std::size_t j = 0; j < entities.size(); ++j) {
-            const Name* n = registry.tryGet<Name>(entities[j]);
-            if (!n || n->value.compare(0, prefix.size(), prefix) != 0) continue;
-            const std::string rest = n->value.substr(prefix.size(), n->value.find('/', prefix.size()) - prefix.size());
-            if (rest.empty() || rest.size() > 9 || rest.find_first_not_of("0123456789") != std::string::npos) continue;
-            const long k = std::stol(rest);
-            if (k <= em->emitted - em->alive || k > em->emitted)
-                return child("/entities", j) + "/name: \"" + n->value + "\" is a name the " + who +
-                       " gives its copies, and that copy is not alive in its run state (" + std::to_string(em->alive) +
-                       " alive of " + std::to_string(em->emitted) + " emitted)";
-        }
-        for (int k = em->emitted - em->alive + 1; k <= em->emitted; ++k) {
+        for (const int k : copyNumbers(*em)) {
             const std::string copy = em->templateName + "#" + std::to_string(k);
-            bool found = false;
-            for (const Entity e : entities)
-                if (const Name* n = registry.tryGet<Name>(e); n && n->value == copy) found = true;
-            if (!found)
+            if (!names.contains(copy))
                 return at + "/alive: " + who + ": copy \"" + copy + "\" is alive in its run state but not in the scene";
+            if (const auto [it, inserted] = claimedBy.emplace(copy, i); !inserted)
+                return at + "/copies: " + who + ": copy \"" + copy + "\" is alive in the run state of " +
+                       entityLabelOf(registry, it->second) + " already";
         }
+    }
+    // Names of a template's copies belong to its emitters' run: only those
+    // alive may be in the scene, or a later copy would take a name in use.
+    std::map<std::string, std::vector<std::size_t>> emittersOf;  // template value -> its emitters
+    for (std::size_t i = 0; i < entities.size(); ++i)
+        if (const Emitter* em = registry.tryGet<Emitter>(entities[i])) emittersOf[em->templateName].push_back(i);
+    for (std::size_t j = 0; j < entities.size() && !emittersOf.empty(); ++j) {
+        const Name* n = registry.tryGet<Name>(entities[j]);
+        const std::size_t hash = n ? n->value.find('#') : std::string::npos;
+        if (hash == std::string::npos) continue;
+        const auto of = emittersOf.find(n->value.substr(0, hash));
+        if (of == emittersOf.end() || !detail::copyNumberIn(n->value, of->first)) continue;
+        if (claimedBy.contains(n->value.substr(0, n->value.find('/')))) continue;
+        const std::string name = child("/entities", j) + "/name: \"" + n->value + "\"";
+        if (of->second.size() > 1)
+            return name + " is a name the emitters of template \"" + of->first +
+                   "\" give their copies, and no emitter has that copy alive in its run state";
+        const Emitter& em = *registry.tryGet<Emitter>(entities[of->second.front()]);
+        return name + " is a name the emitter on " + entityLabelOf(registry, of->second.front()) +
+               " gives its copies, and that copy is not alive in its run state (" + std::to_string(em.alive) +
+               " alive of " + std::to_string(em.emitted) + " emitted)";
     }
     return {};
 }

@@ -86,6 +86,13 @@ Json fieldSchema(const FieldInfo& f) {
         j = Json{{"type", "array"}, {"items", item}, {"minItems", int(f.range.min)}, {"maxItems", int(f.range.max)}};
         break;
     }
+    case FieldKind::IntegerList: {
+        Json item{{"type", "integer"}};
+        if (std::isfinite(f.range.min)) item["minimum"] = std::int64_t(f.range.min);
+        if (std::isfinite(f.range.max)) item["maximum"] = std::int64_t(f.range.max);
+        j = Json{{"type", "array"}, {"items", item}};
+        break;
+    }
     case FieldKind::VectorList:
         j = Json{{"type", "array"}, {"items", ref("vector")}};
         if (std::isfinite(f.range.min)) j["minItems"] = int(f.range.min);

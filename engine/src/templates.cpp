@@ -2,6 +2,7 @@
 
 #include "stepwise/component_table.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -29,8 +30,24 @@ bool isEmittedCopy(const Registry& reg, Entity e) {
     return found;
 }
 
-namespace {
+std::vector<int> storedCopyNumbers(const std::vector<int>& numbers, int emitted) {
+    const int alive = int(numbers.size());
+    for (int i = 0; i < alive; ++i)
+        if (numbers[std::size_t(i)] != emitted - alive + 1 + i) return numbers;
+    return {};
+}
 
+std::optional<int> copyNumberIn(const std::string& name, const std::string& templateName) {
+    const std::size_t n = templateName.size();
+    if (name.size() <= n + 1 || name.compare(0, n, templateName) != 0 || name[n] != '#') return std::nullopt;
+    const std::size_t end = std::min(name.find('/', n + 1), name.size());
+    const std::string digits = name.substr(n + 1, end - n - 1);
+    if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
+        return std::nullopt;
+    return std::stoi(digits);
+}
+
+namespace {
 
 std::uint64_t splitMix64(std::uint64_t z) {
     z += 0x9E3779B97F4A7C15ull;

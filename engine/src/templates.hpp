@@ -8,7 +8,9 @@
 #include "stepwise/registry.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace stepwise::detail {
 
@@ -40,6 +42,15 @@ inline bool outsideTheChoice(const Registry& reg, Entity e) {
     if (reg.count<Template>() == 0) return false;
     return pointEmitter(reg, e) || isEmittedCopy(reg, e);
 }
+
+/// `numbers` (oldest first) as Emitter::copies keeps them: empty when they
+/// are the `alive` numbers up to `emitted`, so a template's only emitter
+/// writes no list.
+std::vector<int> storedCopyNumbers(const std::vector<int>& numbers, int emitted);
+
+/// N when `name` is "TEMPLATE#N" or "TEMPLATE#N/..." (N written in at most
+/// nine digits), else nothing.
+std::optional<int> copyNumberIn(const std::string& name, const std::string& templateName);
 
 /// The random turn of copy `number` of an emitter: a uniform angle in
 /// [-spread, spread] from (world seed, emitter key, number) alone, so a

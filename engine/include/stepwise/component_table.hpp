@@ -41,6 +41,9 @@ enum class FieldKind {
     /// std::uint32_t bit field, a JSON integer in [0, 2^32 - 1] (collision
     /// categories and masks); every value is valid
     Bits,
+    /// std::vector<int>, JSON [n, ...] (an emitter's copy numbers); each
+    /// item within `range`; written only when not empty
+    IntegerList,
     /// std::vector<CompoundShape> (the `shapes` component), JSON
     /// [{"circle"|"box"|"polygon"|"capsule": {...}, ...}, ...]; `range`
     /// bounds the count

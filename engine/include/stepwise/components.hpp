@@ -163,11 +163,24 @@ struct Emitter {
     double spread = 0.0;                 ///< rad, each copy's velocity turned by a uniform angle in +/- spread
     std::optional<double> lifetime;      ///< s a copy lives; absent: until pushed out by count
     std::optional<double> next;          ///< s, world time of the next copy; absent: the world's time at build
-    int emitted = 0;                     ///< copies made so far (the next is TEMPLATE#(emitted + 1))
+    int emitted = 0;                     ///< copies this emitter made so far
     int alive = 0;                       ///< the newest `alive` of them are in the scene
     std::optional<double> oldest;        ///< s, when the oldest copy alive appeared
+    /// The numbers N of its copies alive (named TEMPLATE#N), oldest first;
+    /// empty: the `alive` numbers up to `emitted`, what a template's only
+    /// emitter gives. Several emitters of one template share its numbers.
+    std::vector<int> copies;
     friend bool operator==(const Emitter&, const Emitter&) = default;
 };
+
+/// The numbers of `em`'s copies alive, oldest first: Emitter::copies, or
+/// when that is empty the newest `alive` numbers up to `emitted`.
+inline std::vector<int> copyNumbers(const Emitter& em) {
+    if (!em.copies.empty()) return em.copies;
+    std::vector<int> numbers;
+    for (int k = em.emitted - em.alive + 1; k <= em.emitted; ++k) numbers.push_back(k);
+    return numbers;
+}
 
 /// Which pairs of shapes collide (Box2D's collision filter). Two shapes
 /// with the same non-zero `group` always collide when it is positive and

@@ -374,6 +374,7 @@ void syncCopies(const WorldLayout& layout, Scene& scene) {
             own->emitted = em.emitted;
             own->alive = em.alive;
             own->oldest = em.oldest;
+            own->copies = em.copies;
         }
     }
     const auto isCopy = [&](const Registry& r, Entity e) {

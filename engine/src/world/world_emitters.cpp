@@ -106,16 +106,33 @@ std::optional<Error> compileEmitters(const Scene& scene, WorldImpl& w) {
             }
         }
         run.key = detail::emitterKey(reg, e, i);
-        for (int k = em->emitted - em->alive + 1; k <= em->emitted; ++k) {
+        for (const int k : copyNumbers(*em)) {
             const std::string base = em->templateName + "#" + std::to_string(k);
             const auto it = copyParts.find(base);
             if (it == copyParts.end())
                 return Error{label + ": emitter: copy \"" + base + "\" is alive in its run state but not in the scene"};
             run.copies.push_back(it->second);
+            run.numbers.push_back(k);
         }
         w.emitters.push_back(std::move(run));
     }
     return std::nullopt;
+}
+
+long long WorldImpl::nextCopyNumber(const std::string& templateName) const {
+    // One past every number the template's emitters have given (each gave
+    // its `emitted`, and while the emitters stay the same their numbers are
+    // 1 up to the sum) and every copy alive (an emitter of the template
+    // deleted takes its count out of the sum): the same from the scene a
+    // save writes as from the running World, so a resume numbers as the
+    // long run does.
+    long long given = 0, alive = 0;
+    for (const EmitterRun& em : emitters) {
+        if (em.params.templateName != templateName) continue;
+        given += em.params.emitted;
+        if (!em.numbers.empty()) alive = std::max<long long>(alive, em.numbers.back());
+    }
+    return std::max(given, alive) + 1;
 }
 
 void WorldImpl::runEmitters() {
@@ -150,6 +167,7 @@ void WorldImpl::runEmitters() {
                 reg.destroy(e);
             }
             em.copies.pop_front();
+            em.numbers.pop_front();
             --p.alive;
             // Copies appear `interval` apart, and the times were summed the
             // same way: the next oldest appeared at exactly this time.
@@ -160,12 +178,14 @@ void WorldImpl::runEmitters() {
         const Entity anchor = anchorOf(reg, em.members);
         // A run never writes a time or a count a level cannot hold: past
         // them the emitter stops.
-        const auto canEmit = [&p] {
-            return *p.next + p.interval <= kMaxMagnitude && p.emitted < std::numeric_limits<int>::max();
+        const auto canEmit = [&] {
+            return *p.next + p.interval <= kMaxMagnitude && p.emitted < std::numeric_limits<int>::max() &&
+                   nextCopyNumber(p.templateName) <= std::numeric_limits<int>::max();
         };
         for (int made = 0; now >= *p.next && made < kMaxEmissionsPerStep && canEmit(); ++made) {
             if (p.alive >= p.count) removeOldest();
-            const int number = ++p.emitted;
+            const int number = int(nextCopyNumber(p.templateName));
+            ++p.emitted;
             const std::string base = p.templateName + "#" + std::to_string(number);
             const Vec2 at = em.body != kNoBody ? Vec2{xs()[2 * em.body], xs()[2 * em.body + 1]} : em.position;
             const Vec2 offset = at - reg.tryGet<Position>(anchor)->value;
@@ -202,10 +222,12 @@ void WorldImpl::runEmitters() {
             added.insert(added.end(), copy.begin(), copy.end());
             emitterEvents.push_back({em.entity, base, true});
             em.copies.push_back(std::move(copy));
+            em.numbers.push_back(number);
             if (p.alive == 0) p.oldest = *p.next;
             ++p.alive;
             p.next = *p.next + p.interval;
         }
+        p.copies = detail::storedCopyNumbers(std::vector<int>(em.numbers.begin(), em.numbers.end()), p.emitted);
     }
     changeBodies(reg, removed, added);
 }

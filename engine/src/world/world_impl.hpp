@@ -47,6 +47,7 @@ struct EmitterRun {
     std::vector<Entity> members;       ///< the template's entities in the run's registry, scene order
     std::uint64_t key = 0;             ///< detail::emitterKey
     std::deque<std::vector<Entity>> copies;  ///< the copies alive, oldest first, each its entities in scene order
+    std::deque<int> numbers;                 ///< their numbers N (named TEMPLATE#N), oldest first
 };
 
 class WorldImpl {
@@ -132,6 +133,9 @@ public:
     /// Emissions and removals due at the start of a step (time + dt/2 past
     /// their time), applied in place: changeBodies.
     void runEmitters();
+    /// The number the next copy of template `templateName` takes (as
+    /// wide as a sum of counts, so an emitter can stop short of int's end).
+    long long nextCopyNumber(const std::string& templateName) const;
     /// Takes the bodies of `removed` (with their shapes, joints and springs)
     /// out of every array in place and appends those of `added` (entities
     /// of `reg`, the scene as it now is, in its order), so the arrays are
