@@ -217,7 +217,7 @@ TEST(Determinism, WithSleepOffEveryRecordedHashHolds) {
     std::ifstream in(std::string(STEPWISE_SOURCE_DIR) + "/tests/data/joints_every_type.json");
     std::stringstream joints;
     joints << in.rdbuf();
-    EXPECT_EQ(hex(fnv1a(withoutSleepLines(simulate("rk4", joints.str(), false).text))), hex(0xf2ec1d44050b3a3aull));
+    EXPECT_EQ(hex(fnv1a(withoutSleepLines(simulate("rk4", joints.str(), false).text))), hex(0xb142de4d894d18b6ull));
     EXPECT_EQ(hex(fnv1a(withoutSleepLines(simulate("semi_implicit_euler", joints.str(), false).text))),
               hex(0x6f45dcae7e70229eull));
 }
@@ -235,7 +235,7 @@ namespace {
 /// distance, rope) on boxes, circles and a shapeless body, with contacts.
 /// Re-record as above.
 const std::map<std::string, std::uint64_t> kRecordedJoints = {
-    {"rk4", 0x2b2d8e21ba7eb1afull},
+    {"rk4", 0x5a199fe028514c39ull},
     {"semi_implicit_euler", 0xf3a4a97ca9c0e0b9ull},
 };
 

@@ -2,12 +2,12 @@
 
 #include "joints/direct_joints.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 
@@ -34,6 +34,9 @@ std::uint32_t directRows(const JointConstraint& j) {
 /// positive definite when a group's rows are redundant (two pins on one
 /// body), and changes a well-posed solve by about this fraction.
 constexpr double kRelaxRegularisation = 1e-9;
+/// A pivot of the block elimination below this fraction of its row's own
+/// diagonal entry (the relax pass's regularisation) marks redundant rows.
+constexpr double kPivotFloor = kRelaxRegularisation;
 
 /// The projection leaves this much of a joint's error to the soft rows
 /// (metres; rad for a weld's angle). A projection moves positions without
@@ -47,19 +50,97 @@ constexpr double kRelaxRegularisation = 1e-9;
 constexpr double kProjectionSlop = 0.0005;
 constexpr double kAngularProjectionSlop = 0.002;
 
-/// Groups of at most this many rows are factored dense (12 hinges).
-constexpr std::uint32_t kDenseRows = 24;
-
 struct Row3 {
     double x = 0.0, y = 0.0, w = 0.0;  // Jacobian entries for (vx, vy, omega)
 };
 
+/// A 3x3 block, row-major. A hinge's two rows use the upper-left 2x2; its
+/// third row and column are zero off the diagonal, so every joint is
+/// eliminated by the same code.
+using Block = std::array<double, 9>;
+
+/// The inverse of the symmetric N x N block in the corner of `a`, through
+/// its LDL^T with diagonal pivoting (the largest remaining diagonal first).
+/// False when a pivot falls below its row's `floor` or the block is not
+/// finite: the group's rows are redundant (a body pinned twice, a weld and
+/// a pin on one rigid piece), where an elimination without pivoting across
+/// blocks loses the regularised system to rounding.
+template <int N>
+bool invertSpd(const Block& a, const std::array<double, 3>& floor, Block& out) {
+    double m[N][N], l[N][N] = {}, d[N];
+    int perm[N];
+    for (int r = 0; r < N; ++r) {
+        perm[r] = r;
+        for (int c = 0; c < N; ++c) m[r][c] = a[std::size_t(3 * r + c)];
+    }
+    for (int s = 0; s < N; ++s) {
+        int p = s;
+        for (int i = s + 1; i < N; ++i)
+            if (m[i][i] > m[p][p]) p = i;
+        if (p != s) {
+            for (int c = 0; c < N; ++c) std::swap(m[s][c], m[p][c]);
+            for (int r = 0; r < N; ++r) std::swap(m[r][s], m[r][p]);
+            for (int c = 0; c < s; ++c) std::swap(l[s][c], l[p][c]);
+            std::swap(perm[s], perm[p]);
+        }
+        l[s][s] = 1.0;
+        d[s] = m[s][s];
+        if (!(d[s] >= floor[std::size_t(perm[s])])) return false;
+        for (int i = s + 1; i < N; ++i) l[i][s] = m[i][s] / d[s];
+        for (int i = s + 1; i < N; ++i)
+            for (int j = s + 1; j < N; ++j) m[i][j] -= l[i][s] * l[j][s] * d[s];
+    }
+    // Column c of the inverse: solve L D L^T w = P e_c, then undo P.
+    for (int c = 0; c < N; ++c) {
+        double w[N];
+        for (int r = 0; r < N; ++r) w[r] = perm[r] == c ? 1.0 : 0.0;
+        for (int r = 0; r < N; ++r)
+            for (int k = 0; k < r; ++k) w[r] -= l[r][k] * w[k];
+        for (int r = 0; r < N; ++r) w[r] /= d[r];
+        for (int r = N - 1; r >= 0; --r)
+            for (int k = r + 1; k < N; ++k) w[r] -= l[k][r] * w[k];
+        for (int r = 0; r < N; ++r) out[std::size_t(3 * perm[r] + c)] = w[r];
+    }
+    for (int r = 0; r < N; ++r)
+        for (int c = N; c < 3; ++c) out[std::size_t(3 * r + c)] = out[std::size_t(3 * c + r)] = 0.0;
+    if constexpr (N == 2) out[8] = 0.0;
+    for (const double v : out)
+        if (!std::isfinite(v)) return false;
+    return true;
+}
+
+/// out = a b, in the N x N corner
+template <int N>
+void multiply(const Block& a, const Block& b, Block& out) {
+    for (int r = 0; r < N; ++r)
+        for (int c = 0; c < N; ++c) {
+            double sum = 0.0;
+            for (int m = 0; m < N; ++m) sum += a[3 * r + m] * b[3 * m + c];
+            out[std::size_t(3 * r + c)] = sum;
+        }
+}
+
+/// target -= a b^T, in the N x N corner
+template <int N>
+void subtractTransposed(const Block& a, const Block& b, Block& target) {
+    for (int r = 0; r < N; ++r)
+        for (int c = 0; c < N; ++c) {
+            double sum = 0.0;
+            for (int m = 0; m < N; ++m) sum += a[3 * r + m] * b[3 * c + m];
+            target[std::size_t(3 * r + c)] -= sum;
+        }
+}
+
 } // namespace
 
 struct DirectJoints::Group {
-    std::vector<std::uint32_t> joints;  // indices into the joint span, ascending
-    std::vector<std::uint32_t> offset;  // first row of each joint
-    std::uint32_t rows = 0;
+    /// Indices into the joint span, in elimination order: the bodies of the
+    /// tree walked children first, each body's joints to the static world,
+    /// then the joint to its parent. A joint is eliminated once every joint
+    /// at one of its ends is, so the joints after it that it meets all meet
+    /// at one body, are already coupled, and no block fills in (Baraff).
+    std::vector<std::uint32_t> joints;
+    std::vector<std::uint32_t> offset;  // first row of each joint: 3 per joint
     /// Each dynamic end of each joint: (solver body, joint's place in
     /// `joints`, 0 for end a / 1 for end b), sorted by body, so the joints
     /// meeting at a body are side by side.
@@ -68,23 +149,154 @@ struct DirectJoints::Group {
     };
     std::vector<End> ends;
     std::vector<std::uint32_t> bodyStart;  // ends of one body: [bodyStart[i], bodyStart[i+1])
-    /// Small groups (a ragdoll, a short chain) are factored dense: for a
-    /// few rows the sparse factorisation's bookkeeping costs more than the
-    /// arithmetic (200 five-link chains: 2.15 ms a step sparse).
-    bool dense = false;
-    Eigen::MatrixXd denseMatrix;
-    Eigen::LDLT<Eigen::MatrixXd> denseLdlt;
-    Eigen::SparseMatrix<double> matrix;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
-    std::vector<Eigen::Triplet<double>> triplets;
-    Eigen::VectorXd rhs, x;
+    /// The joints after joint k that share a body with it:
+    /// later[laterStart[k] .. laterStart[k + 1]); their blocks of the
+    /// matrix (rows of the later joint, columns of k), then of the factor.
+    std::vector<std::uint32_t> laterStart, later;
+    std::vector<Block> coupling;
+    /// Where each pair of ends at one body (p, q, place p after place q),
+    /// in the order factor() visits them, adds its entries: a slot of
+    /// `coupling`.
+    std::vector<std::uint32_t> pairSlot;
+    /// For each joint k and each pair (i, j) of its later joints with
+    /// place i >= place j, in factor()'s order: the block the elimination
+    /// of k updates, a slot of `coupling`, or kDiagonal + i.
+    std::vector<std::uint32_t> updateTarget;
+    std::vector<Block> pivot, pivotInverse;  // per joint: its diagonal block, then its inverse
+    /// Per joint and row: the least a pivot may fall to in the elimination,
+    /// the regularisation's share of the row's own diagonal entry; below
+    /// it the group is factored by the sparse LDL^T instead.
+    std::vector<std::array<double, 3>> pivotFloor;
+    std::vector<double> rhs, x;  // 3 per joint (a hinge's third is 0)
     std::vector<double> diag;  // per joint, its 3x3 block of J M^-1 J^T, row-major
     std::vector<Vec2> rA, rB;  // per joint, anchors at the current rotation
     std::vector<std::uint32_t> rowsOf;  // per joint, its row count here (2 or 3)
     std::vector<Row3> jacobian;  // per end, its three rows (point x, point y, angle) at the current rotation
-    bool analysed = false;
+    std::vector<Block> scratch;  // the factor's blocks of one joint's later joints
     bool factored = false;
+    /// Redundant rows (the block elimination met a pivot under its floor):
+    /// this factor call's matrix went to Eigen's sparse LDL^T, whose
+    /// minimum-degree order carries the regularised system through. The
+    /// pattern is analysed the first time a group needs it.
+    bool sparse = false;
+    bool analysed = false;
+    Eigen::SparseMatrix<double> matrix;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+    std::vector<Eigen::Triplet<double>> triplets;
+
+    /// Rows a block uses: 2 when every joint is a hinge (its blocks are
+    /// 2 x 2), else 3.
+    int dim = 3;
+    static constexpr std::uint32_t kDiagonal = 0x80000000u;
+
+    /// Factors the assembled pivots and couplings in place; false when a
+    /// pivot is not positive definite.
+    template <int N>
+    bool eliminate();
+    bool eliminate() { return dim == 2 ? eliminate<2>() : eliminate<3>(); }
+    /// The assembled matrix (own blocks scaled by `diagScale`) by the sparse
+    /// LDL^T; sets `sparse` and `factored`.
+    void factorSparse(double diagScale);
+    /// x = A^-1 rhs with the factor (forward, pivots, backward).
+    template <int N>
+    void solveWith();
+    void solveFactored() {
+        if (sparse) {
+            const Eigen::VectorXd solved = ldlt.solve(Eigen::Map<const Eigen::VectorXd>(rhs.data(), Eigen::Index(rhs.size())));
+            std::copy(solved.data(), solved.data() + solved.size(), x.begin());
+        } else if (dim == 2) {
+            solveWith<2>();
+        } else {
+            solveWith<3>();
+        }
+    }
 };
+
+template <int N>
+bool DirectJoints::Group::eliminate() {
+    std::uint32_t update = 0;
+    for (std::size_t k = 0; k < joints.size(); ++k) {
+        if (!invertSpd<N>(pivot[k], pivotFloor[k], pivotInverse[k])) return false;
+        const std::uint32_t first = laterStart[k], last = laterStart[k + 1];
+        for (std::uint32_t s = first; s < last; ++s) multiply<N>(coupling[s], pivotInverse[k], scratch[s - first]);
+        for (std::uint32_t si = first; si < last; ++si)
+            for (std::uint32_t sj = first; sj <= si; ++sj) {
+                const std::uint32_t t = updateTarget[update++];
+                Block& target = t >= kDiagonal ? pivot[t - kDiagonal] : coupling[t];
+                subtractTransposed<N>(scratch[si - first], coupling[sj], target);
+            }
+        for (std::uint32_t s = first; s < last; ++s) coupling[s] = scratch[s - first];
+    }
+    return true;
+}
+
+void DirectJoints::Group::factorSparse(double diagScale) {
+    // Every entry of the pattern, zeros included, so the pattern analysed
+    // once holds for every call; a hinge's unused third row is a unit.
+    triplets.clear();
+    const std::size_t count = joints.size();
+    for (std::size_t k = 0; k < count; ++k) {
+        const int base = int(3 * k);
+        for (int a = 0; a < 3; ++a)
+            for (int c = 0; c <= a; ++c) {
+                const bool used = std::uint32_t(a) < rowsOf[k] && std::uint32_t(c) < rowsOf[k];
+                const double v = used ? diagScale * diag[9 * k + std::size_t(3 * a + c)] : (a == c ? 1.0 : 0.0);
+                triplets.emplace_back(base + a, base + c, v);
+            }
+        for (std::uint32_t s = laterStart[k]; s < laterStart[k + 1]; ++s)
+            for (int a = 0; a < 3; ++a)
+                for (int c = 0; c < 3; ++c)
+                    triplets.emplace_back(int(3 * later[s]) + a, base + c, coupling[s][std::size_t(3 * a + c)]);
+    }
+    matrix.resize(Eigen::Index(3 * count), Eigen::Index(3 * count));
+    matrix.setFromTriplets(triplets.begin(), triplets.end());
+    if (!analysed) {
+        ldlt.analyzePattern(matrix);
+        analysed = true;
+    }
+    ldlt.factorize(matrix);
+    factored = sparse = ldlt.info() == Eigen::Success;
+}
+
+template <int N>
+void DirectJoints::Group::solveWith() {
+    const std::size_t count = joints.size();
+    x = rhs;
+    for (std::size_t k = 0; k < count; ++k) {
+        const double* yk = &x[3 * k];
+        for (std::uint32_t s = laterStart[k]; s < laterStart[k + 1]; ++s) {
+            const Block& l = coupling[s];
+            double* yi = &x[3 * later[s]];
+            for (int r = 0; r < N; ++r) {
+                double sum = 0.0;
+                for (int m = 0; m < N; ++m) sum += l[std::size_t(3 * r + m)] * yk[m];
+                yi[r] -= sum;
+            }
+        }
+    }
+    for (std::size_t k = 0; k < count; ++k) {
+        const Block& d = pivotInverse[k];
+        double* y = &x[3 * k];
+        double z[N];
+        for (int r = 0; r < N; ++r) {
+            z[r] = 0.0;
+            for (int m = 0; m < N; ++m) z[r] += d[std::size_t(3 * r + m)] * y[m];
+        }
+        for (int r = 0; r < N; ++r) y[r] = z[r];
+    }
+    for (std::size_t k = count; k-- > 0;) {
+        double* xk = &x[3 * k];
+        for (std::uint32_t s = laterStart[k]; s < laterStart[k + 1]; ++s) {
+            const Block& l = coupling[s];
+            const double* xi = &x[3 * later[s]];
+            for (int c = 0; c < N; ++c) {
+                double sum = 0.0;
+                for (int m = 0; m < N; ++m) sum += l[std::size_t(3 * m + c)] * xi[m];
+                xk[c] -= sum;
+            }
+        }
+    }
+}
 
 DirectJoints::DirectJoints() = default;
 DirectJoints::~DirectJoints() = default;
@@ -132,40 +344,123 @@ void DirectJoints::build(std::span<JointConstraint> joints, std::span<const Solv
     for (std::uint32_t k = 0; k < joints.size(); ++k) {
         JointConstraint& j = joints[k];
         const std::uint32_t rows = directRows(j);
-        if (rows == 0) continue;
+        if (rows == 0 || (j.a.solverBody == 0 && j.b.solverBody == 0)) continue;  // nothing there moves
         const std::uint32_t root = find(j.a.solverBody != 0 ? j.a.solverBody : j.b.solverBody);
         if (loop[root] || rowCount[root] > 3 * bodyCount[root]) continue;
         if (groupOf[root] < 0) {
             groupOf[root] = std::int32_t(groups_.size());
             groups_.push_back(std::make_unique<Group>());
         }
-        Group& g = *groups_[std::size_t(groupOf[root])];
-        const std::uint32_t place = std::uint32_t(g.joints.size());
-        g.joints.push_back(k);
-        g.rowsOf.push_back(rows);
-        g.offset.push_back(g.rows);
-        g.rows += rows;
-        if (j.a.solverBody != 0) g.ends.push_back({j.a.solverBody, place, 0});
-        if (j.b.solverBody != 0) g.ends.push_back({j.b.solverBody, place, 1});
+        groups_[std::size_t(groupOf[root])]->joints.push_back(k);
         j.direct = true;
         ++directCount_;
     }
-    for (const std::unique_ptr<Group>& gp : groups_) {
-        Group& g = *gp;
-        std::stable_sort(g.ends.begin(), g.ends.end(), [](const Group::End& l, const Group::End& r) { return l.body < r.body; });
-        g.bodyStart.clear();
-        for (std::uint32_t e = 0; e < g.ends.size(); ++e)
-            if (e == 0 || g.ends[e].body != g.ends[e - 1].body) g.bodyStart.push_back(e);
-        g.bodyStart.push_back(std::uint32_t(g.ends.size()));
-        g.dense = g.rows <= kDenseRows;
-        if (g.dense) g.denseMatrix.resize(g.rows, g.rows);
-        else g.matrix.resize(g.rows, g.rows);
-        g.rhs.resize(g.rows);
-        g.x.resize(g.rows);
-        g.diag.assign(9 * g.joints.size(), 0.0);
-        g.rA.resize(g.joints.size());
-        g.rB.resize(g.joints.size());
+    for (const std::unique_ptr<Group>& gp : groups_) order(*gp, joints);
+}
+
+void DirectJoints::order(Group& g, std::span<const JointConstraint> joints) {
+    // The group's dynamic bodies and the joints at each.
+    std::vector<std::uint32_t> bodies;
+    for (const std::uint32_t k : g.joints)
+        for (const std::uint32_t b : {joints[k].a.solverBody, joints[k].b.solverBody})
+            if (b != 0) bodies.push_back(b);
+    std::sort(bodies.begin(), bodies.end());
+    bodies.erase(std::unique(bodies.begin(), bodies.end()), bodies.end());
+    const auto local = [&](std::uint32_t b) {
+        return std::uint32_t(std::lower_bound(bodies.begin(), bodies.end(), b) - bodies.begin());
+    };
+    std::vector<std::vector<std::uint32_t>> at(bodies.size());  // joint indices at each body, ascending
+    for (const std::uint32_t k : g.joints)
+        for (const std::uint32_t b : {joints[k].a.solverBody, joints[k].b.solverBody})
+            if (b != 0) at[local(b)].push_back(k);
+    const auto otherEnd = [&](std::uint32_t k, std::uint32_t body) {
+        const JointConstraint& j = joints[k];
+        return j.a.solverBody == body ? j.b.solverBody : j.a.solverBody;
+    };
+    // Depth first from the body of lowest index, children before parents:
+    // a body's joints to the static world, then the joint to its parent.
+    std::vector<std::uint32_t> ordered;
+    ordered.reserve(g.joints.size());
+    struct Visit {
+        std::uint32_t body, parentJoint, next;
+    };
+    constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+    std::vector<Visit> stack{{bodies.front(), kNone, 0}};
+    while (!stack.empty()) {
+        Visit& v = stack.back();
+        const std::vector<std::uint32_t>& mine = at[local(v.body)];
+        if (v.next < mine.size()) {
+            const std::uint32_t k = mine[v.next++];
+            const std::uint32_t other = otherEnd(k, v.body);
+            if (k != v.parentJoint && other != 0) stack.push_back({other, k, 0});
+            continue;
+        }
+        for (const std::uint32_t k : mine)
+            if (otherEnd(k, v.body) == 0) ordered.push_back(k);
+        if (v.parentJoint != kNone) ordered.push_back(v.parentJoint);
+        stack.pop_back();
     }
+    g.joints = std::move(ordered);
+
+    const std::size_t count = g.joints.size();
+    g.rowsOf.resize(count);
+    g.offset.resize(count);
+    g.ends.clear();
+    for (std::uint32_t place = 0; place < count; ++place) {
+        const JointConstraint& j = joints[g.joints[place]];
+        g.rowsOf[place] = directRows(j);
+        g.offset[place] = 3 * place;
+        if (j.a.solverBody != 0) g.ends.push_back({j.a.solverBody, place, 0});
+        if (j.b.solverBody != 0) g.ends.push_back({j.b.solverBody, place, 1});
+    }
+    std::stable_sort(g.ends.begin(), g.ends.end(), [](const Group::End& l, const Group::End& r) { return l.body < r.body; });
+    g.bodyStart.clear();
+    for (std::uint32_t e = 0; e < g.ends.size(); ++e)
+        if (e == 0 || g.ends[e].body != g.ends[e - 1].body) g.bodyStart.push_back(e);
+    g.bodyStart.push_back(std::uint32_t(g.ends.size()));
+
+    // Each joint's later joints (those it shares a body with), ascending.
+    std::vector<std::vector<std::uint32_t>> laterOf(count);
+    for (std::size_t bi = 0; bi + 1 < g.bodyStart.size(); ++bi)
+        for (std::uint32_t p = g.bodyStart[bi]; p < g.bodyStart[bi + 1]; ++p)
+            for (std::uint32_t q = g.bodyStart[bi]; q < g.bodyStart[bi + 1]; ++q)
+                if (g.ends[q].k > g.ends[p].k) laterOf[g.ends[p].k].push_back(g.ends[q].k);
+    g.laterStart.assign(1, 0);
+    g.later.clear();
+    for (std::vector<std::uint32_t>& list : laterOf) {
+        std::sort(list.begin(), list.end());
+        g.later.insert(g.later.end(), list.begin(), list.end());
+        g.laterStart.push_back(std::uint32_t(g.later.size()));
+    }
+    const auto slotOf = [&](std::uint32_t k, std::uint32_t i) {
+        return std::uint32_t(std::lower_bound(g.later.begin() + g.laterStart[k], g.later.begin() + g.laterStart[k + 1], i) -
+                             g.later.begin());
+    };
+    g.pairSlot.clear();
+    for (std::size_t bi = 0; bi + 1 < g.bodyStart.size(); ++bi)
+        for (std::uint32_t p = g.bodyStart[bi]; p < g.bodyStart[bi + 1]; ++p)
+            for (std::uint32_t q = g.bodyStart[bi]; q < g.bodyStart[bi + 1]; ++q)
+                if (g.ends[p].k > g.ends[q].k) g.pairSlot.push_back(slotOf(g.ends[q].k, g.ends[p].k));
+    // The updates of each elimination; a block outside the pattern would
+    // be fill-in, which the order rules out.
+    g.updateTarget.clear();
+    for (std::uint32_t k = 0; k < count; ++k)
+        for (std::uint32_t si = g.laterStart[k]; si < g.laterStart[k + 1]; ++si)
+            for (std::uint32_t sj = g.laterStart[k]; sj <= si; ++sj) {
+                const std::uint32_t i = g.later[si], j = g.later[sj];
+                g.updateTarget.push_back(i == j ? Group::kDiagonal + i : slotOf(j, i));
+            }
+    g.dim = std::all_of(g.rowsOf.begin(), g.rowsOf.end(), [](std::uint32_t r) { return r == 2; }) ? 2 : 3;
+    g.coupling.resize(g.later.size());
+    g.scratch.resize(g.later.size());
+    g.pivot.resize(count);
+    g.pivotInverse.resize(count);
+    g.pivotFloor.resize(count);
+    g.rhs.assign(3 * count, 0.0);
+    g.x.assign(3 * count, 0.0);
+    g.diag.assign(9 * count, 0.0);
+    g.rA.resize(count);
+    g.rB.resize(count);
 }
 
 void DirectJoints::factor(std::span<JointConstraint> joints, std::span<const SolverBody> bodies, const Softness& soft,
@@ -186,62 +481,60 @@ void DirectJoints::factor(std::span<JointConstraint> joints, std::span<const Sol
             g.rA[k] = rotate(bodies[j.a.solverBody].dq, j.anchorA);
             g.rB[k] = rotate(bodies[j.b.solverBody].dq, j.anchorB);
         }
-        std::fill(g.diag.begin(), g.diag.end(), 0.0);
-        g.triplets.clear();
-        // A dense group sums its entries straight into the matrix, in the
-        // order the triplets would list them (so the same sums, bit for
-        // bit): a list to replay would be written and read again for nothing.
-        if (g.dense) g.denseMatrix.setZero();
-        // Jacobian rows of one end: point x, point y, angle (weld).
-        const auto rowsOf = [&](const Group::End& e, Row3 out[3]) {
-            const double s = e.side == 0 ? -1.0 : 1.0;
-            const Vec2 r = e.side == 0 ? g.rA[e.k] : g.rB[e.k];
-            out[0] = {s, 0.0, -s * r.y};
-            out[1] = {0.0, s, s * r.x};
-            out[2] = {0.0, 0.0, s};
-        };
-        g.jacobian.resize(3 * g.ends.size());
-        for (std::size_t e = 0; e < g.ends.size(); ++e) rowsOf(g.ends[e], &g.jacobian[3 * e]);
-        for (std::size_t bi = 0; bi + 1 < g.bodyStart.size(); ++bi) {
-            const std::uint32_t first = g.bodyStart[bi], last = g.bodyStart[bi + 1];
-            const SolverBody& body = bodies[g.ends[first].body];
-            const double m = body.invMass, i = body.invInertia;
-            for (std::uint32_t p = first; p < last; ++p) {
-                const Row3* jp = &g.jacobian[3 * p];
-                const std::uint32_t kp = g.ends[p].k;
-                const std::uint32_t np = g.rowsOf[kp];
-                for (std::uint32_t q = first; q < last; ++q) {
-                    const Row3* jq = &g.jacobian[3 * q];
-                    const std::uint32_t kq = g.ends[q].k;
-                    const std::uint32_t nq = g.rowsOf[kq];
-                    for (std::uint32_t a = 0; a < np; ++a)
-                        for (std::uint32_t c = 0; c < nq; ++c) {
-                            const double v = m * (jp[a].x * jq[c].x + jp[a].y * jq[c].y) + i * jp[a].w * jq[c].w;
-                            if (kp == kq) {
-                                g.diag[9 * kp + 3 * a + c] += v;
-                                if (p != q) continue;  // both ends of one joint never meet at one body
-                            }
-                            const std::uint32_t row = g.offset[kp] + a, col = g.offset[kq] + c;
-                            if (row < col) continue;
-                            const double entry = kp == kq ? diagScale * v : v;
-                            if (g.dense) g.denseMatrix(row, col) += entry;
-                            else g.triplets.emplace_back(int(row), int(col), entry);
-                        }
+        // J M^-1 J^T into the joints' own blocks (diag) and their couplings.
+        const auto assemble = [&] {
+            std::fill(g.diag.begin(), g.diag.end(), 0.0);
+            std::fill(g.coupling.begin(), g.coupling.end(), Block{});
+            // Jacobian rows of one end: point x, point y, angle (weld).
+            const auto rowsOf = [&](const Group::End& e, Row3 out[3]) {
+                const double s = e.side == 0 ? -1.0 : 1.0;
+                const Vec2 r = e.side == 0 ? g.rA[e.k] : g.rB[e.k];
+                out[0] = {s, 0.0, -s * r.y};
+                out[1] = {0.0, s, s * r.x};
+                out[2] = {0.0, 0.0, s};
+            };
+            g.jacobian.resize(3 * g.ends.size());
+            for (std::size_t e = 0; e < g.ends.size(); ++e) rowsOf(g.ends[e], &g.jacobian[3 * e]);
+            // J M^-1 J^T body by body: the joints meeting at a body couple there.
+            std::uint32_t pair = 0;
+            for (std::size_t bi = 0; bi + 1 < g.bodyStart.size(); ++bi) {
+                const std::uint32_t first = g.bodyStart[bi], last = g.bodyStart[bi + 1];
+                const SolverBody& body = bodies[g.ends[first].body];
+                const double m = body.invMass, i = body.invInertia;
+                for (std::uint32_t p = first; p < last; ++p) {
+                    const Row3* jp = &g.jacobian[3 * p];
+                    const std::uint32_t kp = g.ends[p].k;
+                    const std::uint32_t np = g.rowsOf[kp];
+                    for (std::uint32_t q = first; q < last; ++q) {
+                        const std::uint32_t kq = g.ends[q].k;
+                        // Both ends of one joint never meet at one body, so
+                        // kp == kq only for p == q: the joint's own block.
+                        if (kp < kq) continue;
+                        const Row3* jq = &g.jacobian[3 * q];
+                        const std::uint32_t nq = g.rowsOf[kq];
+                        double* out = kp == kq ? &g.diag[9 * kp] : g.coupling[g.pairSlot[pair++]].data();
+                        for (std::uint32_t a = 0; a < np; ++a)
+                            for (std::uint32_t c = 0; c < nq; ++c)
+                                out[3 * a + c] += m * (jp[a].x * jq[c].x + jp[a].y * jq[c].y) + i * jp[a].w * jq[c].w;
+                    }
                 }
             }
+        };
+        assemble();
+        // Block LDL^T in the tree's order: eliminating joint k updates only
+        // the blocks among its later joints, which meet at one body.
+        for (std::size_t k = 0; k < g.joints.size(); ++k) {
+            Block& d = g.pivot[k];
+            for (int e = 0; e < 9; ++e) d[std::size_t(e)] = diagScale * g.diag[9 * k + std::size_t(e)];
+            if (g.rowsOf[k] == 2) d[8] = 1.0;  // a hinge has no third row: a unit pivot that touches nothing
+            for (int r = 0; r < 3; ++r) g.pivotFloor[k][std::size_t(r)] = kPivotFloor * d[std::size_t(4 * r)];
         }
-        if (g.dense) {
-            g.denseLdlt.compute(g.denseMatrix);  // reads the lower triangle
-            g.factored = g.denseLdlt.info() == Eigen::Success;
-            continue;
+        g.sparse = false;
+        g.factored = g.eliminate();
+        if (!g.factored) {
+            assemble();  // the elimination wrote over the blocks
+            g.factorSparse(diagScale);
         }
-        g.matrix.setFromTriplets(g.triplets.begin(), g.triplets.end());
-        if (!g.analysed) {
-            g.ldlt.analyzePattern(g.matrix);
-            g.analysed = true;
-        }
-        g.ldlt.factorize(g.matrix);
-        g.factored = g.ldlt.info() == Eigen::Success;
     }
 }
 
@@ -272,10 +565,9 @@ void DirectJoints::solve(std::span<JointConstraint> joints, std::span<SolverBody
             }
             g.rhs[o] = -r[0];
             g.rhs[o + 1] = -r[1];
-            if (weld) g.rhs[o + 2] = -r[2];
+            g.rhs[o + 2] = weld ? -r[2] : 0.0;
         }
-        if (g.dense) g.x = g.denseLdlt.solve(g.rhs);
-        else g.x = g.ldlt.solve(g.rhs);
+        g.solveFactored();
         for (std::size_t k = 0; k < g.joints.size(); ++k) {
             JointConstraint& j = joints[g.joints[k]];
             SolverBody& a = bodies[j.a.solverBody];
@@ -315,6 +607,7 @@ void DirectJoints::project(std::span<const JointConstraint> joints, std::span<co
             g.rhs[o] = -excess.x;
             g.rhs[o + 1] = -excess.y;
             any = any || len > kProjectionSlop;
+            g.rhs[o + 2] = 0.0;
             if (directRows(j) == 3) {
                 const double angle = j.deltaAngle + std::atan2(b.dq.s, b.dq.c) - std::atan2(a.dq.s, a.dq.c);
                 g.rhs[o + 2] = -std::copysign(std::max(std::abs(angle) - kAngularProjectionSlop, 0.0), angle);
@@ -322,8 +615,7 @@ void DirectJoints::project(std::span<const JointConstraint> joints, std::span<co
             }
         }
         if (!any) continue;  // every joint within the slop: nothing moves
-        if (g.dense) g.x = g.denseLdlt.solve(g.rhs);
-        else g.x = g.ldlt.solve(g.rhs);
+        g.solveFactored();
         for (std::size_t k = 0; k < g.joints.size(); ++k) {
             const JointConstraint& j = joints[g.joints[k]];
             const std::uint32_t o = g.offset[k];

@@ -17,11 +17,11 @@
 // of the soft step this is the point the soft Gauss-Seidel iteration
 // converges to (each joint's row: J v + bias + (1/c) K lambda = 0), reached
 // in one solve; the relax pass (gamma = 0, no bias) is the rigid solve.
-// The matrix of a tree factors without fill when eliminated leaves first;
-// Eigen's sparse LDL^T with its minimum-degree ordering finds that order,
-// so the cost is linear in the joints. The pattern is analysed once; each
-// pass factors the values (twice a substep: biased and relax) and each
-// iteration solves. Groups of a few rows are factored dense instead.
+// The matrix of a tree factors without fill when eliminated leaves first:
+// a block LDL^T over the joints (3x3 blocks) in that order costs time
+// linear in the joints. The order and pattern are found once; each pass
+// factors the values (twice a substep: biased and relax) and each
+// iteration solves.
 // After the relax pass, project() moves each group's positions back onto
 // its joints by the part of each error past a slop (see the .cpp).
 // Groups, their order and every factorisation depend only on the joints'
@@ -80,6 +80,8 @@ public:
 private:
     struct Group;  // Eigen's types stay in the .cpp (the engine links Eigen privately)
     void build(std::span<JointConstraint> joints, std::span<const collision::SolverBody> bodies);
+    /// The group's joints in elimination order and the factor's pattern.
+    static void order(Group& g, std::span<const JointConstraint> joints);
 
     bool built_ = false;
     std::size_t builtFor_ = 0;
