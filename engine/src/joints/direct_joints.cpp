@@ -194,6 +194,10 @@ struct DirectJoints::Group {
     template <int N>
     bool eliminate();
     bool eliminate() { return dim == 2 ? eliminate<2>() : eliminate<3>(); }
+    /// J M^-1 J^T at the anchors rA, rB into the joints' own blocks (diag)
+    /// and their couplings; N as `dim`.
+    template <int N>
+    void assemble(std::span<const SolverBody> bodies);
     /// The assembled matrix (own blocks scaled by `diagScale`) by the sparse
     /// LDL^T; sets `sparse` and `factored`.
     void factorSparse(double diagScale);
@@ -228,6 +232,46 @@ bool DirectJoints::Group::eliminate() {
         for (std::uint32_t s = first; s < last; ++s) coupling[s] = scratch[s - first];
     }
     return true;
+}
+
+template <int N>
+void DirectJoints::Group::assemble(std::span<const SolverBody> bodies) {
+    std::fill(diag.begin(), diag.end(), 0.0);
+    std::fill(coupling.begin(), coupling.end(), Block{});
+    // Jacobian rows of each end: point x, point y, angle (weld).
+    jacobian.resize(3 * ends.size());
+    for (std::size_t e = 0; e < ends.size(); ++e) {
+        const double s = ends[e].side == 0 ? -1.0 : 1.0;
+        const Vec2 r = ends[e].side == 0 ? rA[ends[e].k] : rB[ends[e].k];
+        jacobian[3 * e] = {s, 0.0, -s * r.y};
+        jacobian[3 * e + 1] = {0.0, s, s * r.x};
+        jacobian[3 * e + 2] = {0.0, 0.0, s};
+    }
+    // Body by body: the joints meeting at a body couple there. In a group
+    // of hinges (N = 2) every joint has two rows; else each its own.
+    std::uint32_t pair = 0;
+    for (std::size_t bi = 0; bi + 1 < bodyStart.size(); ++bi) {
+        const std::uint32_t first = bodyStart[bi], last = bodyStart[bi + 1];
+        const SolverBody& body = bodies[ends[first].body];
+        const double m = body.invMass, i = body.invInertia;
+        for (std::uint32_t p = first; p < last; ++p) {
+            const Row3* jp = &jacobian[3 * p];
+            const std::uint32_t kp = ends[p].k;
+            const std::uint32_t np = N == 2 ? 2 : rowsOf[kp];
+            for (std::uint32_t q = first; q < last; ++q) {
+                const std::uint32_t kq = ends[q].k;
+                // Both ends of one joint never meet at one body, so kp == kq
+                // only for p == q: the joint's own block.
+                if (kp < kq) continue;
+                const Row3* jq = &jacobian[3 * q];
+                const std::uint32_t nq = N == 2 ? 2 : rowsOf[kq];
+                double* out = kp == kq ? &diag[9 * kp] : coupling[pairSlot[pair++]].data();
+                for (std::uint32_t a = 0; a < np; ++a)
+                    for (std::uint32_t c = 0; c < nq; ++c)
+                        out[3 * a + c] += m * (jp[a].x * jq[c].x + jp[a].y * jq[c].y) + i * jp[a].w * jq[c].w;
+            }
+        }
+    }
 }
 
 void DirectJoints::Group::factorSparse(double diagScale) {
@@ -481,45 +525,7 @@ void DirectJoints::factor(std::span<JointConstraint> joints, std::span<const Sol
             g.rA[k] = rotate(bodies[j.a.solverBody].dq, j.anchorA);
             g.rB[k] = rotate(bodies[j.b.solverBody].dq, j.anchorB);
         }
-        // J M^-1 J^T into the joints' own blocks (diag) and their couplings.
-        const auto assemble = [&] {
-            std::fill(g.diag.begin(), g.diag.end(), 0.0);
-            std::fill(g.coupling.begin(), g.coupling.end(), Block{});
-            // Jacobian rows of one end: point x, point y, angle (weld).
-            const auto rowsOf = [&](const Group::End& e, Row3 out[3]) {
-                const double s = e.side == 0 ? -1.0 : 1.0;
-                const Vec2 r = e.side == 0 ? g.rA[e.k] : g.rB[e.k];
-                out[0] = {s, 0.0, -s * r.y};
-                out[1] = {0.0, s, s * r.x};
-                out[2] = {0.0, 0.0, s};
-            };
-            g.jacobian.resize(3 * g.ends.size());
-            for (std::size_t e = 0; e < g.ends.size(); ++e) rowsOf(g.ends[e], &g.jacobian[3 * e]);
-            // J M^-1 J^T body by body: the joints meeting at a body couple there.
-            std::uint32_t pair = 0;
-            for (std::size_t bi = 0; bi + 1 < g.bodyStart.size(); ++bi) {
-                const std::uint32_t first = g.bodyStart[bi], last = g.bodyStart[bi + 1];
-                const SolverBody& body = bodies[g.ends[first].body];
-                const double m = body.invMass, i = body.invInertia;
-                for (std::uint32_t p = first; p < last; ++p) {
-                    const Row3* jp = &g.jacobian[3 * p];
-                    const std::uint32_t kp = g.ends[p].k;
-                    const std::uint32_t np = g.rowsOf[kp];
-                    for (std::uint32_t q = first; q < last; ++q) {
-                        const std::uint32_t kq = g.ends[q].k;
-                        // Both ends of one joint never meet at one body, so
-                        // kp == kq only for p == q: the joint's own block.
-                        if (kp < kq) continue;
-                        const Row3* jq = &g.jacobian[3 * q];
-                        const std::uint32_t nq = g.rowsOf[kq];
-                        double* out = kp == kq ? &g.diag[9 * kp] : g.coupling[g.pairSlot[pair++]].data();
-                        for (std::uint32_t a = 0; a < np; ++a)
-                            for (std::uint32_t c = 0; c < nq; ++c)
-                                out[3 * a + c] += m * (jp[a].x * jq[c].x + jp[a].y * jq[c].y) + i * jp[a].w * jq[c].w;
-                    }
-                }
-            }
-        };
+        const auto assemble = [&] { g.dim == 2 ? g.assemble<2>(bodies) : g.assemble<3>(bodies); };
         assemble();
         // Block LDL^T in the tree's order: eliminating joint k updates only
         // the blocks among its later joints, which meet at one body.

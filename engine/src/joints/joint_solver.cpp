@@ -95,6 +95,10 @@ void solvePoint(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pa
 /// (axial rows).
 void solveHingeAxial(JointConstraint& j, const SolverBody& a, const SolverBody& b, Pair& p, double h,
                      const Softness& soft, bool useBias) {
+    // The joint's angle (two atan2), once for its spring and its limits: a
+    // ragdoll's hinges have both.
+    const bool limited = j.hasLower || j.hasUpper;
+    const double angle = j.spring || limited ? j.deltaAngle + angleOf(b.dq) - angleOf(a.dq) : 0.0;
     if (j.spring) {
         // Box2D v3's revolute spring: a soft row toward the reference angle
         // on the axial mass, in both passes (it is a force, not an error to
@@ -102,7 +106,6 @@ void solveHingeAxial(JointConstraint& j, const SolverBody& a, const SolverBody& 
         // mass and impulse scales this is the implicit spring-damper of
         // frequency springHz on the joint's relative rotation.
         const Softness spring = Softness::make(j.springHz, j.springDampingRatio, h);
-        const double angle = j.deltaAngle + angleOf(b.dq) - angleOf(a.dq);
         const double cdot = p.wB - p.wA;
         const double impulse = -j.axialMass * spring.massScale * (cdot + spring.biasRate * angle) -
                                spring.impulseScale * j.springImpulse;
@@ -116,8 +119,7 @@ void solveHingeAxial(JointConstraint& j, const SolverBody& a, const SolverBody& 
         j.motorImpulse = std::clamp(old - j.axialMass * cdot, -maxImpulse, maxImpulse);
         p.applyAngular(j.motorImpulse - old);
     }
-    if (!j.hasLower && !j.hasUpper) return;
-    const double angle = j.deltaAngle + angleOf(b.dq) - angleOf(a.dq);
+    if (!limited) return;
     const double invH = 1.0 / h;
     if (j.hasLower) {
         const Row r = limitRow(angle - j.lower, invH, soft, useBias);
