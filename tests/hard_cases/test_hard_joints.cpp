@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -479,6 +480,61 @@ TEST(HardJointsSettings, SofterJointsOpenMore) {
 
 } // namespace
 
+namespace {
+
+/// Bodies and joints handed to the exact solve directly: solver body 0 is
+/// the static world, bodies 1..n move with random velocities, masses spread
+/// over `massRatio` and random anchors within 0.3 m.
+struct TreeRig {
+    std::mt19937 random;
+    std::uniform_real_distribution<double> unit{-1.0, 1.0};
+    std::vector<collision::SolverBody> bodies;
+    std::vector<joints::JointConstraint> joints;
+
+    TreeRig(std::uint32_t seed, int n, double massRatio, double inertiaRadiusSquared) : random(seed) {
+        bodies.resize(std::size_t(n) + 1);
+        for (int b = 1; b <= n; ++b) {
+            collision::SolverBody& body = bodies[std::size_t(b)];
+            const double mass = std::pow(massRatio, 0.5 * (unit(random) + 1.0));
+            body.invMass = 1.0 / mass;
+            body.invInertia = 1.0 / (mass * (inertiaRadiusSquared > 0.0 ? inertiaRadiusSquared : 0.05 + 0.1 * (unit(random) + 1.0)));
+            body.v = {unit(random), unit(random)};
+            body.w = 3.0 * unit(random);
+        }
+    }
+    void join(int a, int b, bool weld) {
+        joints::JointConstraint j;
+        j.kind = weld ? joints::JointKind::Weld : joints::JointKind::Hinge;
+        j.a.solverBody = std::uint32_t(a);
+        j.b.solverBody = std::uint32_t(b);
+        j.anchorA = a == 0 ? Vec2{} : Vec2{0.3 * unit(random), 0.3 * unit(random)};
+        j.anchorB = {0.3 * unit(random), 0.3 * unit(random)};
+        joints.push_back(j);
+    }
+    /// Joint j's velocity error: its point rows, then (a weld) its angle.
+    std::array<double, 3> error(const joints::JointConstraint& j) const {
+        const collision::SolverBody& a = bodies[j.a.solverBody];
+        const collision::SolverBody& b = bodies[j.b.solverBody];
+        const Vec2 cdot = b.v + collision::crossSV(b.w, j.anchorB) - a.v - collision::crossSV(a.w, j.anchorA);
+        return {cdot.x, cdot.y, j.kind == joints::JointKind::Weld ? b.w - a.w : 0.0};
+    }
+    double worstError() const {
+        double worst = 0.0;
+        for (const joints::JointConstraint& j : joints)
+            for (const double e : error(j)) worst = std::max(worst, std::abs(e));
+        return worst;
+    }
+    /// One rigid solve (the relax pass), asserting every joint is in it.
+    void solve() {
+        joints::DirectJoints direct;
+        direct.factor(joints, bodies, collision::Softness{}, false);
+        ASSERT_EQ(direct.directJointCount(), joints.size()) << "every joint of a tree is solved exactly";
+        direct.solve(joints, bodies);
+    }
+};
+
+} // namespace
+
 // The exact solve of a tree of joints, against its definition: after one
 // rigid solve (the relax pass) every joint's velocity error is gone, to the
 // solve's regularisation, whatever the tree's shape. Swept over chains,
@@ -488,26 +544,15 @@ TEST(HardJointsSettings, SofterJointsOpenMore) {
 // eliminated out of the tree's order, or an update sent to the wrong
 // block, leaves errors of the order of the velocities themselves.
 TEST(HardJointsSolver, TheTreeSolveLeavesNoJointVelocityError) {
-    using collision::SolverBody;
-    std::mt19937 random(20240611u);
-    std::uniform_real_distribution<double> unit(-1.0, 1.0);
     enum class Shape { Chain, Star, Binary, Ragdoll, Random };
+    std::uint32_t seed = 1;
     for (const Shape shape : {Shape::Chain, Shape::Star, Shape::Binary, Shape::Ragdoll, Shape::Random})
-        for (const int bodiesWanted : {1, 2, 5, 11, 40, 300})
+        for (const int n : {1, 2, 5, 11, 40, 300})
             for (const bool welds : {false, true})
                 for (const double massRatio : {1.0, 1e4}) {
-                    SCOPED_TRACE("shape " + std::to_string(int(shape)) + ", " + std::to_string(bodiesWanted) +
-                                 " bodies, welds " + std::to_string(welds) + ", mass ratio " + num(massRatio));
-                    // Solver body 0 is the static world; bodies 1..n.
-                    const int n = bodiesWanted;
-                    std::vector<SolverBody> bodies(std::size_t(n) + 1);
-                    for (int b = 1; b <= n; ++b) {
-                        const double mass = std::pow(massRatio, 0.5 * (unit(random) + 1.0));
-                        bodies[std::size_t(b)].invMass = 1.0 / mass;
-                        bodies[std::size_t(b)].invInertia = 1.0 / (mass * (0.05 + 0.1 * (unit(random) + 1.0)));
-                        bodies[std::size_t(b)].v = {unit(random), unit(random)};
-                        bodies[std::size_t(b)].w = 3.0 * unit(random);
-                    }
+                    SCOPED_TRACE("shape " + std::to_string(int(shape)) + ", " + std::to_string(n) + " bodies, welds " +
+                                 std::to_string(welds) + ", mass ratio " + num(massRatio));
+                    TreeRig rig(seed++, n, massRatio, 0.0);
                     // Parent of body b (b >= 2) by shape; body 1 is pinned to the world.
                     const auto parentOf = [&](int b) {
                         switch (shape) {
@@ -517,60 +562,36 @@ TEST(HardJointsSolver, TheTreeSolveLeavesNoJointVelocityError) {
                         case Shape::Ragdoll: return b <= 4 ? 1 : b - 3;  // limbs of three from a hub
                         case Shape::Random: break;
                         }
-                        return 1 + int(std::uniform_int_distribution<int>(0, b - 2)(random));
+                        return 1 + int(std::uniform_int_distribution<int>(0, b - 2)(rig.random));
                     };
-                    std::vector<joints::JointConstraint> list;
-                    const auto join = [&](int a, int b, bool weld) {
-                        joints::JointConstraint j;
-                        j.kind = weld ? joints::JointKind::Weld : joints::JointKind::Hinge;
-                        j.a.solverBody = std::uint32_t(a);
-                        j.b.solverBody = std::uint32_t(b);
-                        j.anchorA = a == 0 ? Vec2{} : Vec2{0.3 * unit(random), 0.3 * unit(random)};
-                        j.anchorB = {0.3 * unit(random), 0.3 * unit(random)};
-                        list.push_back(j);
-                    };
-                    join(0, 1, false);
-                    for (int b = 2; b <= n; ++b) join(parentOf(b), b, welds && b % 3 == 0);
+                    rig.join(0, 1, false);
+                    for (int b = 2; b <= n; ++b) rig.join(parentOf(b), b, welds && b % 3 == 0);
                     // More pins to the world (never a loop among moving
                     // bodies), on bodies hinged to their parent, so that no
                     // piece welded rigid is pinned twice (redundant rows:
                     // the next test).
                     for (int b = 5; b <= n; b += 7)
-                        if (b % 3 != 0 || !welds) join(0, b, false);
+                        if (b % 3 != 0 || !welds) rig.join(0, b, false);
+                    const double before = rig.worstError();
+                    rig.solve();
+                    EXPECT_GT(before, 0.1);
                     // Each row's velocity error, past what the relax pass's
                     // regularisation leaves: (K + eps D) lambda = -J v leaves
-                    // J v' = -eps D lambda, eps = 1e-9, D the row's own
-                    // diagonal (at most k below), lambda its impulse. Allowed
-                    // ten times that, plus 1e-9 of the largest error before.
-                    const auto worstExcess = [&](double before) {
-                        double worst = 0.0;
-                        for (const joints::JointConstraint& j : list) {
-                            const SolverBody& a = bodies[j.a.solverBody];
-                            const SolverBody& b = bodies[j.b.solverBody];
-                            const Vec2 cdot = b.v + collision::crossSV(b.w, j.anchorB) - a.v - collision::crossSV(a.w, j.anchorA);
-                            const double reach = 1.0 + std::max(length(j.anchorA), length(j.anchorB));
-                            const double k = a.invMass + b.invMass + (a.invInertia + b.invInertia) * reach * reach;
-                            const double allowed =
-                                1e-8 * k * (length(j.linearImpulse) + std::abs(j.angularImpulse)) + 1e-9 * before;
-                            worst = std::max(worst, std::max(std::abs(cdot.x), std::abs(cdot.y)) / allowed);
-                            if (j.kind == joints::JointKind::Weld)
-                                worst = std::max(worst, std::abs(b.w - a.w) / allowed);
-                        }
-                        return worst;
-                    };
-                    double before = 0.0;
-                    for (const joints::JointConstraint& j : list) {
-                        const SolverBody& a = bodies[j.a.solverBody];
-                        const SolverBody& b = bodies[j.b.solverBody];
-                        const Vec2 cdot = b.v + collision::crossSV(b.w, j.anchorB) - a.v - collision::crossSV(a.w, j.anchorA);
-                        before = std::max({before, std::abs(cdot.x), std::abs(cdot.y)});
+                    // J v' = -eps D lambda, eps = 1e-9, D the joint's own
+                    // block (its entries at most k below), lambda its
+                    // impulse. Allowed ten times that, plus 1e-9 of the
+                    // largest error before.
+                    double worstExcess = 0.0;
+                    for (const joints::JointConstraint& j : rig.joints) {
+                        const collision::SolverBody& a = rig.bodies[j.a.solverBody];
+                        const collision::SolverBody& b = rig.bodies[j.b.solverBody];
+                        const double reach = 1.0 + std::max(length(j.anchorA), length(j.anchorB));
+                        const double k = a.invMass + b.invMass + (a.invInertia + b.invInertia) * reach * reach;
+                        const double allowed =
+                            1e-8 * k * (length(j.linearImpulse) + std::abs(j.angularImpulse)) + 1e-9 * before;
+                        for (const double e : rig.error(j)) worstExcess = std::max(worstExcess, std::abs(e) / allowed);
                     }
-                    joints::DirectJoints direct;
-                    direct.factor(list, bodies, collision::Softness{}, false);
-                    ASSERT_EQ(direct.directJointCount(), list.size()) << "every joint of a tree is solved exactly";
-                    direct.solve(list, bodies);
-                    EXPECT_GT(before, 0.1);
-                    EXPECT_LT(worstExcess(before), 1.0) << "before " << before;
+                    EXPECT_LT(worstExcess, 1.0) << "before " << before;
                 }
 }
 
@@ -580,59 +601,26 @@ TEST(HardJointsSolver, TheTreeSolveLeavesNoJointVelocityError) {
 // solvable. The solve still removes the joints' velocity error (the rows
 // agree: v = 0 satisfies them all) and gives finite impulses.
 TEST(HardJointsSolver, RedundantRowsInATreeAreStillSolved) {
-    using collision::SolverBody;
-    std::mt19937 random(77u);
-    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    std::uint32_t seed = 77;
     for (const bool star : {true, false})
         for (const int n : {12, 60, 240})
             for (const double massRatio : {1.0, 1e3}) {
                 SCOPED_TRACE(std::string(star ? "star" : "chain") + " of " + std::to_string(n) + ", mass ratio " +
                              num(massRatio));
-                std::vector<SolverBody> bodies(std::size_t(n) + 1);
-                for (int b = 1; b <= n; ++b) {
-                    const double mass = std::pow(massRatio, 0.5 * (unit(random) + 1.0));
-                    bodies[std::size_t(b)].invMass = 1.0 / mass;
-                    bodies[std::size_t(b)].invInertia = 1.0 / (mass * 0.1);
-                    bodies[std::size_t(b)].v = {unit(random), unit(random)};
-                    bodies[std::size_t(b)].w = 3.0 * unit(random);
-                }
-                std::vector<joints::JointConstraint> list;
-                const auto join = [&](int a, int b, bool weld) {
-                    joints::JointConstraint j;
-                    j.kind = weld ? joints::JointKind::Weld : joints::JointKind::Hinge;
-                    j.a.solverBody = std::uint32_t(a);
-                    j.b.solverBody = std::uint32_t(b);
-                    j.anchorA = a == 0 ? Vec2{} : Vec2{0.3 * unit(random), 0.3 * unit(random)};
-                    j.anchorB = {0.3 * unit(random), 0.3 * unit(random)};
-                    list.push_back(j);
-                };
+                TreeRig rig(seed++, n, massRatio, 0.1);
                 // A star: even arms welded to the hub (body 1), odd ones
-                // hinged, every other welded arm pinned. A chain: its first four
-                // bodies welded and pinned at both ends, hinged after.
-                join(0, 1, false);
-                for (int b = 2; b <= n; ++b) join(star ? 1 : b - 1, b, star ? b % 2 == 0 : b <= 4);
-                join(0, 4, false);
+                // hinged, every other welded arm pinned. A chain: its first
+                // four bodies welded and pinned at both ends, hinged after.
+                rig.join(0, 1, false);
+                for (int b = 2; b <= n; ++b) rig.join(star ? 1 : b - 1, b, star ? b % 2 == 0 : b <= 4);
+                rig.join(0, 4, false);
                 if (star)
-                    for (int b = 6; b <= n; b += 4) join(0, b, false);
-                const auto worst = [&] {
-                    double out = 0.0;
-                    for (const joints::JointConstraint& j : list) {
-                        const SolverBody& a = bodies[j.a.solverBody];
-                        const SolverBody& b = bodies[j.b.solverBody];
-                        const Vec2 cdot = b.v + collision::crossSV(b.w, j.anchorB) - a.v - collision::crossSV(a.w, j.anchorA);
-                        out = std::max({out, std::abs(cdot.x), std::abs(cdot.y)});
-                        if (j.kind == joints::JointKind::Weld) out = std::max(out, std::abs(b.w - a.w));
-                    }
-                    return out;
-                };
-                const double before = worst();
-                joints::DirectJoints direct;
-                direct.factor(list, bodies, collision::Softness{}, false);
-                ASSERT_EQ(direct.directJointCount(), list.size());
-                direct.solve(list, bodies);
-                for (const joints::JointConstraint& j : list)
+                    for (int b = 6; b <= n; b += 4) rig.join(0, b, false);
+                const double before = rig.worstError();
+                rig.solve();
+                for (const joints::JointConstraint& j : rig.joints)
                     ASSERT_TRUE(std::isfinite(j.linearImpulse.x) && std::isfinite(j.linearImpulse.y) &&
                                 std::isfinite(j.angularImpulse));
-                EXPECT_LT(worst(), 1e-6 * before);
+                EXPECT_LT(rig.worstError(), 1e-6 * before);
             }
 }
