@@ -1192,8 +1192,8 @@ TEST(Simulation, AnEmitterCopiedWithoutItsTemplateSharesItsCopyNumbers) {
         for (int i = 0; i < 90; ++i) f.ed.stepForward();
         EXPECT_TRUE(f.ed.sim.message().empty()) << f.ed.sim.message();
         const Registry& reg = f.ed.doc.scene.registry;
-        const Emitter& first = *reg.tryGet<Emitter>(f.named("hatch"));
-        const Emitter& copyEmitter = *reg.tryGet<Emitter>(second);
+        const Emitter first = *reg.tryGet<Emitter>(f.named("hatch"));
+        const Emitter copyEmitter = *reg.tryGet<Emitter>(second);
         EXPECT_GT(copyEmitter.emitted, 0);
         std::set<std::string> names;
         for (const Entity e : reg.entities())
@@ -1202,8 +1202,21 @@ TEST(Simulation, AnEmitterCopiedWithoutItsTemplateSharesItsCopyNumbers) {
             for (const int k : copyNumbers(*em)) EXPECT_TRUE(names.contains("doll#" + std::to_string(k))) << k;
         const Result<Scene> reloaded = parseScene(textOf(f.ed.doc.scene), "after.json");
         ASSERT_TRUE(reloaded) << reloaded.error();
+        // The second emitter's copies alive are listed (not its newest
+        // numbers); a copy of it starts from nothing, with no list.
+        ASSERT_FALSE(copyEmitter.copies.empty());
+        f.ed.select({second});
+        ASSERT_TRUE(f.ed.duplicateSelection()) << f.ed.status;
+        const Entity third = f.ed.selection.front();
+        EXPECT_EQ(reg.tryGet<Emitter>(third)->emitted, 0);
+        EXPECT_TRUE(reg.tryGet<Emitter>(third)->copies.empty());
+        for (int i = 0; i < 20; ++i) f.ed.stepForward();
+        EXPECT_TRUE(f.ed.sim.message().empty()) << f.ed.sim.message();
+        EXPECT_GT(f.ed.doc.scene.registry.tryGet<Emitter>(third)->emitted, 0);
+        f.ed.select({third});
+        ASSERT_TRUE(f.ed.deleteSelection()) << f.ed.status;
 
-        const std::vector<int> orphaned = copyNumbers(first);
+        const std::vector<int> orphaned = copyNumbers(*reg.tryGet<Emitter>(f.named("hatch")));
         ASSERT_FALSE(orphaned.empty());
         f.ed.select({f.named("hatch")});
         ASSERT_TRUE(f.ed.deleteSelection()) << f.ed.status;

@@ -532,6 +532,7 @@ std::vector<Entity> cloneEntities(const Registry& src, const std::vector<Entity>
             em->next.reset();
             em->emitted = em->alive = 0;
             em->oldest.reset();
+            em->copies.clear();
         }
         if (Position* p = dst.registry.tryGet<Position>(c)) p->value += offset;
         if (Plane* pl = dst.registry.tryGet<Plane>(c)) pl->offset += dot(pl->normal, offset);
