@@ -158,10 +158,6 @@ struct DirectJoints::Group {
     /// in the order factor() visits them, adds its entries: a slot of
     /// `coupling`.
     std::vector<std::uint32_t> pairSlot;
-    /// For each joint k and each pair (i, j) of its later joints with
-    /// place i >= place j, in factor()'s order: the block the elimination
-    /// of k updates, a slot of `coupling`, or kDiagonal + i.
-    std::vector<std::uint32_t> updateTarget;
     std::vector<Block> pivot, pivotInverse;  // per joint: its diagonal block, then its inverse
     /// Per joint and row: the least a pivot may fall to in the elimination,
     /// the regularisation's share of the row's own diagonal entry; below
@@ -187,7 +183,6 @@ struct DirectJoints::Group {
     /// Rows a block uses: 2 when every joint is a hinge (its blocks are
     /// 2 x 2), else 3.
     int dim = 3;
-    static constexpr std::uint32_t kDiagonal = 0x80000000u;
 
     /// Factors the assembled pivots and couplings in place; false when a
     /// pivot is not positive definite.
@@ -218,17 +213,23 @@ struct DirectJoints::Group {
 
 template <int N>
 bool DirectJoints::Group::eliminate() {
-    std::uint32_t update = 0;
     for (std::size_t k = 0; k < joints.size(); ++k) {
         if (!invertSpd<N>(pivot[k], pivotFloor[k], pivotInverse[k])) return false;
         const std::uint32_t first = laterStart[k], last = laterStart[k + 1];
         for (std::uint32_t s = first; s < last; ++s) multiply<N>(coupling[s], pivotInverse[k], scratch[s - first]);
-        for (std::uint32_t si = first; si < last; ++si)
-            for (std::uint32_t sj = first; sj <= si; ++sj) {
-                const std::uint32_t t = updateTarget[update++];
-                Block& target = t >= kDiagonal ? pivot[t - kDiagonal] : coupling[t];
-                subtractTransposed<N>(scratch[si - first], coupling[sj], target);
+        // Each pair (i, j) of k's later joints, place i >= j: block (i, j)
+        // loses L_ik A_jk^T. It is j's own pivot, or sits in j's list of
+        // later joints, which holds i (no fill) and, like k's, ascends.
+        for (std::uint32_t sj = first; sj < last; ++sj) {
+            const std::uint32_t j = later[sj];
+            subtractTransposed<N>(scratch[sj - first], coupling[sj], pivot[j]);
+            std::uint32_t slot = laterStart[j];
+            for (std::uint32_t si = sj + 1; si < last; ++si) {
+                while (slot < laterStart[j + 1] && later[slot] != later[si]) ++slot;
+                if (slot == laterStart[j + 1]) return false;  // fill: out of the tree's order (never)
+                subtractTransposed<N>(scratch[si - first], coupling[sj], coupling[slot]);
             }
+        }
         for (std::uint32_t s = first; s < last; ++s) coupling[s] = scratch[s - first];
     }
     return true;
@@ -485,15 +486,6 @@ void DirectJoints::order(Group& g, std::span<const JointConstraint> joints) {
         for (std::uint32_t p = g.bodyStart[bi]; p < g.bodyStart[bi + 1]; ++p)
             for (std::uint32_t q = g.bodyStart[bi]; q < g.bodyStart[bi + 1]; ++q)
                 if (g.ends[p].k > g.ends[q].k) g.pairSlot.push_back(slotOf(g.ends[q].k, g.ends[p].k));
-    // The updates of each elimination; a block outside the pattern would
-    // be fill-in, which the order rules out.
-    g.updateTarget.clear();
-    for (std::uint32_t k = 0; k < count; ++k)
-        for (std::uint32_t si = g.laterStart[k]; si < g.laterStart[k + 1]; ++si)
-            for (std::uint32_t sj = g.laterStart[k]; sj <= si; ++sj) {
-                const std::uint32_t i = g.later[si], j = g.later[sj];
-                g.updateTarget.push_back(i == j ? Group::kDiagonal + i : slotOf(j, i));
-            }
     g.dim = std::all_of(g.rowsOf.begin(), g.rowsOf.end(), [](std::uint32_t r) { return r == 2; }) ? 2 : 3;
     g.coupling.resize(g.later.size());
     g.scratch.resize(g.later.size());
