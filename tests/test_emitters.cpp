@@ -434,6 +434,10 @@ TEST(Emitters, RefusalsNameTheEmitterOrTemplate) {
     EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2, "emitted": 4, "alive": 1, "next": 5, "oldest": 4})")),
               "t.json: error: /entities/2/emitter/alive: emitter on entity 2 (\"spout\"): copy \"drop#4\" is alive in "
               "its run state but not in the scene");
+    EXPECT_EQ(refusal(level(R"({"template": "drop", "interval": 1, "count": 2})",
+                            R"(, {"name": "drop#3", "position": {"x": 0, "y": 5}})")),
+              "t.json: error: /entities/2/name: \"drop#3\" is a name the emitter on entity 3 (\"spout\") gives its "
+              "copies, and that copy is not alive in its run state (0 alive of 0 emitted)");
     EXPECT_EQ(refusal(R"({"entities": [{"name": "p", "template": "t", "position": {"x": 0, "y": 0}, "static": true,
                           "radius": 1}]})"),
               "t.json: error: /entities/0/template: entity 0 (\"p\"): a template entity is a dynamic body with a "
