@@ -155,7 +155,9 @@ void WorldImpl::runEmitters() {
     std::vector<Entity> removed, added;
     for (EmitterRun& em : emitters) {
         Emitter& p = em.params;
+        bool changed = false;  // a copy came or went: its list of copies alive is written again
         const auto removeOldest = [&] {
+            changed = true;
             // The copy's name is its first entity's up to the '/' (the
             // anchor's, unless the designer deleted that one).
             if (const Name* name = reg.tryGet<Name>(em.copies.front().front()))
@@ -223,11 +225,13 @@ void WorldImpl::runEmitters() {
             emitterEvents.push_back({em.entity, base, true});
             em.copies.push_back(std::move(copy));
             em.numbers.push_back(number);
+            changed = true;
             if (p.alive == 0) p.oldest = *p.next;
             ++p.alive;
             p.next = *p.next + p.interval;
         }
-        p.copies = detail::storedCopyNumbers(std::vector<int>(em.numbers.begin(), em.numbers.end()), p.emitted);
+        if (changed)
+            p.copies = detail::storedCopyNumbers(std::vector<int>(em.numbers.begin(), em.numbers.end()), p.emitted);
     }
     changeBodies(reg, removed, added);
 }
