@@ -6,7 +6,10 @@
 // the scene, BM_ReloadWorld, which an edit that is not a move still costs).
 // A mass edit goes in place as well (BM_SetMassOfOneBody), and so do a
 // radius (BM_ReshapeOneBody) and a body added and deleted
-// (BM_AddAndDeleteOneBody, two edits an iteration).
+// (BM_AddAndDeleteOneBody, two edits an iteration). The engine's choice of
+// settings, which reads the whole scene, is checked once before the next
+// step however many edits came (BM_SetMassAndSettle: one edit and that
+// check, the cost a frame that edits and then steps pays).
 // Not part of ctest.
 //
 //   build/bench/editor_bench --benchmark_min_time=0.2
@@ -103,6 +106,25 @@ void BM_SetMassOfOneBody(benchmark::State& state) {
     state.counters["bodies"] = double(bodies.size());
 }
 BENCHMARK(BM_SetMassOfOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
+
+/// One mass edit and the check of the engine's choice the next step makes
+/// first (World::settleChoice).
+void BM_SetMassAndSettle(benchmark::State& state) {
+    Scene scene = scenes::circlesInBox(int(state.range(0)));
+    const std::vector<Entity> bodies = bodiesOf(scene);
+    const Entity edited = bodies[bodies.size() / 2];
+    Result<World> world = World::build(scene);
+    bool heavier = false;
+    for (auto _ : state) {
+        heavier = !heavier;
+        scene.registry.emplace<Mass>(edited, Mass{heavier ? 1.0 + 1e-9 : 1.0});
+        Result<void> set = world->setMass(scene, {}, edited);
+        if (set) set = world->settleChoice(scene);
+        if (!set) state.SkipWithError(set.error().c_str());
+    }
+    state.counters["bodies"] = double(bodies.size());
+}
+BENCHMARK(BM_SetMassAndSettle)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
 
 /// A radius edit in place (World::reshapeBody): one circle alternates
 /// between two sizes a part in a billion apart.

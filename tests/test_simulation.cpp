@@ -248,6 +248,37 @@ TEST(Simulation, AMassEditGoesInPlaceAndRunsAsARebuild) {
     }
 }
 
+// The engine's choice of settings reads the whole scene, so edits in
+// place leave it to one check before the next step. A mass dragged through
+// many values while paused (a slider edits once a frame) rebuilds nothing
+// on the way, even through values that would change the choice; the value
+// left at the step decides: 1.5 times the ball's mass keeps the World, 1000
+// times rebuilds it once. Either way the run is a rebuild's.
+TEST(Simulation, EditsInPlaceSettleTheEnginesChoiceOnceBeforeTheNextStep) {
+    for (const double last : {1.5, 1000.0}) {
+        SCOPED_TRACE(last);
+        Fixture inPlace("kinematic.json"), rebuilt("kinematic.json");
+        for (Fixture* f : {&inPlace, &rebuilt}) playThenPause(*f, 60);
+        const Entity ball = inPlace.named("ball 3");
+        const double m0 = inPlace.ed.doc.scene.registry.tryGet<Mass>(ball)->value;
+        const std::uint64_t builds = inPlace.ed.sim.worldBuilds();
+        for (const double factor : {2.0, 1000.0, 300.0, 0.5, 1000.0, last})
+            for (Fixture* f : {&inPlace, &rebuilt})
+                ASSERT_TRUE(f->ed.applyEdit("mass", [&](Scene& s) {
+                    s.registry.tryGet<Mass>(ball)->value = m0 * factor;
+                    return true;
+                }));
+        EXPECT_EQ(inPlace.ed.sim.worldBuilds(), builds) << "no edit rebuilt";
+        rebuilt.ed.sim.sceneChanged();
+        for (int i = 0; i < 30; ++i) {
+            inPlace.ed.stepForward();
+            rebuilt.ed.stepForward();
+        }
+        EXPECT_EQ(inPlace.ed.sim.worldBuilds(), builds + (last > 100.0 ? 1 : 0));
+        EXPECT_EQ(textOf(inPlace.ed.doc.scene), textOf(rebuilt.ed.doc.scene));
+    }
+}
+
 // A turn (the rotate tool: an angle, often with a new position) and a
 // spin go to the live World in place too, and the run goes on as from a
 // rebuilt World: boxes of a pyramid, a compound body, a ragdoll's capsule

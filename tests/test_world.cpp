@@ -471,6 +471,50 @@ TEST(World, AnUnnamedSpringIsCalledByItsNewPlaceAfterADeleteInPlace) {
     EXPECT_EQ(w.stiffnessHints()[0].springName, buildOrDie(s).stiffnessHints()[0].springName);
 }
 
+// An edit in place leaves the engine's choice of settings to one check
+// before the next step (settleChoice): until then the World refuses to
+// step, and the check says when the edit changed what a reload would run.
+// A ball of the kinematic level made 1000 times heavier changes the
+// choice (its mass ratio); 1.5 times, not: that World then steps as one
+// built from the edited scene.
+TEST(World, AnEditInPlaceStepsOnlyOnceTheEnginesChoiceIsSettled) {
+    Result<Scene> loaded = loadSceneFile(std::string(STEPWISE_SOURCE_DIR) + "/levels/kinematic.json");
+    ASSERT_TRUE(loaded.ok()) << loaded.error();
+    for (const double factor : {1000.0, 1.5}) {
+        SCOPED_TRACE(factor);
+        Scene s = loaded.value();
+        Entity ball;
+        for (const Entity e : s.registry.entities())
+            if (const Name* n = s.registry.tryGet<Name>(e); n && n->value == "ball 3") ball = e;
+        ASSERT_FALSE(ball.isNull());
+        World w = buildOrDie(s);
+        s.registry.tryGet<Mass>(ball)->value *= factor;
+        ASSERT_TRUE(w.setMass(s, {}, ball).ok());
+        const Result<void> early = w.step();
+        ASSERT_FALSE(early.ok());
+        EXPECT_EQ(early.error(),
+                  "an edit in place is not yet checked against the engine's choice of settings: call settleChoice");
+        const Result<void> settled = w.settleChoice(s);
+        if (factor > 100.0) {
+            ASSERT_FALSE(settled.ok());
+            EXPECT_EQ(settled.error(), "the edit changes the settings the engine chooses");
+            ASSERT_TRUE(w.reload(s).ok());
+        } else {
+            ASSERT_TRUE(settled.ok()) << settled.error();
+        }
+        World fresh = buildOrDie(s);
+        for (int i = 0; i < 30; ++i) {
+            ASSERT_TRUE(w.step().ok());
+            ASSERT_TRUE(fresh.step().ok());
+        }
+        ASSERT_EQ(w.bodyCount(), fresh.bodyCount());
+        for (std::size_t b = 0; b < w.bodyCount(); ++b) {
+            EXPECT_EQ(w.bodyPosition(b).x, fresh.bodyPosition(b).x) << b;
+            EXPECT_EQ(w.bodyPosition(b).y, fresh.bodyPosition(b).y) << b;
+        }
+    }
+}
+
 TEST(World, StiffChainStaysBoundedUnderImplicitEuler) {
     // k = 1e5 N/m, m = 0.01 kg, dt = 1/60: h w = 53 per spring.
     Result<Scene> loaded = loadSceneFile(std::string(STEPWISE_SOURCE_DIR) + "/levels/stiff_spring.json");

@@ -127,7 +127,7 @@ bool Editor::saveStateAs(const std::filesystem::path& file) {
     // that playing the saved file on gives the bits this session would.
     Scene state = doc.scene;
     state.solverState.reset();
-    if (sim.running() && sim.ensureWorld(doc.scene)) {
+    if (sim.running() && sim.readyToStep(doc.scene)) {
         // A settings edit wakes the sleeping islands at the next step: done
         // now, so the file resumes as this session goes on.
         sim.world()->wakeIfSettingsChanged();

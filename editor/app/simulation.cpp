@@ -229,6 +229,13 @@ bool Simulation::ensureWorld(const Scene& scene) {
     return reload(scene);
 }
 
+bool Simulation::readyToStep(const Scene& scene) {
+    if (!ensureWorld(scene)) return false;
+    if (world_->settleChoice(scene, switches())) return true;
+    stale_ = true;  // the edits change what the engine chooses: as any edit the World declines
+    return reload(scene);
+}
+
 const World* Simulation::editingWorld(const Scene& scene) {
     if (state_ != SimState::Editing) return nullptr;
     if (stale_ || !world_) {
@@ -366,7 +373,7 @@ void Simulation::popHistory() {
 }
 
 bool Simulation::prepareStep(Scene& scene) {
-    if (!ensureWorld(scene)) {
+    if (!readyToStep(scene)) {
         state_ = SimState::Paused;
         return false;
     }
@@ -431,7 +438,7 @@ bool Simulation::finishStep(Scene& scene) {
 }
 
 AdvanceResult Simulation::runSteps(Scene& scene, int count, const std::function<bool()>& gate) {
-    if (!ensureWorld(scene)) {
+    if (!readyToStep(scene)) {
         state_ = SimState::Paused;
         return {};
     }
@@ -490,7 +497,8 @@ bool Simulation::stepBack(Scene& scene) {
     // that entry's scene; after an edit (or a switched system, or a drag)
     // it is recompiled from the restored scene first, with the entry's warm
     // start. Either way the next step is the one the first pass took.
-    const bool sameBuild = world_ && !stale_ && entry.scene == sceneAtBuild_;
+    // A turn taken in place since is checked against the restored scene.
+    const bool sameBuild = world_ && !stale_ && entry.scene == sceneAtBuild_ && world_->settleChoice(scene, switches());
     const auto rebuild = [&] {
         Entity springEntity;
         SystemSwitches on = switches();

@@ -99,6 +99,12 @@ public:
     void sceneEdited(const Scene& scene, const CommandStack::EditSummary& edit);
     /// Builds the World now if it is stale (for overlays while paused).
     bool ensureWorld(const Scene& scene);
+    /// The World ready to step or to save its solver state: built, and the
+    /// engine's choice of settings checked once against the edits taken in
+    /// place since the last step (World::settleChoice); rebuilt from
+    /// `scene` when they change it. Per step, not per frame: a paused
+    /// designer's edits cost no pass over the whole scene.
+    bool readyToStep(const Scene& scene);
 
     /// While editing, the same one World compiled from the edited scene
     /// (recompiled in place after each edit) for the panels and force

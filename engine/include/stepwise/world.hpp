@@ -440,43 +440,50 @@ public:
     /// this World was built from, with that one edit), in place: its inertia
     /// follows, its island wakes, and every other body and every contact's
     /// warm start stay as they are; the steps that follow are those of
-    /// reload(scene, switches). Fails, leaving the World as it was, when the
-    /// edit would change the substeps, iterations or contact stiffness the
-    /// engine chooses, when springs or attractors act (a lighter body could
-    /// be pulled past what a step can take, which a build refuses), or when
-    /// `body` is not a dynamic, non-kinematic body of this World: the caller
-    /// then reloads.
+    /// reload(scene, switches). The engine's choice of settings is not
+    /// checked here but once before the next step, however many edits
+    /// came between (settleChoice). Fails, leaving the World as it was,
+    /// when springs or attractors act (a lighter body could be pulled past
+    /// what a step can take, which a build refuses), or when `body` is not
+    /// a dynamic, non-kinematic body of this World: the caller then reloads.
     Result<void> setMass(const Scene& scene, const SystemSwitches& switches, Entity body);
     /// Gives dynamic body `body` the angle and angular velocity its entity
     /// has in `scene`, in place, as setMass gives a mass (its island wakes;
-    /// the steps that follow are reload's). Fails, leaving the World as it
-    /// was, when the edit would change the engine's choice of settings, when
-    /// `body` is kinematic or not a dynamic body of this World, or when it has
-    /// no turn of its own here (a shapeless body without both an angle and a
-    /// spin).
+    /// the steps that follow are reload's, once settled). Fails, leaving the
+    /// World as it was, when `body` is kinematic or not a dynamic body of
+    /// this World, or when it has no turn of its own here (a shapeless body
+    /// without both an angle and a spin).
     Result<void> turnBody(const Scene& scene, const SystemSwitches& switches, Entity body);
     /// Gives dynamic body `body` the shape, friction, restitution and filter
     /// its entity has in `scene`, in place (its inertia follows; its island
-    /// wakes; the steps that follow are reload's). Fails, leaving the World
-    /// as it was, for a compound body or a chain, an edit that moves the
-    /// body's centre of mass (a polygon's outline, a capsule's ends off
-    /// centre) or makes it a sensor or not, a shape a build refuses, or one
-    /// that changes the engine's choice of settings.
+    /// wakes; the steps that follow are reload's, once settled). Fails,
+    /// leaving the World as it was, for a compound body or a chain, an edit
+    /// that moves the body's centre of mass (a polygon's outline, a
+    /// capsule's ends off centre) or makes it a sensor or not, or a shape a
+    /// build refuses.
     Result<void> reshapeBody(const Scene& scene, const SystemSwitches& switches, Entity body);
     /// Takes the entities of `removed` (no longer in `scene`) out of the
     /// World and adds those of `added` (the last entities of `scene`, in its
     /// order), in place: the islands of removed bodies wake, every other
     /// body and every contact's warm start stay, and the steps that follow
-    /// are those of reload(scene, switches). The editor adds and deletes
+    /// are those of reload(scene, switches), once settled. The editor adds and deletes
     /// bodies this way; a static shape that comes or goes wakes every
     /// island. Fails, leaving the World as it was, for anything but dynamic
     /// and static bodies with a shape and the joints among dynamic ones
     /// (added) or bodies and joints other than planes and kinematic bodies
-    /// (removed), when springs, attractors, boids or emitters act, or when
-    /// the edit would change the engine's choice of settings: the caller
-    /// then reloads.
+    /// (removed), or when springs, attractors, boids or emitters act: the
+    /// caller then reloads.
     Result<void> changeEntities(const Scene& scene, const SystemSwitches& switches, std::span<const Entity> removed,
                                 std::span<const Entity> added);
+    /// After setMass, turnBody, reshapeBody or changeEntities: checks once
+    /// that a reload from `scene` (every edit since the last step applied)
+    /// would run the substeps, iterations and contact stiffness this World
+    /// runs, and takes that reload's choice (its reasons) as its own. The
+    /// choice reads the whole scene, so it is made once per step, not per
+    /// edit; step() refuses until it is settled. Fails when the edits
+    /// change the choice: the caller then reloads. Nothing to do (and no
+    /// cost) when no such edit came since the last check.
+    Result<void> settleChoice(const Scene& scene, const SystemSwitches& switches = {});
     double time() const;
 
     /// Systems this scene needs, in pipeline order: "gravity", "drag",

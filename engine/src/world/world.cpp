@@ -191,6 +191,10 @@ World::~World() = default;
 
 Result<void> World::step() {
     WorldImpl& w = *impl_;
+    // An edit in place leaves the settings as they were: a step under them
+    // could differ from the reload's the edit stands for.
+    if (w.choiceUnsettled)
+        return Error{"an edit in place is not yet checked against the engine's choice of settings: call settleChoice"};
     w.runEmitters();  // copies due now appear (or leave) before the step reads the arrays
     detail::ForceModel& f = w.model;
     const bool timed = w.profiling;
@@ -868,10 +872,9 @@ Result<void> World::setSpringAnchor(Entity spring, Vec2 anchor) {
 
 Result<void> World::moveBody(Entity body, Vec2 position, Vec2 velocity) {
     if (!isFinite(position) || !isFinite(velocity)) return Error{"a position and velocity must be finite"};
-    const std::vector<Entity>& bodies = impl_->bodyEntity;
-    const auto it = std::find(bodies.begin(), bodies.end(), body);
-    if (it == bodies.end()) return Error{"not a dynamic body of this world"};
-    const std::size_t b = std::size_t(it - bodies.begin());
+    const std::uint32_t found = impl_->bodyIndexOf(body);
+    if (found == detail::kNoBody) return Error{"not a dynamic body of this world"};
+    const std::size_t b = found;
     double* x = impl_->xs();
     double* v = impl_->vs();
     x[2 * b] = position.x;

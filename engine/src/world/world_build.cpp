@@ -88,6 +88,8 @@ std::optional<Error> compileBodies(const Registry& reg, WorldImpl& w, BodyIndex&
         start.v.push_back(vel ? vel->value.y : 0.0);
         mass.push_back(mv);
     }
+    w.bodyOfSlot.assign(reg.slotCount(), detail::kNoBody);
+    for (std::size_t b = 0; b < w.bodyEntity.size(); ++b) w.bodyOfSlot[w.bodyEntity[b].index] = std::uint32_t(b);
     detail::ForceModel& f = w.model;
     f.n = w.bodyEntity.size();
     f.mass = std::move(mass);

@@ -22,12 +22,11 @@ bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 /// The state index of `body`, a dynamic, non-kinematic body of the World
 /// that is alive in `scene`; else why an edit of it cannot go in place.
 Result<std::size_t> editableBody(const WorldImpl& w, const Scene& scene, Entity body) {
-    const auto it = std::find(w.bodyEntity.begin(), w.bodyEntity.end(), body);
-    if (it == w.bodyEntity.end()) return Error{"not a dynamic body of this world"};
-    const std::size_t b = std::size_t(it - w.bodyEntity.begin());
+    const std::uint32_t b = w.bodyIndexOf(body);
+    if (b == detail::kNoBody) return Error{"not a dynamic body of this world"};
     if (!w.isKinematic.empty() && w.isKinematic[b]) return Error{"a kinematic body moves as its level says"};
     if (!scene.registry.alive(body)) return Error{"the body is not in the scene"};
-    return b;
+    return std::size_t(b);
 }
 
 } // namespace
@@ -49,6 +48,14 @@ std::optional<Error> WorldImpl::keepChoiceFor(const Scene& scene, const SystemSw
     return std::nullopt;
 }
 
+Result<void> World::settleChoice(const Scene& scene, const SystemSwitches& switches) {
+    WorldImpl& w = *impl_;
+    if (!w.choiceUnsettled) return {};
+    if (std::optional<Error> other = w.keepChoiceFor(scene, switches)) return std::move(*other);
+    w.choiceUnsettled = false;
+    return {};
+}
+
 Result<void> World::setMass(const Scene& scene, const SystemSwitches& switches, Entity body) {
     WorldImpl& w = *impl_;
     const Result<std::size_t> index = editableBody(w, scene, body);
@@ -63,7 +70,7 @@ Result<void> World::setMass(const Scene& scene, const SystemSwitches& switches, 
     if (compound && compound->items.empty()) compound = nullptr;  // refused by a build (checkPolygons)
     const double mass = given ? given->value : compound ? compoundMassProperties(*compound, std::nullopt).mass : 1.0;
     if (!(std::isfinite(mass) && mass > 0.0)) return Error{"mass must be a finite number > 0"};
-    if (std::optional<Error> other = w.keepChoiceFor(scene, switches)) return std::move(*other);
+    w.choiceUnsettled = true;  // checked once, before the next step (settleChoice)
     if (sameBits(f.mass[b], mass)) return {};
 
     f.mass[b] = mass;
@@ -105,7 +112,7 @@ Result<void> World::turnBody(const Scene& scene, const SystemSwitches& switches,
         if (spinSlot == w.spinBody.size() || !reg.has<Angle>(body) || !reg.has<AngularVelocity>(body))
             return Error{"the body has no turn of its own in this world"};
     }
-    if (std::optional<Error> other = w.keepChoiceFor(scene, switches)) return std::move(*other);
+    w.choiceUnsettled = true;  // checked once, before the next step (settleChoice)
     const bool same = c >= 0 ? sameBits(w.collision->angle(std::size_t(c)), angle) &&
                                    sameBits(w.collision->angularVelocity(std::size_t(c)), spin)
                              : sameBits(w.angle[spinSlot], angle) && sameBits(w.angularVelocity[spinSlot], spin);
@@ -147,7 +154,7 @@ Result<void> World::reshapeBody(const Scene& scene, const SystemSwitches& switch
     if (fresh.shape.kind == collision::ShapeKind::Plane || fresh.sensor != old.sensor ||
         !sameBits(fresh.centreOfMass.x, old.centreOfMass.x) || !sameBits(fresh.centreOfMass.y, old.centreOfMass.y))
         return Error{"the edit moves the body's centre of mass or changes its kind of shape"};
-    if (std::optional<Error> other = w.keepChoiceFor(scene, switches)) return std::move(*other);
+    w.choiceUnsettled = true;  // checked once, before the next step (settleChoice)
     w.collision->reshape(std::size_t(c), fresh, made.front().filter);
     w.sleep.extent[b] = w.collision->maxExtent(std::size_t(c));
     w.sleep.wake(std::uint32_t(b));  // as reload's wakeEdited: a changed shape wakes its island
@@ -247,7 +254,7 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
     const std::unordered_set<Entity> fresh(added.begin(), added.end());
     for (std::size_t i = order.size() - added.size(); i < order.size(); ++i)
         if (std::optional<Error> problem = addableProblem(reg, i, fresh)) return std::move(*problem);
-    if (std::optional<Error> other = w.keepChoiceFor(scene, switches)) return std::move(*other);
+    w.choiceUnsettled = true;  // checked once, before the next step (settleChoice)
     w.changeBodies(reg, removed, added);
     // The springs' pull on the bodies at this state, as a build checks it:
     // refused, the caller's rebuild says why.

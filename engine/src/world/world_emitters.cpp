@@ -64,8 +64,6 @@ std::optional<Error> compileEmitters(const Scene& scene, WorldImpl& w) {
     const Registry& reg = scene.registry;
     if (reg.count<Emitter>() == 0) return std::nullopt;
     w.registry = std::make_shared<Registry>(reg);
-    w.bodyOfSlot.assign(reg.slotCount(), kNoBody);
-    for (std::size_t b = 0; b < w.bodyEntity.size(); ++b) w.bodyOfSlot[w.bodyEntity[b].index] = std::uint32_t(b);
     // A copy is every entity named TEMPLATE#N or TEMPLATE#N/..., in scene
     // order: the bodies and joints it was made with (made in that order),
     // whatever has become of the template since (a body added to it or

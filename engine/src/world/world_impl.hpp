@@ -111,6 +111,9 @@ public:
     World::SettingsSource settingsSource = World::SettingsSource::Given;  ///< where substeps came from
     bool hertzFractionRecorded = false;  ///< contactChoice.hertzFraction came from solver_state.chosen
     bool substepsGiven = false, iterationsGiven = false;  ///< by the level's world object
+    /// An edit taken in place has not yet been checked against the
+    /// settings a reload would choose (World::settleChoice); step refuses.
+    bool choiceUnsettled = false;
     std::vector<double> collisionAngleBackup, collisionSpinBackup;  ///< undo after a divergence
     bool profiling = true;
     /// Entities of the state arrays (saveState/restoreState); set by build.
@@ -128,8 +131,13 @@ public:
     WorldSettings sceneWorld;
     std::uint64_t run = 0;  ///< WorldLayout::run  ///< the world settings of the scene built from (restoreState's rebuild)
     /// Entity index -> state index of every dynamic body, kNoBody for the
-    /// other slots (kept with emitters only).
+    /// other slots (a slot's entity may since be another generation).
     std::vector<std::uint32_t> bodyOfSlot;
+    /// The state index of dynamic body `e`; kNoBody when it is none of this World's.
+    std::uint32_t bodyIndexOf(Entity e) const {
+        const std::uint32_t b = e.index < bodyOfSlot.size() ? bodyOfSlot[e.index] : detail::kNoBody;
+        return b != detail::kNoBody && bodyEntity[b] == e ? b : detail::kNoBody;
+    }
     /// Emissions and removals due at the start of a step (time + dt/2 past
     /// their time), applied in place: changeBodies.
     void runEmitters();
