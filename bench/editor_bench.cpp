@@ -6,7 +6,8 @@
 // the scene, BM_ReloadWorld, which an edit that is not a move still costs).
 // A mass edit goes in place as well (BM_SetMassOfOneBody), and so do a
 // radius (BM_ReshapeOneBody) and a body added and deleted
-// (BM_AddAndDeleteOneBody, two edits an iteration). The engine's choice of
+// (BM_AddAndDeleteOneBody, two edits an iteration; BM_AddOneBody, the add
+// alone, which is appended in place). The engine's choice of
 // settings, which reads the whole scene, is checked once before the next
 // step however many edits came (BM_SetMassAndSettle: one edit and that
 // check, the cost a frame that edits and then steps pays).
@@ -164,6 +165,28 @@ void BM_AddAndDeleteOneBody(benchmark::State& state) {
     state.counters["bodies"] = double(bodies.size());
 }
 BENCHMARK(BM_AddAndDeleteOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
+
+/// The add alone, timed (the delete that keeps the level's size is not):
+/// appended to the World in place, where a delete makes its arrays again.
+void BM_AddOneBody(benchmark::State& state) {
+    Scene scene = scenes::circlesInBox(int(state.range(0)));
+    const std::vector<Entity> bodies = bodiesOf(scene);
+    Result<World> world = World::build(scene);
+    const Vec2 above = scene.registry.tryGet<Position>(bodies.back())->value + Vec2{0.0, 2.0};
+    for (auto _ : state) {
+        const Entity e = scene.registry.create();
+        scene.registry.emplace<Position>(e, Position{above});
+        scene.registry.emplace<Radius>(e, Radius{0.1});
+        const Result<void> added = world->changeEntities(scene, {}, {}, std::vector<Entity>{e});
+        state.PauseTiming();
+        (void)scene.registry.destroy(e);
+        const Result<void> removed = world->changeEntities(scene, {}, std::vector<Entity>{e}, {});
+        if (!added || !removed) state.SkipWithError((added ? removed : added).error().c_str());
+        state.ResumeTiming();
+    }
+    state.counters["bodies"] = double(bodies.size());
+}
+BENCHMARK(BM_AddOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
 
 /// The peer: the World rebuilt from the scene (World::reload).
 void BM_ReloadWorld(benchmark::State& state) {

@@ -251,8 +251,6 @@ std::unique_ptr<CollisionSystem> CollisionSystem::changed(std::span<const std::u
     for (std::size_t c = 0; c < oldCount; ++c)
         if (!dropCollider[c] && !jointOnly(c)) keep(c);
     const std::uint32_t addedBase = n.addAll(added);
-    std::vector<std::int32_t> addedIndex(added.size());
-    for (std::size_t k = 0; k < added.size(); ++k) addedIndex[k] = std::int32_t(addedBase + k);
     for (std::size_t c = 0; c < oldCount; ++c)
         if (!dropCollider[c] && jointOnly(c)) keep(c);
     bool anyBroken = false;
@@ -273,17 +271,7 @@ std::unique_ptr<CollisionSystem> CollisionSystem::changed(std::span<const std::u
         anyBroken = anyBroken || j.broken;
         n.addJoint(j, filter[0], filter[1], filter[0] < 0 || filter[1] < 0);
     }
-    for (const JointAdd& add : addedJoints) {
-        joints::JointConstraint j = add.joint;
-        for (joints::JointEnd* end : {&j.a, &j.b}) {
-            if (end->collider < 0) continue;
-            end->collider = addedIndex[std::size_t(end->collider)];
-            end->solverBody = n.solverBodyOf(std::size_t(end->collider));
-        }
-        const std::int32_t fa = add.filterA >= 0 ? addedIndex[std::size_t(add.filterA)] : -1;
-        const std::int32_t fb = add.filterB >= 0 ? addedIndex[std::size_t(add.filterB)] : -1;
-        n.addJoint(j, fa, fb, add.collideConnected);
-    }
+    n.addJointsOf(addedJoints, addedBase);
     if (anyBroken) n.jointsBroke();
     // The warm start of every contact between kept colliders; the map keeps
     // their order, so the cache stays sorted as it was.
@@ -295,6 +283,59 @@ std::unique_ptr<CollisionSystem> CollisionSystem::changed(std::span<const std::u
     }
     n.setWarmStartCache(std::move(cache));
     return next;
+}
+
+void CollisionSystem::addJointsOf(std::span<const JointAdd> addedJoints, std::uint32_t base) {
+    const auto placed = [base](std::int32_t k) { return k >= 0 ? std::int32_t(base) + k : -1; };
+    for (const JointAdd& add : addedJoints) {
+        joints::JointConstraint j = add.joint;
+        for (joints::JointEnd* end : {&j.a, &j.b}) {
+            if (end->collider < 0) continue;
+            end->collider = placed(end->collider);
+            end->solverBody = solverBodyOf(std::size_t(end->collider));
+        }
+        addJoint(j, placed(add.filterA), placed(add.filterB), add.collideConnected);
+    }
+}
+
+bool CollisionSystem::appendsAtEnd() const {
+    for (std::size_t c = 0; c < colliders_.size(); ++c)
+        if (colliders_[c].solverOnly && !isHub(c)) return false;
+    return true;
+}
+
+void CollisionSystem::appended(std::span<const ColliderAdd> added, std::span<const JointAdd> addedJoints) {
+    const std::uint32_t base = addAll(added);
+    addJointsOf(addedJoints, base);
+    // What a system made by changed() starts without: the last step's
+    // contacts and records, the sweep's lazily built static boxes, and
+    // solver bodies' motion within a step (a sleeping body's would stay).
+    constraints_.clear();
+    details_.clear();
+    keptConstraints_.clear();
+    keptDetails_.clear();
+    records_.clear();
+    recordsPending_ = false;
+    recordsFromKept_ = false;
+    detected_ = false;
+    turningFrame_ = true;
+    staticSweepReady_ = false;
+    previousCache_.clear();
+    jointImpulsesBefore_.clear();
+    jointRecords_.clear();
+    lastH_ = 0.0;
+    directJoints_.reset();
+    const BroadPhaseKind kind = broadPhase_.kind();
+    broadPhase_ = BroadPhase{};  // the sweep's order kept between steps starts again, as a new system's
+    broadPhase_.setKind(kind);
+    for (std::size_t i = 0; i < colliders_.size(); ++i)
+        if (const std::uint32_t s = solverIndex_[i]; s != 0 && colliders_[i].hub < 0) {
+            SolverBody b;
+            b.invMass = invMass_[i];
+            b.invInertia = invInertia_[i];
+            bodies_[s] = b;
+        }
+    setWarmStartCache(warmStartCache());
 }
 
 void CollisionSystem::setWarmStartCache(std::vector<CachedImpulse> cache) {

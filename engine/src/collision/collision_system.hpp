@@ -132,6 +132,16 @@ public:
                                              std::span<const std::uint8_t> dropJoint,
                                              std::span<const std::int32_t> bodyMap, std::span<const ColliderAdd> added,
                                              std::span<const JointAdd> addedJoints) const;
+    /// Whether appended() may take an addition: no collider is in the solver
+    /// only because a joint holds it (a build puts those after every shape,
+    /// so new shapes would go before them).
+    bool appendsAtEnd() const;
+    /// Bodies came and none went: `added` and `addedJoints` appended to this
+    /// system in place, with what changed() would leave (the same arrays,
+    /// warm start and joint state; no last step's contacts; solver bodies
+    /// as add() makes them), without copying what stays. Only when
+    /// appendsAtEnd().
+    void appended(std::span<const ColliderAdd> added, std::span<const JointAdd> addedJoints);
     /// Solver body of a collider (0 = static), for mapping joint ends.
     std::uint32_t solverBodyOf(std::size_t collider) const { return solverIndex_[collider]; }
     bool hasJoints() const { return !joints_.empty(); }
@@ -329,6 +339,8 @@ private:
     /// [0, warmStartBound], a friction impulse within friction times it.
     void capWarmStart(std::span<const Vec2> firstSubstepV);
     static Vec2 coincidentNormal(std::uint32_t a, std::uint32_t b);
+    /// Adds the joints of an addition whose colliders start at `base`.
+    void addJointsOf(std::span<const JointAdd> addedJoints, std::uint32_t base);
 
     std::vector<Collider> colliders_;
     std::deque<ConvexPolygon> polygons_;  // the polygon shapes' outlines (addresses stay fixed)

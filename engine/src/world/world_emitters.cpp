@@ -397,14 +397,7 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
 
     // Shapes and joints.
     if (collision) {
-        std::vector<std::uint8_t> dropCollider(collision->colliderCount(), 0);
-        for (std::size_t c = 0; c < dropCollider.size(); ++c) {
-            dropCollider[c] = isGone(collision->collider(c).entity) ? 1 : 0;
-            staticChanged = staticChanged || (dropCollider[c] && collision->collider(c).body < 0);
-        }
-        const std::span<const joints::JointConstraint> oldJoints = collision->jointConstraints();
-        std::vector<std::uint8_t> dropJoint(oldJoints.size(), 0);
-        for (std::size_t k = 0; k < oldJoints.size(); ++k) dropJoint[k] = isGone(oldJoints[k].entity) ? 1 : 0;
+        const std::size_t oldColliders = collision->colliderCount();
         std::vector<collision::CollisionSystem::ColliderAdd> adds;
         std::vector<collision::CollisionSystem::JointAdd> jointAdds;
         detail::ShapeStorage storage;  // add() copies the outlines; they stay put until then
@@ -458,10 +451,27 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
             add.collideConnected = joint.collideConnected;
             jointAdds.push_back(add);
         }
-        collision = collision->changed(dropCollider, dropJoint, bodyMap, adds, jointAdds);
-        collision->setSleepSource(&sleep.asleep, [impl = this](std::uint32_t body) { impl->sleep.wake(body); });
-        colliderOfBody.assign(n, -1);
-        for (std::size_t c = 0; c < collision->colliderCount(); ++c)
+        // Only added: appended in place, and only the new colliders are
+        // looked at. Removed: a new system without them.
+        std::size_t firstNew = oldColliders;
+        if (removed.empty() && collision->appendsAtEnd()) {
+            collision->appended(adds, jointAdds);
+            colliderOfBody.resize(n, -1);
+        } else {
+            std::vector<std::uint8_t> dropCollider(oldColliders, 0);
+            for (std::size_t c = 0; c < oldColliders; ++c) {
+                dropCollider[c] = isGone(collision->collider(c).entity) ? 1 : 0;
+                staticChanged = staticChanged || (dropCollider[c] && collision->collider(c).body < 0);
+            }
+            const std::span<const joints::JointConstraint> oldJoints = collision->jointConstraints();
+            std::vector<std::uint8_t> dropJoint(oldJoints.size(), 0);
+            for (std::size_t k = 0; k < oldJoints.size(); ++k) dropJoint[k] = isGone(oldJoints[k].entity) ? 1 : 0;
+            collision = collision->changed(dropCollider, dropJoint, bodyMap, adds, jointAdds);
+            collision->setSleepSource(&sleep.asleep, [impl = this](std::uint32_t body) { impl->sleep.wake(body); });
+            colliderOfBody.assign(n, -1);
+            firstNew = 0;
+        }
+        for (std::size_t c = firstNew; c < collision->colliderCount(); ++c)
             if (const std::int32_t body = collision->collider(c).body; body >= 0) {
                 // A compound body's hub stands for the body, as World::build has it.
                 if (collision->collider(c).hub >= 0) continue;
