@@ -91,8 +91,10 @@ void BM_DragOneBodyWhilePaused(benchmark::State& state) {
 BENCHMARK(BM_DragOneBodyWhilePaused)->Arg(2000)->Arg(20000)->Arg(200000)->Unit(benchmark::kMicrosecond);
 
 /// A mass edit in place (World::setMass): one body's mass alternates by a
-/// part in a billion, which leaves the engine's choice of settings as it is.
-void BM_SetMassOfOneBody(benchmark::State& state) {
+/// part in a billion, which leaves the engine's choice of settings as it
+/// is; with `settle`, each edit is followed by the check of that choice the
+/// next step makes first (World::settleChoice).
+void setMassOfOneBody(benchmark::State& state, bool settle) {
     Scene scene = scenes::circlesInBox(int(state.range(0)));
     const std::vector<Entity> bodies = bodiesOf(scene);
     const Entity edited = bodies[bodies.size() / 2];
@@ -101,30 +103,15 @@ void BM_SetMassOfOneBody(benchmark::State& state) {
     for (auto _ : state) {
         heavier = !heavier;
         scene.registry.emplace<Mass>(edited, Mass{heavier ? 1.0 + 1e-9 : 1.0});
-        Result<void> set = world->setMass(scene, {}, edited);
+        Result<void> set = world->setMass(scene, edited);
+        if (set && settle) set = world->settleChoice(scene);
         if (!set) state.SkipWithError(set.error().c_str());
     }
     state.counters["bodies"] = double(bodies.size());
 }
+void BM_SetMassOfOneBody(benchmark::State& state) { setMassOfOneBody(state, false); }
 BENCHMARK(BM_SetMassOfOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
-
-/// One mass edit and the check of the engine's choice the next step makes
-/// first (World::settleChoice).
-void BM_SetMassAndSettle(benchmark::State& state) {
-    Scene scene = scenes::circlesInBox(int(state.range(0)));
-    const std::vector<Entity> bodies = bodiesOf(scene);
-    const Entity edited = bodies[bodies.size() / 2];
-    Result<World> world = World::build(scene);
-    bool heavier = false;
-    for (auto _ : state) {
-        heavier = !heavier;
-        scene.registry.emplace<Mass>(edited, Mass{heavier ? 1.0 + 1e-9 : 1.0});
-        Result<void> set = world->setMass(scene, {}, edited);
-        if (set) set = world->settleChoice(scene);
-        if (!set) state.SkipWithError(set.error().c_str());
-    }
-    state.counters["bodies"] = double(bodies.size());
-}
+void BM_SetMassAndSettle(benchmark::State& state) { setMassOfOneBody(state, true); }
 BENCHMARK(BM_SetMassAndSettle)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
 
 /// A radius edit in place (World::reshapeBody): one circle alternates

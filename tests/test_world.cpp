@@ -489,7 +489,7 @@ TEST(World, AnEditInPlaceStepsOnlyOnceTheEnginesChoiceIsSettled) {
         ASSERT_FALSE(ball.isNull());
         World w = buildOrDie(s);
         s.registry.tryGet<Mass>(ball)->value *= factor;
-        ASSERT_TRUE(w.setMass(s, {}, ball).ok());
+        ASSERT_TRUE(w.setMass(s, ball).ok());
         const Result<void> early = w.step();
         ASSERT_FALSE(early.ok());
         EXPECT_EQ(early.error(),

@@ -183,12 +183,12 @@ void Simulation::sceneEdited(const Scene& scene, const CommandStack::EditSummary
         // against the scene it would be rebuilt from, which with a mouse
         // spring is a copy: those rebuild. (An undo after steps brings back
         // an entity's mass or shape with its pose of the time.)
-        if ((changed & kMass) != 0) inPlace = builtMouseSpring_.isNull() && world_->setMass(scene, switches(), entity);
+        if ((changed & kMass) != 0) inPlace = builtMouseSpring_.isNull() && world_->setMass(scene, entity);
         if (inPlace && (changed & kShape) != 0)
             inPlace = builtMouseSpring_.isNull() && world_->reshapeBody(scene, switches(), entity);
         if (inPlace && (changed & kPose) != 0) inPlace = world_->moveBody(entity, p->value, v ? v->value : Vec2{}).ok();
         if (inPlace && (changed & kTurn) != 0)
-            inPlace = builtMouseSpring_.isNull() && world_->turnBody(scene, switches(), entity);
+            inPlace = builtMouseSpring_.isNull() && world_->turnBody(scene, entity);
     }
     // A partly applied edit is rebuilt whole, like any other.
     if (!inPlace) stale_ = true;

@@ -440,20 +440,20 @@ public:
     /// this World was built from, with that one edit), in place: its inertia
     /// follows, its island wakes, and every other body and every contact's
     /// warm start stay as they are; the steps that follow are those of
-    /// reload(scene, switches). The engine's choice of settings is not
+    /// reload(scene). The engine's choice of settings is not
     /// checked here but once before the next step, however many edits
     /// came between (settleChoice). Fails, leaving the World as it was,
     /// when springs or attractors act (a lighter body could be pulled past
     /// what a step can take, which a build refuses), or when `body` is not
     /// a dynamic, non-kinematic body of this World: the caller then reloads.
-    Result<void> setMass(const Scene& scene, const SystemSwitches& switches, Entity body);
+    Result<void> setMass(const Scene& scene, Entity body);
     /// Gives dynamic body `body` the angle and angular velocity its entity
     /// has in `scene`, in place, as setMass gives a mass (its island wakes;
     /// the steps that follow are reload's, once settled). Fails, leaving the
     /// World as it was, when `body` is kinematic or not a dynamic body of
     /// this World, or when it has no turn of its own here (a shapeless body
     /// without both an angle and a spin).
-    Result<void> turnBody(const Scene& scene, const SystemSwitches& switches, Entity body);
+    Result<void> turnBody(const Scene& scene, Entity body);
     /// Gives dynamic body `body` the shape, friction, restitution and filter
     /// its entity has in `scene`, in place (its inertia follows; its island
     /// wakes; the steps that follow are reload's, once settled). Fails,

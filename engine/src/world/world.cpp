@@ -808,6 +808,7 @@ Result<void> World::restoreOtherCopies(const WorldState& s) {
     if (!next) return Error{next.error()};
     next->impl_->profiling = w.profiling;
     next->impl_->run = w.run;  // the same run: its snapshots restore here too
+    next->impl_->choiceUnsettled = w.choiceUnsettled;
     next->impl_->layout = next->impl_->makeLayout();
     if (Result<void> restored = next->restoreState(s); !restored) return restored;
     impl_ = std::move(next->impl_);

@@ -56,7 +56,7 @@ Result<void> World::settleChoice(const Scene& scene, const SystemSwitches& switc
     return {};
 }
 
-Result<void> World::setMass(const Scene& scene, const SystemSwitches& switches, Entity body) {
+Result<void> World::setMass(const Scene& scene, Entity body) {
     WorldImpl& w = *impl_;
     const Result<std::size_t> index = editableBody(w, scene, body);
     if (!index) return index.failure();
@@ -93,7 +93,7 @@ Result<void> World::setMass(const Scene& scene, const SystemSwitches& switches, 
     return {};
 }
 
-Result<void> World::turnBody(const Scene& scene, const SystemSwitches& switches, Entity body) {
+Result<void> World::turnBody(const Scene& scene, Entity body) {
     WorldImpl& w = *impl_;
     const Result<std::size_t> index = editableBody(w, scene, body);
     if (!index) return index.failure();
