@@ -357,6 +357,42 @@ TEST(Emitters, TheArraysAStepWalksHoldTheCopiesAliveAndNothingElse) {
     EXPECT_TRUE(shrank);
 }
 
+TEST(Emitters, PolygonCopiesThatComeAndGoHoldFewOutlinesAndResumeExactly) {
+    // A copy's outline stays where it is while its neighbours come and go
+    // (the contact system points at it); the outlines of copies gone are
+    // freed once they are half of those held. 100 triangles come and 95 go:
+    // the outlines held stay within twice those alive plus 16 (and one new
+    // copy's), and a save after the frees resumes as the long run goes on.
+    const std::string level = R"({"world": {"gravity": {"x": 0, "y": -9.81}, "substeps": 2},
+      "entities": [
+        {"name": "ground", "position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 30, "height": 1}},
+        {"name": "shard", "template": "bit", "position": {"x": 40, "y": 40}, "mass": 0.5,
+         "polygon": {"vertices": [{"x": -0.2, "y": -0.1}, {"x": 0.2, "y": -0.1}, {"x": 0, "y": 0.25}]}},
+        {"name": "spout", "position": {"x": -5, "y": 2}, "emitter": {"template": "bit", "interval": 0.1,
+         "count": 5, "lifetime": 0.45, "velocity": {"x": 4, "y": 1}}}
+      ]})";
+    const Scene scene = parseLevel(level);
+    World world = buildWorld(scene);
+    const WorldImpl& w = internals(world);
+    std::size_t most = 0;
+    bool freed = false;
+    for (int s = 0; s < 600; ++s) {
+        const std::size_t before = w.collision->outlinesHeld();
+        ASSERT_TRUE(world.step());
+        const std::size_t alive = world.copiesAlive(), held = w.collision->outlinesHeld();
+        ASSERT_LE(held, 2 * alive + 16 + 1) << "step " << s;
+        freed = freed || held < before;
+        most = std::max(most, held);
+    }
+    EXPECT_TRUE(freed);
+    EXPECT_GT(most, 2u * 5u);  // outlines of copies gone were held a while
+    const std::string expected = savedRunText(world, scene);
+    for (const int split : {95, 302, 541}) {
+        SCOPED_TRACE("split " + std::to_string(split));
+        EXPECT_EQ(savedAfterResumeAt(scene, split, 600), expected);
+    }
+}
+
 TEST(Emitters, SnapshotsAcrossEmissionsRestoreExactlyWithOneBuildEach) {
     // Step back across emissions and removals: a snapshot from before the
     // copies changed is restored by building the World from the snapshot's

@@ -307,9 +307,124 @@ bool CollisionSystem::appendsAtEnd() const {
 void CollisionSystem::appended(std::span<const ColliderAdd> added, std::span<const JointAdd> addedJoints) {
     const std::uint32_t base = addAll(added);
     addJointsOf(addedJoints, base);
-    // What a system made by changed() starts without: the last step's
-    // contacts and records, the sweep's lazily built static boxes, and
-    // solver bodies' motion within a step (a sleeping body's would stay).
+    forgetLastStep();
+    setWarmStartCache(warmStartCache());
+}
+
+namespace {
+
+/// Keeps the entries of `values` whose index `keep` marks, in order.
+template <class T>
+void keepMarked(std::vector<T>& values, std::span<const std::int32_t> map) {
+    std::size_t out = 0;
+    for (std::size_t i = 0; i < values.size(); ++i)
+        if (map[i] >= 0) values[out++] = values[i];
+    values.resize(out);
+}
+
+/// An ascending list of indices, the dropped taken out and the rest renumbered.
+void renumber(std::vector<std::uint32_t>& list, std::span<const std::int32_t> map) {
+    std::size_t out = 0;
+    for (const std::uint32_t i : list)
+        if (map[i] >= 0) list[out++] = std::uint32_t(map[i]);
+    list.resize(out);
+}
+
+} // namespace
+
+void CollisionSystem::removed(std::span<const std::uint8_t> dropCollider, std::span<const std::uint8_t> dropJoint,
+                              std::span<const std::int32_t> bodyMap) {
+    const std::size_t oldCount = colliders_.size();
+    std::vector<std::int32_t> colliderMap(oldCount, -1);
+    std::int32_t kept = 0;
+    for (std::size_t c = 0; c < oldCount; ++c)
+        if (!dropCollider[c]) colliderMap[c] = kept++;
+    // Solver bodies in their order, the static one first, as add() numbers
+    // them for the kept colliders.
+    std::vector<std::int32_t> solverMap(bodies_.size(), -1);
+    if (!bodies_.empty()) solverMap[0] = 0;
+    std::int32_t solvers = bodies_.empty() ? 0 : 1;
+    for (std::size_t c = 0; c < oldCount; ++c)
+        if (colliderMap[c] >= 0 && colliders_[c].hub < 0 && solverIndex_[c] != 0) solverMap[solverIndex_[c]] = solvers++;
+    for (std::size_t c = 0; c < oldCount; ++c) {
+        if (colliderMap[c] < 0) continue;
+        Collider& col = colliders_[c];
+        if (col.body >= 0) col.body = bodyMap[std::size_t(col.body)];
+        if (col.hub >= 0) col.hub = colliderMap[std::size_t(col.hub)];
+        solverIndex_[c] = std::uint32_t(solverMap[solverIndex_[c]]);
+    }
+    keepMarked(colliders_, colliderMap);
+    keepMarked(filters_, colliderMap);
+    keepMarked(colliderAsleep_, colliderMap);
+    keepMarked(angles_, colliderMap);
+    keepMarked(angularVelocities_, colliderMap);
+    keepMarked(invMass_, colliderMap);
+    keepMarked(invInertia_, colliderMap);
+    keepMarked(maxExtent_, colliderMap);
+    keepMarked(solverIndex_, colliderMap);
+    keepMarked(bodies_, solverMap);
+    for (auto* list : {&finite_, &planes_, &offsetBodies_, &shapesOfHubs_, &awakeShapesOfHubs_, &awakeSolverColliders_})
+        renumber(*list, colliderMap);
+    filtered_ = anyKinematic_ = anySensor_ = false;
+    for (std::size_t c = 0; c < colliders_.size(); ++c) {
+        filtered_ = filtered_ || !(filters_[c] == Filter{});
+        anyKinematic_ = anyKinematic_ || colliders_[c].kinematic;
+        anySensor_ = anySensor_ || colliders_[c].sensor;
+    }
+    // The outlines of the colliders gone stay in the deques (the kept ones'
+    // addresses must not move); past half dead they are copied afresh.
+    std::size_t livePolygons = 0, liveSegments = 0;
+    for (const Collider& c : colliders_) {
+        livePolygons += c.shape.kind == ShapeKind::Polygon ? 1 : 0;
+        liveSegments += c.shape.kind == ShapeKind::ChainSegment ? 1 : 0;
+    }
+    if (polygons_.size() > 2 * livePolygons + 16) {
+        std::deque<ConvexPolygon> fresh;
+        for (Collider& c : colliders_)
+            if (c.shape.kind == ShapeKind::Polygon) c.shape.polygon = &fresh.emplace_back(*c.shape.polygon);
+        polygons_ = std::move(fresh);
+    }
+    if (segments_.size() > 2 * liveSegments + 16) {
+        std::deque<ChainSegment> fresh;
+        for (Collider& c : colliders_)
+            if (c.shape.kind == ShapeKind::ChainSegment) c.shape.segment = &fresh.emplace_back(*c.shape.segment);
+        segments_ = std::move(fresh);
+    }
+    // The joints kept, added again in order as changed() adds them.
+    std::vector<joints::JointConstraint> oldJoints = std::move(joints_);
+    joints_.clear();
+    noCollide_.clear();
+    breakable_.clear();
+    bool anyBroken = false;
+    for (std::size_t k = 0; k < oldJoints.size(); ++k) {
+        if (dropJoint[k]) continue;
+        joints::JointConstraint j = oldJoints[k];
+        for (joints::JointEnd* end : {&j.a, &j.b}) {
+            if (end->collider < 0) continue;
+            end->collider = colliderMap[std::size_t(end->collider)];
+            end->solverBody = solverBodyOf(std::size_t(end->collider));
+        }
+        std::int32_t filter[2] = {-1, -1};
+        if (j.noCollideKey != 0) {
+            filter[0] = colliderMap[std::size_t(j.noCollideKey >> 32)];
+            filter[1] = colliderMap[std::size_t(j.noCollideKey & 0xFFFFFFFFu)];
+        }
+        j.noCollideKey = 0;
+        anyBroken = anyBroken || j.broken;
+        addJoint(j, filter[0], filter[1], filter[0] < 0 || filter[1] < 0);
+    }
+    if (anyBroken) jointsBroke();
+    std::vector<CachedImpulse> cache;
+    for (const CachedImpulse& c : warmStartCache()) {
+        const std::int32_t a = colliderMap[c.colliderA()], b = colliderMap[c.colliderB()];
+        if (a < 0 || b < 0) continue;
+        cache.push_back({CachedImpulse::makeKey(std::uint32_t(a), std::uint32_t(b), c.feature()), c.normal, c.tangent});
+    }
+    forgetLastStep();
+    setWarmStartCache(std::move(cache));
+}
+
+void CollisionSystem::forgetLastStep() {
     constraints_.clear();
     details_.clear();
     keptConstraints_.clear();
@@ -323,6 +438,8 @@ void CollisionSystem::appended(std::span<const ColliderAdd> added, std::span<con
     previousCache_.clear();
     jointImpulsesBefore_.clear();
     jointRecords_.clear();
+    sensorOverlaps_.clear();
+    sensorEvents_.clear();
     lastH_ = 0.0;
     directJoints_.reset();
     const BroadPhaseKind kind = broadPhase_.kind();
@@ -335,7 +452,6 @@ void CollisionSystem::appended(std::span<const ColliderAdd> added, std::span<con
             b.invInertia = invInertia_[i];
             bodies_[s] = b;
         }
-    setWarmStartCache(warmStartCache());
 }
 
 void CollisionSystem::setWarmStartCache(std::vector<CachedImpulse> cache) {

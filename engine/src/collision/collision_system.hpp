@@ -142,6 +142,18 @@ public:
     /// as add() makes them), without copying what stays. Only when
     /// appendsAtEnd().
     void appended(std::span<const ColliderAdd> added, std::span<const JointAdd> addedJoints);
+    /// Bodies went: the colliders `dropCollider` marks and the joints
+    /// `dropJoint` marks taken out of this system in place, the rest moved
+    /// up in their order with their state-vector bodies mapped by `bodyMap`,
+    /// leaving what changed() with nothing added would (the same arrays,
+    /// warm start and joint state; no last step's contacts), without
+    /// making every array again. Then appended() may add, when
+    /// appendsAtEnd().
+    void removed(std::span<const std::uint8_t> dropCollider, std::span<const std::uint8_t> dropJoint,
+                 std::span<const std::int32_t> bodyMap);
+    /// Polygon outlines and chain segments held, those of colliders gone
+    /// included (removed() frees them once they are half).
+    std::size_t outlinesHeld() const { return polygons_.size() + segments_.size(); }
     /// Solver body of a collider (0 = static), for mapping joint ends.
     std::uint32_t solverBodyOf(std::size_t collider) const { return solverIndex_[collider]; }
     bool hasJoints() const { return !joints_.empty(); }
@@ -339,6 +351,11 @@ private:
     /// [0, warmStartBound], a friction impulse within friction times it.
     void capWarmStart(std::span<const Vec2> firstSubstepV);
     static Vec2 coincidentNormal(std::uint32_t a, std::uint32_t b);
+    /// What a system made by changed() starts without, dropped in place:
+    /// the last step's contacts and records, the sweep's lazily built static
+    /// boxes, the broad phase's kept order and solver bodies' motion within
+    /// a step (a sleeping body's would stay).
+    void forgetLastStep();
     /// Adds the joints of an addition whose colliders start at `base`.
     void addJointsOf(std::span<const JointAdd> addedJoints, std::uint32_t base);
 

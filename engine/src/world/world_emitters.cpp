@@ -451,13 +451,12 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
             add.collideConnected = joint.collideConnected;
             jointAdds.push_back(add);
         }
-        // Only added: appended in place, and only the new colliders are
-        // looked at. Removed: a new system without them.
+        // In place: the gone taken out, then the new appended (only the new
+        // colliders are looked at when nothing went). With bodies held in
+        // the solver only by a joint (a build puts them after every shape),
+        // new shapes go before them: a new system.
         std::size_t firstNew = oldColliders;
-        if (removed.empty() && collision->appendsAtEnd()) {
-            collision->appended(adds, jointAdds);
-            colliderOfBody.resize(n, -1);
-        } else {
+        if (!removed.empty()) {
             std::vector<std::uint8_t> dropCollider(oldColliders, 0);
             for (std::size_t c = 0; c < oldColliders; ++c) {
                 dropCollider[c] = isGone(collision->collider(c).entity) ? 1 : 0;
@@ -466,11 +465,30 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
             const std::span<const joints::JointConstraint> oldJoints = collision->jointConstraints();
             std::vector<std::uint8_t> dropJoint(oldJoints.size(), 0);
             for (std::size_t k = 0; k < oldJoints.size(); ++k) dropJoint[k] = isGone(oldJoints[k].entity) ? 1 : 0;
-            collision = collision->changed(dropCollider, dropJoint, bodyMap, adds, jointAdds);
-            collision->setSleepSource(&sleep.asleep, [impl = this](std::uint32_t body) { impl->sleep.wake(body); });
-            colliderOfBody.assign(n, -1);
+            if (adds.empty() || collision->appendsAtEnd()) {
+                collision->removed(dropCollider, dropJoint, bodyMap);
+            } else {
+                collision = collision->changed(dropCollider, dropJoint, bodyMap, adds, jointAdds);
+                collision->setSleepSource(&sleep.asleep, [impl = this](std::uint32_t body) { impl->sleep.wake(body); });
+                adds.clear();
+                jointAdds.clear();
+            }
             firstNew = 0;
         }
+        if (!adds.empty() || !jointAdds.empty()) {
+            if (collision->appendsAtEnd()) {
+                collision->appended(adds, jointAdds);
+            } else {
+                std::vector<std::uint8_t> none(collision->colliderCount(), 0), noJoint(collision->jointConstraints().size(), 0);
+                std::vector<std::int32_t> same(n);
+                for (std::size_t b = 0; b < n; ++b) same[b] = std::int32_t(b);
+                collision = collision->changed(none, noJoint, same, adds, jointAdds);
+                collision->setSleepSource(&sleep.asleep, [impl = this](std::uint32_t body) { impl->sleep.wake(body); });
+                firstNew = 0;
+            }
+        }
+        if (firstNew == 0) colliderOfBody.assign(n, -1);
+        else colliderOfBody.resize(n, -1);
         for (std::size_t c = firstNew; c < collision->colliderCount(); ++c)
             if (const std::int32_t body = collision->collider(c).body; body >= 0) {
                 // A compound body's hub stands for the body, as World::build has it.
