@@ -522,6 +522,54 @@ TEST(World, ADeletedChainsSegmentsAreFreedAndTheRunIsARebuilds) {
     }
 }
 
+// A body deleted in place beside a sleeping jointed chain: the chain
+// stays asleep, and what the World reports of its joints after the next
+// step (anchors, angles) is where the links rest, as a World built from
+// the scene without the body reports it (whose joints never had an awake
+// step to take their geometry from).
+TEST(World, ASleepingChainsJointsReadAfterADeleteInPlaceAsARebuilds) {
+    Result<Scene> loaded = parseScene(R"({"world": {"gravity": {"x": 0, "y": -9.81}, "substeps": 4, "sleep": true},
+      "entities": [
+        {"name": "ground", "position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 40, "height": 1},
+         "friction": 0.8},
+        {"name": "l0", "position": {"x": -1, "y": 0.1}, "box": {"width": 1, "height": 0.2}, "friction": 0.8},
+        {"name": "l1", "position": {"x": 0, "y": 0.1}, "box": {"width": 1, "height": 0.2}, "friction": 0.8},
+        {"name": "l2", "position": {"x": 1, "y": 0.1}, "box": {"width": 1, "height": 0.2}, "friction": 0.8},
+        {"name": "h0", "joint": {"type": "hinge", "a": "l0", "b": "l1", "anchor": {"x": -0.5, "y": 0.1}}},
+        {"name": "h1", "joint": {"type": "hinge", "a": "l1", "b": "l2", "anchor": {"x": 0.5, "y": 0.1}}},
+        {"name": "ball", "position": {"x": 10, "y": 0.5}, "radius": 0.3, "friction": 0.8}
+      ]})", "sleeping chain");
+    ASSERT_TRUE(loaded.ok()) << loaded.error();
+    Scene s = loaded.value();
+    World w = buildOrDie(s);
+    for (int i = 0; i < 600 && w.sleepingBodyCount() < 4; ++i) ASSERT_TRUE(w.step().ok());
+    ASSERT_EQ(w.sleepingBodyCount(), 4u);
+    w.writeBack(s);
+    Entity ball;
+    for (const Entity e : s.registry.entities())
+        if (const Name* n = s.registry.tryGet<Name>(e); n && n->value == "ball") ball = e;
+    ASSERT_TRUE(s.registry.destroy(ball));
+    ASSERT_TRUE(w.changeEntities(s, {}, std::vector<Entity>{ball}, {}).ok());
+    ASSERT_TRUE(w.settleChoice(s).ok());
+    Scene rebuiltScene = s;
+    rebuiltScene.solverState = w.solverState();
+    World rebuilt = buildOrDie(rebuiltScene);
+    ASSERT_TRUE(w.step().ok());
+    ASSERT_TRUE(rebuilt.step().ok());
+    EXPECT_EQ(w.sleepingBodyCount(), 3u);
+    ASSERT_EQ(w.joints().size(), 2u);
+    ASSERT_EQ(rebuilt.joints().size(), 2u);
+    for (std::size_t k = 0; k < 2; ++k) {
+        // Where the hinges are: between the links, on the ground.
+        EXPECT_NEAR(w.joints()[k].anchorA.x, k == 0 ? -0.5 : 0.5, 0.05) << k;
+        EXPECT_NEAR(w.joints()[k].anchorA.y, 0.1, 0.02) << k;
+        EXPECT_LT(w.joints()[k].separation, 1e-3) << k;
+        EXPECT_EQ(w.joints()[k].angle, rebuilt.joints()[k].angle) << k;
+        EXPECT_EQ(w.joints()[k].anchorA.x, rebuilt.joints()[k].anchorA.x) << k;
+        EXPECT_EQ(w.joints()[k].anchorB.y, rebuilt.joints()[k].anchorB.y) << k;
+    }
+}
+
 // An edit in place leaves the engine's choice of settings to one check
 // before the next step (settleChoice): until then the World refuses to
 // step, and the check says when the edit changed what a reload would run.

@@ -299,9 +299,9 @@ void CollisionSystem::addJointsOf(std::span<const JointAdd> addedJoints, std::ui
 }
 
 bool CollisionSystem::appendsAtEnd() const {
-    for (std::size_t c = 0; c < colliders_.size(); ++c)
-        if (colliders_[c].solverOnly && !isHub(c)) return false;
-    return true;
+    // Such bodies come after every shape (build, changed(), removed() keep
+    // that order), so the last collider is one if any is.
+    return colliders_.empty() || !colliders_.back().solverOnly || isHub(colliders_.size() - 1);
 }
 
 void CollisionSystem::appended(std::span<const ColliderAdd> added, std::span<const JointAdd> addedJoints) {
@@ -445,13 +445,9 @@ void CollisionSystem::forgetLastStep() {
     const BroadPhaseKind kind = broadPhase_.kind();
     broadPhase_ = BroadPhase{};  // the sweep's order kept between steps starts again, as a new system's
     broadPhase_.setKind(kind);
-    for (std::size_t i = 0; i < colliders_.size(); ++i)
-        if (const std::uint32_t s = solverIndex_[i]; s != 0 && colliders_[i].hub < 0) {
-            SolverBody b;
-            b.invMass = invMass_[i];
-            b.invInertia = invInertia_[i];
-            bodies_[s] = b;
-        }
+    // Solver bodies keep the motion of their last step: an awake body's is
+    // set afresh when the next step begins, and a sleeping one's is never
+    // read (its joints report where it rests: poseResting).
 }
 
 void CollisionSystem::setWarmStartCache(std::vector<CachedImpulse> cache) {
@@ -1576,6 +1572,10 @@ void CollisionSystem::endStep() {
         }
     }
     jointRecords_.clear();
+    // A sleeping joint's bodies have not moved since their island fell
+    // asleep (or since the World was built): it reports where they rest,
+    // which its last awake step, if it had one here, no longer says.
+    if (anySleeping_) joints::poseResting(joints_, centres_, angles_);
     if (!joints_.empty()) {
         turns_.resize(bodies_.size());
         for (std::size_t s = 0; s < bodies_.size(); ++s) turns_[s] = std::atan2(bodies_[s].dq.s, bodies_[s].dq.c);
@@ -1586,13 +1586,13 @@ void CollisionSystem::endStep() {
         r.joint = j.entity;
         r.a = j.entityA;
         r.b = j.entityB;
-        const joints::JointAnchors anchors = joints::jointAnchors(j, bodies_);
+        const joints::JointAnchors anchors = j.asleep ? joints::restingAnchors(j) : joints::jointAnchors(j, bodies_);
         r.anchorA = anchors.a;
         r.anchorB = anchors.b;
         r.separation = anchors.separation;
         r.force = joints::jointForce(j, lastH_);
         r.torque = joints::jointTorque(j, lastH_);
-        r.angle = joints::jointAngle(j, std::span<const double>(turns_));
+        r.angle = j.asleep ? j.deltaAngle : joints::jointAngle(j, std::span<const double>(turns_));
         jointRecords_.push_back(r);
     }
     // Usually already in order (constraints follow the sorted pairs); the

@@ -353,8 +353,7 @@ private:
     static Vec2 coincidentNormal(std::uint32_t a, std::uint32_t b);
     /// What a system made by changed() starts without, dropped in place:
     /// the last step's contacts and records, the sweep's lazily built static
-    /// boxes, the broad phase's kept order and solver bodies' motion within
-    /// a step (a sleeping body's would stay).
+    /// boxes and the broad phase's kept order.
     void forgetLastStep();
     /// Adds the joints of an addition whose colliders start at `base`.
     void addJointsOf(std::span<const JointAdd> addedJoints, std::uint32_t base);

@@ -336,26 +336,41 @@ void setImpulses(JointConstraint& j, const JointImpulse& in) {
     }
 }
 
+namespace {
+
+/// The joint's centres, anchors and angles from its bodies' centres and
+/// angles (per collider).
+void poseJoint(JointConstraint& j, std::span<const Vec2> centres, std::span<const double> angles) {
+    const auto pose = [&](const JointEnd& e, Vec2& centre, double& angle) {
+        centre = e.collider >= 0 ? centres[std::size_t(e.collider)] : e.fixedCentre;
+        angle = e.collider >= 0 ? angles[std::size_t(e.collider)] : e.fixedAngle;
+    };
+    double angleA = 0.0, angleB = 0.0;
+    pose(j.a, j.centreA, angleA);
+    pose(j.b, j.centreB, angleB);
+    const Rot qA = Rot::fromAngle(angleA), qB = Rot::fromAngle(angleB);
+    j.anchorA = rotate(qA, j.a.local);
+    j.anchorB = rotate(qB, j.b.local);
+    j.deltaCenter = j.centreB - j.centreA;
+    j.deltaAngle = angleB - angleA - j.referenceAngle;
+    j.axisA = rotate(qA, j.localAxis);
+}
+
+} // namespace
+
 void prepareJoints(std::span<JointConstraint> joints, std::span<const SolverBody> bodies,
                    std::span<const Vec2> centres, std::span<const double> angles) {
     for (JointConstraint& j : joints) {
         if (j.asleep) continue;  // its island sleeps: nothing moves it
-        const auto pose = [&](const JointEnd& e, Vec2& centre, double& angle) {
-            centre = e.collider >= 0 ? centres[std::size_t(e.collider)] : e.fixedCentre;
-            angle = e.collider >= 0 ? angles[std::size_t(e.collider)] : e.fixedAngle;
-        };
-        double angleA = 0.0, angleB = 0.0;
-        pose(j.a, j.centreA, angleA);
-        pose(j.b, j.centreB, angleB);
-        const Rot qA = Rot::fromAngle(angleA), qB = Rot::fromAngle(angleB);
-        j.anchorA = rotate(qA, j.a.local);
-        j.anchorB = rotate(qB, j.b.local);
-        j.deltaCenter = j.centreB - j.centreA;
-        j.deltaAngle = angleB - angleA - j.referenceAngle;
-        j.axisA = rotate(qA, j.localAxis);
+        poseJoint(j, centres, angles);
         const double k = bodies[j.a.solverBody].invInertia + bodies[j.b.solverBody].invInertia;
         j.axialMass = k > 0.0 ? 1.0 / k : 0.0;
     }
+}
+
+void poseResting(std::span<JointConstraint> joints, std::span<const Vec2> centres, std::span<const double> angles) {
+    for (JointConstraint& j : joints)
+        if (j.asleep && !j.broken) poseJoint(j, centres, angles);
 }
 
 void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies) {
@@ -479,6 +494,14 @@ JointAnchors jointAnchors(const JointConstraint& j, std::span<const SolverBody> 
     JointAnchors out;
     out.a = j.centreA + a.dp + rotate(a.dq, j.anchorA);
     out.b = j.centreB + b.dp + rotate(b.dq, j.anchorB);
+    out.separation = length(out.b - out.a);
+    return out;
+}
+
+JointAnchors restingAnchors(const JointConstraint& j) {
+    JointAnchors out;
+    out.a = j.centreA + j.anchorA;
+    out.b = j.centreB + j.anchorB;
     out.separation = length(out.b - out.a);
     return out;
 }

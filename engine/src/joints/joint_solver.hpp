@@ -143,6 +143,10 @@ void setImpulses(JointConstraint& joint, const JointImpulse& impulses);
 /// `angles` are per collider (step start).
 void prepareJoints(std::span<JointConstraint> joints, std::span<const collision::SolverBody> bodies,
                    std::span<const Vec2> centres, std::span<const double> angles);
+/// The same geometry for the sleeping joints (asleep, not broken), from
+/// where their bodies rest: what they report (restingAnchors, deltaAngle)
+/// after a load or an edit as well as after the step they fell asleep in.
+void poseResting(std::span<JointConstraint> joints, std::span<const Vec2> centres, std::span<const double> angles);
 void warmStartJoints(std::span<JointConstraint> joints, std::span<collision::SolverBody> bodies);
 /// One Gauss-Seidel pass over the joints; `soft` is the rigid rows'
 /// softness (used in biased passes only), `directSoft` that of the rows
@@ -188,5 +192,7 @@ inline double jointAngle(const JointConstraint& joint, std::span<const double> t
     return joint.deltaAngle + turns[joint.b.solverBody] - turns[joint.a.solverBody];
 }
 JointAnchors jointAnchors(const JointConstraint& joint, std::span<const collision::SolverBody> bodies);
+/// A sleeping joint's anchors (poseResting): its bodies do not move.
+JointAnchors restingAnchors(const JointConstraint& joint);
 
 } // namespace stepwise::joints

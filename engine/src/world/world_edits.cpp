@@ -233,19 +233,22 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
     for (const Entity e : removed)
         if (reg.alive(e)) return Error{"a removed entity is still in the scene"};
     const auto isGone = [&gone](Entity e) { return !e.isNull() && gone.count(e) != 0; };
-    for (std::size_t b = 0; b < w.bodyEntity.size(); ++b)
+    for (std::size_t b = 0; b < w.bodyEntity.size() && !gone.empty(); ++b)
         if (isGone(w.bodyEntity[b]) && !w.isKinematic.empty() && w.isKinematic[b])
             return Error{"a kinematic body is removed by a rebuild"};
-    for (std::size_t c = 0; c < w.collision->colliderCount(); ++c)
-        if (w.collision->collider(c).shape.kind == collision::ShapeKind::Plane && isGone(w.collision->collider(c).entity))
-            return Error{"a plane is removed by a rebuild"};
-    for (const joints::JointConstraint& j : w.collision->jointConstraints())
-        if (!isGone(j.entity) && (isGone(j.entityA) || isGone(j.entityB)))
-            return Error{"a joint stays while a body it holds is removed"};
-    const auto bodyGone = [&](std::uint32_t b) { return b != detail::kNoBody && isGone(w.bodyEntity[b]); };
-    for (const detail::SpringData& s : w.model.springs)
-        if (!isGone(s.entity) && (bodyGone(s.a) || bodyGone(s.b)))
-            return Error{"a spring stays while a body it holds is removed"};
+    if (!gone.empty()) {
+        for (std::size_t c = 0; c < w.collision->colliderCount(); ++c)
+            if (w.collision->collider(c).shape.kind == collision::ShapeKind::Plane &&
+                isGone(w.collision->collider(c).entity))
+                return Error{"a plane is removed by a rebuild"};
+        for (const joints::JointConstraint& j : w.collision->jointConstraints())
+            if (!isGone(j.entity) && (isGone(j.entityA) || isGone(j.entityB)))
+                return Error{"a joint stays while a body it holds is removed"};
+        const auto bodyGone = [&](std::uint32_t b) { return b != detail::kNoBody && isGone(w.bodyEntity[b]); };
+        for (const detail::SpringData& s : w.model.springs)
+            if (!isGone(s.entity) && (bodyGone(s.a) || bodyGone(s.b)))
+                return Error{"a spring stays while a body it holds is removed"};
+    }
     // The added: the scene's last entities, in its order, as a build would
     // append them.
     const std::vector<Entity>& order = reg.entities();

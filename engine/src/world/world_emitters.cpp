@@ -238,23 +238,23 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
     // Flags by entity slot: a removed entity's slot may be reused by an
     // added one, which is told apart by its generation. An undone add
     // takes its slot out of the registry's table with it, so the removed
-    // and this World's own bodies count too.
+    // count too (this World's own bodies are within bodyOfSlot).
     std::size_t slots = std::max(reg.slotCount(), bodyOfSlot.size());
     for (const Entity e : removed) slots = std::max(slots, std::size_t(e.index) + 1);
-    for (const Entity e : bodyEntity) slots = std::max(slots, std::size_t(e.index) + 1);
-    std::vector<Entity> goneAt(slots);
+    std::vector<Entity> goneAt(removed.empty() ? 0 : slots);
     for (const Entity e : removed) goneAt[e.index] = e;
     const auto isGone = [&goneAt](Entity e) { return e.index < goneAt.size() && goneAt[e.index] == e; };
     const std::size_t oldN = bodyEntity.size();
     // A removed body's island wakes: what touched it moves on without it.
-    for (std::size_t b = 0; b < oldN; ++b)
-        if (sleep.island[b] >= 0 && isGone(bodyEntity[b])) sleep.wake(std::uint32_t(b));
+    if (!removed.empty())
+        for (std::size_t b = 0; b < oldN; ++b)
+            if (sleep.island[b] >= 0 && isGone(bodyEntity[b])) sleep.wake(std::uint32_t(b));
     std::vector<std::int32_t> bodyMap(oldN, -1);
     std::size_t n = 0;
     for (std::size_t b = 0; b < oldN; ++b)
         if (!isGone(bodyEntity[b])) bodyMap[b] = std::int32_t(n++);
     const auto compact = [&](auto& values, std::size_t stride) {
-        if (values.empty()) return;
+        if (values.empty() || n == oldN) return;  // nothing gone: every value stays where it is
         std::size_t out = 0;
         for (std::size_t b = 0; b < oldN; ++b) {
             if (bodyMap[b] < 0) continue;
