@@ -134,8 +134,9 @@ void BM_ReshapeOneBody(benchmark::State& state) {
 BENCHMARK(BM_ReshapeOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
 
 /// A ball added above the box and deleted again, each in place
-/// (World::changeEntities): two edits per iteration, against two reloads.
-void BM_AddAndDeleteOneBody(benchmark::State& state) {
+/// (World::changeEntities): with `addOnly`, only the add is timed (the
+/// delete that keeps the level's size is not).
+void addAndDeleteOneBody(benchmark::State& state, bool addOnly) {
     Scene scene = scenes::circlesInBox(int(state.range(0)));
     const std::vector<Entity> bodies = bodiesOf(scene);
     Result<World> world = World::build(scene);
@@ -145,34 +146,18 @@ void BM_AddAndDeleteOneBody(benchmark::State& state) {
         scene.registry.emplace<Position>(e, Position{above});
         scene.registry.emplace<Radius>(e, Radius{0.1});
         const Result<void> added = world->changeEntities(scene, {}, {}, std::vector<Entity>{e});
+        if (addOnly) state.PauseTiming();
         (void)scene.registry.destroy(e);
         const Result<void> removed = world->changeEntities(scene, {}, std::vector<Entity>{e}, {});
         if (!added || !removed) state.SkipWithError((added ? removed : added).error().c_str());
+        if (addOnly) state.ResumeTiming();
     }
     state.counters["bodies"] = double(bodies.size());
 }
+/// Two edits per iteration, against two reloads.
+void BM_AddAndDeleteOneBody(benchmark::State& state) { addAndDeleteOneBody(state, false); }
 BENCHMARK(BM_AddAndDeleteOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
-
-/// The add alone, timed (the delete that keeps the level's size is not):
-/// appended to the World in place, where a delete makes its arrays again.
-void BM_AddOneBody(benchmark::State& state) {
-    Scene scene = scenes::circlesInBox(int(state.range(0)));
-    const std::vector<Entity> bodies = bodiesOf(scene);
-    Result<World> world = World::build(scene);
-    const Vec2 above = scene.registry.tryGet<Position>(bodies.back())->value + Vec2{0.0, 2.0};
-    for (auto _ : state) {
-        const Entity e = scene.registry.create();
-        scene.registry.emplace<Position>(e, Position{above});
-        scene.registry.emplace<Radius>(e, Radius{0.1});
-        const Result<void> added = world->changeEntities(scene, {}, {}, std::vector<Entity>{e});
-        state.PauseTiming();
-        (void)scene.registry.destroy(e);
-        const Result<void> removed = world->changeEntities(scene, {}, std::vector<Entity>{e}, {});
-        if (!added || !removed) state.SkipWithError((added ? removed : added).error().c_str());
-        state.ResumeTiming();
-    }
-    state.counters["bodies"] = double(bodies.size());
-}
+void BM_AddOneBody(benchmark::State& state) { addAndDeleteOneBody(state, true); }
 BENCHMARK(BM_AddOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
 
 /// The peer: the World rebuilt from the scene (World::reload).

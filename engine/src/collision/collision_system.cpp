@@ -253,14 +253,22 @@ std::unique_ptr<CollisionSystem> CollisionSystem::changed(std::span<const std::u
     const std::uint32_t addedBase = n.addAll(added);
     for (std::size_t c = 0; c < oldCount; ++c)
         if (!dropCollider[c] && jointOnly(c)) keep(c);
+    n.addKeptJoints(joints_, dropJoint, colliderMap);
+    n.addJointsOf(addedJoints, addedBase);
+    n.setWarmStartCache(keptCache(warmStartCache(), colliderMap));
+    return next;
+}
+
+void CollisionSystem::addKeptJoints(std::span<const joints::JointConstraint> old, std::span<const std::uint8_t> dropJoint,
+                                    std::span<const std::int32_t> colliderMap) {
     bool anyBroken = false;
-    for (std::size_t k = 0; k < joints_.size(); ++k) {
+    for (std::size_t k = 0; k < old.size(); ++k) {
         if (dropJoint[k]) continue;
-        joints::JointConstraint j = joints_[k];
+        joints::JointConstraint j = old[k];
         for (joints::JointEnd* end : {&j.a, &j.b}) {
             if (end->collider < 0) continue;
             end->collider = colliderMap[std::size_t(end->collider)];
-            end->solverBody = n.solverBodyOf(std::size_t(end->collider));
+            end->solverBody = solverBodyOf(std::size_t(end->collider));
         }
         std::int32_t filter[2] = {-1, -1};
         if (j.noCollideKey != 0) {
@@ -269,20 +277,22 @@ std::unique_ptr<CollisionSystem> CollisionSystem::changed(std::span<const std::u
         }
         j.noCollideKey = 0;
         anyBroken = anyBroken || j.broken;
-        n.addJoint(j, filter[0], filter[1], filter[0] < 0 || filter[1] < 0);
+        addJoint(j, filter[0], filter[1], filter[0] < 0 || filter[1] < 0);
     }
-    n.addJointsOf(addedJoints, addedBase);
-    if (anyBroken) n.jointsBroke();
-    // The warm start of every contact between kept colliders; the map keeps
-    // their order, so the cache stays sorted as it was.
-    std::vector<CachedImpulse> cache;
-    for (const CachedImpulse& c : warmStartCache()) {
+    if (anyBroken) jointsBroke();
+}
+
+std::vector<CachedImpulse> CollisionSystem::keptCache(std::vector<CachedImpulse> all,
+                                                      std::span<const std::int32_t> colliderMap) {
+    // The map keeps the colliders' order, so the cache stays sorted as it was.
+    std::size_t out = 0;
+    for (const CachedImpulse& c : all) {
         const std::int32_t a = colliderMap[c.colliderA()], b = colliderMap[c.colliderB()];
         if (a < 0 || b < 0) continue;
-        cache.push_back({CachedImpulse::makeKey(std::uint32_t(a), std::uint32_t(b), c.feature()), c.normal, c.tangent});
+        all[out++] = {CachedImpulse::makeKey(std::uint32_t(a), std::uint32_t(b), c.feature()), c.normal, c.tangent};
     }
-    n.setWarmStartCache(std::move(cache));
-    return next;
+    all.resize(out);
+    return all;
 }
 
 void CollisionSystem::addJointsOf(std::span<const JointAdd> addedJoints, std::uint32_t base) {
@@ -395,31 +405,8 @@ void CollisionSystem::removed(std::span<const std::uint8_t> dropCollider, std::s
     joints_.clear();
     noCollide_.clear();
     breakable_.clear();
-    bool anyBroken = false;
-    for (std::size_t k = 0; k < oldJoints.size(); ++k) {
-        if (dropJoint[k]) continue;
-        joints::JointConstraint j = oldJoints[k];
-        for (joints::JointEnd* end : {&j.a, &j.b}) {
-            if (end->collider < 0) continue;
-            end->collider = colliderMap[std::size_t(end->collider)];
-            end->solverBody = solverBodyOf(std::size_t(end->collider));
-        }
-        std::int32_t filter[2] = {-1, -1};
-        if (j.noCollideKey != 0) {
-            filter[0] = colliderMap[std::size_t(j.noCollideKey >> 32)];
-            filter[1] = colliderMap[std::size_t(j.noCollideKey & 0xFFFFFFFFu)];
-        }
-        j.noCollideKey = 0;
-        anyBroken = anyBroken || j.broken;
-        addJoint(j, filter[0], filter[1], filter[0] < 0 || filter[1] < 0);
-    }
-    if (anyBroken) jointsBroke();
-    std::vector<CachedImpulse> cache;
-    for (const CachedImpulse& c : warmStartCache()) {
-        const std::int32_t a = colliderMap[c.colliderA()], b = colliderMap[c.colliderB()];
-        if (a < 0 || b < 0) continue;
-        cache.push_back({CachedImpulse::makeKey(std::uint32_t(a), std::uint32_t(b), c.feature()), c.normal, c.tangent});
-    }
+    addKeptJoints(oldJoints, dropJoint, colliderMap);
+    std::vector<CachedImpulse> cache = keptCache(warmStartCache(), colliderMap);
     forgetLastStep();
     setWarmStartCache(std::move(cache));
 }

@@ -355,6 +355,12 @@ private:
     /// the last step's contacts and records, the sweep's lazily built static
     /// boxes and the broad phase's kept order.
     void forgetLastStep();
+    /// Adds the joints of `old` that `dropJoint` does not mark, their ends
+    /// renumbered by `colliderMap` (old collider -> kept, -1 gone).
+    void addKeptJoints(std::span<const joints::JointConstraint> old, std::span<const std::uint8_t> dropJoint,
+                       std::span<const std::int32_t> colliderMap);
+    /// The warm-start entries between kept colliders, renumbered.
+    static std::vector<CachedImpulse> keptCache(std::vector<CachedImpulse> all, std::span<const std::int32_t> colliderMap);
     /// Adds the joints of an addition whose colliders start at `base`.
     void addJointsOf(std::span<const JointAdd> addedJoints, std::uint32_t base);
 
