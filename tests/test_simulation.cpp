@@ -252,8 +252,8 @@ TEST(Simulation, AMassEditGoesInPlaceAndRunsAsARebuild) {
 // place leave it to one check before the next step. A mass dragged through
 // many values while paused (a slider edits once a frame) rebuilds nothing
 // on the way, even through values that would change the choice; the value
-// left at the step decides: 1.5 times the ball's mass keeps the World, 1000
-// times rebuilds it once. Either way the run is a rebuild's.
+// left at the step decides: 1.5 times the ball's mass keeps the World, a
+// thousand times rebuilds it once. Either way the run is a rebuild's.
 TEST(Simulation, EditsInPlaceSettleTheEnginesChoiceOnceBeforeTheNextStep) {
     for (const double last : {1.5, 1000.0}) {
         SCOPED_TRACE(last);

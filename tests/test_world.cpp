@@ -472,6 +472,28 @@ TEST(World, AnUnnamedSpringIsCalledByItsNewPlaceAfterADeleteInPlace) {
     EXPECT_EQ(w.stiffnessHints()[0].springName, buildOrDie(s).stiffnessHints()[0].springName);
 }
 
+namespace {
+
+/// Steps `w` (just edited in place, its choice settled) and a World built
+/// from `edited` with w's solver state, as a rebuild after the edit would
+/// carry it, `steps` times: every body's position the same bits.
+void expectStepsAsARebuild(World& w, const Scene& edited, int steps) {
+    Scene rebuiltScene = edited;
+    rebuiltScene.solverState = w.solverState();
+    World rebuilt = buildOrDie(rebuiltScene);
+    for (int i = 0; i < steps; ++i) {
+        ASSERT_TRUE(w.step().ok());
+        ASSERT_TRUE(rebuilt.step().ok());
+    }
+    ASSERT_EQ(w.bodyCount(), rebuilt.bodyCount());
+    for (std::size_t b = 0; b < w.bodyCount(); ++b) {
+        EXPECT_EQ(w.bodyPosition(b).x, rebuilt.bodyPosition(b).x) << b;
+        EXPECT_EQ(w.bodyPosition(b).y, rebuilt.bodyPosition(b).y) << b;
+    }
+}
+
+} // namespace
+
 // Each kind of body added in place beside a settling pile, a body before
 // it deleted (its colliders move up), then it deleted, each in place:
 // after each edit the run is that of a World built from the edited scene
@@ -511,18 +533,7 @@ TEST(World, EachKindOfBodyAddedAndDeletedInPlaceRunsAsARebuilds) {
         const auto runsAsARebuild = [&](const char* what) {
             SCOPED_TRACE(what);
             ASSERT_TRUE(w.settleChoice(s).ok());
-            Scene rebuiltScene = s;
-            rebuiltScene.solverState = w.solverState();
-            World rebuilt = buildOrDie(rebuiltScene);
-            for (int i = 0; i < 30; ++i) {
-                ASSERT_TRUE(w.step().ok());
-                ASSERT_TRUE(rebuilt.step().ok());
-            }
-            ASSERT_EQ(w.bodyCount(), rebuilt.bodyCount());
-            for (std::size_t b = 0; b < w.bodyCount(); ++b) {
-                ASSERT_EQ(w.bodyPosition(b).x, rebuilt.bodyPosition(b).x) << b;
-                ASSERT_EQ(w.bodyPosition(b).y, rebuilt.bodyPosition(b).y) << b;
-            }
+            expectStepsAsARebuild(w, s, 30);
             w.writeBack(s);
         };
         w.writeBack(s);
@@ -583,18 +594,7 @@ TEST(World, ADeletedChainsSegmentsAreFreedAndTheRunIsARebuilds) {
         ASSERT_TRUE(w.changeEntities(s, {}, std::vector<Entity>{e}, {}).ok());
         ASSERT_TRUE(w.settleChoice(s).ok());
         EXPECT_EQ(contacts.outlinesHeld(), 2u);  // the short chain's two segments
-        Scene rebuiltScene = s;
-        rebuiltScene.solverState = w.solverState();
-        World rebuilt = buildOrDie(rebuiltScene);
-        for (int i = 0; i < 40; ++i) {
-            ASSERT_TRUE(w.step().ok());
-            ASSERT_TRUE(rebuilt.step().ok());
-        }
-        ASSERT_EQ(w.bodyCount(), rebuilt.bodyCount());
-        for (std::size_t b = 0; b < w.bodyCount(); ++b) {
-            EXPECT_EQ(w.bodyPosition(b).x, rebuilt.bodyPosition(b).x) << b;
-            EXPECT_EQ(w.bodyPosition(b).y, rebuilt.bodyPosition(b).y) << b;
-        }
+        expectStepsAsARebuild(w, s, 40);
     }
 }
 
@@ -649,7 +649,7 @@ TEST(World, ASleepingChainsJointsReadAfterADeleteInPlaceAsARebuilds) {
 // An edit in place leaves the engine's choice of settings to one check
 // before the next step (settleChoice): until then the World refuses to
 // step, and the check says when the edit changed what a reload would run.
-// A ball of the kinematic level made 1000 times heavier changes the
+// A ball of the kinematic level made a thousand times heavier changes the
 // choice (its mass ratio); 1.5 times, not: that World then steps as one
 // built from the edited scene.
 TEST(World, AnEditInPlaceStepsOnlyOnceTheEnginesChoiceIsSettled) {
