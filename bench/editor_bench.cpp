@@ -7,7 +7,8 @@
 // A mass edit goes in place as well (BM_SetMassOfOneBody), and so do a
 // radius (BM_ReshapeOneBody) and a body added and deleted
 // (BM_AddAndDeleteOneBody, two edits an iteration; BM_AddOneBody, the add
-// alone, which is appended in place). The engine's choice of
+// alone, which is appended in place; BM_DeleteAndUndoOneBody, a body
+// brought back where it stood). The engine's choice of
 // settings, which reads the whole scene, is checked once before the next
 // step however many edits came (BM_SetMassAndSettle: one edit and that
 // check, the cost a frame that edits and then steps pays).
@@ -159,6 +160,29 @@ void BM_AddAndDeleteOneBody(benchmark::State& state) { addAndDeleteOneBody(state
 BENCHMARK(BM_AddAndDeleteOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
 void BM_AddOneBody(benchmark::State& state) { addAndDeleteOneBody(state, true); }
 BENCHMARK(BM_AddOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
+
+/// A body in the middle of the level deleted and brought back where it
+/// stood in the scene order, as an undo of the delete restores it, each
+/// in place: two edits per iteration.
+void BM_DeleteAndUndoOneBody(benchmark::State& state) {
+    Scene scene = scenes::circlesInBox(int(state.range(0)));
+    const std::vector<Entity> bodies = bodiesOf(scene);
+    Result<World> world = World::build(scene);
+    const Entity middle = bodies[bodies.size() / 2];
+    Registry aside;
+    const Entity copy = aside.create();
+    copyComponents(scene.registry, middle, aside, copy);
+    for (auto _ : state) {
+        const Registry::Slots before = scene.registry.slots();
+        (void)scene.registry.destroy(middle);
+        const Result<void> removed = world->changeEntities(scene, {}, std::vector<Entity>{middle}, {});
+        scene.registry.setSlots(before);
+        copyComponents(aside, copy, scene.registry, middle);
+        const Result<void> back = world->changeEntities(scene, {}, {}, std::vector<Entity>{middle});
+        if (!removed || !back) state.SkipWithError((removed ? back : removed).error().c_str());
+    }
+}
+BENCHMARK(BM_DeleteAndUndoOneBody)->Arg(2'000)->Arg(20'000)->Arg(200'000)->Unit(benchmark::kMicrosecond);
 
 /// The peer: the World rebuilt from the scene (World::reload).
 void BM_ReloadWorld(benchmark::State& state) {

@@ -487,21 +487,21 @@ void expectStepsAsARebuild(World& w, const Scene& edited, int steps) {
     }
     ASSERT_EQ(w.bodyCount(), rebuilt.bodyCount());
     for (std::size_t b = 0; b < w.bodyCount(); ++b) {
+        EXPECT_EQ(w.bodyEntity(b), rebuilt.bodyEntity(b)) << b;
         EXPECT_EQ(w.bodyPosition(b).x, rebuilt.bodyPosition(b).x) << b;
         EXPECT_EQ(w.bodyPosition(b).y, rebuilt.bodyPosition(b).y) << b;
     }
+    ASSERT_EQ(w.joints().size(), rebuilt.joints().size());
+    for (std::size_t k = 0; k < w.joints().size(); ++k) {
+        EXPECT_EQ(w.joints()[k].joint, rebuilt.joints()[k].joint) << k;
+        EXPECT_EQ(w.joints()[k].force.x, rebuilt.joints()[k].force.x) << k;
+    }
 }
 
-} // namespace
-
-// Each kind of body added in place beside a settling pile, a body before
-// it deleted (its colliders move up), then it deleted, each in place:
-// after each edit the run is that of a World built from the edited scene
-// with the same warm start, bit for bit, for a circle, a
-// box, a polygon, a capsule, a compound body (its hub and shapes), a
-// static box and a static chain (which wake every island).
-TEST(World, EachKindOfBodyAddedAndDeletedInPlaceRunsAsARebuilds) {
-    const std::vector<std::pair<std::string, std::string>> kinds = {
+/// One body of each kind a level can add in place (the fields after its
+/// name), placed to land on tests' small pile of two boxes near x = 0.
+std::vector<std::pair<std::string, std::string>> kindsOfBody() {
+    return {
         {"circle", R"("position": {"x": 0.3, "y": 1.7}, "radius": 0.25)"},
         {"box", R"("position": {"x": 0.3, "y": 1.7}, "angle": 0.4, "box": {"width": 0.6, "height": 0.3})"},
         {"polygon", R"("position": {"x": 0.3, "y": 1.7}, "polygon": {"vertices": [{"x": -0.3, "y": -0.2},
@@ -514,7 +514,18 @@ TEST(World, EachKindOfBodyAddedAndDeletedInPlaceRunsAsARebuilds) {
         {"static chain", R"("position": {"x": -4, "y": 0.15}, "static": true, "chain": {"points": [{"x": 1, "y": 0.5},
             {"x": 0, "y": 0}, {"x": -1, "y": 0.5}]})"},
     };
-    for (const auto& [kind, fields] : kinds) {
+}
+
+} // namespace
+
+// Each kind of body added in place beside a settling pile, a body before
+// it deleted (its colliders move up), then it deleted, each in place:
+// after each edit the run is that of a World built from the edited scene
+// with the same warm start, bit for bit, for a circle, a
+// box, a polygon, a capsule, a compound body (its hub and shapes), a
+// static box and a static chain (which wake every island).
+TEST(World, EachKindOfBodyAddedAndDeletedInPlaceRunsAsARebuilds) {
+    for (const auto& [kind, fields] : kindsOfBody()) {
         SCOPED_TRACE(kind);
         Result<Scene> loaded = parseScene(R"({"world": {"gravity": {"x": 0, "y": -9.81}, "substeps": 2, "sleep": true},
           "entities": [
@@ -556,6 +567,90 @@ TEST(World, EachKindOfBodyAddedAndDeletedInPlaceRunsAsARebuilds) {
             runsAsARebuild(gone == far ? "a body before it deleted" : "deleted");
         }
     }
+}
+
+// An undone delete brings entities back where they stood in the scene
+// order, between kept ones: in place, each kind of body (and a hinged
+// pair with its joint) goes back to its place in the World's bodies,
+// colliders and joints, and the run is that of a World built from the
+// scene, bit for bit, in the same order of bodies and joints. In half the
+// cases the pile sleeps meanwhile (a sleeping island's labels are
+// renumbered too) and a kept body goes in the same edit.
+TEST(World, EachKindOfBodyBroughtBackWhereItStoodRunsAsARebuilds) {
+    std::vector<std::pair<std::string, std::string>> kinds = kindsOfBody();
+    kinds.push_back({"hinged pair", ""});
+    for (const bool sleeping : {false, true})
+        for (const auto& [kind, fields] : kinds) {
+            SCOPED_TRACE(kind + (sleeping ? ", the pile asleep" : ""));
+            const std::string middle =
+                kind == "hinged pair"
+                    ? R"({"name": "p1", "position": {"x": -2, "y": 2}, "box": {"width": 0.8, "height": 0.2}},
+                         {"name": "p2", "position": {"x": -1.2, "y": 2}, "box": {"width": 0.8, "height": 0.2}},
+                         {"name": "hinge", "joint": {"type": "hinge", "a": "p1", "b": "p2",
+                          "anchor": {"x": -1.6, "y": 2}}},)"
+                    : R"({"name": "new", )" + fields + "},";
+            Result<Scene> loaded = parseScene(R"({"world": {"gravity": {"x": 0, "y": -9.81}, "substeps": 2, "sleep": true},
+              "entities": [
+                {"name": "ground", "position": {"x": 0, "y": -0.5}, "static": true, "box": {"width": 20, "height": 1}},
+                {"name": "b1", "position": {"x": 0, "y": 0.3}, "box": {"width": 0.6, "height": 0.6}},
+                )" + middle + R"(
+                {"name": "b2", "position": {"x": 0.1, "y": 0.95}, "box": {"width": 0.6, "height": 0.6}},
+                {"name": "far", "position": {"x": -4, "y": 1.2}, "radius": 0.2},
+                {"name": "q1", "position": {"x": 6, "y": 2}, "box": {"width": 0.8, "height": 0.2}},
+                {"name": "q2", "position": {"x": 6.8, "y": 2}, "box": {"width": 0.8, "height": 0.2}},
+                {"name": "kept hinge", "joint": {"type": "hinge", "a": "q1", "b": "q2", "anchor": {"x": 6.4, "y": 2}}}
+              ]})", "pile");
+            ASSERT_TRUE(loaded.ok()) << loaded.error();
+            Scene s = loaded.value();
+            World w = buildOrDie(s);
+            for (int i = 0; i < (sleeping ? 400 : 20); ++i) ASSERT_TRUE(w.step().ok());
+            w.writeBack(s);
+            // The middle entities go, kept aside with their places.
+            Registry aside;
+            std::vector<std::pair<Entity, Entity>> gone;  // handle, copy aside
+            const std::vector<Entity> order = s.registry.entities();
+            for (std::size_t i = 0; i < order.size(); ++i) {
+                const Name* name = s.registry.tryGet<Name>(order[i]);
+                if (!name || (name->value != "new" && name->value != "p1" && name->value != "p2" && name->value != "hinge"))
+                    continue;
+                const Entity copy = aside.create();
+                copyComponents(s.registry, order[i], aside, copy);
+                gone.emplace_back(order[i], copy);
+            }
+            ASSERT_FALSE(gone.empty());
+            const Registry::Slots before = s.registry.slots();
+            std::vector<Entity> handles;
+            for (const auto& [e, copy] : gone) {
+                handles.push_back(e);
+                ASSERT_TRUE(s.registry.destroy(e));
+            }
+            ASSERT_TRUE(w.changeEntities(s, {}, handles, {}).ok());
+            ASSERT_TRUE(w.settleChoice(s).ok());
+            for (int i = 0; i < 10; ++i) ASSERT_TRUE(w.step().ok());
+            w.writeBack(s);
+            // Back where they stood, as an undo does: the slot table as it
+            // was, then the components.
+            s.registry.setSlots(before);
+            for (const auto& [e, copy] : gone) copyComponents(aside, copy, s.registry, e);
+            ASSERT_EQ(s.registry.entities(), order);
+            // In half the cases a body goes in the same edit (an undo of
+            // an edit that deleted some and added others).
+            std::vector<Entity> goneNow;
+            if (sleeping) {
+                std::size_t asleep = 0;
+                for (std::size_t b = 0; b < w.bodyCount(); ++b) asleep += w.asleep(b) ? 1 : 0;
+                // (A static shape gone woke every island.)
+                if (kind.rfind("static", 0) != 0) ASSERT_GE(asleep, 2u) << "the hinged pair at x = 6 sleeps";
+                for (const Entity e : s.registry.entities())
+                    if (const Name* n = s.registry.tryGet<Name>(e); n && n->value == "far") goneNow.push_back(e);
+                ASSERT_EQ(goneNow.size(), 1u);
+                ASSERT_TRUE(s.registry.destroy(goneNow.front()));
+            }
+            const Result<void> back = w.changeEntities(s, {}, goneNow, handles);
+            ASSERT_TRUE(back.ok()) << back.error();
+            ASSERT_TRUE(w.settleChoice(s).ok());
+            expectStepsAsARebuild(w, s, 30);
+        }
 }
 
 // A static chain deleted in place leaves its segments' storage behind

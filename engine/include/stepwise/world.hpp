@@ -463,8 +463,9 @@ public:
     /// build refuses.
     Result<void> reshapeBody(const Scene& scene, const SystemSwitches& switches, Entity body);
     /// Takes the entities of `removed` (no longer in `scene`) out of the
-    /// World and adds those of `added` (the last entities of `scene`, in its
-    /// order), in place: the islands of removed bodies wake, every other
+    /// World and adds those of `added` (entities of `scene`, at its end or,
+    /// as an undone delete brings them back, where they stood), in place,
+    /// each in its place in the scene order: the islands of removed bodies wake, every other
     /// body and every contact's warm start stay, and the steps that follow
     /// are those of reload(scene, switches), once settled. The editor adds and deletes
     /// bodies this way; a static shape that comes or goes wakes every

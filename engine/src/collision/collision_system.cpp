@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace stepwise::collision {
 
@@ -211,7 +212,8 @@ std::unique_ptr<CollisionSystem> CollisionSystem::changed(std::span<const std::u
                                                           std::span<const std::uint8_t> dropJoint,
                                                           std::span<const std::int32_t> bodyMap,
                                                           std::span<const ColliderAdd> added,
-                                                          std::span<const JointAdd> addedJoints) const {
+                                                          std::span<const JointAdd> addedJoints,
+                                                          std::span<const std::uint32_t> sceneIndex) const {
     auto next = std::make_unique<CollisionSystem>();
     CollisionSystem& n = *next;
     n.settings_ = settings_;
@@ -244,17 +246,48 @@ std::unique_ptr<CollisionSystem> CollisionSystem::changed(std::span<const std::u
         n.add(copy, angles_[c], angularVelocities_[c], filters_[c]);
         n.maxExtent_.back() = maxExtent_[c];  // a hub's reach is its shapes'
     };
-    // Shapes (and compound bodies' hubs) in their order, the new ones, then
-    // the bodies in the solver only because a joint holds them: World::build's
-    // order.
+    // Shapes (and compound bodies' hubs) in their order with the new ones
+    // merged in by scene order, then the bodies in the solver only because
+    // a joint holds them: World::build's order.
+    std::vector<std::int32_t> placed(added.size(), -1);  // each add's collider
+    std::size_t nextAdd = 0;
+    const auto sceneOf = [&](Entity e) {
+        return e.index < sceneIndex.size() ? sceneIndex[e.index] : std::numeric_limits<std::uint32_t>::max();
+    };
+    const auto addEntity = [&] {  // the colliders of the next added entity
+        const Entity e = added[nextAdd].collider.entity;
+        for (; nextAdd < added.size() && added[nextAdd].collider.entity == e; ++nextAdd) {
+            Collider c = added[nextAdd].collider;
+            if (c.hub >= 0) c.hub = placed[std::size_t(c.hub)];  // listed before its shapes
+            placed[nextAdd] = std::int32_t(n.colliders_.size());
+            n.add(c, added[nextAdd].angle, added[nextAdd].angularVelocity, added[nextAdd].filter);
+            if (c.hub >= 0)
+                n.maxExtent_[std::size_t(c.hub)] = std::max(n.maxExtent_[std::size_t(c.hub)], n.maxExtent_.back());
+        }
+    };
     const auto jointOnly = [&](std::size_t c) { return colliders_[c].solverOnly && !isHub(c); };
-    for (std::size_t c = 0; c < oldCount; ++c)
-        if (!dropCollider[c] && !jointOnly(c)) keep(c);
-    const std::uint32_t addedBase = n.addAll(added);
+    for (std::size_t c = 0; c < oldCount; ++c) {
+        if (dropCollider[c] || jointOnly(c)) continue;
+        while (nextAdd < added.size() && sceneOf(added[nextAdd].collider.entity) < sceneOf(colliders_[c].entity))
+            addEntity();
+        keep(c);
+    }
+    while (nextAdd < added.size()) addEntity();
     for (std::size_t c = 0; c < oldCount; ++c)
         if (!dropCollider[c] && jointOnly(c)) keep(c);
-    n.addKeptJoints(joints_, dropJoint, colliderMap);
-    n.addJointsOf(addedJoints, addedBase);
+    // The joints in scene order too.
+    bool anyBroken = false;
+    std::size_t nextJoint = 0;
+    for (std::size_t k = 0; k < joints_.size(); ++k) {
+        if (dropJoint[k]) continue;
+        for (; nextJoint < addedJoints.size() && sceneOf(addedJoints[nextJoint].joint.entity) < sceneOf(joints_[k].entity);
+             ++nextJoint)
+            n.addJointOf(addedJoints[nextJoint], placed);
+        anyBroken = anyBroken || joints_[k].broken;
+        n.addKeptJoint(joints_[k], colliderMap);
+    }
+    for (; nextJoint < addedJoints.size(); ++nextJoint) n.addJointOf(addedJoints[nextJoint], placed);
+    if (anyBroken) n.jointsBroke();
     n.setWarmStartCache(keptCache(warmStartCache(), colliderMap));
     return next;
 }
@@ -264,22 +297,25 @@ void CollisionSystem::addKeptJoints(std::span<const joints::JointConstraint> old
     bool anyBroken = false;
     for (std::size_t k = 0; k < old.size(); ++k) {
         if (dropJoint[k]) continue;
-        joints::JointConstraint j = old[k];
-        for (joints::JointEnd* end : {&j.a, &j.b}) {
-            if (end->collider < 0) continue;
-            end->collider = colliderMap[std::size_t(end->collider)];
-            end->solverBody = solverBodyOf(std::size_t(end->collider));
-        }
-        std::int32_t filter[2] = {-1, -1};
-        if (j.noCollideKey != 0) {
-            filter[0] = colliderMap[std::size_t(j.noCollideKey >> 32)];
-            filter[1] = colliderMap[std::size_t(j.noCollideKey & 0xFFFFFFFFu)];
-        }
-        j.noCollideKey = 0;
-        anyBroken = anyBroken || j.broken;
-        addJoint(j, filter[0], filter[1], filter[0] < 0 || filter[1] < 0);
+        anyBroken = anyBroken || old[k].broken;
+        addKeptJoint(old[k], colliderMap);
     }
     if (anyBroken) jointsBroke();
+}
+
+void CollisionSystem::addKeptJoint(joints::JointConstraint j, std::span<const std::int32_t> colliderMap) {
+    for (joints::JointEnd* end : {&j.a, &j.b}) {
+        if (end->collider < 0) continue;
+        end->collider = colliderMap[std::size_t(end->collider)];
+        end->solverBody = solverBodyOf(std::size_t(end->collider));
+    }
+    std::int32_t filter[2] = {-1, -1};
+    if (j.noCollideKey != 0) {
+        filter[0] = colliderMap[std::size_t(j.noCollideKey >> 32)];
+        filter[1] = colliderMap[std::size_t(j.noCollideKey & 0xFFFFFFFFu)];
+    }
+    j.noCollideKey = 0;
+    addJoint(j, filter[0], filter[1], filter[0] < 0 || filter[1] < 0);
 }
 
 std::vector<CachedImpulse> CollisionSystem::keptCache(std::vector<CachedImpulse> all,
@@ -295,17 +331,21 @@ std::vector<CachedImpulse> CollisionSystem::keptCache(std::vector<CachedImpulse>
     return all;
 }
 
-void CollisionSystem::addJointsOf(std::span<const JointAdd> addedJoints, std::uint32_t base) {
-    const auto placed = [base](std::int32_t k) { return k >= 0 ? std::int32_t(base) + k : -1; };
-    for (const JointAdd& add : addedJoints) {
-        joints::JointConstraint j = add.joint;
-        for (joints::JointEnd* end : {&j.a, &j.b}) {
-            if (end->collider < 0) continue;
-            end->collider = placed(end->collider);
-            end->solverBody = solverBodyOf(std::size_t(end->collider));
-        }
-        addJoint(j, placed(add.filterA), placed(add.filterB), add.collideConnected);
+void CollisionSystem::addJointsOf(std::span<const JointAdd> addedJoints, std::uint32_t base, std::size_t addedCount) {
+    std::vector<std::int32_t> placed(addedCount);
+    for (std::size_t k = 0; k < addedCount; ++k) placed[k] = std::int32_t(base + k);
+    for (const JointAdd& add : addedJoints) addJointOf(add, placed);
+}
+
+void CollisionSystem::addJointOf(const JointAdd& add, std::span<const std::int32_t> placed) {
+    const auto at = [placed](std::int32_t k) { return k >= 0 ? placed[std::size_t(k)] : -1; };
+    joints::JointConstraint j = add.joint;
+    for (joints::JointEnd* end : {&j.a, &j.b}) {
+        if (end->collider < 0) continue;
+        end->collider = at(end->collider);
+        end->solverBody = solverBodyOf(std::size_t(end->collider));
     }
+    addJoint(j, at(add.filterA), at(add.filterB), add.collideConnected);
 }
 
 bool CollisionSystem::appendsAtEnd() const {
@@ -316,7 +356,7 @@ bool CollisionSystem::appendsAtEnd() const {
 
 void CollisionSystem::appended(std::span<const ColliderAdd> added, std::span<const JointAdd> addedJoints) {
     const std::uint32_t base = addAll(added);
-    addJointsOf(addedJoints, base);
+    addJointsOf(addedJoints, base, added.size());
     forgetLastStep();
     setWarmStartCache(warmStartCache());
 }

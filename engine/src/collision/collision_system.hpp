@@ -117,13 +117,15 @@ public:
         std::int32_t filterA = -1, filterB = -1;
         bool collideConnected = false;
     };
-    /// Bodies came and went (an emitter's copies): the system with the
-    /// colliders `dropCollider` marks and the joints `dropJoint` marks taken
-    /// out, the rest in their order with their state-vector bodies mapped by
-    /// `bodyMap` (old index -> new), and `added` appended after the shapes
-    /// (before the solver-only bodies, where World::build puts them) with
-    /// `addedJoints` after the joints: the very arrays a build of the scene
-    /// as it now is would make. Every kept collider's rotation and spin,
+    /// Bodies came and went (an emitter's copies, an undone delete): the
+    /// system with the colliders `dropCollider` marks and the joints
+    /// `dropJoint` marks taken out, the rest in their order with their
+    /// state-vector bodies mapped by `bodyMap` (old index -> new), and
+    /// `added` and `addedJoints` merged in by their entities' places in the
+    /// scene order (`sceneIndex`, by entity slot), all shapes before the
+    /// solver-only bodies, where World::build puts them: the very arrays a
+    /// build of the scene as it now is would make. `added` lists each
+    /// entity's colliders together, in scene order. Every kept collider's rotation and spin,
     /// every kept joint's impulses and state and every warm-start entry
     /// between kept colliders stay as they are; the removed bodies' entries
     /// go. The settings, the broad-phase choice and the sleep source carry
@@ -131,7 +133,8 @@ public:
     std::unique_ptr<CollisionSystem> changed(std::span<const std::uint8_t> dropCollider,
                                              std::span<const std::uint8_t> dropJoint,
                                              std::span<const std::int32_t> bodyMap, std::span<const ColliderAdd> added,
-                                             std::span<const JointAdd> addedJoints) const;
+                                             std::span<const JointAdd> addedJoints,
+                                             std::span<const std::uint32_t> sceneIndex) const;
     /// Whether appended() may take an addition: no collider is in the solver
     /// only because a joint holds it (a build puts those after every shape,
     /// so new shapes would go before them).
@@ -359,10 +362,15 @@ private:
     /// renumbered by `colliderMap` (old collider -> kept, -1 gone).
     void addKeptJoints(std::span<const joints::JointConstraint> old, std::span<const std::uint8_t> dropJoint,
                        std::span<const std::int32_t> colliderMap);
+    /// Adds a kept joint, its ends renumbered by `colliderMap`.
+    void addKeptJoint(joints::JointConstraint j, std::span<const std::int32_t> colliderMap);
+    /// Adds an added joint, its ends' places in the addition mapped to
+    /// colliders by `placed` (index in the ColliderAdd list -> collider).
+    void addJointOf(const JointAdd& add, std::span<const std::int32_t> placed);
     /// The warm-start entries between kept colliders, renumbered.
     static std::vector<CachedImpulse> keptCache(std::vector<CachedImpulse> all, std::span<const std::int32_t> colliderMap);
     /// Adds the joints of an addition whose colliders start at `base`.
-    void addJointsOf(std::span<const JointAdd> addedJoints, std::uint32_t base);
+    void addJointsOf(std::span<const JointAdd> addedJoints, std::uint32_t base, std::size_t addedCount);
 
     std::vector<Collider> colliders_;
     std::deque<ConvexPolygon> polygons_;  // the polygon shapes' outlines (addresses stay fixed)

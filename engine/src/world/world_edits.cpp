@@ -249,16 +249,23 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
             if (!isGone(s.entity) && (bodyGone(s.a) || bodyGone(s.b)))
                 return Error{"a spring stays while a body it holds is removed"};
     }
-    // The added: the scene's last entities, in its order, as a build would
-    // append them.
-    const std::vector<Entity>& order = reg.entities();
-    if (added.size() > order.size() || !std::equal(added.begin(), added.end(), order.end() - std::ptrdiff_t(added.size())))
-        return Error{"added entities are not the scene's last"};
+    // The added, in scene order: new entities at its end, or entities
+    // brought back where they stood (an undone delete).
     const std::unordered_set<Entity> fresh(added.begin(), added.end());
-    for (std::size_t i = order.size() - added.size(); i < order.size(); ++i)
-        if (std::optional<Error> problem = addableProblem(reg, i, fresh)) return std::move(*problem);
+    for (const Entity e : added)
+        if (!reg.alive(e)) return Error{"an added entity is not in the scene"};
+    std::vector<Entity> inOrder;
+    inOrder.reserve(added.size());
+    const std::vector<Entity>& order = reg.entities();
+    // The new entities are most often the last: look from the end.
+    for (std::size_t i = order.size(); i-- > 0 && inOrder.size() < fresh.size();)
+        if (fresh.count(order[i])) {
+            if (std::optional<Error> problem = addableProblem(reg, i, fresh)) return std::move(*problem);
+            inOrder.push_back(order[i]);
+        }
+    std::reverse(inOrder.begin(), inOrder.end());
     w.choiceUnsettled = true;  // checked once, before the next step (settleChoice)
-    w.changeBodies(reg, removed, added);
+    w.changeBodies(reg, removed, inOrder);
     // The springs' pull on the bodies at this state, as a build checks it:
     // refused, the caller's rebuild says why.
     if (std::optional<Error> refused = detail::checkFirstStepForces(w, w.kind)) return std::move(*refused);

@@ -267,20 +267,24 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
         if (body != kNoBody) body = std::uint32_t(bodyMap[body]);
     };
     detail::AlignedDoubles nextX(x[current].begin(), x[current].end()), nextV(v[current].begin(), v[current].end());
-    compact(nextX, 2);
-    compact(nextV, 2);
-    compact(bodyEntity, 1);
-    compact(bodyName, 1);
-    compact(model.mass, 1);
-    compact(model.invMass, 1);
-    compact(isKinematic, 1);
-    compact(sleep.timer, 1);
-    compact(sleep.anchor, detail::kAnchorStride);
-    compact(sleep.anchored, 1);
-    compact(sleep.island, 1);
-    compact(sleep.asleep, 1);
-    compact(sleep.extent, 1);
-    compact(sleep.restless, 1);
+    // Every array with a value (or `stride` values) per body.
+    const auto eachBodyArray = [&](auto&& f) {
+        f(nextX, 2);
+        f(nextV, 2);
+        f(bodyEntity, 1);
+        f(bodyName, 1);
+        f(model.mass, 1);
+        f(model.invMass, 1);
+        f(isKinematic, 1);
+        f(sleep.timer, 1);
+        f(sleep.anchor, detail::kAnchorStride);
+        f(sleep.anchored, 1);
+        f(sleep.island, 1);
+        f(sleep.asleep, 1);
+        f(sleep.extent, 1);
+        f(sleep.restless, 1);
+    };
+    eachBodyArray(compact);
     for (std::int32_t& label : sleep.island)
         if (label >= 0) label = bodyMap[std::size_t(label)];
     for (std::uint32_t& b : kinematicBody) remap(b);
@@ -303,8 +307,13 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
         springName.resize(out);
     }
 
-    // The copies' bodies, at the end in scene order (a static entity is
-    // shapes only, as World::build has it).
+    // Where each entity stands in the scene order (messages name it so).
+    std::vector<std::uint32_t> sceneIndex(slots, 0);
+    for (std::size_t i = 0; i < reg.entities().size(); ++i) sceneIndex[reg.entities()[i].index] = std::uint32_t(i);
+
+    // The new bodies, at the end in scene order (a static entity is shapes
+    // only, as World::build has it).
+    const std::size_t keptBodies = n;
     bool staticChanged = false;
     for (const Entity e : added) {
         const Position* p = reg.tryGet<Position>(e);
@@ -337,13 +346,43 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
         sleep.restless.push_back(0);
     }
     n = bodyEntity.size();
+    // Bodies brought back where they stood (an undone delete) take their
+    // places in the scene order, as a build lists them. The kept keep their
+    // order, and so do the new, so only a merge of the two moves anything.
+    const auto sceneOfBody = [&](std::size_t b) { return sceneIndex[bodyEntity[b].index]; };
+    if (keptBodies > 0 && n > keptBodies && sceneOfBody(keptBodies) < sceneOfBody(keptBodies - 1)) {
+        std::vector<std::uint32_t> from(n);  // from[k]: the body that goes k-th
+        for (std::size_t b = 0; b < n; ++b) from[b] = std::uint32_t(b);
+        std::stable_sort(from.begin(), from.end(),
+                         [&](std::uint32_t a, std::uint32_t b) { return sceneOfBody(a) < sceneOfBody(b); });
+        std::vector<std::int32_t> to(n);
+        for (std::size_t k = 0; k < n; ++k) to[from[k]] = std::int32_t(k);
+        eachBodyArray([&](auto& values, std::size_t stride) {
+            if (values.empty()) return;
+            const auto was = values;
+            for (std::size_t k = 0; k < n; ++k)
+                for (std::size_t i = 0; i < stride; ++i) values[k * stride + i] = was[from[k] * stride + i];
+        });
+        for (std::int32_t& b : bodyMap)
+            if (b >= 0) b = to[std::size_t(b)];
+        for (std::int32_t& label : sleep.island)
+            if (label >= 0) label = to[std::size_t(label)];
+        const auto moved = [&](std::uint32_t& body) {
+            if (body != kNoBody) body = std::uint32_t(to[body]);
+        };
+        for (std::uint32_t& b : kinematicBody) moved(b);
+        for (std::uint32_t& b : spinBody) moved(b);
+        for (std::uint32_t& b : model.boids.body) moved(b);
+        for (detail::AttractorData& a : model.attractors) moved(a.body);
+        for (detail::SpringData& d : model.springs) {
+            moved(d.a);
+            moved(d.b);
+        }
+    }
     model.n = n;
     bodyOfSlot.assign(slots, kNoBody);
     for (std::size_t b = 0; b < n; ++b) bodyOfSlot[bodyEntity[b].index] = std::uint32_t(b);
     const auto bodyOf = [this](Entity e) { return e.index < bodyOfSlot.size() ? bodyOfSlot[e.index] : kNoBody; };
-    // Where each entity stands in the scene order (messages name it so).
-    std::vector<std::uint32_t> sceneIndex(slots, 0);
-    for (std::size_t i = 0; i < reg.entities().size(); ++i) sceneIndex[reg.entities()[i].index] = std::uint32_t(i);
     bodySceneIndex.resize(n);
     for (std::size_t b = 0; b < n; ++b) bodySceneIndex[b] = sceneIndex[bodyEntity[b].index];
     // The kept springs' places moved with the removed entities; an unnamed
@@ -452,9 +491,14 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
             jointAdds.push_back(add);
         }
         // In place: the gone taken out, then the new appended (only the new
-        // colliders are looked at when nothing went). With bodies held in
-        // the solver only by a joint (a build puts them after every shape),
-        // new shapes go before them: a new system.
+        // colliders are looked at when nothing went). New entities that are
+        // not the scene's last (an undone delete) go between kept ones, and
+        // with bodies held in the solver only by a joint (a build puts them
+        // after every shape) new shapes go before them: a new system.
+        const std::vector<Entity>& order = reg.entities();
+        const bool atEnd = added.size() <= order.size() &&
+                           std::equal(added.begin(), added.end(), order.end() - std::ptrdiff_t(added.size()));
+        const bool appends = atEnd && collision->appendsAtEnd();
         std::size_t firstNew = oldColliders;
         if (!removed.empty()) {
             std::vector<std::uint8_t> dropCollider(oldColliders, 0);
@@ -465,10 +509,10 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
             const std::span<const joints::JointConstraint> oldJoints = collision->jointConstraints();
             std::vector<std::uint8_t> dropJoint(oldJoints.size(), 0);
             for (std::size_t k = 0; k < oldJoints.size(); ++k) dropJoint[k] = isGone(oldJoints[k].entity) ? 1 : 0;
-            if (adds.empty() || collision->appendsAtEnd()) {
+            if ((adds.empty() && jointAdds.empty()) || appends) {
                 collision->removed(dropCollider, dropJoint, bodyMap);
             } else {
-                collision = collision->changed(dropCollider, dropJoint, bodyMap, adds, jointAdds);
+                collision = collision->changed(dropCollider, dropJoint, bodyMap, adds, jointAdds, sceneIndex);
                 collision->setSleepSource(&sleep.asleep, [impl = this](std::uint32_t body) { impl->sleep.wake(body); });
                 adds.clear();
                 jointAdds.clear();
@@ -476,13 +520,13 @@ void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> remove
             firstNew = 0;
         }
         if (!adds.empty() || !jointAdds.empty()) {
-            if (collision->appendsAtEnd()) {
+            if (appends) {
                 collision->appended(adds, jointAdds);
             } else {
+                // Nothing went (else the branch above took the adds): the
+                // kept bodies' map is the merge's alone.
                 std::vector<std::uint8_t> none(collision->colliderCount(), 0), noJoint(collision->jointConstraints().size(), 0);
-                std::vector<std::int32_t> same(n);
-                for (std::size_t b = 0; b < n; ++b) same[b] = std::int32_t(b);
-                collision = collision->changed(none, noJoint, same, adds, jointAdds);
+                collision = collision->changed(none, noJoint, bodyMap, adds, jointAdds, sceneIndex);
                 collision->setSleepSource(&sleep.asleep, [impl = this](std::uint32_t body) { impl->sleep.wake(body); });
                 firstNew = 0;
             }
