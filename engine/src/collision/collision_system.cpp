@@ -1592,7 +1592,12 @@ void CollisionSystem::endStep() {
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
         const ContactConstraint& c = constraints_[k];
         const ContactDetail& d = details_[k];
-        for (int i = 0; i < c.pointCount; ++i) {
+        // A manifold's two points in the order of their keys: the clipped
+        // points' feature ids come in either order, and one pair out of
+        // order makes the whole cache take the sort below.
+        const bool swapped = c.pointCount == 2 && (d.id[1] & 0xFFFF) < (d.id[0] & 0xFFFF);
+        for (int k = 0; k < c.pointCount; ++k) {
+            const int i = swapped ? 1 - k : k;
             const ContactPoint& p = c.points[i];
             const std::uint64_t key = CachedImpulse::makeKey(d.colliderA, d.colliderB, d.id[i]);
             cache_.push_back({key, p.normalImpulse, p.tangentImpulse});
