@@ -363,7 +363,7 @@ void CollisionSystem::appended(std::span<const ColliderAdd> added, std::span<con
 
 namespace {
 
-/// Keeps the entries of `values` whose index `keep` marks, in order.
+/// Keeps the entries of `values` that `map` sends somewhere (>= 0), in order.
 template <class T>
 void keepMarked(std::vector<T>& values, std::span<const std::int32_t> map) {
     std::size_t out = 0;
