@@ -465,15 +465,17 @@ public:
     /// Takes the entities of `removed` (no longer in `scene`) out of the
     /// World and adds those of `added` (entities of `scene`, at its end or,
     /// as an undone delete brings them back, where they stood), in place,
-    /// each in its place in the scene order: the islands of removed bodies wake, every other
-    /// body and every contact's warm start stay, and the steps that follow
-    /// are those of reload(scene, switches), once settled. The editor adds and deletes
-    /// bodies this way; a static shape that comes or goes wakes every
-    /// island. Fails, leaving the World as it was, for anything but dynamic
-    /// and static bodies with a shape and the joints among dynamic ones
-    /// (added) or bodies and joints other than planes and kinematic bodies
-    /// (removed), or when springs, attractors, boids or emitters act: the
-    /// caller then reloads.
+    /// each at its place in the scene order: the islands of removed bodies
+    /// wake, every other body and every contact's warm start stay, and the
+    /// steps that follow are those of reload(scene, switches), once
+    /// settled. The editor adds and deletes bodies this way; a static shape
+    /// that comes or goes wakes every island, and with emitters their run
+    /// takes the edited scene as its own. Fails, leaving the World as it
+    /// was, for anything but dynamic and static bodies with a shape and the
+    /// joints among dynamic ones (added), for planes, kinematic bodies and
+    /// what still holds a removed body (removed), for an emitter, a
+    /// template body or an emitted copy, and when attractors or boids act:
+    /// the caller then reloads.
     Result<void> changeEntities(const Scene& scene, const SystemSwitches& switches, std::span<const Entity> removed,
                                 std::span<const Entity> added);
     /// After setMass, turnBody, reshapeBody or changeEntities: checks once

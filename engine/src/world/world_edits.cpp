@@ -223,7 +223,21 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
                                    std::span<const Entity> added) {
     WorldImpl& w = *impl_;
     const Registry& reg = scene.registry;
-    if (!w.emitters.empty()) return Error{"a level with emitters changes its bodies as it runs: a rebuild"};
+    // In a level with emitters the run's registry and the emitters follow
+    // the scene (emittersFollow); an emitter, a template or a copy (named
+    // TEMPLATE#N) changes what the emitters do: a rebuild.
+    if (!w.emitters.empty()) {
+        const auto emitterPart = [](const Registry& r, Entity e) {
+            const Name* name = r.tryGet<Name>(e);
+            return r.has<Emitter>(e) || r.has<Template>(e) || (name && name->value.find('#') != std::string::npos);
+        };
+        for (const Entity e : removed)
+            if (w.registry->alive(e) && emitterPart(*w.registry, e))
+                return Error{"an emitter, a template or an emitted copy is removed by a rebuild"};
+        for (const Entity e : added)
+            if (reg.alive(e) && emitterPart(reg, e))
+                return Error{"an emitter, a template or an emitted copy is added by a rebuild"};
+    }
     if (!w.collision || !switches.collisions) return Error{"no contact solver to add shapes to"};
     if (w.model.attractorsOn() || w.model.boidsOn)
         return Error{"attractors and boids act on every body: a rebuild checks them"};
@@ -266,6 +280,7 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
     std::reverse(inOrder.begin(), inOrder.end());
     w.choiceUnsettled = true;  // checked once, before the next step (settleChoice)
     w.changeBodies(reg, removed, inOrder);
+    if (!w.emitters.empty()) w.emittersFollow(reg);
     // The springs' pull on the bodies at this state, as a build checks it:
     // refused, the caller's rebuild says why.
     if (std::optional<Error> refused = detail::checkFirstStepForces(w, w.kind)) return std::move(*refused);

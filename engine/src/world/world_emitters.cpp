@@ -234,6 +234,18 @@ void WorldImpl::runEmitters() {
     changeBodies(reg, removed, added);
 }
 
+void WorldImpl::emittersFollow(const Registry& reg) {
+    registry = std::make_shared<Registry>(reg);
+    const std::vector<Entity>& order = reg.entities();
+    for (std::size_t i = 0; i < order.size(); ++i)
+        for (EmitterRun& run : emitters)
+            if (run.entity == order[i]) {
+                run.key = detail::emitterKey(reg, order[i], i);
+                run.body = bodyOfSlot[order[i].index];
+            }
+    layout = makeLayout();
+}
+
 void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> removed, std::span<const Entity> added) {
     // Flags by entity slot: a removed entity's slot may be reused by an
     // added one, which is told apart by its generation. An undone add

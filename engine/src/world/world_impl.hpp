@@ -145,13 +145,19 @@ public:
     /// wide as a sum of counts, so an emitter can stop short of int's end).
     long long nextCopyNumber(const std::string& templateName) const;
     /// Takes the bodies of `removed` (with their shapes, joints and springs)
-    /// out of every array in place and appends those of `added` (entities
-    /// of `reg`, the scene as it now is, in its order), so the arrays are
+    /// out of every array in place and puts those of `added` (entities of
+    /// `reg`, the scene as it now is, in its order) at their places in the
+    /// scene order, so the arrays are
     /// what World::build would make of that scene; every other body's state
     /// and warm start stay. An added entity is a dynamic body with a shape,
     /// or a joint or spring among such bodies (a spring may also hold one to
     /// a body already here): emitters' copies and the editor's additions.
     void changeBodies(const Registry& reg, std::span<const Entity> removed, std::span<const Entity> added);
+    /// After an edit of a level with emitters (not of an emitter, a
+    /// template or a copy): the run's registry taken afresh from the
+    /// edited scene, and each emitter's body and key renumbered, as
+    /// compileEmitters makes them.
+    void emittersFollow(const Registry& reg);
     /// The layout of the arrays as they are now.
     std::shared_ptr<const WorldLayout> makeLayout() const;
     /// The names activeSystems() reports, in pipeline order.
