@@ -224,7 +224,7 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
     WorldImpl& w = *impl_;
     const Registry& reg = scene.registry;
     // In a level with emitters the run's registry and the emitters follow
-    // the scene (emittersFollow); an emitter, a template or a copy (named
+    // the scene (below); an emitter, a template or a copy (named
     // TEMPLATE#N) changes what the emitters do: a rebuild.
     if (!w.emitters.empty()) {
         const auto emitterPart = [](const Registry& r, Entity e) {
@@ -279,8 +279,11 @@ Result<void> World::changeEntities(const Scene& scene, const SystemSwitches& swi
         }
     std::reverse(inOrder.begin(), inOrder.end());
     w.choiceUnsettled = true;  // checked once, before the next step (settleChoice)
+    // With emitters, the run's registry is the edited scene, as a build
+    // takes it (compileEmitters); before changeBodies, whose layout holds it.
+    if (!w.emitters.empty()) w.registry = std::make_shared<Registry>(reg);
     w.changeBodies(reg, removed, inOrder);
-    if (!w.emitters.empty()) w.emittersFollow(reg);
+    if (!w.emitters.empty()) w.renumberEmitters(reg);
     // The springs' pull on the bodies at this state, as a build checks it:
     // refused, the caller's rebuild says why.
     if (std::optional<Error> refused = detail::checkFirstStepForces(w, w.kind)) return std::move(*refused);

@@ -234,16 +234,14 @@ void WorldImpl::runEmitters() {
     changeBodies(reg, removed, added);
 }
 
-void WorldImpl::emittersFollow(const Registry& reg) {
-    registry = std::make_shared<Registry>(reg);
+void WorldImpl::renumberEmitters(const Registry& reg) {
     const std::vector<Entity>& order = reg.entities();
-    for (std::size_t i = 0; i < order.size(); ++i)
-        for (EmitterRun& run : emitters)
-            if (run.entity == order[i]) {
-                run.key = detail::emitterKey(reg, order[i], i);
-                run.body = bodyOfSlot[order[i].index];
-            }
-    layout = makeLayout();
+    std::vector<std::uint32_t> sceneIndex(reg.slotCount(), 0);
+    for (std::size_t i = 0; i < order.size(); ++i) sceneIndex[order[i].index] = std::uint32_t(i);
+    for (EmitterRun& run : emitters) {
+        run.key = detail::emitterKey(reg, run.entity, sceneIndex[run.entity.index]);
+        run.body = bodyIndexOf(run.entity);
+    }
 }
 
 void WorldImpl::changeBodies(const Registry& reg, std::span<const Entity> removed, std::span<const Entity> added) {

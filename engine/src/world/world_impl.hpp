@@ -154,10 +154,9 @@ public:
     /// a body already here): emitters' copies and the editor's additions.
     void changeBodies(const Registry& reg, std::span<const Entity> removed, std::span<const Entity> added);
     /// After an edit of a level with emitters (not of an emitter, a
-    /// template or a copy): the run's registry taken afresh from the
-    /// edited scene, and each emitter's body and key renumbered, as
-    /// compileEmitters makes them.
-    void emittersFollow(const Registry& reg);
+    /// template or a copy) and changeBodies: each emitter's body and key
+    /// renumbered from the edited scene, as compileEmitters makes them.
+    void renumberEmitters(const Registry& reg);
     /// The layout of the arrays as they are now.
     std::shared_ptr<const WorldLayout> makeLayout() const;
     /// The names activeSystems() reports, in pipeline order.
