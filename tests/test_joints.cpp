@@ -4,6 +4,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
+#include "joints/joint_solver.hpp"
 #include "world/world_internals.hpp"
 
 #include "test_support.hpp"
@@ -13,6 +14,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <cmath>
 #include <numbers>
@@ -1181,4 +1183,77 @@ TEST(JointLevels, TheSuspensionAbsorbsTheBump) {
     EXPECT_LT(suspended, 0.5 * rigid);
     EXPECT_GT(endSuspended, 12.0);
     EXPECT_GT(endRigid, 12.0);
+}
+
+namespace {
+
+/// Hinges of an n x n grid of bodies (solver bodies 1..n*n), each to its
+/// right and lower neighbour, and the top row's left body to the fixed body.
+std::vector<stepwise::joints::JointConstraint> gridJoints(int n) {
+    std::vector<stepwise::joints::JointConstraint> joints;
+    const auto body = [n](int row, int col) { return std::uint32_t(1 + row * n + col); };
+    const auto add = [&](std::uint32_t a, std::uint32_t b) {
+        stepwise::joints::JointConstraint& j = joints.emplace_back();
+        j.a.solverBody = a;
+        j.b.solverBody = b;
+    };
+    add(0, body(0, 0));
+    for (int row = 0; row < n; ++row)
+        for (int col = 0; col < n; ++col) {
+            if (col + 1 < n) add(body(row, col), body(row, col + 1));
+            if (row + 1 < n) add(body(row, col), body(row + 1, col));
+        }
+    return joints;
+}
+
+bool shareMovingBody(const stepwise::joints::JointConstraint& p, const stepwise::joints::JointConstraint& q) {
+    for (const std::uint32_t x : {p.a.solverBody, p.b.solverBody})
+        if (x != 0 && (x == q.a.solverBody || x == q.b.solverBody)) return true;
+    return false;
+}
+
+} // namespace
+
+TEST(JointPasses, NeighboursInTheOrderShareABodyOnlyWhereAColourEnds) {
+    // The passes' order exists so that each solve need not wait on the one
+    // before: consecutive joints may share a body only at the few places
+    // one colour hands over to the next. Every grid size, every joint once.
+    for (const int n : {2, 3, 10, 100}) {
+        const std::vector<stepwise::joints::JointConstraint> joints = gridJoints(n);
+        std::vector<std::uint32_t> order;
+        stepwise::joints::colourJoints(joints, std::size_t(n * n + 1), order);
+        std::vector<std::uint32_t> sorted = order;
+        std::sort(sorted.begin(), sorted.end());
+        std::vector<std::uint32_t> all(joints.size());
+        for (std::size_t k = 0; k < all.size(); ++k) all[k] = std::uint32_t(k);
+        EXPECT_EQ(sorted, all) << n << " x " << n;
+        int shared = 0, sharedInJointOrder = 0;
+        for (std::size_t k = 1; k < order.size(); ++k) {
+            shared += shareMovingBody(joints[order[k - 1]], joints[order[k]]);
+            sharedInJointOrder += shareMovingBody(joints[k - 1], joints[k]);
+        }
+        // A body has at most 4 hinges, so greedy colouring needs at most 7
+        // colours: at most 6 hand-overs.
+        EXPECT_LE(shared, 6) << n << " x " << n;
+        if (n == 100) EXPECT_GT(sharedInJointOrder, 9000);
+        // A joint to the fixed body holds no other joint back: it takes the first colour.
+        EXPECT_EQ(order.front(), 0u) << n << " x " << n;
+    }
+}
+
+TEST(JointPasses, ABrokenJointIsOrderedAsIfItWereNotThere) {
+    // A run resumed from a file saved after a break has no such joint; it
+    // must visit the others in the order the run that broke it does.
+    const std::vector<stepwise::joints::JointConstraint> whole = gridJoints(6);
+    for (std::size_t broken = 0; broken < whole.size(); ++broken) {
+        std::vector<stepwise::joints::JointConstraint> withBreak = whole;
+        withBreak[broken].broken = true;
+        std::vector<stepwise::joints::JointConstraint> without = whole;
+        without.erase(without.begin() + std::ptrdiff_t(broken));
+        std::vector<std::uint32_t> a, b;
+        stepwise::joints::colourJoints(withBreak, 37, a);
+        stepwise::joints::colourJoints(without, 37, b);
+        for (std::uint32_t& k : b) k += k >= broken ? 1u : 0u;  // back to the indices with the break
+        EXPECT_EQ(a, b) << "joint " << broken << " broken";
+    }
 }

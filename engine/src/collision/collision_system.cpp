@@ -469,6 +469,7 @@ void CollisionSystem::forgetLastStep() {
     sensorEvents_.clear();
     lastH_ = 0.0;
     directJoints_.reset();
+    jointOrderReady_ = false;
     const BroadPhaseKind kind = broadPhase_.kind();
     broadPhase_ = BroadPhase{};  // the sweep's order kept between steps starts again, as a new system's
     broadPhase_.setKind(kind);
@@ -716,6 +717,7 @@ void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_
     if (bodies_.empty()) bodies_.push_back(SolverBody{});
     joints::JointConstraint& j = joints_.emplace_back(joint);
     directJoints_.reset();
+    jointOrderReady_ = false;
     if (j.maxForce > 0.0) breakable_.push_back(std::uint32_t(joints_.size() - 1));
     if (!collideConnected && filterA >= 0 && filterB >= 0) {
         const auto lo = std::uint64_t(std::min(filterA, filterB)), hi = std::uint64_t(std::max(filterA, filterB));
@@ -767,6 +769,7 @@ void CollisionSystem::jointsBroke() {
         if (!j.broken && j.noCollideKey != 0) noCollide_.push_back(j.noCollideKey);
     std::sort(noCollide_.begin(), noCollide_.end());
     directJoints_.reset();
+    jointOrderReady_ = false;
 }
 
 void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m,
@@ -1278,6 +1281,10 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // the softness is the world's, else the engine's choice by how the
     // joint is solved (JointSettings).
     const bool jointed = !joints_.empty();
+    if (jointed && !jointOrderReady_) {
+        joints::colourJoints(joints_, bodies_.size(), jointOrder_);
+        jointOrderReady_ = true;
+    }
     const double jointCap = 0.5 / h;
     const Softness jointSoft = Softness::make(
         std::min(jointSettings_.hertz.value_or(joints::JointSettings::kLoopHertz), jointCap),
@@ -1292,7 +1299,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, crowdBodies_.empty() ? 64 : 2,
                      impactScratch_);
     if (settings_.warmStart) {
-        if (jointed) joints::warmStartJoints(joints_, bodies_);
+        if (jointed) joints::warmStartJoints(joints_, jointOrder_, bodies_);
         coloured_.warmStart(constraints_, bodies_);
     }
     crowdSaved_.resize(crowdBodies_.size());
@@ -1311,7 +1318,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     const bool alternate = !settings_.oneColourOrder;
     for (int it = 0; it < settings_.iterations; ++it, reverse = alternate && !reverse) {
         if (jointed) {
-            joints::solveJoints(joints_, bodies_, h, jointSoft, directSoft, true);
+            joints::solveJoints(joints_, jointOrder_, bodies_, h, jointSoft, directSoft, true);
             directJoints_.solve(joints_, bodies_);
         }
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
@@ -1356,7 +1363,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     if (jointed) directJoints_.factor(joints_, bodies_, directSoft, false);
     for (int it = 0; it < settings_.relaxIterations; ++it, reverse = alternate && !reverse) {
         if (jointed) {
-            joints::solveJoints(joints_, bodies_, h, jointSoft, directSoft, false);
+            joints::solveJoints(joints_, jointOrder_, bodies_, h, jointSoft, directSoft, false);
             directJoints_.solve(joints_, bodies_);
         }
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);

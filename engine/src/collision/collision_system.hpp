@@ -432,6 +432,8 @@ private:
     std::vector<joints::JointConstraint> joints_;
     joints::JointSettings jointSettings_;
     joints::DirectJoints directJoints_;  // the tree-shaped groups' exact solve
+    std::vector<std::uint32_t> jointOrder_;  // the joint passes' order (colourJoints)
+    bool jointOrderReady_ = false;           // false: a joint was added, broke or mended since it was made
     std::vector<joints::DirectJoints::Move> jointMoves_;  // per solver body: its projection (directJoints_.project)
     std::vector<std::uint32_t> jointMoved_;
     std::vector<std::pair<std::uint32_t, double>> stiffened_;  // bodies whose inertia a joint raised this substep

@@ -6,6 +6,7 @@
 #include "joints/joint_solver.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace stepwise::joints {
@@ -373,8 +374,42 @@ void poseResting(std::span<JointConstraint> joints, std::span<const Vec2> centre
         if (j.asleep && !j.broken) poseJoint(j, centres, angles);
 }
 
-void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies) {
-    for (JointConstraint& j : joints) {
+void colourJoints(std::span<const JointConstraint> joints, std::size_t bodyCount, std::vector<std::uint32_t>& order) {
+    constexpr int kColours = 64;
+    std::vector<std::uint64_t> used(bodyCount, 0);
+    constexpr std::uint8_t kNone = 255;
+    std::vector<std::uint8_t> colourOf(joints.size());
+    // start[c + 1]: where colour c begins once summed (the overflow is colour kColours).
+    std::uint32_t start[kColours + 3] = {};
+    // A broken joint is left out (every pass skips it): the joints still
+    // whole are coloured as a level saved after the break would colour them,
+    // so a run resumed from that save visits them in the same order.
+    for (std::size_t k = 0; k < joints.size(); ++k) {
+        if (joints[k].broken) {
+            colourOf[k] = kNone;
+            continue;
+        }
+        const std::uint32_t a = joints[k].a.solverBody, b = joints[k].b.solverBody;
+        const std::uint64_t free = ~((a != 0 ? used[a] : 0) | (b != 0 ? used[b] : 0));
+        const int colour = free != 0 ? std::countr_zero(free) : kColours;
+        if (colour < kColours) {
+            if (a != 0) used[a] |= std::uint64_t(1) << colour;
+            if (b != 0) used[b] |= std::uint64_t(1) << colour;
+        }
+        colourOf[k] = std::uint8_t(colour);
+        ++start[colour + 2];
+    }
+    // A stable counting sort by colour.
+    for (int c = 2; c < kColours + 3; ++c) start[c] += start[c - 1];
+    order.resize(start[kColours + 2]);
+    for (std::size_t k = 0; k < joints.size(); ++k)
+        if (colourOf[k] != kNone) order[start[colourOf[k] + 1]++] = std::uint32_t(k);
+}
+
+void warmStartJoints(std::span<JointConstraint> joints, std::span<const std::uint32_t> order,
+                     std::span<SolverBody> bodies) {
+    for (const std::uint32_t k : order) {
+        JointConstraint& j = joints[k];
         if (j.asleep) continue;
         SolverBody& a = bodies[j.a.solverBody];
         SolverBody& b = bodies[j.b.solverBody];
@@ -427,9 +462,10 @@ void warmStartJoints(std::span<JointConstraint> joints, std::span<SolverBody> bo
     }
 }
 
-void solveJoints(std::span<JointConstraint> joints, std::span<SolverBody> bodies, double h, const Softness& loopSoft,
-                 const Softness& directSoft, bool useBias) {
-    for (JointConstraint& j : joints) {
+void solveJoints(std::span<JointConstraint> joints, std::span<const std::uint32_t> order, std::span<SolverBody> bodies,
+                 double h, const Softness& loopSoft, const Softness& directSoft, bool useBias) {
+    for (const std::uint32_t k : order) {
+        JointConstraint& j = joints[k];
         if (j.asleep) continue;
         const Softness& soft = j.direct ? directSoft : loopSoft;
         SolverBody& a = bodies[j.a.solverBody];
