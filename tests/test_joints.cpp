@@ -1241,6 +1241,20 @@ TEST(JointPasses, NeighboursInTheOrderShareABodyOnlyWhereAColourEnds) {
     }
 }
 
+TEST(JointPasses, AHubWithMoreJointsThanColoursKeepsThemAllInJointOrder) {
+    // 100 spokes on one hub: each needs its own colour; past the 64th they
+    // go last, still in joint order, so every spoke is solved exactly once.
+    std::vector<stepwise::joints::JointConstraint> spokes(100);
+    for (std::size_t k = 0; k < spokes.size(); ++k) {
+        spokes[k].a.solverBody = 1;
+        spokes[k].b.solverBody = std::uint32_t(2 + k);
+    }
+    std::vector<std::uint32_t> order;
+    stepwise::joints::colourJoints(spokes, 102, order);
+    ASSERT_EQ(order.size(), spokes.size());
+    for (std::size_t k = 0; k < order.size(); ++k) EXPECT_EQ(order[k], k);
+}
+
 TEST(JointPasses, ABrokenJointIsOrderedAsIfItWereNotThere) {
     // A run resumed from a file saved after a break has no such joint; it
     // must visit the others in the order the run that broke it does.
