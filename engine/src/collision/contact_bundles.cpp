@@ -124,7 +124,7 @@ template <int Points>
 [[gnu::always_inline]] inline void warmStartBundle(ContactBundle<Points>& c, SolverBody* bodies) {
     const BodyLanes a = gather(bodies, c.bodyA), b = gather(bodies, c.bodyB);
     Velocities v{a.vx, a.vy, a.w, b.vx, b.vy, b.w};
-    const Masses m{load(c.invMassA), load(c.invInertiaA), load(c.invMassB), load(c.invInertiaB)};
+    const Masses m{a.invMass, load(c.invInertiaA), b.invMass, load(c.invInertiaB)};
     const D4 nx = load(c.nx), ny = load(c.ny);
     const D4 tx = ny, ty = -nx;
     for (int i = 0; i < Points; ++i) {
@@ -161,17 +161,18 @@ template <int Points, bool UseBias>
     SolverBody* bodies = args.bodies;
     const BodyLanes a = gather(bodies, c.bodyA), b = gather(bodies, c.bodyB);
     Velocities v{a.vx, a.vy, a.w, b.vx, b.vy, b.w};
-    const Masses m{load(c.invMassA), load(c.invInertiaA), load(c.invMassB), load(c.invInertiaB)};
+    const Masses m{a.invMass, load(c.invInertiaA), b.invMass, load(c.invInertiaB)};
     const D4 mA = m.mA, iA = m.iA, mB = m.mB, iB = m.iB;
     const D4 nx = load(c.nx), ny = load(c.ny);
-    const M4 isStatic = loadMask(c.touchesStatic);
+    const M4 flags = loadMask(c.flags);
+    const M4 isStatic = (flags & kTouchesStatic) != 0;
     const D4 biasRate = isStatic ? splat(args.staticSoft.biasRate) : splat(args.soft.biasRate);
     const D4 massScale = isStatic ? splat(args.staticSoft.massScale) : splat(args.soft.massScale);
     const D4 impulseScale = isStatic ? splat(args.staticSoft.impulseScale) : splat(args.soft.impulseScale);
     const D4 rigidDepth = isStatic ? splat(args.staticSoft.rigidDepth) : splat(args.soft.rigidDepth);
     const D4 baseGap = (b.dpx - a.dpx) * nx + (b.dpy - a.dpy) * ny;
     const D4 zero = splat(0.0), one = splat(1.0);
-    const M4 roundA = loadMask(c.roundA), roundB = loadMask(c.roundB);
+    const M4 roundA = (flags & kRoundA) != 0, roundB = (flags & kRoundB) != 0;
     const D4 qcA = roundA ? one : a.qc, qsA = roundA ? zero : a.qs;
     const D4 qcB = roundB ? one : b.qc, qsB = roundB ? zero : b.qs;
     Target t[2];
@@ -202,14 +203,19 @@ template <int Points, bool UseBias>
     if constexpr (Points == 1) {
         normalPoint(v, c.points[0], t[0], nx, ny, m);
     } else {
-        const M4 useBlock = loadMask(c.block) & (t[0].massScale == t[1].massScale);
+        const M4 block = (flags & kBlock) != 0;
+        const M4 useBlock = block & (t[0].massScale == t[1].massScale);
         Velocities blockV = v;
         D4 blockX1 = zero, blockX2 = zero;
         if (anyLane(useBlock)) {
             PointLanes& p1 = c.points[0];
             PointLanes& p2 = c.points[1];
             const D4 k11 = load(c.k11), k12 = load(c.k12), k22 = load(c.k22);
-            const D4 i11 = load(c.i11), i12 = load(c.i12), i22 = load(c.i22);
+            // K^-1 as prepareContacts forms it; zero in the lanes without a
+            // block (as BlockMass leaves it there).
+            const D4 invDet = one / (k11 * k22 - k12 * k12);
+            const D4 i11 = block ? k22 * invDet : zero, i12 = block ? -k12 * invDet : zero,
+                     i22 = block ? k11 * invDet : zero;
             const D4 rnA1 = load(p1.rnA), rnB1 = load(p1.rnB), rnA2 = load(p2.rnA), rnB2 = load(p2.rnB);
             const D4 dvx = v.vBx - v.vAx, dvy = v.vBy - v.vAy;
             const D4 a1 = load(p1.normalImpulse), a2 = load(p2.normalImpulse);
@@ -346,20 +352,15 @@ void fillLane(ContactBundle<Points>& bundle, int lane, const ContactConstraint& 
     bundle.nx[lane] = c.normal.x;
     bundle.ny[lane] = c.normal.y;
     bundle.friction[lane] = c.friction;
-    bundle.invMassA[lane] = a.invMass;
     bundle.invInertiaA[lane] = a.invInertia;
-    bundle.invMassB[lane] = b.invMass;
     bundle.invInertiaB[lane] = b.invInertia;
-    bundle.touchesStatic[lane] = c.touchesStatic ? -1 : 0;
-    bundle.block[lane] = c.block ? -1 : 0;
-    bundle.roundA[lane] = c.roundA ? -1 : 0;
-    bundle.roundB[lane] = c.roundB ? -1 : 0;
-    bundle.k11[lane] = c.blockMass.k11;
-    bundle.k12[lane] = c.blockMass.k12;
-    bundle.k22[lane] = c.blockMass.k22;
-    bundle.i11[lane] = c.blockMass.i11;
-    bundle.i12[lane] = c.blockMass.i12;
-    bundle.i22[lane] = c.blockMass.i22;
+    bundle.flags[lane] = (c.touchesStatic ? kTouchesStatic : 0) | (c.block ? kBlock : 0) | (c.roundA ? kRoundA : 0) |
+                         (c.roundB ? kRoundB : 0);
+    if constexpr (Points == 2) {
+        bundle.k11[lane] = c.blockMass.k11;
+        bundle.k12[lane] = c.blockMass.k12;
+        bundle.k22[lane] = c.blockMass.k22;
+    }
     for (int i = 0; i < Points; ++i) {
         const ContactPoint& p = c.points[i];
         PointLanes& q = bundle.points[i];

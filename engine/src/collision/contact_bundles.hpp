@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 namespace stepwise::collision {
@@ -38,11 +39,27 @@ struct PointLanes {
     alignas(32) double normalImpulse[kContactLanes], tangentImpulse[kContactLanes];
 };
 
+/// The block solve's K (BlockMass) of kContactLanes two-point contacts; its
+/// inverse is formed in the pass (the same operations as prepareContacts',
+/// so the same bits), which costs a division a bundle against 96 bytes more
+/// to stream through every pass.
+struct BlockLanes {
+    alignas(32) double k11[kContactLanes], k12[kContactLanes], k22[kContactLanes];
+};
+struct NoBlockLanes {};
+
+/// ContactBundle::flags bits: ContactConstraint's touchesStatic, block,
+/// roundA and roundB.
+constexpr std::int64_t kTouchesStatic = 1, kBlock = 2, kRoundA = 4, kRoundB = 8;
+
 /// kContactLanes contacts of `Points` points each, one array per quantity.
 /// Unused lanes join static body 0 to itself with zero masses: they compute
-/// zeros and write nothing that matters.
+/// zeros and write nothing that matters. Only what the passes cannot take
+/// from the bodies they gather is here (the inverse masses come with the
+/// velocities): the passes stream every bundle a dozen times a step, and
+/// in a large pile they wait on memory, not arithmetic.
 template <int Points>
-struct ContactBundle {
+struct ContactBundle : std::conditional_t<Points == 2, BlockLanes, NoBlockLanes> {
     /// Leaves the lanes unset: the bundles are rebuilt every step, every
     /// field of a used lane is set, and only a colour's last bundle (which
     /// may have unused lanes) is zeroed first. A value-initialising resize
@@ -51,15 +68,8 @@ struct ContactBundle {
     std::uint32_t bodyA[kContactLanes], bodyB[kContactLanes];
     std::uint32_t source[kContactLanes];  ///< index in the step's contacts; ~0u for an unused lane
     alignas(32) double nx[kContactLanes], ny[kContactLanes], friction[kContactLanes];
-    alignas(32) double invMassA[kContactLanes], invInertiaA[kContactLanes];  ///< 1/kg, 1/(kg m^2)
-    alignas(32) double invMassB[kContactLanes], invInertiaB[kContactLanes];
-    alignas(32) std::int64_t touchesStatic[kContactLanes];  ///< all bits set or clear
-    alignas(32) std::int64_t block[kContactLanes];          ///< all bits set or clear (two points only)
-    /// ContactConstraint::roundA, roundB: all bits set or clear.
-    alignas(32) std::int64_t roundA[kContactLanes], roundB[kContactLanes];
-    /// The block solve's K and its inverse (BlockMass), two points only.
-    alignas(32) double k11[kContactLanes], k12[kContactLanes], k22[kContactLanes];
-    alignas(32) double i11[kContactLanes], i12[kContactLanes], i22[kContactLanes];
+    alignas(32) double invInertiaA[kContactLanes], invInertiaB[kContactLanes];  ///< 1/(kg m^2)
+    alignas(32) std::int64_t flags[kContactLanes];  ///< kTouchesStatic, kBlock, kRoundA, kRoundB
     PointLanes points[Points];
 };
 
