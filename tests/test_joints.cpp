@@ -1235,7 +1235,9 @@ TEST(JointPasses, NeighboursInTheOrderShareABodyOnlyWhereAColourEnds) {
         // A body has at most 4 hinges, so greedy colouring needs at most 7
         // colours: at most 6 hand-overs.
         EXPECT_LE(shared, 6) << n << " x " << n;
-        if (n == 100) EXPECT_GT(sharedInJointOrder, 9000);
+        if (n == 100) {
+            EXPECT_GT(sharedInJointOrder, 9000);
+        }
         // A joint to the fixed body holds no other joint back: it takes the first colour.
         EXPECT_EQ(order.front(), 0u) << n << " x " << n;
     }
