@@ -683,7 +683,8 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
         if (colliders_[a].sensor || colliders_[b].sensor) continue;  // a sensor wakes nothing
         if (!collides(a, b)) continue;
         if (!noCollide_.empty() && joinedNotColliding(a, b)) continue;
-        const double closing = std::max(length(startV_[a] - startV_[b]), length(endV_[a] - endV_[b]));
+        const double closing =
+            std::sqrt(std::max(lengthSquared(startV_[a] - startV_[b]), lengthSquared(endV_[a] - endV_[b])));
         // Within reach this step: the gap the two can close in dt (the
         // speeds at both ends of the step, forces included, and the spin)
         // plus the slop. Farther, the awake shape cannot touch the sleeping
@@ -926,7 +927,7 @@ void CollisionSystem::rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFram
     for (std::size_t i = 0; i < colliders_.size(); ++i) {
         const Vec2 r = centres_[i] - centroid;
         const Vec2 u0 = ref0 + Vec2{-omega0 * r.y, omega0 * r.x}, u1 = ref1 + Vec2{-omega1 * r.y, omega1 * r.x};
-        const double drift = std::max(length(startV_[i] - u0), length(endV_[i] - u1));
+        const double drift = std::sqrt(std::max(lengthSquared(startV_[i] - u0), lengthSquared(endV_[i] - u1)));
         rotatedMargins_[i] = (kSpeculativeBase + dt_ * drift + sweep * maxExtent_[i] + spin_[i]) * widen;
         sum += rotatedMargins_[i];
     }
@@ -986,7 +987,9 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     forEachActive([&](std::size_t i) {
         // How far any point of the shape can swing about its centre (m).
         spin_[i] = dt * std::abs(angularVelocities_[i]) * maxExtent_[i];
-        const double drift = std::max(length(startV_[i] - ref0), length(endV_[i] - ref1));
+        // sqrt is monotonic and correctly rounded: the root of the larger
+        // square is the larger root, one square root instead of two.
+        const double drift = std::sqrt(std::max(lengthSquared(startV_[i] - ref0), lengthSquared(endV_[i] - ref1)));
         margins_[i] = kSpeculativeBase + dt * drift + spin_[i];
         meanFrameSum += margins_[i];
     });
@@ -1061,7 +1064,8 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     // step, from the two bodies' relative velocity (at either end of the
     // step) and their spin.
     const auto pairMargin = [&](std::uint32_t a, std::uint32_t b) {
-        const double closing = std::max(length(startV_[a] - startV_[b]), length(endV_[a] - endV_[b]));
+        const double closing =
+            std::sqrt(std::max(lengthSquared(startV_[a] - startV_[b]), lengthSquared(endV_[a] - endV_[b])));
         return 2.0 * kSpeculativeBase + dt * closing + spin_[a] + spin_[b];
     };
     for (const ProxyPair& pair : pairs_) {
