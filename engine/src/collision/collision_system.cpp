@@ -1123,7 +1123,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
     }
     addDeepOverlapsToCrowd();
     prepareContacts(constraints_, details_, bodies_);
-    indexImpacts(constraints_, details_, bodies_.size(), impactScratch_);
+    indexImpacts(constraints_, bodies_.size(), impactScratch_);
     if (settings_.warmStart && !cache_.empty()) capWarmStart(firstSubstepV);
     coloured_.build(constraints_, bodies_, settings_.simd);
     if (!joints_.empty()) joints::prepareJoints(joints_, bodies_, centres_, angles_);

@@ -88,17 +88,12 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
     }
 }
 
-void indexImpacts(std::span<const ContactConstraint> contacts, std::span<const ContactDetail> details,
-                  std::size_t bodyCount, ImpactScratch& scratch) {
+void indexImpacts(std::span<const ContactConstraint> contacts, std::size_t bodyCount, ImpactScratch& scratch) {
     scratch.reach.assign(bodyCount, 0.0);
-    scratch.pairBodies.resize(2 * contacts.size());
-    scratch.restitution.resize(contacts.size());
+    scratch.pairsReady = false;
     scratch.incidentReady = false;
     for (std::size_t k = 0; k < contacts.size(); ++k) {
         const ContactConstraint& c = contacts[k];
-        scratch.pairBodies[2 * k] = c.bodyA;
-        scratch.pairBodies[2 * k + 1] = c.bodyB;
-        scratch.restitution[k] = details[k].restitution;
         for (int i = 0; i < c.pointCount; ++i) {
             scratch.reach[c.bodyA] = std::max(scratch.reach[c.bodyA], std::abs(c.points[i].rnA));
             scratch.reach[c.bodyB] = std::max(scratch.reach[c.bodyB], std::abs(c.points[i].rnB));
@@ -107,6 +102,21 @@ void indexImpacts(std::span<const ContactConstraint> contacts, std::span<const C
 }
 
 namespace {
+
+/// The contacts' bodies and restitutions, packed; made by the first
+/// substep that finds two bodies fast enough to look at contacts (a
+/// resting pile never does, and then never reads its details).
+void packPairs(std::span<const ContactConstraint> contacts, std::span<const ContactDetail> details,
+               ImpactScratch& scratch) {
+    scratch.pairBodies.resize(2 * contacts.size());
+    scratch.restitution.resize(contacts.size());
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+        scratch.pairBodies[2 * k] = contacts[k].bodyA;
+        scratch.pairBodies[2 * k + 1] = contacts[k].bodyB;
+        scratch.restitution[k] = details[k].restitution;
+    }
+    scratch.pairsReady = true;
+}
 
 /// Which contacts touch which body, from the packed pairs: a counting sort
 /// of (body, contact) by body. Static body 0 never changes velocity, so it
@@ -166,6 +176,7 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
     // No two bodies fast enough together (a resting pile): every contact
     // would be passed over.
     if (fastest + fastest < quiet) return;
+    if (!scratch.pairsReady) packPairs(contacts, details, scratch);
     // The first pass: the contacts not passed over at the start velocities.
     now.assign(words, 0);
     for (std::size_t k = 0; k < contacts.size(); ++k)

@@ -153,6 +153,7 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
 /// the first impulse of the step lists them (most steps of a resting scene
 /// have none).
 struct ImpactScratch {
+    bool pairsReady = false;              ///< pairBodies and restitution hold this step's contacts
     bool incidentReady = false;           ///< start and incident list this step's contacts
     std::vector<std::uint32_t> start;     ///< solver body b's contacts: incident[start[b], start[b + 1])
     std::vector<std::uint32_t> incident;  ///< contact indices, ascending per body
@@ -167,8 +168,7 @@ struct ImpactScratch {
     /// crowd's approaching contacts all read it, and a detail is 88 bytes.
     std::vector<double> restitution;
 };
-void indexImpacts(std::span<const ContactConstraint> contacts, std::span<const ContactDetail> details,
-                  std::size_t bodyCount, ImpactScratch& scratch);
+void indexImpacts(std::span<const ContactConstraint> contacts, std::size_t bodyCount, ImpactScratch& scratch);
 void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDetail> details,
                       std::span<SolverBody> bodies, double h, double threshold, int maxPasses,
                       ImpactScratch& scratch);
