@@ -15,6 +15,8 @@
 #include <system_error>
 
 #include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -146,10 +148,22 @@ Result<StreamedFileWriter> StreamedFileWriter::open(const fs::path& given) {
     tmpName += path.filename().string();
     tmpName += ".tmp-XXXXXX";
     std::string tmpl = (w.folder_ / tmpName).string();
+    // A signal whose handler removes the unfinished temporaries (the
+    // command line's interrupt) must not land between mkstemp creating the
+    // file and the file being listed: the handler would miss it and leave
+    // it behind (one interrupted render --frames in thirty did). Blocked
+    // for those two calls, it is delivered right after, with the file listed.
+    sigset_t all, before;
+    sigfillset(&all);
+    ::pthread_sigmask(SIG_BLOCK, &all, &before);
     w.fd_ = ::mkstemp(tmpl.data());
-    if (w.fd_ < 0) return Error{w.name_ + ": error: cannot write: " + std::strerror(errno)};
-    w.tmpPath_ = tmpl;
-    w.slot_ = listTemporary(w.tmpPath_);
+    const int created = errno;
+    if (w.fd_ >= 0) {
+        w.tmpPath_ = tmpl;
+        w.slot_ = listTemporary(w.tmpPath_);
+    }
+    ::pthread_sigmask(SIG_SETMASK, &before, nullptr);
+    if (w.fd_ < 0) return Error{w.name_ + ": error: cannot write: " + std::strerror(created)};
     // Keep an existing file's permissions; a new file gets 0666 less umask
     // (mkstemp makes 0600).
     struct stat existing {};
