@@ -574,8 +574,9 @@ TEST(World, EachKindOfBodyAddedAndDeletedInPlaceRunsAsARebuilds) {
 // pair with its joint) goes back to its place in the World's bodies,
 // colliders and joints, and the run is that of a World built from the
 // scene, bit for bit, in the same order of bodies and joints, at 1, 2 and
-// 8 substeps and the engine's choice. In half the cases the pile sleeps meanwhile (a sleeping island's labels are
-// renumbered too) and a kept body goes in the same edit.
+// 8 substeps and the engine's choice. In half the cases the pile sleeps
+// meanwhile (a sleeping island's labels are renumbered too) and a kept
+// body goes in the same edit.
 TEST(World, EachKindOfBodyBroughtBackWhereItStoodRunsAsARebuilds) {
     std::vector<std::pair<std::string, std::string>> kinds = kindsOfBody();
     kinds.push_back({"hinged pair", ""});
