@@ -280,6 +280,108 @@ TEST(BroadPhase, AFastPileSideBySideKeepsEveryPairAndACrowdStaysBounded) {
     }
 }
 
+// A grid kept between calls (the pairs of grown boxes, filtered) must give
+// exactly a fresh grid's pairs and crowd flags on every call. Boxes drift
+// and jitter at a speed swept from rest (almost every call served from the
+// kept pairs) to faster than their growth (few served), with a floor wider
+// than the cells and static boxes; for three calls a crowd of 100 is
+// dropped on one point (which a fresh grid thins by its Z-order window) and
+// spreads out. Cores are given on one run of each speed and left out on the
+// other.
+TEST(BroadPhase, KeptPairsEqualAFreshGridOnEveryCallAtAnySpeed) {
+    std::size_t servedAtRest = 0, servedFastest = 0;
+    for (const double speed : {0.0, 1e-4, 1e-3, 0.01, 0.05, 0.2, 1.0}) {
+        for (const bool withCores : {false, true}) {
+            std::mt19937 rng{std::uint32_t(1000 * speed) + (withCores ? 7u : 0u)};
+            std::uniform_real_distribution<double> unit(-1.0, 1.0);
+            std::vector<Vec2> centre, half;
+            std::vector<std::uint8_t> movable;
+            for (int row = 0; row < 30; ++row)
+                for (int col = 0; col < 40; ++col) {
+                    centre.push_back({1.05 * col, 1.05 * row + 0.5});
+                    half.push_back({0.5 + 0.02 * unit(rng), 0.5 + 0.02 * unit(rng)});
+                    movable.push_back(col % 13 == 0 ? 0 : 1);
+                }
+            centre.push_back({20.0, -0.5});  // a floor far wider than a cell
+            half.push_back({30.0, 0.5});
+            movable.push_back(0);
+            const std::size_t scene = centre.size();
+            std::vector<Vec2> crowd(100);
+            for (Vec2& p : crowd) p = {10.0 + 0.01 * unit(rng), 40.0 + 0.01 * unit(rng)};
+            BroadPhase kept(BroadPhaseKind::UniformGrid);
+            std::size_t served = 0;
+            for (int call = 0; call < 60; ++call) {
+                std::vector<Aabb> boxes;
+                std::vector<double> cores;
+                for (std::size_t i = 0; i < scene; ++i) {
+                    if (movable[i]) centre[i] += speed * Vec2{unit(rng), unit(rng)};
+                    const double margin = 0.02 + speed * 0.5 * (1.0 + unit(rng));
+                    boxes.push_back({centre[i] - half[i] - Vec2{margin, margin}, centre[i] + half[i] + Vec2{margin, margin}});
+                    cores.push_back(4.0 * half[i].x * half[i].y);
+                }
+                movable.resize(scene);
+                if (call >= 30 && call < 33) {
+                    for (Vec2& p : crowd) {
+                        p = Vec2{10.0, 40.0} + 4.0 * (p - Vec2{10.0, 40.0});
+                        boxes.push_back({p - Vec2{0.3, 0.3}, p + Vec2{0.3, 0.3}});
+                        cores.push_back(0.36);
+                        movable.push_back(1);
+                    }
+                }
+                const std::span<const double> coreArea = withCores ? std::span<const double>(cores) : std::span<const double>();
+                std::vector<ProxyPair> keptPairs, freshPairs;
+                kept.findPairs(boxes, movable, keptPairs, coreArea);
+                BroadPhase fresh(BroadPhaseKind::UniformGrid);
+                fresh.findPairs(boxes, movable, freshPairs, coreArea);
+                ASSERT_EQ(keptPairs, freshPairs) << "speed " << speed << ", call " << call;
+                ASSERT_TRUE(std::ranges::equal(kept.crowded(), fresh.crowded())) << "speed " << speed << ", call " << call;
+                served += kept.lastServedFromKept() ? 1 : 0;
+            }
+            if (speed == 0.0) servedAtRest += served;
+            if (speed == 1.0) servedFastest += served;
+        }
+    }
+    // At rest, all but the crowd's calls and the pause after them (8 calls);
+    // boxes moving up to a metre a call outrun their growth.
+    EXPECT_GE(servedAtRest, 2u * 45u);
+    EXPECT_LE(servedFastest, 2u * 10u);
+}
+
+// The grown boxes' grid is coarser than a fresh one, so a cluster of small
+// boxes can fill one fresh cell past the crowd count while the grown grid
+// splits it over four cells (its boundaries fall across the cluster). The
+// kept pairs would then hold pairs the fresh grid's Z-order window drops:
+// they must not be served. Cells here: 2 m fresh (median extent 1 m, from a
+// far row of boxes), 2.5 m grown, one origin at (0, 0) and one at -0.125 m;
+// the cluster fills the fresh cell [4, 6) x [4, 6), which the grown cells
+// split at 4.875 m.
+TEST(BroadPhase, KeptPairsAreNotServedWhereAFreshGridWouldSeeACrowd) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> inCell(4.05, 5.85);
+    std::vector<Aabb> boxes{{{0.0, 0.0}, {1.0, 1.0}}};
+    for (int i = 0; i < 200; ++i) {
+        const Vec2 p{100.0 + 1.5 * (i % 20), 1.5 * (i / 20)};
+        boxes.push_back({p, p + Vec2{1.0, 1.0}});
+    }
+    for (int i = 0; i < 70; ++i) {
+        const Vec2 p{inCell(rng), inCell(rng)};
+        boxes.push_back({p, p + Vec2{0.1, 0.1}});
+    }
+    const std::vector<std::uint8_t> movable(boxes.size(), 1);
+    BroadPhase kept(BroadPhaseKind::UniformGrid), fresh(BroadPhaseKind::UniformGrid);
+    std::vector<ProxyPair> keptPairs, freshPairs, brute;
+    for (int call = 0; call < 3; ++call) {
+        kept.findPairs(boxes, movable, keptPairs);
+        fresh.findPairs(boxes, movable, freshPairs);
+        BroadPhase(BroadPhaseKind::BruteForce).findPairs(boxes, movable, brute);
+        ASSERT_EQ(std::count(fresh.crowded().begin(), fresh.crowded().end(), 1), 70) << "the cluster is a crowd";
+        EXPECT_LT(freshPairs.size(), brute.size()) << "its window thins the pairs";
+        EXPECT_FALSE(kept.lastServedFromKept()) << call;
+        EXPECT_EQ(keptPairs, freshPairs) << call;
+        EXPECT_TRUE(std::ranges::equal(kept.crowded(), fresh.crowded())) << call;
+    }
+}
+
 // ---------------------------------------------------------------- response
 
 TEST(Collision, HeadOnElasticUnequalMassesMatchTheCourseNotesFormula) {

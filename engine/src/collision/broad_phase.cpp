@@ -73,6 +73,10 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uin
                            std::vector<ProxyPair>& pairs, std::span<const double> coreArea) {
     pairs.clear();
     crowded_.clear();
+    servedFromKept_ = false;
+    if (kind_ == BroadPhaseKind::UniformGrid &&
+        (reuseKept(boxes, movable, pairs) || keepGrownPairs(boxes, movable, pairs, coreArea)))
+        return;
     switch (kind_) {
     case BroadPhaseKind::SweepAndPrune:
         sweepAndPrune(boxes, movable, pairs);
@@ -91,18 +95,158 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::span<const std::uin
                 if ((movable[i] || movable[j]) && overlaps(boxes[i], boxes[j])) pairs.push_back({i, j});
         break;
     }
+    sortPairs(pairs, boxes.size());
+}
+
+void BroadPhase::sortPairs(std::vector<ProxyPair>& pairs, std::size_t boxCount) {
     // (a, b) as one key a * 2^32 + b: its order is ProxyPair's.
     pairKeys_.resize(pairs.size());
     for (std::size_t i = 0; i < pairs.size(); ++i) pairKeys_[i] = (std::uint64_t(pairs[i].a) << 32) | pairs[i].b;
     // Keyed by the first box: a counting sort by it, when there are not
     // far more boxes than pairs.
-    if (boxes.size() <= 4 * pairs.size() + 4096)
-        bucketSort(pairKeys_, sortScratch_, boxes.size(), bucketStart_,
+    if (boxCount <= 4 * pairs.size() + 4096)
+        bucketSort(pairKeys_, sortScratch_, boxCount, bucketStart_,
                    [](std::uint64_t k) { return std::size_t(k >> 32); });
     else
         radixSort(pairKeys_, sortScratch_);
     for (std::size_t i = 0; i < pairs.size(); ++i)
         pairs[i] = {std::uint32_t(pairKeys_[i] >> 32), std::uint32_t(pairKeys_[i])};
+}
+
+BroadPhase::GridFrame BroadPhase::gridFrame(std::span<const Aabb> boxes) {
+    const std::size_t n = boxes.size();
+    GridFrame frame{1e-6, {0.0, 0.0}};
+    large_.clear();
+    if (n == 0) return frame;
+    // Cell size: twice the median box extent, so a typical box spans 1-4
+    // cells. The median, not the mean: one huge shape (a static circle of
+    // radius 1e6) would otherwise make the cells huge and put every body in
+    // one cell.
+    extents_.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+        extents_[i] = std::max(boxes[i].upper.x - boxes[i].lower.x, boxes[i].upper.y - boxes[i].lower.y);
+    median_.assign(extents_.begin(), extents_.end());
+    std::nth_element(median_.begin(), median_.begin() + std::ptrdiff_t(n / 2), median_.end());
+    frame.cell = std::max(2.0 * median_[n / 2], 1e-6);
+    // Boxes much larger than a cell (walls, floors, a huge circle) stay out
+    // of the cells: they would span thousands. uniformGrid tests each
+    // against every box instead, a tight loop of four comparisons (10,000
+    // boxes: ~10 us per large box).
+    bool first = true;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (extents_[i] > kLargeCells * frame.cell) {
+            large_.push_back(i);
+            continue;
+        }
+        if (first || boxes[i].lower.x < frame.lo.x) frame.lo.x = boxes[i].lower.x;
+        if (first || boxes[i].lower.y < frame.lo.y) frame.lo.y = boxes[i].lower.y;
+        first = false;
+    }
+    return frame;
+}
+
+std::int64_t BroadPhase::GridFrame::cellOf(double v, double origin) const {
+    // The boxes in the grid lie above and right of lo, so the quotient is
+    // not negative and truncation is floor (std::floor is a library call
+    // without SSE4.1); the else branch keeps floor for anything else.
+    const double q = (v - origin) / cell;
+    return q >= 0.0 ? std::int64_t(q) : std::int64_t(std::floor(q));
+}
+
+bool BroadPhase::freshGridIsSparse(std::span<const Aabb> boxes) {
+    // The cells uniformGrid would enter each box in, by its arithmetic,
+    // counted instead of listed and sorted.
+    const GridFrame frame = gridFrame(boxes);
+    const auto masked = [](std::int64_t v) { return std::uint64_t(v & 0xFFFF); };
+    std::uint64_t maxX = 0, maxY = 0;
+    lowerCell_.resize(boxes.size());
+    upperCell_.resize(boxes.size());
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        if (extents_[i] > kLargeCells * frame.cell) continue;
+        lowerCell_[i] = {frame.cellOf(boxes[i].lower.x, frame.lo.x), frame.cellOf(boxes[i].lower.y, frame.lo.y)};
+        upperCell_[i] = {frame.cellOf(boxes[i].upper.x, frame.lo.x), frame.cellOf(boxes[i].upper.y, frame.lo.y)};
+        for (std::int64_t x = lowerCell_[i].x; x <= upperCell_[i].x; ++x) maxX = std::max(maxX, masked(x));
+        for (std::int64_t y = lowerCell_[i].y; y <= upperCell_[i].y; ++y) maxY = std::max(maxY, masked(y));
+    }
+    const std::uint64_t columns = maxX + 1;
+    if (columns * (maxY + 1) > 4 * boxes.size() + 4096) return false;  // too many cells to count: taken as dense
+    cellCounts_.assign(std::size_t(columns * (maxY + 1)), 0u);
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        if (extents_[i] > kLargeCells * frame.cell) continue;
+        for (std::int64_t x = lowerCell_[i].x; x <= upperCell_[i].x; ++x)
+            for (std::int64_t y = lowerCell_[i].y; y <= upperCell_[i].y; ++y)
+                if (++cellCounts_[std::size_t(masked(y) * columns + masked(x))] > kDenseCell) return false;
+    }
+    return true;
+}
+
+bool BroadPhase::reuseKept(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
+                           std::vector<ProxyPair>& pairs) {
+    if (!kept_.valid) return false;
+    const std::size_t n = boxes.size();
+    // The kept pairs, filtered by overlap, are a fresh grid's pairs when the
+    // same boxes are movable, each box lies inside its grown box (a pair
+    // that overlaps then overlapped grown, and the grown boxes' grid had no
+    // crowd, so it found every such pair), and the fresh grid would have no
+    // crowd either (no cell over kDenseCell boxes, where a Z-order window
+    // would thin the pairs).
+    bool holds = n == kept_.grown.size() && std::equal(movable.begin(), movable.end(), kept_.movable.begin());
+    for (std::size_t i = 0; holds && i < n; ++i) {
+        const Aabb& b = boxes[i];
+        const Aabb& g = kept_.grown[i];
+        holds = g.lower.x <= b.lower.x && g.lower.y <= b.lower.y && b.upper.x <= g.upper.x && b.upper.y <= g.upper.y;
+    }
+    holds = holds && freshGridIsSparse(boxes);
+    if (!holds) {
+        // Kept for under two calls: the boxes outrun their growth (a fast
+        // pile), and growing them each step would cost more than the grid.
+        if (kept_.served < 2) pauseAfterFailure();
+        kept_.valid = false;
+        return false;
+    }
+    if (kept_.served == 1) pauseLength_ = kKeepPause;  // it pays: the next failure pauses briefly again
+    for (const ProxyPair& p : kept_.pairs)
+        if (overlaps(boxes[p.a], boxes[p.b])) pairs.push_back(p);
+    overlapTests_ = kept_.pairs.size();
+    crowded_.assign(n, 0);
+    ++kept_.served;
+    servedFromKept_ = true;
+    return true;
+}
+
+void BroadPhase::pauseAfterFailure() {
+    // Twice as long after each failure in a row (up to 64 calls): a pile
+    // that stays fast pays for a wasted grid on under 2% of its steps.
+    pause_ = pauseLength_;
+    pauseLength_ = std::min(2 * pauseLength_, kKeepLongestPause);
+}
+
+bool BroadPhase::keepGrownPairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
+                                std::vector<ProxyPair>& pairs, std::span<const double> coreArea) {
+    if (pause_ > 0) {
+        --pause_;
+        return false;
+    }
+    // Grown by an eighth of its extent a side: a box whose shape and margin
+    // are a metre keeps its pairs while it moves a dozen centimetres, about
+    // Box2D's fixed 10 cm.
+    kept_.grown.resize(boxes.size());
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        const Aabb& b = boxes[i];
+        const double grow = 0.125 * std::max(b.upper.x - b.lower.x, b.upper.y - b.lower.y);
+        kept_.grown[i] = {b.lower - Vec2{grow, grow}, b.upper + Vec2{grow, grow}};
+    }
+    kept_.pairs.clear();
+    uniformGrid(kept_.grown, movable, kept_.pairs, coreArea);
+    if (std::find(crowded_.begin(), crowded_.end(), std::uint8_t(1)) != crowded_.end()) {
+        pauseAfterFailure();
+        return false;
+    }
+    sortPairs(kept_.pairs, boxes.size());
+    kept_.movable.assign(movable.begin(), movable.end());
+    kept_.valid = true;
+    kept_.served = 0;
+    return reuseKept(boxes, movable, pairs);
 }
 
 void BroadPhase::sweepAndPrune(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
@@ -153,33 +297,8 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
     overlapTests_ = 0;
     crowded_.assign(n, 0);
     if (n == 0) return;
-    // Cell size: twice the median box extent, so a typical box spans 1-4
-    // cells. The median, not the mean: one huge shape (a static circle of
-    // radius 1e6) would otherwise make the cells huge and put every body in
-    // one cell.
-    extents_.resize(n);
-    for (std::uint32_t i = 0; i < n; ++i)
-        extents_[i] = std::max(boxes[i].upper.x - boxes[i].lower.x, boxes[i].upper.y - boxes[i].lower.y);
-    median_.assign(extents_.begin(), extents_.end());
-    std::nth_element(median_.begin(), median_.begin() + n / 2, median_.end());
-    const double cell = std::max(2.0 * median_[n / 2], 1e-6);
-    // Boxes much larger than a cell (walls, floors, a huge circle) stay out
-    // of the grid: they would span thousands of cells. Each is tested
-    // against every box instead, a tight loop of four comparisons
-    // (10,000 boxes: ~10 us per large box).
-    constexpr double kLargeCells = 8.0;
-    large_.clear();
-    Vec2 lo{0.0, 0.0};
-    bool first = true;
-    for (std::uint32_t i = 0; i < n; ++i) {
-        if (extents_[i] > kLargeCells * cell) {
-            large_.push_back(i);
-            continue;
-        }
-        if (first || boxes[i].lower.x < lo.x) lo.x = boxes[i].lower.x;
-        if (first || boxes[i].lower.y < lo.y) lo.y = boxes[i].lower.y;
-        first = false;
-    }
+    const GridFrame frame = gridFrame(boxes);
+    const double cell = frame.cell;
     overlapTests_ += large_.size() * n;
     for (const std::uint32_t a : large_) {
         for (std::uint32_t b = 0; b < n; ++b) {
@@ -190,18 +309,13 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
         }
     }
     cellKeys_.clear();
-    // The boxes in the grid lie above and right of lo, so the quotient is
-    // not negative and truncation is floor (std::floor is a library call
-    // without SSE4.1); the else branch keeps floor for anything else.
-    auto cellOf = [&](double v, double origin) {
-        const double q = (v - origin) / cell;
-        return q >= 0.0 ? std::int64_t(q) : std::int64_t(std::floor(q));
-    };
     lowerCell_.resize(n);
     for (std::uint32_t i = 0; i < n; ++i) {
         if (extents_[i] > kLargeCells * cell) continue;
-        const std::int64_t x0 = cellOf(boxes[i].lower.x, lo.x), x1 = cellOf(boxes[i].upper.x, lo.x);
-        const std::int64_t y0 = cellOf(boxes[i].lower.y, lo.y), y1 = cellOf(boxes[i].upper.y, lo.y);
+        const std::int64_t x0 = frame.cellOf(boxes[i].lower.x, frame.lo.x);
+        const std::int64_t x1 = frame.cellOf(boxes[i].upper.x, frame.lo.x);
+        const std::int64_t y0 = frame.cellOf(boxes[i].lower.y, frame.lo.y);
+        const std::int64_t y1 = frame.cellOf(boxes[i].upper.y, frame.lo.y);
         lowerCell_[i] = {x0, y0};
         for (std::int64_t x = x0; x <= x1; ++x)
             for (std::int64_t y = y0; y <= y1; ++y)
@@ -250,7 +364,7 @@ void BroadPhase::uniformGrid(std::span<const Aabb> boxes, std::span<const std::u
         };
         std::size_t reach = end - begin;
         if (end - begin > kDenseCell && coresCoverCell()) {
-            const double originX = lo.x + double(cx) * cell, originY = lo.y + double(cy) * cell;
+            const double originX = frame.lo.x + double(cx) * cell, originY = frame.lo.y + double(cy) * cell;
             const auto morton = [&](std::uint64_t entry) {
                 const Aabb& b = boxes[std::uint32_t(entry)];
                 // Centre within the cell, quantised to 16 bits per axis.

@@ -5,7 +5,8 @@
 // order (sorted by (a, b)), so the solver's result does not depend on which
 // one ran; the one exception is a crowd (a grid cell with more than
 // kDenseCell boxes whose shapes cover it kCrowdedCover times over), where
-// the grid bounds the pairs per box.
+// the grid bounds the pairs per box. The grid keeps the pairs of grown
+// boxes between calls while that gives exactly a fresh grid's pairs.
 
 #include "collision/collision_types.hpp"
 
@@ -47,8 +48,28 @@ public:
     /// Per box of the last call: 1 when it sat in a crowded grid cell;
     /// empty when no grid ran.
     std::span<const std::uint8_t> crowded() const { return crowded_; }
+    /// Whether the last call's pairs came from the kept grown pairs (see
+    /// keepGrownPairs) instead of a fresh grid.
+    bool lastServedFromKept() const { return servedFromKept_; }
 
 private:
+    void sortPairs(std::vector<ProxyPair>& pairs, std::size_t boxCount);
+    /// A uniform grid's cells: their side (m) and the corner of cell (0, 0).
+    struct GridFrame {
+        double cell;
+        Vec2 lo;
+        std::int64_t cellOf(double v, double origin) const;
+    };
+    /// The cells of a grid of these boxes; leaves each box's extent in
+    /// extents_ and the boxes too large for a cell in large_.
+    GridFrame gridFrame(std::span<const Aabb> boxes);
+    /// Whether a uniform grid of these boxes would have no cell of over
+    /// kDenseCell boxes (so no crowd).
+    bool freshGridIsSparse(std::span<const Aabb> boxes);
+    bool reuseKept(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
+    bool keepGrownPairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable,
+                        std::vector<ProxyPair>& pairs, std::span<const double> coreArea);
+    void pauseAfterFailure();
     void sweepAndPrune(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs);
     void uniformGrid(std::span<const Aabb> boxes, std::span<const std::uint8_t> movable, std::vector<ProxyPair>& pairs,
                      std::span<const double> coreArea);
@@ -67,6 +88,8 @@ private:
     /// top of each other reach this.
     static constexpr double kCrowdedCover = 16.0;
     static constexpr std::size_t kDenseNeighbours = 4;
+    /// A box wider than this many cells stays out of the grid's cells.
+    static constexpr double kLargeCells = 8.0;
     struct SortedBox {
         double lowerX, upperX, lowerY, upperY;
         std::uint32_t index;
@@ -79,6 +102,8 @@ private:
         std::int64_t x, y;
     };
     std::vector<CellIndex> lowerCell_;  // grid: the cell of each box's lower corner
+    std::vector<CellIndex> upperCell_;  // freshGridIsSparse: the cell of each box's upper corner
+    std::vector<std::uint32_t> cellCounts_;  // freshGridIsSparse: boxes per cell
     struct CellBox {
         Aabb box;
         std::int64_t cellX, cellY;  // the cell of its lower corner
@@ -93,6 +118,23 @@ private:
     std::vector<std::uint32_t> large_;
     std::size_t overlapTests_ = 0;
     std::vector<std::uint8_t> crowded_;     // grid: boxes too large for the cells
+
+    /// Grid only: the pairs of every box grown by an eighth of its extent,
+    /// kept while each box stays inside its grown box. Filtered by the
+    /// boxes' own overlap they are exactly the pairs a fresh grid would
+    /// find, so a pile at rest does not rebuild its grid every step
+    /// (keepGrownPairs says when that holds).
+    struct KeptPairs {
+        bool valid = false;
+        std::vector<Aabb> grown;
+        std::vector<std::uint8_t> movable;
+        std::vector<ProxyPair> pairs;  // sorted
+        std::size_t served = 0;        // calls answered since it was made
+    } kept_;
+    std::size_t pause_ = 0;          // grid calls left before keeping pairs is tried again
+    static constexpr std::size_t kKeepPause = 8, kKeepLongestPause = 64;
+    std::size_t pauseLength_ = kKeepPause;  // the next pause's
+    bool servedFromKept_ = false;
 };
 
 } // namespace stepwise::collision
