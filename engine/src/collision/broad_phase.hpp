@@ -123,7 +123,7 @@ private:
     /// kept while each box stays inside its grown box. Filtered by the
     /// boxes' own overlap they are exactly the pairs a fresh grid would
     /// find, so a pile at rest does not rebuild its grid every step
-    /// (keepGrownPairs says when that holds).
+    /// (reuseKept says when that holds).
     struct KeptPairs {
         bool valid = false;
         std::vector<Aabb> grown;

@@ -337,6 +337,9 @@ private:
     /// island (an awake body has a manifold with a sleeping one): then the
     /// detection starts over with that island awake.
     bool sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, Vec2 ref1);
+    /// The larger of colliders a and b's relative speeds at the two ends of
+    /// the step (m/s): how fast their gap can close within it.
+    double closingSpeed(std::size_t a, std::size_t b) const;
     /// Replaces margins_ by margins in a frame that turns with the bodies,
     /// when those add up to less than meanFrameSum (all colliders awake).
     void rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFrameSum);
