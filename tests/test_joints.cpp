@@ -4,6 +4,7 @@
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
+#include "integrators/integrator.hpp"
 #include "joints/joint_solver.hpp"
 #include "world/world_internals.hpp"
 
@@ -1271,4 +1272,103 @@ TEST(JointPasses, ABrokenJointIsOrderedAsIfItWereNotThere) {
         for (std::uint32_t& k : b) k += k >= broken ? 1u : 0u;  // back to the indices with the break
         EXPECT_EQ(a, b) << "joint " << broken << " broken";
     }
+}
+
+namespace {
+
+/// A hinge grid falling onto a floor: plain hinges (bundled), hinges with a
+/// motor, limits or a spring, a weld and a breaking hinge among them (one
+/// at a time, in the same colours), corners hung from the world, and a hub
+/// with 70 spokes, more joints on one body than there are colours (the
+/// overflow).
+std::string mixedJointScene() {
+    std::ostringstream s;
+    s << R"({"version": 1, )" << world(4) << R"(, "entities": [)"
+      << R"({"name": "floor", "position": {"x": 0, "y": -9.3}, "static": true, "box": {"width": 60, "height": 1}})";
+    constexpr int n = 9;
+    const auto name = [](int r, int c) { return "g" + std::to_string(r) + "_" + std::to_string(c); };
+    for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c)
+            s << R"(, {"name": ")" << name(r, c) << R"(", "position": {"x": )" << c << R"(, "y": )" << -r
+              << R"(}, "mass": )" << num(1.0 + 0.1 * ((r * n + c) % 5)) << (c % 3 == 0 ? R"(, "radius": 0.3})" : R"(, "box": {"width": 0.5, "height": 0.4}})");
+    int k = 0;
+    const auto hinge = [&](const std::string& a, const std::string& b, double x, double y) {
+        s << R"(, {"name": "j)" << k << R"(", "joint": {"type": ")" << (k == 40 ? "weld" : "hinge") << R"(", "a": ")"
+          << a << '"' << (b.empty() ? "" : R"(, "b": ")" + b + '"') << R"(, "anchor": {"x": )" << num(x)
+          << R"(, "y": )" << num(y) << "}";
+        if (k == 40) {
+        } else if (k % 11 == 3) {
+            s << R"(, "motor_speed": 2, "max_motor_torque": 5)";
+        } else if (k % 13 == 5) {
+            s << R"(, "lower": -0.2, "upper": 0.3)";
+        } else if (k % 17 == 7) {
+            s << R"(, "spring_hz": 3, "spring_damping_ratio": 0.5)";
+        } else if (k == 61) {
+            s << R"(, "max_force": 30)";
+        }
+        s << "}}";
+        ++k;
+    };
+    for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c) {
+            if (c + 1 < n) hinge(name(r, c), name(r, c + 1), c + 0.5, -r);
+            if (r + 1 < n) hinge(name(r, c), name(r + 1, c), c, -r - 0.5);
+        }
+    hinge(name(0, 0), "", 0.0, 0.5);
+    hinge(name(0, n - 1), "", n - 1.0, 0.5);
+    s << R"(, {"name": "hub", "position": {"x": -8, "y": 0}, "mass": 5, "radius": 0.5})";
+    hinge("hub", "", -8.0, 0.0);
+    for (int i = 0; i < 70; ++i) {
+        const double a = 2.0 * kPi * i / 70.0;
+        s << R"(, {"name": "spoke)" << i << R"(", "position": {"x": )" << num(-8.0 + 1.5 * std::cos(a))
+          << R"(, "y": )" << num(1.5 * std::sin(a)) << R"(}, "mass": 0.1, "radius": 0.05})";
+        hinge("hub", "spoke" + std::to_string(i), -8.0 + 0.5 * std::cos(a), 0.5 * std::sin(a));
+    }
+    s << "]}";
+    return s.str();
+}
+
+std::string runJoints(const Scene& scene, bool simd, int steps, std::size_t* bundled = nullptr,
+                      std::size_t* oneAtATime = nullptr) {
+    World w = build(scene);
+    internals(w).collision->settings().simd = simd;
+    for (int i = 0; i < steps; ++i) EXPECT_TRUE(w.step());
+    if (bundled) *bundled = internals(w).collision->jointBundles().bundledCount();
+    if (oneAtATime) *oneAtATime = internals(w).collision->jointBundles().oneAtATimeCount();
+    Scene out = scene;
+    w.writeBack(out);
+    return sceneToJsonText(out);
+}
+
+} // namespace
+
+TEST(JointPasses, BundledHingesGiveTheBitsOfTheOneAtATimePassesOnEveryInstructionSet) {
+    const Scene scene = load(mixedJointScene());
+    constexpr int kSteps = 150;
+    std::size_t bundled = 0, oneAtATime = 0;
+    const std::string expected = runJoints(scene, false, kSteps, &bundled, &oneAtATime);
+    EXPECT_EQ(bundled, 0u) << "with SIMD off every joint goes one at a time";
+    int levelsRun = 0;
+    for (detail::SimdLevel level : {detail::SimdLevel::Baseline, detail::SimdLevel::Avx2, detail::SimdLevel::Avx512}) {
+        if (detail::setSimdLevel(level) != level) continue;
+        ++levelsRun;
+        EXPECT_TRUE(runJoints(scene, true, kSteps, &bundled, &oneAtATime) == expected)
+            << "SIMD level " << int(level) << " differs from one at a time";
+        // The plain hinges are bundled; the others, and the hub's spokes past
+        // the 64th colour, are not.
+        EXPECT_GT(bundled, 100u);
+        EXPECT_GT(oneAtATime, 20u);
+    }
+    detail::setSimdLevel(detail::SimdLevel::Avx512);  // back to the best there is
+    EXPECT_GE(levelsRun, 1);
+    // The run did what the scene is for: the grid fell onto the floor (its
+    // contacts solve with the joints) and the weak hinge broke.
+    World w = build(scene);
+    bool broke = false;
+    for (int i = 0; i < kSteps; ++i) {
+        ASSERT_TRUE(w.step());
+        broke = broke || !w.jointBreaks().empty();
+    }
+    EXPECT_TRUE(broke);
+    EXPECT_FALSE(w.contacts().empty());
 }

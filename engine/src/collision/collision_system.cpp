@@ -859,6 +859,7 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
     substeps_ = substeps;
     substepsDone_ = 0;
     detected_ = false;
+    jointBundlesReady_ = false;
     stepStartX_ = x;
     timings_ = {};
     syncShapes();
@@ -940,7 +941,7 @@ void CollisionSystem::rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFram
     if (sum < meanFrameSum) margins_.swap(rotatedMargins_);
 }
 
-void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
+void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = colliders_.size();
     const double dt = dt_;
@@ -1127,11 +1128,21 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV) {
         }
     }
     addDeepOverlapsToCrowd();
+    if (!joints_.empty()) {
+        joints::prepareJoints(joints_, bodies_, centres_, angles_);
+        // The joints' geometric stiffness, from the last step's impulses at
+        // this step's anchors: once a step (it changes slowly, and a pass
+        // over every joint each substep costs as much as a Gauss-Seidel
+        // pass). Before the contacts are prepared, so their masses and every
+        // pass see the inertia the joints see: a contact's impulse is then
+        // applied with the inertia it was computed with, whichever path
+        // solves it (the SIMD bundles copy the inertias here).
+        joints::stiffenRotation(joints_, bodies_, h, stiffened_, stiffenScratch_);
+    }
     prepareContacts(constraints_, details_, bodies_);
     indexImpacts(constraints_, bodies_.size(), impactScratch_);
     if (settings_.warmStart && !cache_.empty()) capWarmStart(firstSubstepV);
     coloured_.build(constraints_, bodies_, settings_.simd);
-    if (!joints_.empty()) joints::prepareJoints(joints_, bodies_, centres_, angles_);
     timings_.narrowPhaseMs = msSince(narrowStart);
 }
 
@@ -1245,12 +1256,8 @@ Vec2 CollisionSystem::coincidentNormal(std::uint32_t a, std::uint32_t b) {
 void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double h) {
     // Detection waits for the first substep's forces (see detect()).
     if (!detected_) {
-        detect(v);
+        detect(v, h);
         detected_ = true;
-        // The joints' geometric stiffness, from the last step's impulses at
-        // this step's start: once a step (it changes slowly, and a pass over
-        // every joint each substep costs as much as a Gauss-Seidel pass).
-        if (!joints_.empty()) joints::stiffenRotation(joints_, bodies_, h, stiffened_, stiffenScratch_);
         // The awake solver bodies' indices side by side, for the substeps'
         // loops (a Collider is over a hundred bytes; these are twelve).
         awakeSolved_.resize(awakeSolverColliders_.size());
@@ -1291,8 +1298,17 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // joint is solved (JointSettings).
     const bool jointed = !joints_.empty();
     if (jointed && !jointOrderReady_) {
-        joints::colourJoints(joints_, bodies_.size(), jointOrder_);
+        joints::colourJoints(joints_, bodies_.size(), jointOrder_, &jointColourEnds_);
         jointOrderReady_ = true;
+        jointBundlesReady_ = false;
+    }
+    // Once a step, after prepareJoints (in detect) and any wake: the
+    // bundles copy the step-start anchors and which joints sleep, and leave
+    // out the joints an exactly solved tree takes.
+    if (jointed && !jointBundlesReady_) {
+        directJoints_.ensureBuilt(joints_, bodies_);
+        jointBundles_.build(joints_, jointOrder_, jointColourEnds_, settings_.simd);
+        jointBundlesReady_ = true;
     }
     const double jointCap = 0.5 / h;
     const Softness jointSoft = Softness::make(
@@ -1308,7 +1324,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, crowdBodies_.empty() ? 64 : 2,
                      impactScratch_);
     if (settings_.warmStart) {
-        if (jointed) joints::warmStartJoints(joints_, jointOrder_, bodies_);
+        if (jointed) jointBundles_.warmStart(joints_, bodies_);
         coloured_.warmStart(constraints_, bodies_);
     }
     crowdSaved_.resize(crowdBodies_.size());
@@ -1327,7 +1343,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     const bool alternate = !settings_.oneColourOrder;
     for (int it = 0; it < settings_.iterations; ++it, reverse = alternate && !reverse) {
         if (jointed) {
-            joints::solveJoints(joints_, jointOrder_, bodies_, h, jointSoft, directSoft, true);
+            jointBundles_.solve(joints_, bodies_, h, jointSoft, directSoft, true);
             directJoints_.solve(joints_, bodies_);
         }
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
@@ -1372,7 +1388,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     if (jointed) directJoints_.factor(joints_, bodies_, directSoft, false);
     for (int it = 0; it < settings_.relaxIterations; ++it, reverse = alternate && !reverse) {
         if (jointed) {
-            joints::solveJoints(joints_, jointOrder_, bodies_, h, jointSoft, directSoft, false);
+            jointBundles_.solve(joints_, bodies_, h, jointSoft, directSoft, false);
             directJoints_.solve(joints_, bodies_);
         }
         coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
@@ -1405,6 +1421,9 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         angularVelocities_[sb.collider] = bodies_[sb.solver].w;
     }
     if (++substepsDone_ == substeps_) {
+        // Back to the joints for what reads them after the step (breaking,
+        // records, snapshots, the next step's warm start).
+        if (jointed) jointBundles_.storeImpulses(joints_);
         correctStepPositions(x);
         sweepAgainstStatic(x);
         syncShapes();

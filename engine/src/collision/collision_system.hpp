@@ -13,6 +13,7 @@
 #include "collision/narrow_phase.hpp"
 #include "collision/position_correction.hpp"
 #include "joints/direct_joints.hpp"
+#include "joints/joint_bundles.hpp"
 #include "joints/joint_solver.hpp"
 
 #include "stepwise/components.hpp"
@@ -233,6 +234,7 @@ public:
     const CollisionTimings& timings() const { return timings_; }
     /// The last step's contacts in colours (counts, order), for tests and benchmarks.
     const ColouredContacts& colouredContacts() const { return coloured_; }
+    const joints::JointBundles& jointBundles() const { return jointBundles_; }
 
     /// Sets the rotational state: undoes a step's change (after a
     /// divergence), or resumes from a snapshot.
@@ -348,7 +350,7 @@ private:
     void splitCache();
     /// Broad and narrow phase at the step-start positions; `firstSubstepV`
     /// is the unconstrained velocity after the first substep's forces.
-    void detect(std::span<const Vec2> firstSubstepV);
+    void detect(std::span<const Vec2> firstSubstepV, double h);
     /// The most normal impulse this step's first substep can need at one
     /// contact point (N*s), from the awake bodies' motion and forces at the
     /// step's start (see capWarmStart).
@@ -437,6 +439,9 @@ private:
     joints::DirectJoints directJoints_;  // the tree-shaped groups' exact solve
     std::vector<std::uint32_t> jointOrder_;  // the joint passes' order (colourJoints)
     bool jointOrderReady_ = false;           // false: a joint was added, broke or mended since it was made
+    std::vector<std::uint32_t> jointColourEnds_;  // where each colour ends in jointOrder_ (colourJoints)
+    joints::JointBundles jointBundles_;           // the joint passes: plain hinges in SIMD lanes, the rest one at a time
+    bool jointBundlesReady_ = false;              // built this step
     std::vector<joints::DirectJoints::Move> jointMoves_;  // per solver body: its projection (directJoints_.project)
     std::vector<std::uint32_t> jointMoved_;
     std::vector<std::pair<std::uint32_t, double>> stiffened_;  // bodies whose inertia a joint raised this substep

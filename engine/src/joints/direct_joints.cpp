@@ -501,7 +501,7 @@ void DirectJoints::order(Group& g, std::span<const JointConstraint> joints) {
 
 void DirectJoints::factor(std::span<JointConstraint> joints, std::span<const SolverBody> bodies, const Softness& soft,
                           bool biased) {
-    if (!built_ || builtFor_ != joints.size()) build(joints, bodies);
+    ensureBuilt(joints, bodies);
     // Fixed point of the soft Gauss-Seidel row: J v + bias + (1/c) K lambda
     // = 0 with massScale = c / (1 + c), impulseScale = 1 / (1 + c).
     biased_ = biased;

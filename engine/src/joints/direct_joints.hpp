@@ -74,6 +74,12 @@ public:
                  std::vector<Move>& moves, std::vector<std::uint32_t>& moved);
     /// Forgets the grouping (the joints changed).
     void reset() { built_ = false; }
+    /// Groups the joints now if they changed since the last grouping, which
+    /// marks the ones it solves (JointConstraint::direct); factor() does it
+    /// too, but the joint bundles need the marks before the warm start.
+    void ensureBuilt(std::span<JointConstraint> joints, std::span<const collision::SolverBody> bodies) {
+        if (!built_ || builtFor_ != joints.size()) build(joints, bodies);
+    }
     /// Joints solved here, for tests and the docs' measurements.
     std::size_t directJointCount() const { return directCount_; }
 

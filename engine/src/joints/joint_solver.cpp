@@ -374,7 +374,8 @@ void poseResting(std::span<JointConstraint> joints, std::span<const Vec2> centre
         if (j.asleep && !j.broken) poseJoint(j, centres, angles);
 }
 
-void colourJoints(std::span<const JointConstraint> joints, std::size_t bodyCount, std::vector<std::uint32_t>& order) {
+void colourJoints(std::span<const JointConstraint> joints, std::size_t bodyCount, std::vector<std::uint32_t>& order,
+                  std::vector<std::uint32_t>* colourEnds) {
     constexpr int kColours = 64;
     std::vector<std::uint64_t> used(bodyCount, 0);
     constexpr std::uint8_t kNone = 255;
@@ -404,6 +405,8 @@ void colourJoints(std::span<const JointConstraint> joints, std::size_t bodyCount
     order.resize(start[kColours + 2]);
     for (std::size_t k = 0; k < joints.size(); ++k)
         if (colourOf[k] != kNone) order[start[colourOf[k] + 1]++] = std::uint32_t(k);
+    // Each colour's end is now where the next one began.
+    if (colourEnds) colourEnds->assign(start + 1, start + kColours + 2);
 }
 
 void warmStartJoints(std::span<JointConstraint> joints, std::span<const std::uint32_t> order,

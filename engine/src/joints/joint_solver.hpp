@@ -154,8 +154,10 @@ void poseResting(std::span<JointConstraint> joints, std::span<const Vec2> centre
 /// joints of one colour share no body, so the processor overlaps their
 /// solves: in joint order a grid's neighbours wait on each other's
 /// velocities, and 100 x 100 hinges took a quarter longer a pass (Box2D v3
-/// colours its joints the same way).
-void colourJoints(std::span<const JointConstraint> joints, std::size_t bodyCount, std::vector<std::uint32_t>& order);
+/// colours its joints the same way). `colourEnds`, if given, receives
+/// where each of the 64 colours ends in `order`, then where the rest ends.
+void colourJoints(std::span<const JointConstraint> joints, std::size_t bodyCount, std::vector<std::uint32_t>& order,
+                  std::vector<std::uint32_t>* colourEnds = nullptr);
 /// Applies the accumulated impulses, in `order` (colourJoints).
 void warmStartJoints(std::span<JointConstraint> joints, std::span<const std::uint32_t> order,
                      std::span<collision::SolverBody> bodies);

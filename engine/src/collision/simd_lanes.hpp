@@ -1,0 +1,93 @@
+#pragma once
+// Four solver lanes in vector registers, shared by the contact and joint
+// bundles: the vector types, loads and stores, and the gather and scatter
+// of the lanes' bodies. Each helper is one IEEE operation per lane (or pure
+// data movement), so a bundle's lanes get the bits of the scalar solve.
+
+#include "collision/contact_solver.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+// The helpers below pass four-double vectors by value; they are always
+// inlined, so the baseline build's note that such a call's ABI differs
+// from an AVX build's never applies.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace stepwise::collision::simd {
+
+/// Lanes in one vector: fixed (not the machine's width) so the results are
+/// the same everywhere.
+constexpr int kLanes = 4;
+
+// Four doubles in one GCC/Clang vector: SSE2 runs it as two halves, AVX2
+// and AVX-512 in one register; the arithmetic per lane is the same IEEE
+// operation everywhere (no FMA: -ffp-contract=off on the engine).
+typedef double D4 __attribute__((vector_size(32)));
+typedef std::int64_t M4 __attribute__((vector_size(32)));  // a comparison's result: lanes all ones or zeros
+
+[[gnu::always_inline]] inline D4 load(const double* p) {
+    D4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+[[gnu::always_inline]] inline M4 loadMask(const std::int64_t* p) {
+    M4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+[[gnu::always_inline]] inline void store(double* p, D4 v) { std::memcpy(p, &v, sizeof v); }
+[[gnu::always_inline]] inline D4 splat(double x) { return D4{x, x, x, x}; }
+/// std::max(a, b) and std::min(a, b) lane by lane, to the bit (also for
+/// NaN and signed zeros): (a < b) ? b : a and (b < a) ? b : a.
+[[gnu::always_inline]] inline D4 maxOf(D4 a, D4 b) { return a < b ? b : a; }
+[[gnu::always_inline]] inline D4 minOf(D4 a, D4 b) { return b < a ? b : a; }
+[[gnu::always_inline]] inline bool anyLane(M4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
+[[gnu::always_inline]] inline bool allLanes(M4 m) { return (m[0] & m[1] & m[2] & m[3]) != 0; }
+
+/// Velocities of the four lanes' bodies, and their motion since the step began.
+struct BodyLanes {
+    D4 vx, vy, w, invMass, dpx, dpy, qc, qs;
+};
+// SolverBody holds (v.x, v.y, w, invMass) and (dp.x, dp.y, dq.c, dq.s) as
+// four consecutive doubles each: one load per lane and a 4x4 transpose
+// (pure data movement, so it changes no bit) give the lanes.
+static_assert(offsetof(SolverBody, w) == 2 * sizeof(double) && offsetof(SolverBody, invMass) == 3 * sizeof(double) &&
+                  offsetof(SolverBody, dq) == offsetof(SolverBody, dp) + 2 * sizeof(double),
+              "gather() reads SolverBody as two runs of four doubles");
+[[gnu::always_inline]] inline void transpose(D4& r0, D4& r1, D4& r2, D4& r3) {
+    const D4 t0 = __builtin_shufflevector(r0, r1, 0, 4, 2, 6);
+    const D4 t1 = __builtin_shufflevector(r0, r1, 1, 5, 3, 7);
+    const D4 t2 = __builtin_shufflevector(r2, r3, 0, 4, 2, 6);
+    const D4 t3 = __builtin_shufflevector(r2, r3, 1, 5, 3, 7);
+    r0 = __builtin_shufflevector(t0, t2, 0, 1, 4, 5);
+    r1 = __builtin_shufflevector(t1, t3, 0, 1, 4, 5);
+    r2 = __builtin_shufflevector(t0, t2, 2, 3, 6, 7);
+    r3 = __builtin_shufflevector(t1, t3, 2, 3, 6, 7);
+}
+[[gnu::always_inline]] inline BodyLanes gather(const SolverBody* bodies, const std::uint32_t* index) {
+    const SolverBody& b0 = bodies[index[0]];
+    const SolverBody& b1 = bodies[index[1]];
+    const SolverBody& b2 = bodies[index[2]];
+    const SolverBody& b3 = bodies[index[3]];
+    D4 v0 = load(&b0.v.x), v1 = load(&b1.v.x), v2 = load(&b2.v.x), v3 = load(&b3.v.x);
+    D4 p0 = load(&b0.dp.x), p1 = load(&b1.dp.x), p2 = load(&b2.dp.x), p3 = load(&b3.dp.x);
+    transpose(v0, v1, v2, v3);  // vx, vy, w, invMass
+    transpose(p0, p1, p2, p3);  // dp.x, dp.y, dq.c, dq.s
+    return {v0, v1, v2, v3, p0, p1, p2, p3};
+}
+[[gnu::always_inline]] inline void scatter(SolverBody* bodies, const std::uint32_t* index, const D4& vx, const D4& vy,
+                                           const D4& w, const D4& invMass) {
+    // Back to one (v.x, v.y, w, invMass) row per lane (invMass as gathered,
+    // unchanged), stored in lane order as the one-at-a-time solve stores;
+    // lanes on static body 0 write its zeros back.
+    D4 r0 = vx, r1 = vy, r2 = w, r3 = invMass;
+    transpose(r0, r1, r2, r3);
+    store(&bodies[index[0]].v.x, r0);
+    store(&bodies[index[1]].v.x, r1);
+    store(&bodies[index[2]].v.x, r2);
+    store(&bodies[index[3]].v.x, r3);
+}
+
+} // namespace stepwise::collision::simd
