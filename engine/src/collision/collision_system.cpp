@@ -470,6 +470,7 @@ void CollisionSystem::forgetLastStep() {
     lastH_ = 0.0;
     directJoints_.reset();
     jointOrderReady_ = false;
+    jointBundlesReady_ = false;  // its joint indices may be stale
     const BroadPhaseKind kind = broadPhase_.kind();
     broadPhase_ = BroadPhase{};  // the sweep's order kept between steps starts again, as a new system's
     broadPhase_.setKind(kind);
@@ -718,6 +719,7 @@ void CollisionSystem::addJoint(const joints::JointConstraint& joint, std::int32_
     joints::JointConstraint& j = joints_.emplace_back(joint);
     directJoints_.reset();
     jointOrderReady_ = false;
+    jointBundlesReady_ = false;  // its joint indices may be stale
     if (j.maxForce > 0.0) breakable_.push_back(std::uint32_t(joints_.size() - 1));
     if (!collideConnected && filterA >= 0 && filterB >= 0) {
         const auto lo = std::uint64_t(std::min(filterA, filterB)), hi = std::uint64_t(std::max(filterA, filterB));
@@ -770,6 +772,7 @@ void CollisionSystem::jointsBroke() {
     std::sort(noCollide_.begin(), noCollide_.end());
     directJoints_.reset();
     jointOrderReady_ = false;
+    jointBundlesReady_ = false;  // its joint indices may be stale
 }
 
 void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m,
@@ -1421,9 +1424,6 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         angularVelocities_[sb.collider] = bodies_[sb.solver].w;
     }
     if (++substepsDone_ == substeps_) {
-        // Back to the joints for what reads them after the step (breaking,
-        // records, snapshots, the next step's warm start).
-        if (jointed) jointBundles_.storeImpulses(joints_);
         correctStepPositions(x);
         sweepAgainstStatic(x);
         syncShapes();
@@ -1611,6 +1611,10 @@ std::size_t CollisionSystem::contactPointCount() const {
 }
 
 void CollisionSystem::endStep() {
+    // Back to the joints for what reads them after the step (breaking,
+    // records, snapshots, the next step's warm start), also after a step cut
+    // short, which undoSolverState then takes back.
+    if (jointBundlesReady_) jointBundles_.storeImpulses(joints_);
     joints::restoreInertia(bodies_, stiffened_);
     stiffened_.clear();
     // The cache this step started from is kept (swapped, not copied) so a
