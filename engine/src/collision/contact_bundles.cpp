@@ -2,8 +2,6 @@
 
 #include "collision/simd_lanes.hpp"
 
-#include "integrators/integrator.hpp"  // detail::simdLevel: the instruction set the integrators use
-
 #include <bit>
 #include <cstddef>
 #include <cstring>
@@ -246,30 +244,8 @@ template <int Mode>  // 0 warm start, 1 biased solve, 2 relax
 using PassKernel = void (*)(const PassArgs&);
 
 template <int Mode>
-void passBaseline(const PassArgs& args) {
-    colourPass<Mode>(args);
-}
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define STEPWISE_CONTACT_DISPATCH 1
-template <int Mode>
-__attribute__((target("avx2"))) void passAvx2(const PassArgs& args) {
-    colourPass<Mode>(args);
-}
-template <int Mode>
-__attribute__((target("avx512f"))) void passAvx512(const PassArgs& args) {
-    colourPass<Mode>(args);
-}
-#endif
-
-template <int Mode>
 PassKernel passKernel() {
-    switch (detail::simdLevel()) {
-#ifdef STEPWISE_CONTACT_DISPATCH
-        case detail::SimdLevel::Avx512: return passAvx512<Mode>;
-        case detail::SimdLevel::Avx2: return passAvx2<Mode>;
-#endif
-        default: return passBaseline<Mode>;
-    }
+    return kernelFor<PassArgs, colourPass<Mode>>();
 }
 
 template <int Points>

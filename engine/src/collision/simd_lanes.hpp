@@ -5,6 +5,7 @@
 // data movement), so a bundle's lanes get the bits of the scalar solve.
 
 #include "collision/contact_solver.hpp"
+#include "integrators/integrator.hpp"  // detail::simdLevel: the instruction set the integrators use
 
 #include <cstddef>
 #include <cstdint>
@@ -88,6 +89,35 @@ static_assert(offsetof(SolverBody, w) == 2 * sizeof(double) && offsetof(SolverBo
     store(&bodies[index[1]].v.x, r1);
     store(&bodies[index[2]].v.x, r2);
     store(&bodies[index[3]].v.x, r3);
+}
+
+/// The pass `Pass` (always inlined) compiled for SSE2, AVX2 and AVX-512 from
+/// the same source; kernelFor picks the one for the instruction set the
+/// integrators use (detail::simdLevel).
+template <class Args, void (*Pass)(const Args&)>
+void onBaseline(const Args& args) {
+    Pass(args);
+}
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define STEPWISE_SIMD_DISPATCH 1
+template <class Args, void (*Pass)(const Args&)>
+__attribute__((target("avx2"))) void onAvx2(const Args& args) {
+    Pass(args);
+}
+template <class Args, void (*Pass)(const Args&)>
+__attribute__((target("avx512f"))) void onAvx512(const Args& args) {
+    Pass(args);
+}
+#endif
+template <class Args, void (*Pass)(const Args&)>
+auto kernelFor() -> void (*)(const Args&) {
+    switch (detail::simdLevel()) {
+#ifdef STEPWISE_SIMD_DISPATCH
+        case detail::SimdLevel::Avx512: return onAvx512<Args, Pass>;
+        case detail::SimdLevel::Avx2: return onAvx2<Args, Pass>;
+#endif
+        default: return onBaseline<Args, Pass>;
+    }
 }
 
 } // namespace stepwise::collision::simd

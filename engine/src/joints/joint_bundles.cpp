@@ -1,7 +1,5 @@
 #include "joints/joint_bundles.hpp"
 
-#include "integrators/integrator.hpp"  // detail::simdLevel: the instruction set the integrators use
-
 namespace stepwise::joints {
 
 using collision::SolverBody;
@@ -124,30 +122,8 @@ template <bool WarmStart>
 using PassKernel = void (*)(const PassArgs&);
 
 template <bool WarmStart>
-void passBaseline(const PassArgs& args) {
-    bundlePass<WarmStart>(args);
-}
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define STEPWISE_JOINT_DISPATCH 1
-template <bool WarmStart>
-__attribute__((target("avx2"))) void passAvx2(const PassArgs& args) {
-    bundlePass<WarmStart>(args);
-}
-template <bool WarmStart>
-__attribute__((target("avx512f"))) void passAvx512(const PassArgs& args) {
-    bundlePass<WarmStart>(args);
-}
-#endif
-
-template <bool WarmStart>
 PassKernel passKernel() {
-    switch (detail::simdLevel()) {
-#ifdef STEPWISE_JOINT_DISPATCH
-        case detail::SimdLevel::Avx512: return passAvx512<WarmStart>;
-        case detail::SimdLevel::Avx2: return passAvx2<WarmStart>;
-#endif
-        default: return passBaseline<WarmStart>;
-    }
+    return kernelFor<PassArgs, bundlePass<WarmStart>>();
 }
 
 } // namespace
