@@ -1,5 +1,8 @@
 #include "joints/joint_bundles.hpp"
 
+#include <algorithm>
+#include <iterator>
+
 namespace stepwise::joints {
 
 using collision::SolverBody;
@@ -150,13 +153,10 @@ void JointBundles::build(std::span<const JointConstraint> joints, std::span<cons
                 continue;
             }
             if (lane == HingeBundle::kLanes) {
+                // Value-initialised: every lane starts as an unused one (body
+                // 0 to body 0, zeros), and only its joint needs marking.
                 HingeBundle& h = bundles_.emplace_back();
-                for (int m = 0; m < HingeBundle::kLanes; ++m) {
-                    h.anchorAx[m] = h.anchorAy[m] = h.anchorBx[m] = h.anchorBy[m] = 0.0;
-                    h.deltaX[m] = h.deltaY[m] = h.impulseX[m] = h.impulseY[m] = 0.0;
-                    h.bodyA[m] = h.bodyB[m] = 0;
-                    h.joint[m] = HingeBundle::kNoJoint;
-                }
+                std::fill(std::begin(h.joint), std::end(h.joint), HingeBundle::kNoJoint);
                 axial_.resize(axial_.size() + HingeBundle::kLanes, 0.0);
                 lane = 0;
             }
@@ -182,20 +182,24 @@ void JointBundles::build(std::span<const JointConstraint> joints, std::span<cons
     }
 }
 
+template <class Bundles, class Rest>
+void JointBundles::forEachSegment(Bundles&& bundles, Rest&& rest) const {
+    std::uint32_t bundle = 0, joint = 0;
+    for (const Segment& s : segments_) {
+        if (s.bundleEnd > bundle) bundles(bundle, s.bundleEnd - bundle);
+        if (s.restEnd > joint) rest(std::span<const std::uint32_t>(rest_).subspan(joint, s.restEnd - joint));
+        bundle = s.bundleEnd;
+        joint = s.restEnd;
+    }
+}
+
 void JointBundles::warmStart(std::span<JointConstraint> joints, std::span<SolverBody> bodies) {
     const PassKernel kernel = passKernel<true>();
-    std::uint32_t bundle = 0, rest = 0;
-    for (const Segment& s : segments_) {
-        if (s.bundleEnd > bundle) {
-            PassArgs args{bodies.data(), bundles_.data() + bundle,
-                          axial_.data() + HingeBundle::kLanes * bundle, s.bundleEnd - bundle, {}};
-            kernel(args);
-        }
-        if (s.restEnd > rest)
-            warmStartJoints(joints, std::span<const std::uint32_t>(rest_).subspan(rest, s.restEnd - rest), bodies);
-        bundle = s.bundleEnd;
-        rest = s.restEnd;
-    }
+    forEachSegment(
+        [&](std::uint32_t first, std::uint32_t count) {
+            kernel(PassArgs{bodies.data(), bundles_.data() + first, axial_.data() + HingeBundle::kLanes * first, count, {}});
+        },
+        [&](std::span<const std::uint32_t> order) { warmStartJoints(joints, order, bodies); });
 }
 
 void JointBundles::solve(std::span<JointConstraint> joints, std::span<SolverBody> bodies, double h,
@@ -205,18 +209,13 @@ void JointBundles::solve(std::span<JointConstraint> joints, std::span<SolverBody
     const RowLanes row = useBias ? RowLanes{splat(loopSoft.biasRate), splat(loopSoft.massScale),
                                             splat(loopSoft.impulseScale), true}
                                  : RowLanes{splat(0.0), splat(1.0), splat(0.0), false};
-    std::uint32_t bundle = 0, rest = 0;
-    for (const Segment& s : segments_) {
-        if (s.bundleEnd > bundle) {
-            PassArgs args{bodies.data(), bundles_.data() + bundle, nullptr, s.bundleEnd - bundle, row};
-            kernel(args);
-        }
-        if (s.restEnd > rest)
-            solveJoints(joints, std::span<const std::uint32_t>(rest_).subspan(rest, s.restEnd - rest), bodies, h,
-                        loopSoft, directSoft, useBias);
-        bundle = s.bundleEnd;
-        rest = s.restEnd;
-    }
+    forEachSegment(
+        [&](std::uint32_t first, std::uint32_t count) {
+            kernel(PassArgs{bodies.data(), bundles_.data() + first, nullptr, count, row});
+        },
+        [&](std::span<const std::uint32_t> order) {
+            solveJoints(joints, order, bodies, h, loopSoft, directSoft, useBias);
+        });
 }
 
 void JointBundles::storeImpulses(std::span<JointConstraint> joints) const {

@@ -61,6 +61,10 @@ private:
     struct Segment {
         std::uint32_t bundleEnd, restEnd;
     };
+    /// Calls bundles(first, count) for each colour's bundles, then
+    /// rest(order) for its joints solved one at a time, colour by colour.
+    template <class Bundles, class Rest>
+    void forEachSegment(Bundles&& bundles, Rest&& rest) const;
     std::vector<HingeBundle> bundles_;
     std::vector<std::uint32_t> rest_;
     /// Per bundle lane: the axial impulse the warm start applies
