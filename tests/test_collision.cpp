@@ -646,3 +646,118 @@ TEST(Collision, SmallRotationMatchesLibmWithinTwoUnitsInTheLastPlace) {
     EXPECT_EQ(std::bit_cast<std::uint64_t>(rotationBy(0.0).s), 0u);  // no turn: exactly the identity
     EXPECT_EQ(rotationBy(0.0).c, 1.0);
 }
+
+namespace {
+std::uint64_t bitsOf(double x) { return std::bit_cast<std::uint64_t>(x); }
+
+/// Two copies of a scene, one whose impact passes read every contact in
+/// every pass: every step, both must give the same bits (positions,
+/// velocities, spins and the contacts' impulses, restitution included).
+/// `looked`: the contacts the shortcut read, and over those the reference read.
+struct Looked {
+    double count = 0.0, ratio = 0.0;
+};
+void expectImpactShortcutsExact(const std::function<MiniWorld()>& make, int steps, const std::string& what,
+                                Looked& looked) {
+    MiniWorld fast = make(), full = make();
+    full.collision.impactScratch().lookAtEveryContact = true;
+    double lookedFast = 0.0, lookedFull = 0.0, impulse = 0.0, fired = 0.0;
+    for (int i = 0; i < steps; ++i) {
+        fast.step(1.0 / 60.0);
+        full.step(1.0 / 60.0);
+        lookedFast += double(fast.collision.impactScratch().looked);
+        lookedFull += double(full.collision.impactScratch().looked);
+        fired += double(fast.collision.impactScratch().fired);
+        ASSERT_EQ(fast.collision.impactScratch().fired, full.collision.impactScratch().fired) << what << ", step " << i;
+        const std::string at = what + ", step " + std::to_string(i);
+        for (std::size_t b = 0; b < fast.x.size(); ++b) {
+            ASSERT_EQ(bitsOf(fast.x[b].x), bitsOf(full.x[b].x)) << at << ", body " << b;
+            ASSERT_EQ(bitsOf(fast.x[b].y), bitsOf(full.x[b].y)) << at << ", body " << b;
+            ASSERT_EQ(bitsOf(fast.v[b].x), bitsOf(full.v[b].x)) << at << ", body " << b;
+            ASSERT_EQ(bitsOf(fast.v[b].y), bitsOf(full.v[b].y)) << at << ", body " << b;
+        }
+        for (std::size_t c = 0; c < fast.collision.colliderCount(); ++c)
+            ASSERT_EQ(bitsOf(fast.collision.angularVelocity(c)), bitsOf(full.collision.angularVelocity(c)))
+                << at << ", collider " << c;
+        const std::span<const ContactRecord> a = fast.collision.contacts(), b = full.collision.contacts();
+        ASSERT_EQ(a.size(), b.size()) << at;
+        for (std::size_t k = 0; k < a.size(); ++k) {
+            ASSERT_EQ(bitsOf(a[k].normalImpulse), bitsOf(b[k].normalImpulse)) << at << ", contact " << k;
+            impulse += a[k].normalImpulse;
+        }
+    }
+    EXPECT_GT(lookedFull, 0.0) << what;
+    EXPECT_GT(impulse, 0.0) << what;
+    EXPECT_GT(fired, 0.0) << what << ": no impact was propagated";
+    EXPECT_LE(lookedFast, lookedFull) << what;
+    looked = {lookedFast, lookedFast / lookedFull};
+}
+} // namespace
+
+TEST(ImpactPropagation, PassingContactsOverGivesTheBitsOfFullPassesInAnyFrame) {
+    // The passes skip a contact when its bodies' bounds, measured from the
+    // bodies' mean velocity, say it cannot approach at the threshold. Swept
+    // over that shared velocity, from rest to 1 km/s, with bouncy and dead
+    // bodies. What the passes read follows the relative motion, not the
+    // shared one.
+    double atRest[2] = {0.0, 0.0};
+    for (const Vec2 shared : {Vec2{0.0, 0.0}, Vec2{3.0, -40.0}, Vec2{-700.0, 700.0}}) {
+        for (const int bouncy : {0, 1}) {
+            const double restitution = 0.6 * bouncy;
+            const std::string what = "block moving at (" + std::to_string(shared.x) + ", " +
+                                     std::to_string(shared.y) + ") m/s, restitution " + std::to_string(restitution);
+            // A block of touching circles, struck by a column of boxes: the
+            // block's own contacts barely move relative to each other until
+            // the strikes send impacts through it. (No gravity: a block in
+            // free fall would soon be fast even in the frame of rest.)
+            Looked looked;
+            expectImpactShortcutsExact(
+                [&] {
+                    MiniWorld w;
+                    w.collision.settings().restitutionThreshold = 4.0 * 10.0 / 240.0;
+                    std::mt19937 rng(11);
+                    std::uniform_real_distribution<double> jitter(-0.01, 0.01);
+                    for (int i = 0; i < 100; ++i)
+                        w.dynamic(circle(0.35), {0.7 * (i % 10), 0.7 * (i / 10)},
+                                  shared + Vec2{jitter(rng), jitter(rng)}, 1.0 + 0.5 * (i % 4), restitution, 0.3);
+                    for (int i = 0; i < 6; ++i)
+                        w.dynamic(box(0.6, 0.5), {-4.0 - 0.3 * i, 0.3 + 1.2 * i}, shared + Vec2{6.0, 100 * jitter(rng)},
+                                  1.5, restitution, 0.3, 30 * jitter(rng));
+                    return w;
+                },
+                40, what, looked);
+            if (shared == Vec2{}) atRest[bouncy] = looked.count;
+            EXPECT_LT(looked.count, 1.1 * atRest[bouncy]) << what << ": read more than the same block at rest";
+        }
+    }
+    // Zero gravity, zero threshold: every approach is an impact and no bound
+    // is under the threshold; only contacts whose bodies have not changed
+    // since they were last read are skipped.
+    Looked zero;
+    expectImpactShortcutsExact(
+        [] {
+            MiniWorld w;
+            w.collision.settings().restitutionThreshold = 0.0;
+            for (int i = 0; i < 40; ++i)
+                w.dynamic(circle(0.3), {0.61 * (i % 8), 0.61 * (i / 8)}, {i % 2 == 0 ? 0.5 : -0.5, 0.0}, 1.0, 0.5);
+            return w;
+        },
+        60, "zero threshold", zero);
+    EXPECT_GT(zero.ratio, 0.9);
+    // A pyramid landing and settling: once it rests the passes read almost
+    // nothing, where bounds measured from rest read most of it (both bodies
+    // of each contact carry the substep's g h, half the threshold).
+    Looked resting;
+    expectImpactShortcutsExact(
+        [] {
+            int top = 0;
+            MiniWorld w = pyramid(12, top);
+            w.collision.settings().iterations = 1;
+            w.collision.settings().restitutionThreshold = 4.0 * 10.0 / 240.0;
+            for (Vec2& v : w.v) v = {0.0, -1.0};  // a landing: impacts at first
+            for (Vec2& x : w.x) x.y += 0.01;
+            return w;
+        },
+        120, "pyramid", resting);
+    EXPECT_LT(resting.ratio, 0.25) << "the resting pyramid's contacts were read, not passed over";
+}

@@ -1615,6 +1615,7 @@ void CollisionSystem::endStep() {
     // records, snapshots, the next step's warm start), also after a step cut
     // short, which undoSolverState then takes back.
     if (jointBundlesReady_) jointBundles_.storeImpulses(joints_);
+    storeImpacts(constraints_, details_, impactScratch_);
     joints::restoreInertia(bodies_, stiffened_);
     stiffened_.clear();
     // The cache this step started from is kept (swapped, not copied) so a

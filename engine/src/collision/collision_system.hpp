@@ -235,6 +235,9 @@ public:
     /// The last step's contacts in colours (counts, order), for tests and benchmarks.
     const ColouredContacts& colouredContacts() const { return coloured_; }
     const joints::JointBundles& jointBundles() const { return jointBundles_; }
+    /// The impact passes' scratch: their statistics, and the reference mode
+    /// (every contact in every pass) tests compare against.
+    ImpactScratch& impactScratch() { return impactScratch_; }
 
     /// Sets the rotational state: undoes a step's change (after a
     /// divergence), or resumes from a snapshot.
