@@ -1142,10 +1142,10 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
         // solves it (the SIMD bundles copy the inertias here).
         joints::stiffenRotation(joints_, bodies_, h, stiffened_, stiffenScratch_);
     }
-    prepareContacts(constraints_, details_, bodies_);
-    indexImpacts(constraints_, bodies_.size(), impactScratch_);
+    prepareContacts(constraints_, details_, bodies_, contactPairs_);
+    impactScratch_.startStep();
     if (settings_.warmStart && !cache_.empty()) capWarmStart(firstSubstepV);
-    coloured_.build(constraints_, bodies_, settings_.simd);
+    coloured_.build(constraints_, contactPairs_, bodies_, settings_.simd);
     timings_.narrowPhaseMs = msSince(narrowStart);
 }
 
@@ -1166,7 +1166,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
 // harder than the sum; there the bound replaces part of the warm start, the
 // same way in a straight run and a resumed one, so a resume stays exact.
 double CollisionSystem::warmStartBound(std::span<const Vec2> firstSubstepV) const {
-    const std::vector<double>& reach = impactScratch_.reach;
+    const std::vector<double>& reach = contactPairs_.reach;
     // The fastest point of a kinematic body that touches something: a body
     // it drives is pushed at up to that speed.
     double driven = 0.0;
@@ -1324,8 +1324,8 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // In a crowd every pair approaches every other: the passes would run to
     // the bound over hundreds of thousands of contacts (60% of a 2,000-body
     // crowd's step). Two passes there; the push-apart does the rest.
-    propagateImpacts(constraints_, details_, bodies_, h, settings_.restitutionThreshold, crowdBodies_.empty() ? 64 : 2,
-                     impactScratch_);
+    propagateImpacts(constraints_, details_, bodies_, contactPairs_, h, settings_.restitutionThreshold,
+                     crowdBodies_.empty() ? 64 : 2, impactScratch_);
     if (settings_.warmStart) {
         if (jointed) jointBundles_.warmStart(joints_, bodies_);
         coloured_.warmStart(constraints_, bodies_);

@@ -418,6 +418,7 @@ private:
     std::vector<ContactConstraint> constraints_;
     std::vector<ContactDetail> details_;  // parallel to constraints_
     ColouredContacts coloured_;           // constraints_ in colours and SIMD bundles
+    ContactPairs contactPairs_;           // constraints_' bodies and point counts, packed (prepareContacts)
     ImpactScratch impactScratch_;         // which constraints_ touch which body (propagateImpacts)
     std::vector<CachedImpulse> cache_;
     std::vector<CachedImpulse> previousCache_;     // the cache the last step started from (undoSolverState)

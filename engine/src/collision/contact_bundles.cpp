@@ -287,7 +287,8 @@ void fillLane(ContactBundle<Points>& bundle, int lane, const ContactConstraint& 
 /// `out`; lanes left over stay unused (all zero: static body 0 against itself).
 template <int Points>
 void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32_t> order,
-            std::span<const ContactConstraint> contacts, std::span<const SolverBody> bodies) {
+            std::span<const ContactConstraint> contacts, std::span<const std::uint32_t> pairBodies,
+            std::span<const SolverBody> bodies) {
     const std::size_t first = out.size(), count = (order.size() + kContactLanes - 1) / kContactLanes;
     out.resize(first + count);
     // fillLane sets every field of a used lane; only the last bundle can
@@ -295,8 +296,9 @@ void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32
     if (count > 0) std::memset(static_cast<void*>(&out.back()), 0, sizeof(ContactBundle<Points>));
     // A colour's contacts are scattered through `contacts` (about 240 bytes
     // each) and their bodies through `bodies`: the copy waits on memory, not
-    // arithmetic. Fetch the contacts a few lanes ahead, and the bodies of
-    // those whose contact has had time to arrive.
+    // arithmetic. Fetch the contacts a few lanes ahead, and the bodies a few
+    // lanes ahead too, named by the packed pairs (reading them from a contact
+    // fetched only lanes before waited on that contact).
     constexpr std::size_t kContactAhead = 8, kBodiesAhead = 4;
     for (std::size_t k = 0; k < order.size(); ++k) {
         if (k + kContactAhead < order.size()) {
@@ -306,11 +308,13 @@ void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32
         if (k + kBodiesAhead < order.size()) {
             // Both lines of each body: the inverse inertia sits on the
             // second (the iterations' fields fill the first).
-            const ContactConstraint& ahead = contacts[order[k + kBodiesAhead]];
-            __builtin_prefetch(&bodies[ahead.bodyA]);
-            __builtin_prefetch(&bodies[ahead.bodyA].invInertia);
-            __builtin_prefetch(&bodies[ahead.bodyB]);
-            __builtin_prefetch(&bodies[ahead.bodyB].invInertia);
+            const std::size_t ahead = order[k + kBodiesAhead];
+            const SolverBody& a = bodies[pairBodies[2 * ahead]];
+            const SolverBody& b = bodies[pairBodies[2 * ahead + 1]];
+            __builtin_prefetch(&a);
+            __builtin_prefetch(&a.invInertia);
+            __builtin_prefetch(&b);
+            __builtin_prefetch(&b.invInertia);
         }
         fillLane(out[first + k / kContactLanes], int(k % kContactLanes), contacts[order[k]], order[k], bodies);
     }
@@ -345,8 +349,8 @@ void storeLanes(std::span<const ContactBundle<Points>> bundles, std::span<Contac
 
 } // namespace
 
-void ColouredContacts::build(std::span<const ContactConstraint> contacts, std::span<const SolverBody> bodies,
-                             bool simd) {
+void ColouredContacts::build(std::span<const ContactConstraint> contacts, const ContactPairs& pairs,
+                             std::span<const SolverBody> bodies, bool simd) {
     simd_ = simd;
     const std::size_t n = contacts.size();
     colourMask_.assign(bodies.size(), 0u);
@@ -354,13 +358,15 @@ void ColouredContacts::build(std::span<const ContactConstraint> contacts, std::s
     // Counts per (colour, point count); the overflow is colour kContactColours.
     std::uint32_t counts[kContactColours + 1][2] = {};
     constexpr std::uint32_t kAllColours = (1u << kContactColours) - 1u;
+    // From the packed pairs, not the 232-byte contacts (ContactPairs).
     for (std::size_t k = 0; k < n; ++k) {
-        const ContactConstraint& c = contacts[k];
+        const std::uint32_t bodyA = pairs.bodies[2 * k], bodyB = pairs.bodies[2 * k + 1];
+        const bool two = pairs.twoPoints[k] != 0;
         // Static body 0 is in no colour: any number of contacts of one colour
         // may touch it (it never moves, so they do not interact through it).
-        const std::uint32_t used = (c.bodyA != 0 ? colourMask_[c.bodyA] : 0u) | (c.bodyB != 0 ? colourMask_[c.bodyB] : 0u);
+        const std::uint32_t used = (bodyA != 0 ? colourMask_[bodyA] : 0u) | (bodyB != 0 ? colourMask_[bodyB] : 0u);
         std::uint32_t free = ~used & kAllColours;
-        if (c.pointCount == 2 && used != 0) {
+        if (two && used != 0) {
             // Two-point manifolds (boxes, polygons: stacks) take the first
             // colour above every colour their bodies already have, wrapping
             // only when none is left. The contacts come roughly bottom-up
@@ -379,11 +385,11 @@ void ColouredContacts::build(std::span<const ContactConstraint> contacts, std::s
         int colour = kContactColours;
         if (free != 0) {
             colour = std::countr_zero(free);
-            if (c.bodyA != 0) colourMask_[c.bodyA] |= 1u << colour;
-            if (c.bodyB != 0) colourMask_[c.bodyB] |= 1u << colour;
+            if (bodyA != 0) colourMask_[bodyA] |= 1u << colour;
+            if (bodyB != 0) colourMask_[bodyB] |= 1u << colour;
         }
         colourOf_[k] = std::uint8_t(colour);
-        ++counts[colour][c.pointCount == 2 ? 1 : 0];
+        ++counts[colour][two ? 1 : 0];
     }
     colourCount_ = 0;
     for (int colour = 0; colour < kContactColours; ++colour)
@@ -407,7 +413,7 @@ void ColouredContacts::build(std::span<const ContactConstraint> contacts, std::s
         std::uint32_t cursor[kContactColours + 1][2];
         std::memcpy(cursor, start, sizeof cursor);
         for (std::size_t k = 0; k < n; ++k)
-            order_[cursor[colourOf_[k]][contacts[k].pointCount == 2 ? 1 : 0]++] = std::uint32_t(k);
+            order_[cursor[colourOf_[k]][pairs.twoPoints[k]]++] = std::uint32_t(k);
     }
     one_.clear();
     two_.clear();
@@ -418,8 +424,8 @@ void ColouredContacts::build(std::span<const ContactConstraint> contacts, std::s
         oneStart_[std::size_t(colour)] = std::uint32_t(one_.size());
         twoStart_[std::size_t(colour)] = std::uint32_t(two_.size());
         const std::span<const std::uint32_t> all(order_);
-        bundle<1>(one_, all.subspan(start[colour][0], counts[colour][0]), contacts, bodies);
-        bundle<2>(two_, all.subspan(start[colour][1], counts[colour][1]), contacts, bodies);
+        bundle<1>(one_, all.subspan(start[colour][0], counts[colour][0]), contacts, pairs.bodies, bodies);
+        bundle<2>(two_, all.subspan(start[colour][1], counts[colour][1]), contacts, pairs.bodies, bodies);
     }
     oneStart_[std::size_t(colourCount_)] = std::uint32_t(one_.size());
     twoStart_[std::size_t(colourCount_)] = std::uint32_t(two_.size());

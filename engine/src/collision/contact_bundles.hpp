@@ -81,7 +81,8 @@ public:
     /// takes the first colour that neither of its dynamic bodies has yet;
     /// static body 0 never blocks a colour. `simd` picks the path for the
     /// whole step (SolverSettings::simd).
-    void build(std::span<const ContactConstraint> contacts, std::span<const SolverBody> bodies, bool simd);
+    void build(std::span<const ContactConstraint> contacts, const ContactPairs& pairs,
+               std::span<const SolverBody> bodies, bool simd);
     void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies);
     /// One pass over the colours (then the overflow), or backwards.
     void solve(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h, const Softness& soft,

@@ -50,13 +50,21 @@ Softness Softness::make(double hertz, double dampingRatio, double h) {
 }
 
 void prepareContacts(std::span<ContactConstraint> contacts, std::span<const ContactDetail> details,
-                     std::span<const SolverBody> bodies) {
+                     std::span<const SolverBody> bodies, ContactPairs& pairs) {
+    pairs.bodies.resize(2 * contacts.size());
+    pairs.twoPoints.resize(contacts.size());
+    pairs.reach.assign(bodies.size(), 0.0);
     for (std::size_t k = 0; k < contacts.size(); ++k) {
         ContactConstraint& c = contacts[k];
         const SolverBody& a = bodies[c.bodyA];
         const SolverBody& b = bodies[c.bodyB];
+        pairs.bodies[2 * k] = c.bodyA;
+        pairs.bodies[2 * k + 1] = c.bodyB;
+        pairs.twoPoints[k] = c.pointCount == 2 ? 1 : 0;
         for (int i = 0; i < c.pointCount; ++i) {
             ContactPoint& p = c.points[i];
+            pairs.reach[c.bodyA] = std::max(pairs.reach[c.bodyA], std::abs(p.rnA));
+            pairs.reach[c.bodyB] = std::max(pairs.reach[c.bodyB], std::abs(p.rnB));
             p.normalMass = effectiveMass(a, b, p.rnA, p.rnB);
             p.tangentMass = effectiveMass(a, b, -p.dnA, -p.dnB);
             p.adjustedSeparation = details[k].separation[i] - (p.dnB - p.dnA);
@@ -88,59 +96,40 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
     }
 }
 
-void indexImpacts(std::span<const ContactConstraint> contacts, std::size_t bodyCount, ImpactScratch& scratch) {
-    scratch.reach.assign(bodyCount, 0.0);
-    scratch.looked = scratch.fired = 0;
-    scratch.pairsReady = false;
-    scratch.incidentReady = false;
-    for (std::size_t k = 0; k < contacts.size(); ++k) {
-        const ContactConstraint& c = contacts[k];
-        for (int i = 0; i < c.pointCount; ++i) {
-            scratch.reach[c.bodyA] = std::max(scratch.reach[c.bodyA], std::abs(c.points[i].rnA));
-            scratch.reach[c.bodyB] = std::max(scratch.reach[c.bodyB], std::abs(c.points[i].rnB));
-        }
-    }
-}
-
 namespace {
 
-/// The contacts' bodies and restitutions, packed; made by the first
-/// substep that finds two bodies fast enough to look at contacts (a
-/// resting pile never does, and then never reads its details).
-void packPairs(std::span<const ContactConstraint> contacts, std::span<const ContactDetail> details,
-               ImpactScratch& scratch) {
-    scratch.pairBodies.resize(2 * contacts.size());
-    scratch.restitution.resize(contacts.size());
-    scratch.impulse.assign(contacts.size(), 0.0);
-    for (std::size_t k = 0; k < contacts.size(); ++k) {
-        scratch.pairBodies[2 * k] = contacts[k].bodyA;
-        scratch.pairBodies[2 * k + 1] = contacts[k].bodyB;
-        scratch.restitution[k] = details[k].restitution;
-    }
+/// The contacts' restitutions, packed, and their impulses zeroed; made by
+/// the first substep that finds two bodies fast enough to look at contacts
+/// (a resting pile never does, and then never reads its details).
+void packRestitution(std::span<const ContactDetail> details, ImpactScratch& scratch) {
+    scratch.restitution.resize(details.size());
+    scratch.impulse.assign(details.size(), 0.0);
+    for (std::size_t k = 0; k < details.size(); ++k) scratch.restitution[k] = details[k].restitution;
     scratch.pairsReady = true;
 }
 
 /// Which contacts touch which body, from the packed pairs: a counting sort
 /// of (body, contact) by body. Static body 0 never changes velocity, so it
 /// lists nothing.
-void indexIncident(std::size_t contactCount, std::size_t bodyCount, ImpactScratch& scratch) {
+void indexIncident(std::span<const std::uint32_t> pairBodies, std::size_t bodyCount, ImpactScratch& scratch) {
+    const std::size_t contactCount = pairBodies.size() / 2;
     scratch.start.assign(bodyCount + 1, 0u);
     for (std::size_t k = 0; k < 2 * contactCount; ++k)
-        if (const std::uint32_t b = scratch.pairBodies[k]; b != 0) ++scratch.start[b + 1];
+        if (const std::uint32_t b = pairBodies[k]; b != 0) ++scratch.start[b + 1];
     for (std::size_t b = 0; b < bodyCount; ++b) scratch.start[b + 1] += scratch.start[b];
     scratch.incident.resize(scratch.start[bodyCount]);
     std::vector<std::uint32_t>& at = scratch.now32;  // next free slot per body
     at.assign(scratch.start.begin(), scratch.start.end() - 1);
     for (std::size_t k = 0; k < 2 * contactCount; ++k)
-        if (const std::uint32_t b = scratch.pairBodies[k]; b != 0) scratch.incident[at[b]++] = std::uint32_t(k / 2);
+        if (const std::uint32_t b = pairBodies[k]; b != 0) scratch.incident[at[b]++] = std::uint32_t(k / 2);
     scratch.incidentReady = true;
 }
 
 } // namespace
 
 void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDetail> details,
-                      std::span<SolverBody> bodies, double h, double threshold, int maxPasses,
-                      ImpactScratch& scratch) {
+                      std::span<SolverBody> bodies, const ContactPairs& pairs, double h, double threshold,
+                      int maxPasses, ImpactScratch& scratch) {
     // Touching within this many metres counts as an impact (Box2D's linear
     // slop): without it a pair that closes its gap exactly at the end of a
     // substep would be stopped by the speculative constraint instead.
@@ -193,7 +182,7 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
     std::vector<double>& bound = scratch.bound;
     const auto boundOf = [&](const SolverBody& b) {
         return (std::abs(b.v.x - u.x) + std::abs(b.v.y - u.y)) +
-               std::abs(b.w) * scratch.reach[std::size_t(&b - bodies.data())];
+               std::abs(b.w) * pairs.reach[std::size_t(&b - bodies.data())];
     };
     bound.resize(bodies.size());
     double fastest = 0.0;
@@ -210,9 +199,9 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
     // would be passed over.
     const bool every = scratch.lookAtEveryContact;
     if (fastest + fastest < quiet && !every) return;
-    if (!scratch.pairsReady) packPairs(contacts, details, scratch);
+    if (!scratch.pairsReady) packRestitution(details, scratch);
     const auto passedOver = [&](std::size_t k) {
-        return !every && bound[scratch.pairBodies[2 * k]] + bound[scratch.pairBodies[2 * k + 1]] < quiet;
+        return !every && bound[pairs.bodies[2 * k]] + bound[pairs.bodies[2 * k + 1]] < quiet;
     };
     // The first pass: the contacts not passed over at the start velocities.
     now.assign(words, 0);
@@ -222,7 +211,7 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
     // in this pass if it comes after k, else in the next pass (k included).
     const auto touched = [&](std::uint32_t body, std::size_t k) {
         if (body == 0) return;
-        if (!scratch.incidentReady) indexIncident(contacts.size(), bodies.size(), scratch);
+        if (!scratch.incidentReady) indexIncident(pairs.bodies, bodies.size(), scratch);
         for (std::uint32_t i = scratch.start[body]; i < scratch.start[body + 1]; ++i) {
             const std::uint32_t m = scratch.incident[i];
             (m > k ? now : next)[m / 64] |= std::uint64_t(1) << (m % 64);

@@ -133,10 +133,22 @@ struct SolverSettings {
 /// (metres, negative when overlapping).
 double currentSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c, const ContactPoint& p);
 
+/// What the colouring and the impact passes read of every contact, packed
+/// side by side. A ContactConstraint is 232 bytes: a pass that streamed the
+/// whole array for its bodies and point count read it from memory again
+/// (on Box2D's many pyramids, 13 MB for 0.5 MB of pairs).
+struct ContactPairs {
+    std::vector<std::uint32_t> bodies;    ///< contact k's bodyA, bodyB at 2k, 2k + 1
+    std::vector<std::uint8_t> twoPoints;  ///< 1 when contact k has two points
+    /// Per solver body: the largest |rn| of its contact points this step (m).
+    std::vector<double> reach;
+};
+
 /// Prepares masses, the block solve's 2x2 systems and adjusted separations
-/// (once per step, after the narrow phase).
+/// (once per step, after the narrow phase), and packs `pairs` in the same
+/// pass over the contacts.
 void prepareContacts(std::span<ContactConstraint> contacts, std::span<const ContactDetail> details,
-                     std::span<const SolverBody> bodies);
+                     std::span<const SolverBody> bodies, ContactPairs& pairs);
 
 /// Impact propagation, run at the start of each substep on the
 /// unconstrained velocities: repeatedly applies a pairwise impact
@@ -149,10 +161,11 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
 /// contact was last looked at (or that fired then): the others would find
 /// what they found before and do nothing, so the result is that of passes
 /// over every contact, at the cost of the contacts that move. `scratch` holds
-/// which contacts touch which body; indexImpacts resets it once a step, and
+/// which contacts touch which body; startStep resets it once a step, and
 /// the first impulse of the step lists them (most steps of a resting scene
 /// have none). The impulses each contact received are kept packed in the
-/// scratch and go to the details in storeImpacts, once a step.
+/// scratch and go to the details in storeImpacts, once a step. The
+/// contacts' bodies and the bodies' reaches come from ContactPairs.
 struct ImpactScratch {
     /// Full passes over every contact, no contact passed over: the result
     /// the marks and bounds must reproduce bit for bit (tests compare the two).
@@ -161,17 +174,16 @@ struct ImpactScratch {
     /// they applied (statistics: tests check that a pile moving together is
     /// passed over).
     std::size_t looked = 0, fired = 0;
-    bool pairsReady = false;              ///< pairBodies and restitution hold this step's contacts
+    bool pairsReady = false;              ///< restitution and impulse hold this step's contacts
     bool incidentReady = false;           ///< start and incident list this step's contacts
     std::vector<std::uint32_t> start;     ///< solver body b's contacts: incident[start[b], start[b + 1])
     std::vector<std::uint32_t> incident;  ///< contact indices, ascending per body
     std::vector<std::uint64_t> now, next;  ///< contacts to look at in this pass and the next (bit sets)
     std::vector<std::uint32_t> now32;      ///< the listing's cursor per body
-    /// Per solver body: the largest |rn| of its contact points this step
-    /// (m), and at the start of a substep a bound on the normal speed any
-    /// of its points can have, |v.x| + |v.y| + |w| reach (m/s).
-    std::vector<double> reach, bound;
-    std::vector<std::uint32_t> pairBodies;  ///< bodyA, bodyB of each contact, packed
+    /// Per solver body, at the start of a substep: a bound on the normal
+    /// speed any of its points can have, |v.x - u.x| + |v.y - u.y| + |w|
+    /// reach (m/s).
+    std::vector<double> bound;
     /// Each contact's restitution (ContactDetail::restitution), packed: a
     /// crowd's approaching contacts all read it, and a detail is 88 bytes.
     std::vector<double> restitution;
@@ -180,15 +192,19 @@ struct ImpactScratch {
     /// details, whose scattered writes were half the passes' cost in a
     /// churned pile.
     std::vector<double> impulse;
+    /// Forgets the last step's contacts (once a step, after detection).
+    void startStep() {
+        looked = fired = 0;
+        pairsReady = incidentReady = false;
+    }
 };
-void indexImpacts(std::span<const ContactConstraint> contacts, std::size_t bodyCount, ImpactScratch& scratch);
 /// Writes this step's propagated impulses to details[k].restitutionImpulse,
 /// once.
 void storeImpacts(std::span<const ContactConstraint> contacts, std::span<ContactDetail> details,
                   ImpactScratch& scratch);
 void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDetail> details,
-                      std::span<SolverBody> bodies, double h, double threshold, int maxPasses,
-                      ImpactScratch& scratch);
+                      std::span<SolverBody> bodies, const ContactPairs& pairs, double h, double threshold,
+                      int maxPasses, ImpactScratch& scratch);
 
 /// Applies the accumulated impulses of contacts[order[0]], contacts[order[1]], ...
 void warmStart(std::span<ContactConstraint> contacts, std::span<const std::uint32_t> order,
