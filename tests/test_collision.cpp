@@ -761,3 +761,50 @@ TEST(ImpactPropagation, PassingContactsOverGivesTheBitsOfFullPassesInAnyFrame) {
         120, "pyramid", resting);
     EXPECT_LT(resting.ratio, 0.25) << "the resting pyramid's contacts were read, not passed over";
 }
+
+TEST(BroadPhase, ShapesWhoseFiltersExcludeEveryPairFindNoPairsAndGiveTheSameBits) {
+    // Box2D's joint grid: circles that overlap but whose filters exclude one
+    // another (category 2, every mask bit but 2). The broad phase has
+    // nothing to find; a far static circle that could collide with them
+    // makes it run, and must change nothing else.
+    Filter apart;
+    apart.category = 2;
+    apart.mask = ~2u;
+    const auto make = [&](bool farCircle) {
+        MiniWorld w;
+        w.gravity = {0.0, -10.0};
+        for (int i = 0; i < 100; ++i) {
+            const int body = int(w.x.size());
+            w.x.push_back({1.0 * (i % 10), 1.0 * (i / 10)});
+            w.v.push_back({0.1 * (i % 3), 0.0});
+            w.mass.push_back(1.0);
+            Collider c;
+            c.shape = circle(0.6);  // neighbours overlap by 0.2 m
+            c.body = body;
+            c.mass = 1.0;
+            c.entity = Entity{std::uint32_t(w.collision.colliderCount()), 0};
+            w.collision.add(c, 0.0, 0.0, apart);
+        }
+        if (farCircle) w.fixed(circle(1.0), {1000.0, 1000.0});
+        return w;
+    };
+    MiniWorld skipped = make(false), searched = make(true);
+    for (int i = 0; i < 30; ++i) {
+        skipped.step(1.0 / 60.0);
+        searched.step(1.0 / 60.0);
+        ASSERT_EQ(skipped.collision.candidatePairCount(), 0u) << "step " << i;
+        ASSERT_GT(searched.collision.candidatePairCount(), 100u) << "step " << i;
+        ASSERT_EQ(searched.collision.manifoldCount(), 0u) << "step " << i;
+        for (std::size_t b = 0; b < skipped.x.size(); ++b) {
+            ASSERT_EQ(bitsOf(skipped.x[b].x), bitsOf(searched.x[b].x)) << "step " << i << ", body " << b;
+            ASSERT_EQ(bitsOf(skipped.x[b].y), bitsOf(searched.x[b].y)) << "step " << i << ", body " << b;
+            ASSERT_EQ(bitsOf(skipped.v[b].y), bitsOf(searched.v[b].y)) << "step " << i << ", body " << b;
+        }
+    }
+    // A shape that can meet them, added mid-run, is found the next step.
+    const Vec2 below = skipped.x[0] + Vec2{0.0, -1.0};
+    skipped.dynamic(circle(0.5), below, skipped.v[0], 1.0);
+    skipped.step(1.0 / 60.0);
+    EXPECT_GT(skipped.collision.candidatePairCount(), 0u);
+    EXPECT_GT(skipped.collision.manifoldCount(), 0u) << "the added circle touches the grid's corner";
+}

@@ -100,6 +100,7 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
         const std::size_t hub = std::size_t(c.hub);
         filtered_ = filtered_ || !(filter == Filter{});
         filters_.push_back(filter);
+        collidableKnown_ = false;
         anyKinematic_ = anyKinematic_ || c.kinematic;
         anySensor_ = anySensor_ || c.sensor;
         colliderAsleep_.push_back(0);
@@ -123,6 +124,7 @@ void CollisionSystem::add(const Collider& c, double angle, double angularVelocit
     const bool dynamic = c.body >= 0 && (c.mass > 0.0 || c.kinematic);
     filtered_ = filtered_ || !(filter == Filter{});
     filters_.push_back(filter);
+    collidableKnown_ = false;
     anyKinematic_ = anyKinematic_ || c.kinematic;
     anySensor_ = anySensor_ || c.sensor;
     colliderAsleep_.push_back(0);
@@ -189,6 +191,7 @@ void CollisionSystem::reshape(std::size_t i, const Collider& fresh, const Filter
     c.restitution = fresh.restitution;
     filters_[i] = filter;
     filtered_ = filtered_ || !(filter == Filter{});
+    collidableKnown_ = false;
     maxExtent_[i] = shapeReach(c.shape);
     // The sweep's test of a fast body reads the smallest reach it noted
     // when it first ran (one shape: compound bodies are not reshaped).
@@ -415,7 +418,7 @@ void CollisionSystem::removed(std::span<const std::uint8_t> dropCollider, std::s
     keepMarked(bodies_, solverMap);
     for (auto* list : {&finite_, &planes_, &offsetBodies_, &shapesOfHubs_, &awakeShapesOfHubs_, &awakeSolverColliders_})
         renumber(*list, colliderMap);
-    filtered_ = anyKinematic_ = anySensor_ = false;
+    filtered_ = anyKinematic_ = anySensor_ = collidableKnown_ = false;
     for (std::size_t c = 0; c < colliders_.size(); ++c) {
         filtered_ = filtered_ || !(filters_[c] == Filter{});
         anyKinematic_ = anyKinematic_ || colliders_[c].kinematic;
@@ -697,6 +700,36 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
     if (woken.empty()) return true;
     for (const std::uint32_t body : woken) wakeBody_(body);
     return false;
+}
+
+bool CollisionSystem::nothingCanCollide() {
+    if (collidableKnown_) return nothingCollides_;
+    collidableKnown_ = true;
+    nothingCollides_ = false;
+    // Sensors sense what their filter lets through, and with no filter
+    // every pair may collide.
+    if (anySensor_ || !filtered_) return false;
+    // The distinct filters of the shapes in the broad phase and the planes,
+    // and whether each is held by two or more: a level has a handful.
+    constexpr std::size_t kFewFilters = 16;
+    std::vector<std::pair<Filter, std::size_t>> distinct;
+    for (const std::vector<std::uint32_t>* list : {&finite_, &planes_})
+        for (const std::uint32_t c : *list) {
+            const Filter& f = filters_[c];
+            const auto same = std::find_if(distinct.begin(), distinct.end(), [&](const auto& d) { return d.first == f; });
+            if (same != distinct.end()) {
+                ++same->second;
+            } else if (distinct.size() == kFewFilters) {
+                return false;  // many kinds of shape: not worth finding out
+            } else {
+                distinct.emplace_back(f, 1);
+            }
+        }
+    for (std::size_t i = 0; i < distinct.size(); ++i)
+        for (std::size_t j = i; j < distinct.size(); ++j)
+            if ((j != i || distinct[i].second > 1) && shouldCollide(distinct[i].first, distinct[j].first)) return false;
+    nothingCollides_ = true;
+    return true;
 }
 
 bool CollisionSystem::joinedNotColliding(std::uint32_t a, std::uint32_t b) const {
@@ -1015,7 +1048,11 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
         rots[i] = kind == ShapeKind::Circle || kind == ShapeKind::Plane ? Rot{} : Rot::fromAngle(angles_[i]);
     });
 
-    if (anySleeping_) {
+    if (nothingCanCollide()) {
+        // No pair could make a contact: no boxes, no pairs (and no crowd).
+        pairs_.clear();
+        crowdBodies_.clear();
+    } else if (anySleeping_) {
         if (!sleepingBroadPhase(rots, ref0, ref1)) {
             refreshSleeping(stepStartX_);  // the woken island's shapes join the awake ones
             continue;

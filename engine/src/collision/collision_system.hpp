@@ -460,6 +460,12 @@ private:
     /// Each collider's filter, kept apart from the colliders: only a level
     /// with filters reads it.
     std::vector<Filter> filters_;
+    /// Whether the filters let no two shapes meet (Box2D's joint grid: its
+    /// circles all exclude one another), and whether that is known for the
+    /// colliders as they are (any add, reshape or removal makes it unknown).
+    /// Such a scene builds no boxes and finds no pairs.
+    bool nothingCanCollide();
+    bool nothingCollides_ = false, collidableKnown_ = false;
     /// Sensors: whether there are any, the pairs the broad phase found for
     /// them this step (sensor collider << 32 | other), the overlapping ones
     /// at the end of the last step (sorted, same keys), and its events.

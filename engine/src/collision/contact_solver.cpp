@@ -154,12 +154,12 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
     // the median velocity of up to 63 moving bodies spread through the list
     // (each component's median; over all bodies it would make the bounds'
     // sum least, and cost more than the passes it saves). Every body a
-    // substep's gravity has just given g h (half the threshold's half) is
-    // measured from that shared velocity, so a resting pyramid, which sways
-    // by millimetres a second, passes nearly all its contacts over, where
-    // measured from rest the sway plus g h on both bodies put most of them
-    // past the threshold. (A mean would follow a few fast strikers and put
-    // a resting block in motion.)
+    // substep's gravity has just given g h (a quarter of the default
+    // threshold) is measured from that shared velocity, so a resting
+    // pyramid, which sways by millimetres a second, passes nearly all its
+    // contacts over, where measured from rest the sway plus g h on both
+    // bodies put most of them past the threshold. (A mean would follow a few
+    // fast strikers and put a resting block in motion.)
     constexpr std::size_t kSample = 63;
     double xs[kSample], ys[kSample];
     std::size_t sampled = 0;
