@@ -564,3 +564,33 @@ TEST(Sleep, AFileThatSplitsAJoinedGroupWakesBothIslands) {
     EXPECT_EQ(sleepingAfterLoad(level(hinge, "")), 0u) << "the awake bob is joined to the sleeping crate";
     EXPECT_EQ(sleepingAfterLoad(level(hinge, bobAsleepAlone)), 0u) << "two islands the joint makes one";
 }
+
+// A step's statistics count its contact points without making the records
+// (the count is taken as the step ends): it must be the number of records
+// contacts() then makes, while islands fall asleep, wake, and whether or not
+// anyone asked for the records of the steps between.
+TEST(Sleep, TheStepsContactCountIsTheNumberOfItsRecords) {
+    Scene scene = boxStacks(2, 4, true);
+    addBall(scene, {0.0, 9.5});                     // lands on stack 0 after it sleeps
+    const Entity fast = addBall(scene, {4.0, 0.3});  // rolls into stack 1
+    scene.registry.emplace<Velocity>(fast, Velocity{{6.0, 0.0}});
+    World asked = build(scene), unasked = build(scene);
+    std::size_t slept = 0, most = 0, before = 0;
+    bool woke = false;
+    for (int k = 0; k < 240; ++k) {
+        ASSERT_TRUE(asked.step().ok());
+        ASSERT_TRUE(unasked.step().ok());
+        const std::size_t count = asked.lastStats().contactCount;
+        const std::size_t records = asked.contacts().size();
+        ASSERT_EQ(count, records) << "step " << k;
+        ASSERT_EQ(unasked.lastStats().contactCount, records) << "step " << k;
+        if (k % 7 == 0) ASSERT_EQ(unasked.contacts().size(), records) << "step " << k;
+        slept = std::max(slept, asked.sleepingBodyCount());
+        woke = woke || asked.sleepingBodyCount() < before;
+        before = asked.sleepingBodyCount();
+        most = std::max(most, records);
+    }
+    EXPECT_GE(slept, 4u) << "no island fell asleep";
+    EXPECT_TRUE(woke) << "no island woke";
+    EXPECT_GT(most, 10u);
+}

@@ -1638,13 +1638,7 @@ void CollisionSystem::makeRecords() const {
 }
 
 std::size_t CollisionSystem::contactPointCount() const {
-    if (!recordsPending_) return records_.size();
-    std::size_t count = records_.size();
-    const std::vector<ContactConstraint>& constraints = recordedConstraints();
-    const std::vector<ContactDetail>& details = recordedDetails();
-    for (std::size_t k = 0; k < constraints.size(); ++k)
-        for (int i = 0; i < constraints[k].pointCount; ++i) count += isRecord(constraints[k], details[k], i) ? 1 : 0;
-    return count;
+    return records_.size() + (recordsPending_ ? pendingRecordCount_ : 0);
 }
 
 void CollisionSystem::endStep() {
@@ -1666,6 +1660,7 @@ void CollisionSystem::endStep() {
     // run that never looks at them does not pay for them.
     recordsPending_ = true;
     recordsFromKept_ = false;
+    pendingRecordCount_ = 0;
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
         const ContactConstraint& c = constraints_[k];
         const ContactDetail& d = details_[k];
@@ -1678,6 +1673,7 @@ void CollisionSystem::endStep() {
             const ContactPoint& p = c.points[i];
             const std::uint64_t key = CachedImpulse::makeKey(d.colliderA, d.colliderB, d.id[i]);
             cache_.push_back({key, p.normalImpulse, p.tangentImpulse});
+            pendingRecordCount_ += isRecord(c, d, i) ? 1 : 0;
         }
     }
     jointRecords_.clear();

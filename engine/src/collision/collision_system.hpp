@@ -431,6 +431,10 @@ private:
     mutable std::vector<ContactRecord> records_;
     mutable bool recordsPending_ = false;
     bool recordsFromKept_ = false;
+    /// How many records the pending manifolds will make, counted by endStep
+    /// as it reads them for the cache: every step's statistics ask, and a
+    /// count of its own read every manifold from memory again.
+    std::size_t pendingRecordCount_ = 0;
     std::vector<ContactConstraint> keptConstraints_;
     std::vector<ContactDetail> keptDetails_;
     void makeRecords() const;
