@@ -1470,7 +1470,9 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
 }
 
 void CollisionSystem::correctStepPositions(std::span<Vec2> x) {
-    if (!correctPositions(constraints_, bodies_, inCrowd_, positionCorrection_, positionScratch_)) return;
+    const bool corrected = correctPositions(constraints_, bodies_, inCrowd_, positionCorrection_, positionScratch_);
+    const bool turned = correctTurnedAgainstStatic(corrected);
+    if (!corrected && !turned) return;
     // Back from the centre of mass's move and the turn to the body's
     // position: p = c - R(angle) offset.
     for (const SolvedBody& sb : awakeSolved_) {
@@ -1485,6 +1487,151 @@ void CollisionSystem::correctStepPositions(std::span<Vec2> x) {
             x[sb.body] = stepStart_[i] + b.dp - rotate(Rot::fromAngle(angles_[i]), c.centreOfMass);
         }
     }
+}
+
+namespace {
+/// The radius that rounds a shape's outline: its ends, its corners or the
+/// whole shape (metres; 0 for a box).
+double roundingOf(const Shape& shape) {
+    switch (shape.kind) {
+    case ShapeKind::Circle:
+    case ShapeKind::Capsule: return shape.radius;
+    case ShapeKind::Polygon: return shape.polygon->cornerRadius;
+    case ShapeKind::Box:
+    case ShapeKind::Plane:
+    case ShapeKind::ChainSegment: return 0.0;
+    }
+    return 0.0;
+}
+} // namespace
+
+CollisionSystem::PresentPose CollisionSystem::presentPose(std::uint32_t shape, const SolverBody& body) const {
+    // The body's centre of mass moved by dp; the shape turned with the body
+    // by dq about it.
+    const Vec2 startCentre = centres_[ownerOf(shape)];
+    const Vec2 centre = startCentre + body.dp;
+    const Rot q0 = rotScratch_[shape];
+    return {centre, centre + rotate(body.dq, centres_[shape] - startCentre),
+            Rot{body.dq.c * q0.c - body.dq.s * q0.s, body.dq.s * q0.c + body.dq.c * q0.s}};
+}
+
+bool CollisionSystem::correctTurnedAgainstStatic(bool scratchReady) {
+    // The step-start contacts follow the points they were found at exactly
+    // (currentSeparation). A body can meet the static world elsewhere only
+    // if it turned by more than the slop at its reach while touching it (a
+    // lone circle turns under its contact point and never does), or if it
+    // went farther than the motion its contacts were found for (the solve
+    // sped it up). Such a body's static neighbours are looked up afresh, as
+    // the sweep does: a chain segment answers only within its own length,
+    // so the segment a tumbling plank swings onto may have no contact yet.
+    const double slop = positionCorrection_.slop;
+    // The turn this step: the substeps' (in the angles) and the position
+    // pass's (not yet written to them).
+    const auto turnOf = [&](std::uint32_t owner, std::uint32_t solver) {
+        return (angles_[owner] - stepStartAngle_[owner]) + (scratchReady ? positionScratch_.turned[solver] : 0.0);
+    };
+    turnedBodies_.clear();
+    for (std::size_t k = 0; k < constraints_.size(); ++k) {
+        const ContactConstraint& c = constraints_[k];
+        // One side truly static: a kinematic side moved this step too.
+        if ((c.bodyA == 0) == (c.bodyB == 0)) continue;
+        const ContactDetail& d = details_[k];
+        const bool staticFirst = c.bodyA == 0;
+        const std::uint32_t moving = staticFirst ? d.colliderB : d.colliderA;
+        const Collider& shape = colliders_[moving];
+        if (shape.shape.kind == ShapeKind::Circle && shape.hub < 0) continue;
+        const std::uint32_t solver = staticFirst ? c.bodyB : c.bodyA;
+        const double turn = turnOf(ownerOf(moving), solver);
+        // A corner the contacts do not hold comes at most turn x reach
+        // nearer; a rounded part's nearest point moves off its anchor, which
+        // then lies r (1 - cos turn) short of it (kept under the position
+        // pass's own tolerance, a micrometre).
+        const bool cornerCanReach = std::abs(turn) * maxExtent_[moving] > slop;
+        if (!cornerCanReach) {
+            const double rounding = roundingOf(shape.shape), sinHalf = std::sin(0.5 * turn);
+            if (!(rounding > 0.0 && rounding * 2.0 * sinHalf * sinHalf > 1e-7)) continue;
+        }
+        turnedBodies_.push_back(solver);
+    }
+    std::sort(turnedBodies_.begin(), turnedBodies_.end());
+    if (!staticSweepReady_) prepareStaticSweep();
+    turnedContacts_.clear();
+    for (const SolvedBody& sb : awakeSolved_) {
+        const std::uint32_t i = sb.collider;
+        const Collider& owner = colliders_[i];
+        if (owner.kinematic) continue;
+        const SolverBody& b = bodies_[sb.solver];
+        const double travel = length(b.dp) + std::abs(turnOf(i, sb.solver)) * maxExtent_[i];
+        const double foreseen =
+            2.0 * kSpeculativeBase + dt_ * std::max(length(startV_[i]), length(endV_[i])) + spin_[i];
+        if (!(travel > foreseen) && !std::binary_search(turnedBodies_.begin(), turnedBodies_.end(), sb.solver))
+            continue;
+        const auto near = [&](std::uint32_t shape) {
+            const Collider& moving = colliders_[shape];
+            if (moving.sensor) return;
+            const auto take = [&](std::uint32_t fixed) {
+                const Collider& f = colliders_[fixed];
+                if (f.sensor || !collides(shape, fixed) || (!noCollide_.empty() && joinedNotColliding(shape, fixed)))
+                    return;
+                turnedContacts_.push_back({sb.solver, shape, fixed});
+            };
+            for (const std::uint32_t p : planes_) take(p);
+            if (staticBoxes_.empty()) return;
+            const PresentPose pose = presentPose(shape, b);
+            Aabb box = computeAabb(moving.shape, pose.at, pose.q);
+            box.lower -= Vec2{slop, slop};
+            box.upper += Vec2{slop, slop};
+            staticBoxes_.query(box, take);
+        };
+        if (!owner.solverOnly) {
+            near(i);
+        } else {
+            const auto first = std::lower_bound(hubShapes_.begin(), hubShapes_.end(), std::pair{i, 0u});
+            for (auto it = first; it != hubShapes_.end() && it->first == i; ++it) near(it->second);
+        }
+    }
+    if (turnedContacts_.empty()) return false;
+    // Each body's are together: the bodies were visited once each.
+    bool moved = false;
+    for (std::size_t begin = 0; begin < turnedContacts_.size();) {
+        const std::uint32_t solver = turnedContacts_[begin].solver;
+        std::size_t end = begin;
+        while (end < turnedContacts_.size() && turnedContacts_[end].solver == solver) ++end;
+        SolverBody& body = bodies_[solver];
+        double turned = 0.0;
+        for (int pass = 0; pass < positionCorrection_.maxPasses; ++pass) {
+            presentContacts_.clear();
+            for (std::size_t t = begin; t < end; ++t) {
+                const std::uint32_t moving = turnedContacts_[t].moving, fixed = turnedContacts_[t].fixed;
+                const PresentPose pose = presentPose(moving, body);
+                // Planes are placed by their normal and offset alone (as detect() calls them).
+                const bool plane = colliders_[fixed].shape.kind == ShapeKind::Plane;
+                // The narrow phase's least margin: a clipped manifold can
+                // lose its deep point when its other one lies beyond a zero
+                // margin (the points past the slop are all that act).
+                const Manifold m = collide(colliders_[fixed].shape, plane ? Vec2{} : centres_[fixed],
+                                           plane ? Rot{} : staticRots_[fixed], colliders_[moving].shape, pose.at,
+                                           pose.q, 2.0 * kSpeculativeBase);
+                for (int i = 0; i < m.pointCount; ++i)
+                    presentContacts_.push_back({m.normal, m.points[i].point - pose.centre, m.points[i].separation});
+            }
+            bool deep = false;
+            for (const PresentContact& p : presentContacts_) deep = deep || p.separation < -slop;
+            if (!deep) break;
+            // Before the first move: the scratch the write-back reads.
+            if (!scratchReady) {
+                positionScratch_.turned.assign(bodies_.size(), 0.0);
+                positionScratch_.moved.assign(bodies_.size(), 0);
+                scratchReady = true;
+            }
+            positionScratch_.moved[solver] = 1;
+            moved = true;
+            if (!(pushOutOfStatic(body, presentContacts_, positionCorrection_, turned) < -1e-6)) break;
+        }
+        if (turned != 0.0) positionScratch_.turned[solver] += turned;
+        begin = end;
+    }
+    return moved;
 }
 
 void CollisionSystem::prepareStaticSweep() {

@@ -324,6 +324,21 @@ private:
     /// After the step's last substep: positions out of overlap beyond the
     /// slop (position_correction.hpp), written back to `x` and the angles.
     void correctStepPositions(std::span<Vec2> x);
+    /// Part of the position pass: a body that turned far this step (a
+    /// tumbling box, a spinning capsule) can meet the static world with
+    /// features its step-start contacts do not hold (a corner that swung
+    /// down, the far side of a rounded end). Its static contacts are found
+    /// again at its present pose and it is pushed out to the slop along
+    /// them. Returns whether a body moved; `scratchReady`: the position
+    /// pass has sized positionScratch_ this step.
+    bool correctTurnedAgainstStatic(bool scratchReady);
+    /// Where a shape is within the step, from its body's move so far.
+    struct PresentPose {
+        Vec2 centre;  ///< the body's centre of mass, metres
+        Vec2 at;      ///< the shape's centre, metres
+        Rot q;        ///< the shape's rotation
+    };
+    PresentPose presentPose(std::uint32_t shape, const SolverBody& body) const;
     /// After the position pass: bodies that moved farther this step than
     /// their speculative margins allowed, swept against the static shapes
     /// near their path and put back where their centroid would pass into
@@ -537,6 +552,12 @@ private:
     int substepsDone_ = 0;  // of this step, counted by solveSubstep
     PositionCorrectionSettings positionCorrection_;
     PositionCorrectionScratch positionScratch_;
+    struct TurnedStaticContact {
+        std::uint32_t solver, moving, fixed;  // the body's solver index, its shape's collider, the static collider
+    };
+    std::vector<std::uint32_t> turnedBodies_;          // correctTurnedAgainstStatic's turned bodies (solver indices)
+    std::vector<TurnedStaticContact> turnedContacts_;  // and the static shapes near them, grouped by body
+    std::vector<PresentContact> presentContacts_;      // one body's static contacts at its present pose
 };
 
 } // namespace stepwise::collision

@@ -99,4 +99,32 @@ bool correctPositions(std::span<const ContactConstraint> contacts, std::span<Sol
     return true;
 }
 
+double pushOutOfStatic(SolverBody& body, std::span<const PresentContact> points,
+                       const PositionCorrectionSettings& settings, double& turned) {
+    if (!(body.invMass > 0.0)) return 0.0;
+    Vec2 moved;         // this pass's move of the centre of mass, metres
+    double turn = 0.0;  // and its turn, rad
+    double worst = 0.0;
+    for (const PresentContact& p : points) {
+        const double rn = cross(p.arm, p.normal);
+        // A point turned by a small angle a about the centre moves by
+        // a cross(arm, n) along n.
+        const double excess = p.separation + dot(moved, p.normal) + turn * rn + settings.slop;
+        if (excess >= 0.0) continue;
+        worst = std::min(worst, excess);
+        const double move = -excess;
+        const double turning = std::min(move, settings.maxTurningCorrection);
+        const double impulse = turning / (body.invMass + body.invInertia * rn * rn);
+        const double push = (move - turning) / body.invMass;
+        moved += (body.invMass * (impulse + push)) * p.normal;
+        turn += body.invInertia * rn * impulse;
+    }
+    body.dp += moved;
+    if (turn != 0.0) {
+        body.dq = turnedBy(body.dq, turn);
+        turned += turn;
+    }
+    return worst;
+}
+
 } // namespace stepwise::collision

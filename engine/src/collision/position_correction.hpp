@@ -29,7 +29,7 @@ struct PositionCorrectionSettings {
     /// turning it (the turn is linearised: a metre of correction through a
     /// corner would spin a box round).
     double maxTurningCorrection = 0.05;
-    int maxPasses = 8;               ///< at most, over the static contacts per step
+    int maxPasses = 16;              ///< at most, over the static contacts per step
 };
 
 /// What the pass moved: per solver body, the change of its angle (rad); its
@@ -49,5 +49,21 @@ struct PositionCorrectionScratch {
 bool correctPositions(std::span<const ContactConstraint> contacts, std::span<SolverBody> bodies,
                       std::span<const std::uint8_t> crowd, const PositionCorrectionSettings& settings,
                       PositionCorrectionScratch& scratch);
+
+/// Where a body, at its pose once the passes above have run, meets a static
+/// shape: a point of a manifold found afresh by the narrow phase.
+struct PresentContact {
+    Vec2 normal;              ///< unit, from the static shape into the body
+    Vec2 arm;                 ///< the point minus the body's centre of mass now, metres
+    double separation = 0.0;  ///< metres (< 0: overlap)
+};
+
+/// One pass of correctPositions' static rule over one body's contacts found
+/// at its present pose: each point deeper than the slop is moved back to
+/// it, the later points' depths following the earlier moves (linearised).
+/// The move is added to body.dp and body.dq and its turn (rad) to `turned`;
+/// returns the deepest excess past the slop it found (<= 0, metres).
+double pushOutOfStatic(SolverBody& body, std::span<const PresentContact> points,
+                       const PositionCorrectionSettings& settings, double& turned);
 
 } // namespace stepwise::collision
