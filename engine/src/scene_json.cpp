@@ -6,6 +6,7 @@
 
 #include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
+#include "stepwise/world.hpp"
 #include "stepwise/world_fields.hpp"
 
 #include "json_reader.hpp"
@@ -572,15 +573,19 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
             refuse(at, "unknown key \"" + key + "\" in solver_state. Known keys: contacts, joints, bodies, chosen");
         if (key == "chosen") {
             // What the engine chose for the run that wrote this file: the
-            // substeps and iterations (both required) and the contacts'
-            // stiffness cap (optional).
-            static constexpr std::array<std::string_view, 3> kChosenKeys{"substeps", "solver_iterations",
-                                                                         "contact_hertz_fraction"};
+            // substeps and iterations (both required), the contacts'
+            // stiffness cap and their stiffness (optional).
+            static constexpr std::array<std::string_view, 4> kChosenKeys{"substeps", "solver_iterations",
+                                                                         "contact_hertz_fraction", "contact_hertz"};
             ChosenSettings chosen;
             readEntry(value, at, "the engine's chosen settings", kChosenKeys, 2,
                       [&](const std::string& field, const Json& fv, const std::string& fa) {
                           if (field == "contact_hertz_fraction") {
                               chosen.contactHertzFraction = readNumber(fv, fa, NumberRange{0.0, 0.25, true});
+                              return;
+                          }
+                          if (field == "contact_hertz") {
+                              chosen.contactHertz = readNumber(fv, fa, NumberRange{kContactHertz, 1e9, false});
                               return;
                           }
                           const int count = int(readInteger(fv, fa, 1, 1000));
@@ -1262,6 +1267,7 @@ void appendSolverState(const SolverState& state, const Registry& registry, std::
                ", \"solver_iterations\": " + std::to_string(state.chosen->solverIterations);
         if (state.chosen->contactHertzFraction)
             out += ", \"contact_hertz_fraction\": " + number(*state.chosen->contactHertzFraction);
+        if (state.chosen->contactHertz) out += ", \"contact_hertz\": " + number(*state.chosen->contactHertz);
         out += "},\n";
     }
     out += "    \"contacts\": [";

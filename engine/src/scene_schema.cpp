@@ -236,7 +236,7 @@ std::string sceneJsonSchema() {
         {"properties", Json{{"chosen", Json{{"type", "object"},
                                             {"description", "what the engine chose for the run, run again on resume: the "
                                                             "substeps and solver_iterations of a level that leaves them "
-                                                            "out, and the contacts' stiffness cap"},
+                                                            "out, and the contacts' stiffness cap and stiffness"},
                                             {"additionalProperties", false},
                                             {"required", Json::array({"substeps", "solver_iterations"})},
                                             {"properties", Json{{"substeps", Json{{"type", "integer"}, {"minimum", 1}, {"maximum", 1000}}},
@@ -244,7 +244,12 @@ std::string sceneJsonSchema() {
                                                                 {"contact_hertz_fraction",
                                                                  Json{{"type", "number"}, {"exclusiveMinimum", 0}, {"maximum", 0.25},
                                                                       {"description", "the contacts' stiffness cap as a fraction of the "
-                                                                                      "substep rate (1/4, or 1/8 for a deep column)"}}}}}}},
+                                                                                      "substep rate (1/4, or 1/8 for a deep column)"}}},
+                                                                {"contact_hertz",
+                                                                 Json{{"type", "number"}, {"minimum", 60}, {"maximum", 1e9},
+                                                                      {"description", "the contacts' stiffness, Hz, when the engine raised "
+                                                                                      "it above 60 for a tall stack or a strong load "
+                                                                                      "(absent: 60)"}}}}}}},
                             {"contacts", Json{{"type", "array"}, {"items", contact}}},
                             {"joints", Json{{"type", "array"}, {"items", joint}}},
                             {"bodies", Json{{"type", "array"}, {"items", bodySleep}}}}}};

@@ -152,6 +152,10 @@ struct ChosenSettings {
     int solverIterations = 8;
     /// Absent in a file written without it: chosen again on load.
     std::optional<double> contactHertzFraction;
+    /// The contacts' stiffness, Hz, when the engine raised it above
+    /// kContactHertz (ContactSettingsChoice::contactHertz); absent with a
+    /// recorded contactHertzFraction: kContactHertz.
+    std::optional<double> contactHertz;
 
     friend bool operator==(const ChosenSettings&, const ChosenSettings&) = default;
 };

@@ -193,6 +193,13 @@ struct WorldState {
     void writeBack(Scene& scene) const;
 };
 
+/// The contacts' stiffness when no rule needs more, Hz (Box2D v3's is 30;
+/// 60 gives 4x less overlap in a 25-deep circle pile at the same cost).
+inline constexpr double kContactHertz = 60.0;
+/// The gravity kContactHertz serves, m/s^2: a stronger load may stiffen the
+/// contacts by up to sqrt(g / kReferenceGravity) (ContactSettingsChoice).
+inline constexpr double kReferenceGravity = 10.0;
+
 /// What the engine runs when a level gives no `substeps` (and no
 /// `solver_iterations`), decided from the scene's structure (its bodies,
 /// shapes, masses, joints and gravity) and, for stacks and impacts, from the
@@ -215,9 +222,12 @@ struct WorldState {
 ///    them) drives what it strikes at up to (1 + e) M / (M + m) of its
 ///    speed; that body's travel per substep stays under kImpactTravel of
 ///    its size (8 substeps at most).
-/// Contacts stop stiffening at 60 Hz (contactHertz): past 4 substeps, or 8
-/// for a deep column, so a contact rule that cannot hold stops where more
-/// substeps stop helping.
+/// Contacts stiffen with the substep rate up to 60 Hz (kContactHertz): past
+/// 4 substeps, or 8 for a deep column, more substeps stop helping. Under a
+/// load stronger than kReferenceGravity, a contact rule that cannot hold at
+/// 60 Hz (a tall stack, a strong load) raises the stiffness to what holds
+/// it, by up to sqrt(g / kReferenceGravity) (contactHertz), and takes the
+/// substeps that carry it, up to 16.
 /// docs/collisions.md "Substeps when the level gives none".
 struct ContactSettingsChoice {
     int substeps = 1;
@@ -257,6 +267,12 @@ struct ContactSettingsChoice {
     /// gravity (SolverSettings::hertzFraction); the rules above use the
     /// same cap.
     double hertzFraction = 0.25;
+    /// The contacts' stiffness, Hz: kContactHertz, or under a load past
+    /// kReferenceGravity what the pile, column and load rules need when they
+    /// fail there (at most kContactHertz sqrt(g / kReferenceGravity)); the
+    /// solver caps it at hertzFraction of the substep rate
+    /// (SolverSettings::contactHertz).
+    double contactHertz = kContactHertz;
     /// "pile 12 deep ...": what made the choice.
     std::string reason() const;
 };
@@ -299,18 +315,19 @@ inline constexpr double kLoopJointHertzFraction = 0.25;
 inline constexpr int kImpactMaxSubsteps = 8;
 /// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
 /// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
-/// compresses by load / (m_n omega^2), omega = 2 pi min(60 Hz, f / h) with
-/// f the contacts' cap (ContactSettingsChoice::hertzFraction),
+/// compresses by load / (m_n omega^2), omega = 2 pi min(contactHertz, f / h)
+/// with f the contacts' cap (ContactSettingsChoice::hertzFraction),
 /// with a factor measured on the 30-row pile (docs/collisions.md, "Substeps
 /// when the level gives none"). The lowest
 /// contact between bodies carries (depth - 1) heavy bodies on a light one:
 /// load (depth - 1) M g over m_n = m M / (m + M), i.e. (depth - 1)(1 + R)
 /// m_n g with R = M / m (2 (depth - 1) for equal bodies).
-double expectedPileOverlap(int depth, double gravity, double h, double massRatio = 1.0, double hertzFraction = 0.25);
+double expectedPileOverlap(int depth, double gravity, double h, double massRatio = 1.0, double hertzFraction = 0.25,
+                           double contactHertz = kContactHertz);
 /// Expected overlap (m) of the contact under the bottom body of a pile
 /// `depth` deep on static ground: load ((depth - 1) R + 1) m g over m_n = m.
 double expectedSupportOverlap(int depth, double gravity, double h, double massRatio = 1.0,
-                              double hertzFraction = 0.25);
+                              double hertzFraction = 0.25, double contactHertz = kContactHertz);
 /// world.restitution_threshold when the level gives none: four times the
 /// speed gravity adds in one substep (m/s), so resting contacts never bounce
 /// and, with zero gravity, every approach does.
@@ -322,7 +339,8 @@ struct PileHint {
     double expectedOverlap = 0.0;  ///< metres
     double diameter = 0.0;         ///< metres
     int substeps = 1;              ///< the level's
-    int substepsNeeded = 1;        ///< the fewest that keep it under 2% (16 at most)
+    int substepsNeeded = 1;        ///< the fewest that keep it under 2% (16 at most; 0: none does)
+    double overlapAtMost = 0.0;    ///< metres, at 16 substeps when none keeps it under 2%
     std::string message() const;
 };
 

@@ -527,7 +527,10 @@ std::optional<ChosenSettings> chosenSettings(const WorldImpl& w) {
         w.collision && (counts || w.hertzFractionRecorded || w.stats.step > 0);
     if (!counts && !stiffness) return std::nullopt;
     ChosenSettings chosen{w.settings.substeps, w.settings.solverIterations, std::nullopt};
-    if (stiffness) chosen.contactHertzFraction = w.contactChoice.hertzFraction;
+    if (stiffness) {
+        chosen.contactHertzFraction = w.contactChoice.hertzFraction;
+        if (w.contactChoice.contactHertz != kContactHertz) chosen.contactHertz = w.contactChoice.contactHertz;
+    }
     return chosen;
 }
 } // namespace
@@ -1059,20 +1062,26 @@ std::optional<PileHint> World::pileHint() const {
     // Equal bodies: the warning's model is the one measured on the 30-row
     // pile; the choice also weighs the mass ratio (a heavy body on a light
     // one), so it never gets less than this asks for.
-    const double overlap =
-        expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(substeps), 1.0, c.hertzFraction);
+    const double overlap = expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(substeps), 1.0,
+                                               c.hertzFraction, c.contactHertz);
     if (!(overlap > limit)) return std::nullopt;
     PileHint hint;
     hint.stackDepth = c.stackDepth;
     hint.expectedOverlap = overlap;
     hint.diameter = c.diameter;
     hint.substeps = substeps;
-    hint.substepsNeeded = 16;
+    // None up to 16 may hold it (a load past what the chosen stiffness
+    // carries): then the warning says what 16 leave.
+    hint.substepsNeeded = 0;
     for (int s = substeps + 1; s <= 16; ++s)
-        if (expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(s), 1.0, c.hertzFraction) <= limit) {
+        if (expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(s), 1.0, c.hertzFraction,
+                                c.contactHertz) <= limit) {
             hint.substepsNeeded = s;
             break;
         }
+    if (hint.substepsNeeded == 0)
+        hint.overlapAtMost =
+            expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / 16.0, 1.0, c.hertzFraction, c.contactHertz);
     return hint;
 }
 
@@ -1131,12 +1140,18 @@ std::string ImpactHint::message() const {
 }
 
 std::string PileHint::message() const {
-    char text[320];
-    std::snprintf(text, sizeof text,
-                  "piles up to %d bodies deep: expected sinkage %.0f mm (%.1f%% of a %.2g m diameter) at %d substep%s; "
-                  "%d substeps would hold it under 2%%",
-                  stackDepth, 1e3 * expectedOverlap, 100.0 * expectedOverlap / diameter, diameter, substeps,
-                  substeps == 1 ? "" : "s", substepsNeeded);
+    char text[400];
+    const int written = std::snprintf(
+        text, sizeof text, "piles up to %d bodies deep: expected sinkage %.0f mm (%.1f%% of a %.2g m diameter) at %d substep%s; ",
+        stackDepth, 1e3 * expectedOverlap, 100.0 * expectedOverlap / diameter, diameter, substeps,
+        substeps == 1 ? "" : "s");
+    const std::size_t at = std::size_t(std::max(written, 0));
+    if (substepsNeeded > 0)
+        std::snprintf(text + at, sizeof text - at, "%d substeps would hold it under 2%%", substepsNeeded);
+    else
+        std::snprintf(text + at, sizeof text - at,
+                      "no substep count up to 16 holds it under 2%% (16 leave %.0f mm): lower the load or the pile",
+                      1e3 * overlapAtMost);
     return text;
 }
 

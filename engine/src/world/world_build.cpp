@@ -286,7 +286,10 @@ std::optional<Error> chooseSolverCounts(const Scene& scene, const SystemSwitches
     // The stiffness cap follows the structure the run started from (a deep
     // column standing); a resume keeps it whatever the bodies have become.
     w.hertzFractionRecorded = recorded && recorded->contactHertzFraction;
-    if (w.hertzFractionRecorded) w.contactChoice.hertzFraction = *recorded->contactHertzFraction;
+    if (w.hertzFractionRecorded) {
+        w.contactChoice.hertzFraction = *recorded->contactHertzFraction;
+        w.contactChoice.contactHertz = recorded->contactHertz.value_or(kContactHertz);
+    }
     if (recorded && (recorded->substeps < 1 || recorded->solverIterations < 1))
         return Error{"solver_state.chosen: substeps and solver_iterations must be integers >= 1"};
     if (ws.substeps == 0) w.settings.substeps = recorded ? recorded->substeps : choice.substeps;
@@ -320,6 +323,7 @@ std::optional<Error> compileCollisions(const Scene& scene, const SystemSwitches&
     w.collision->settings().iterations = w.settings.solverIterations;
     // From the scene's structure, whatever substeps the level gives.
     w.collision->settings().hertzFraction = w.contactChoice.hertzFraction;
+    w.collision->settings().contactHertz = w.contactChoice.contactHertz;
     w.collision->settings().oneColourOrder = w.contactChoice.hertzFraction < 0.25;
     if (ws.jointHz) w.collision->jointSettings().hertz = *ws.jointHz;
     if (ws.jointDampingRatio) w.collision->jointSettings().dampingRatio = *ws.jointDampingRatio;

@@ -376,11 +376,12 @@ namespace stepwise {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+static_assert(kContactHertz == collision::SolverSettings{}.contactHertz, "one default contact stiffness");
 
-/// omega^2 of the resting soft contact at substeps of h seconds, its
-/// stiffness capped at `fraction` of the substep rate.
-double contactOmega2(double h, double fraction) {
-    const double hertz = std::min(collision::SolverSettings{}.contactHertz, fraction / h);
+/// omega^2 of the resting soft contact at substeps of h seconds: `hertz`,
+/// capped at `fraction` of the substep rate.
+double contactOmega2(double h, double fraction, double contactHertz) {
+    const double hertz = std::min(contactHertz, fraction / h);
     const double omega = 2.0 * kPi * hertz;
     return omega * omega;
 }
@@ -670,7 +671,8 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
 
 } // namespace
 
-double expectedPileOverlap(int depth, double gravity, double h, double massRatio, double hertzFraction) {
+double expectedPileOverlap(int depth, double gravity, double h, double massRatio, double hertzFraction,
+                           double contactHertz) {
     // A resting soft contact compresses by load / (m_n omega^2). In a pile
     // `depth` bodies deep the lowest contacts between bodies carry about
     // (depth - 1) heavy bodies on a light one (world.hpp). kMeasured folds in
@@ -680,13 +682,14 @@ double expectedPileOverlap(int depth, double gravity, double h, double massRatio
     constexpr double kMeasured = 1.0;
     if (depth < 2 || !(gravity > 0.0) || !(h > 0.0)) return 0.0;
     const double ratio = std::max(1.0, massRatio);
-    return kMeasured * double(depth - 1) * (1.0 + ratio) * gravity / contactOmega2(h, hertzFraction);
+    return kMeasured * double(depth - 1) * (1.0 + ratio) * gravity / contactOmega2(h, hertzFraction, contactHertz);
 }
 
-double expectedSupportOverlap(int depth, double gravity, double h, double massRatio, double hertzFraction) {
+double expectedSupportOverlap(int depth, double gravity, double h, double massRatio, double hertzFraction,
+                              double contactHertz) {
     if (depth < 1 || !(gravity > 0.0) || !(h > 0.0)) return 0.0;
     const double ratio = std::max(1.0, massRatio);
-    return (double(depth - 1) * ratio + 1.0) * gravity / contactOmega2(h, hertzFraction);
+    return (double(depth - 1) * ratio + 1.0) * gravity / contactOmega2(h, hertzFraction, contactHertz);
 }
 
 double derivedRestitutionThreshold(double gravity, double h) { return 4.0 * gravity * h; }
@@ -702,6 +705,7 @@ std::string ContactSettingsChoice::reason() const {
     if (loadSubsteps > 1 && loadSubsteps == substeps)
         add("load " + number(gravity) + " m/s^2 on " + number(diameter) + " m bodies" +
             (support > 0.0 ? ", supports " + number(support) + " m thick" : std::string()));
+    if (contactHertz > kContactHertz) add("contacts stiffened to " + number(contactHertz) + " Hz");
     if (springSubsteps > 1 && springSubsteps == substeps) add("springs up to " + number(springRate) + " rad/s");
     if (impactSubsteps > 1 && impactSubsteps == substeps)
         add("impact " + number(impactSpeed) + " m/s on " + number(impactSize) + " m bodies" +
@@ -1017,35 +1021,61 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
 
     // The fewest substeps (up to 16) that hold every rule.
     const double dt = scene.world.dt;
-    const auto pileHolds = [&](int s) {
-        return expectedPileOverlap(choice.stackDepth, choice.gravity, dt / s, choice.massRatio, fraction) <=
-               0.01 * choice.diameter;
+    // Each contact rule asks that an overlap, load / (m omega^2), stay
+    // under a limit: overlap(h, hertz) for substeps of h and stiffness
+    // hertz (capped at `fraction` of the substep rate).
+    const auto pileOverlap = [&](double h, double hertz) {
+        return expectedPileOverlap(choice.stackDepth, choice.gravity, h, choice.massRatio, fraction, hertz);
     };
-    const auto loadHolds = [&](int s) {
-        if (choice.stackDepth < 1) return true;
-        double limit = 0.01 * choice.diameter;
-        if (choice.support > 0.0) limit = std::min(limit, 0.1 * choice.support);
-        return expectedSupportOverlap(choice.stackDepth, choice.gravity, dt / s, choice.massRatio, fraction) <= limit;
+    const double pileLimit = 0.01 * choice.diameter;
+    const auto loadOverlap = [&](double h, double hertz) {
+        return choice.stackDepth < 1
+                   ? 0.0
+                   : expectedSupportOverlap(choice.stackDepth, choice.gravity, h, choice.massRatio, fraction, hertz);
     };
+    const double loadLimit = choice.support > 0.0 ? std::min(pileLimit, 0.1 * choice.support) : pileLimit;
+    // A column's layers compress in series: the contact k layers down
+    // carries k bodies, so the top sinks by the sum, n (n - 1) / 2 times a
+    // layer's load overlap; it must stay under 1% of a body.
+    const auto columnOverlap = [&](double h, double hertz) {
+        if (choice.columnHeight < 2) return 0.0;
+        const double n = double(choice.columnHeight);
+        return 0.5 * n * (n - 1.0) * expectedPileOverlap(2, choice.gravity, h, 1.0, fraction, hertz);
+    };
+    const double columnLimit = 0.01 * choice.columnWidth;
+    // The stiffness the rules need under a strong load: the default
+    // (kContactHertz) unless a rule fails there at any substeps; then the
+    // stiffness at which it holds (the overlap falls as 1 / hertz^2),
+    // reached with substeps fine enough to carry it. At most the default
+    // scaled by sqrt(g / kReferenceGravity), which keeps every overlap where
+    // it is at 10 m/s^2: the default was measured there, and a 100-row
+    // pyramid, which the rules read as far deeper than it sinks, runs as
+    // it did.
+    {
+        constexpr double kUncapped = 1e-12;  // s: a substep short enough that only the stiffness caps omega
+        const double base = kContactHertz;
+        const auto needs = [&](const auto& overlap, double limit) {
+            const double at = overlap(kUncapped, base);
+            return at > limit && limit > 0.0 ? base * std::sqrt(at / limit) : base;
+        };
+        const double needed = std::max({base, needs(pileOverlap, pileLimit), needs(loadOverlap, loadLimit),
+                                        needs(columnOverlap, columnLimit)});
+        choice.contactHertz = std::min(needed, base * std::sqrt(std::max(1.0, choice.gravity / kReferenceGravity)));
+    }
+    const double hertz = choice.contactHertz;
+    const auto pileHolds = [&](int s) { return pileOverlap(dt / s, hertz) <= pileLimit; };
+    const auto loadHolds = [&](int s) { return loadOverlap(dt / s, hertz) <= loadLimit; };
+    const auto columnHolds = [&](int s) { return columnOverlap(dt / s, hertz) <= columnLimit; };
     // A contact rule that cannot hold stops where more substeps stop
-    // stiffening the contacts (contactHertz's cap).
+    // stiffening the contacts (the stiffness chosen above).
     const auto contactsSaturated = [&](int s) {
-        return contactOmega2(dt / s, fraction) == contactOmega2(dt / (2 * s), fraction);
+        return contactOmega2(dt / s, fraction, hertz) == contactOmega2(dt / (2 * s), fraction, hertz);
     };
     const auto fewest = [&](const auto& holds, bool contact) {
         int s = 1;
         for (; s < 16; s *= 2)
             if (holds(s) || (contact && contactsSaturated(s))) break;
         return s;
-    };
-    // A column's layers compress in series: the contact k layers down
-    // carries k bodies, so the top sinks by the sum, n (n - 1) / 2 times a
-    // layer's load overlap; it must stay under 1% of a body.
-    const auto columnHolds = [&](int s) {
-        if (choice.columnHeight < 2) return true;
-        const double n = double(choice.columnHeight);
-        return 0.5 * n * (n - 1.0) * expectedPileOverlap(2, choice.gravity, dt / s, 1.0, fraction) <=
-               0.01 * choice.columnWidth;
     };
     choice.pileSubsteps = std::max(fewest(pileHolds, true), fewest(columnHolds, true));
     choice.loadSubsteps = fewest(loadHolds, true);

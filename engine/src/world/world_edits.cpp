@@ -39,10 +39,18 @@ std::optional<Error> WorldImpl::keepChoiceFor(const Scene& scene, const SystemSw
     const ContactSettingsChoice choice = chooseContactSettings(scene, switches);
     const int substeps = ws.substeps != 0 ? ws.substeps : choice.substeps;
     const int iterations = ws.solverIterations != 0 ? ws.solverIterations : ws.substeps == 0 ? choice.iterations : 8;
+    // The stiffness the contacts get at these substeps: a heavier body may
+    // raise what the rules ask for (contactHertz) past what the substeps
+    // carry, and then nothing the solver runs changes.
+    const auto stiffness = [&](const ContactSettingsChoice& c) {
+        return std::min(c.contactHertz, c.hertzFraction * double(substeps) / settings.dt);
+    };
     if (substeps != settings.substeps || iterations != settings.solverIterations ||
-        !sameBits(choice.hertzFraction, contactChoice.hertzFraction))
+        !sameBits(choice.hertzFraction, contactChoice.hertzFraction) ||
+        !sameBits(stiffness(choice), stiffness(contactChoice)))
         return Error{"the edit changes the settings the engine chooses"};
     contactChoice = choice;
+    if (collision) collision->settings().contactHertz = choice.contactHertz;
     hertzFractionRecorded = false;
     if (settingsSource == World::SettingsSource::Recorded) settingsSource = World::SettingsSource::Chosen;
     return std::nullopt;
