@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -473,6 +474,22 @@ double depthBelowZero(const Scene& out, Entity e, Tumbler kind) {
     return std::max(0.0, -lowest);
 }
 
+/// Builds `scene` and steps it `steps` times: the deepest any of `bodies`
+/// reached below y = 0 at the end of a step (depthBelowZero); infinity
+/// when a step fails.
+double deepestBelowZero(const Scene& scene, std::span<const Entity> bodies, Tumbler kind, int steps) {
+    Result<World> w = World::build(scene);
+    if (!w) return std::numeric_limits<double>::infinity();
+    double deepest = 0.0;
+    Scene out = scene;
+    for (int i = 0; i < steps; ++i) {
+        if (!w->step()) return std::numeric_limits<double>::infinity();
+        w->writeBack(out);
+        for (const Entity e : bodies) deepest = std::max(deepest, depthBelowZero(out, e, kind));
+    }
+    return deepest;
+}
+
 } // namespace
 
 // A body that turns within a step meets the ground with parts its contacts
@@ -504,15 +521,7 @@ TEST(HardContacts, ATumblingBodyNeverEndsAStepDeeperInTheGroundThanTheSlop) {
                             s.registry.emplace<Chain>(e, std::move(chain));
                         }
                         const Entity body = tumbler(s, kind, {0.0, 1.5}, spin);
-                        Result<World> w = World::build(s);
-                        ASSERT_TRUE(w) << w.error();
-                        double deepest = 0.0;
-                        Scene out = s;
-                        for (int i = 0; i < 90; ++i) {
-                            ASSERT_TRUE(w->step());
-                            w->writeBack(out);
-                            deepest = std::max(deepest, depthBelowZero(out, body, kind));
-                        }
+                        const double deepest = deepestBelowZero(s, std::span(&body, 1), kind, 90);
                         EXPECT_LE(deepest, kSlop + kSlopTolerance)
                             << "a " << nameOf(kind) << " spun at " << spin << " rad/s onto " << nameOf(ground)
                             << ", g " << g << ", substeps " << label(substeps);
@@ -547,15 +556,7 @@ TEST(HardContacts, ACollapsingStackNeverEndsAStepDeeperInThePlaneThanTheSlop) {
                             s.registry.tryGet<Velocity>(e)->value = {};
                             bodies.push_back(e);
                         }
-                        Result<World> w = World::build(s);
-                        ASSERT_TRUE(w) << w.error();
-                        double deepest = 0.0;
-                        Scene out = s;
-                        for (int i = 0; i < 60; ++i) {
-                            ASSERT_TRUE(w->step());
-                            w->writeBack(out);
-                            for (const Entity e : bodies) deepest = std::max(deepest, depthBelowZero(out, e, kind));
-                        }
+                        const double deepest = deepestBelowZero(s, bodies, kind, 60);
                         EXPECT_LE(deepest, kSlop + kSlopTolerance)
                             << height << " " << nameOf(kind) << "s at g " << g << ", substeps " << label(substeps)
                             << ", iterations " << (iterations ? std::to_string(iterations) : label(0));

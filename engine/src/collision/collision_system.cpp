@@ -1505,6 +1505,10 @@ double roundingOf(const Shape& shape) {
 }
 } // namespace
 
+double CollisionSystem::foreseenTravel(std::size_t i) const {
+    return 2.0 * kSpeculativeBase + dt_ * std::max(length(startV_[i]), length(endV_[i])) + spin_[i];
+}
+
 CollisionSystem::PresentPose CollisionSystem::presentPose(std::uint32_t shape, const SolverBody& body) const {
     // The body's centre of mass moved by dp; the shape turned with the body
     // by dq about it.
@@ -1562,13 +1566,11 @@ bool CollisionSystem::correctTurnedAgainstStatic(bool scratchReady) {
         if (owner.kinematic) continue;
         const SolverBody& b = bodies_[sb.solver];
         const double travel = length(b.dp) + std::abs(turnOf(i, sb.solver)) * maxExtent_[i];
-        const double foreseen =
-            2.0 * kSpeculativeBase + dt_ * std::max(length(startV_[i]), length(endV_[i])) + spin_[i];
-        if (!(travel > foreseen) && !std::binary_search(turnedBodies_.begin(), turnedBodies_.end(), sb.solver))
+        if (!(travel > foreseenTravel(i)) &&
+            !std::binary_search(turnedBodies_.begin(), turnedBodies_.end(), sb.solver))
             continue;
-        const auto near = [&](std::uint32_t shape) {
+        forEachSolidShape(i, [&](std::uint32_t shape) {
             const Collider& moving = colliders_[shape];
-            if (moving.sensor) return;
             const auto take = [&](std::uint32_t fixed) {
                 const Collider& f = colliders_[fixed];
                 if (f.sensor || !collides(shape, fixed) || (!noCollide_.empty() && joinedNotColliding(shape, fixed)))
@@ -1582,13 +1584,7 @@ bool CollisionSystem::correctTurnedAgainstStatic(bool scratchReady) {
             box.lower -= Vec2{slop, slop};
             box.upper += Vec2{slop, slop};
             staticBoxes_.query(box, take);
-        };
-        if (!owner.solverOnly) {
-            near(i);
-        } else {
-            const auto first = std::lower_bound(hubShapes_.begin(), hubShapes_.end(), std::pair{i, 0u});
-            for (auto it = first; it != hubShapes_.end() && it->first == i; ++it) near(it->second);
-        }
+        });
     }
     if (turnedContacts_.empty()) return false;
     // Each body's are together: the bodies were visited once each.
@@ -1679,26 +1675,15 @@ void CollisionSystem::sweepAgainstStatic(std::span<Vec2> x) {
         // within its own length).
         const double turn = angles_[i] - stepStartAngle_[i];
         const double travel = length(b.dp) + std::abs(turn) * maxExtent_[i];
-        const double foreseen =
-            2.0 * kSpeculativeBase + dt_ * std::max(length(startV_[i]), length(endV_[i])) + spin_[i];
-        if (!(travel > foreseen) && !(travel > 0.5 * minReach_[i])) continue;
+        if (!(travel > foreseenTravel(i)) && !(travel > 0.5 * minReach_[i])) continue;
         shapes.clear();
         shapeColliders.clear();
-        if (!owner.solverOnly) {
-            if (owner.sensor) continue;
-            shapes.push_back({&owner.shape, Vec2{}});
-            shapeColliders.push_back(i);
-        } else {
-            // A compound body's hub: its shapes, each about the body's centre.
-            const auto first = std::lower_bound(hubShapes_.begin(), hubShapes_.end(), std::pair{i, 0u});
-            for (auto it = first; it != hubShapes_.end() && it->first == i; ++it) {
-                const Collider& shape = colliders_[it->second];
-                if (shape.sensor) continue;
-                shapes.push_back({&shape.shape, shape.centreOfMass - owner.centreOfMass});
-                shapeColliders.push_back(it->second);
-            }
-            if (shapes.empty()) continue;
-        }
+        // Each shape about the body's centre (a compound body's hub).
+        forEachSolidShape(i, [&](std::uint32_t j) {
+            shapes.push_back({&colliders_[j].shape, j == i ? Vec2{} : colliders_[j].centreOfMass - owner.centreOfMass});
+            shapeColliders.push_back(j);
+        });
+        if (shapes.empty()) continue;
         const BodySweep sweep{stepStart_[i], stepStart_[i] + b.dp, stepStartAngle_[i], angles_[i]};
         double fraction = 1.0;
         for (std::size_t k = 0; k < shapes.size(); ++k) {

@@ -339,6 +339,23 @@ private:
         Rot q;        ///< the shape's rotation
     };
     PresentPose presentPose(std::uint32_t shape, const SolverBody& body) const;
+    /// How far collider i's body was foreseen to move this step when its
+    /// contacts were found (its speculative reach, metres): a body that went
+    /// farther may meet static shapes it has no contact with.
+    double foreseenTravel(std::size_t i) const;
+    /// Visits the shapes of solver collider i that push (not sensors): the
+    /// collider itself, or a compound body's shapes (once the static sweep
+    /// is prepared: hubShapes_).
+    template <typename Visit>
+    void forEachSolidShape(std::uint32_t i, Visit&& visit) const {
+        if (!colliders_[i].solverOnly) {
+            if (!colliders_[i].sensor) visit(i);
+            return;
+        }
+        const auto first = std::lower_bound(hubShapes_.begin(), hubShapes_.end(), std::pair{i, 0u});
+        for (auto it = first; it != hubShapes_.end() && it->first == i; ++it)
+            if (!colliders_[it->second].sensor) visit(it->second);
+    }
     /// After the position pass: bodies that moved farther this step than
     /// their speculative margins allowed, swept against the static shapes
     /// near their path and put back where their centroid would pass into

@@ -11,6 +11,19 @@ inline Rot turnedBy(Rot q, double angle) {
     const Rot r = Rot::fromAngle(angle);
     return {q.c * r.c - q.s * r.s, q.s * r.c + q.c * r.s};
 }
+
+/// A correction of `move` metres at one point, as position impulses (kg m):
+/// up to maxTurningCorrection through the point's inverse mass
+/// (`inverseMass`, turning included), the rest without turning
+/// (`linearMass`), since the turn is linearised.
+struct PositionImpulse {
+    double turning = 0.0, linear = 0.0;
+};
+inline PositionImpulse splitCorrection(double move, double inverseMass, double linearMass,
+                                       const PositionCorrectionSettings& settings) {
+    const double turning = std::min(move, settings.maxTurningCorrection);
+    return {turning / inverseMass, (move - turning) / linearMass};
+}
 } // namespace
 
 bool correctPositions(std::span<const ContactConstraint> contacts, std::span<SolverBody> bodies,
@@ -57,13 +70,11 @@ bool correctPositions(std::span<const ContactConstraint> contacts, std::span<Sol
             if (excess >= 0.0) continue;
             worst = std::min(worst, excess);
             const double move = std::min(-fraction * excess, cap);
-            const double turning = std::min(move, settings.maxTurningCorrection);
             const double inverseMass =
                 a.invMass + b.invMass + a.invInertia * p.rnA * p.rnA + b.invInertia * p.rnB * p.rnB;
             const double linearMass = a.invMass + b.invMass;
             if (inverseMass <= 0.0 || linearMass <= 0.0) continue;
-            const double impulse = turning / inverseMass;  // kg m: a position impulse
-            const double push = (move - turning) / linearMass;  // the rest, without turning
+            const auto [impulse, push] = splitCorrection(move, inverseMass, linearMass, settings);
             scratch.moved[c.bodyA] = 1;
             scratch.moved[c.bodyB] = 1;
             a.dp -= (a.invMass * (impulse + push)) * n;
@@ -112,10 +123,8 @@ double pushOutOfStatic(SolverBody& body, std::span<const PresentContact> points,
         const double excess = p.separation + dot(moved, p.normal) + turn * rn + settings.slop;
         if (excess >= 0.0) continue;
         worst = std::min(worst, excess);
-        const double move = -excess;
-        const double turning = std::min(move, settings.maxTurningCorrection);
-        const double impulse = turning / (body.invMass + body.invInertia * rn * rn);
-        const double push = (move - turning) / body.invMass;
+        const auto [impulse, push] =
+            splitCorrection(-excess, body.invMass + body.invInertia * rn * rn, body.invMass, settings);
         moved += (body.invMass * (impulse + push)) * p.normal;
         turn += body.invInertia * rn * impulse;
     }
