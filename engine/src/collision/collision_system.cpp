@@ -643,6 +643,39 @@ void CollisionSystem::bodyEdges(std::vector<std::pair<std::uint32_t, std::uint32
     }
 }
 
+void CollisionSystem::staticSupports(std::vector<Support>& out, std::vector<std::uint8_t>& held) const {
+    const auto fixed = [&](std::uint32_t c) { return colliders_[c].body < 0 || colliders_[c].kinematic; };
+    for (std::size_t k = 0; k < details_.size(); ++k) {
+        const ContactDetail& d = details_[k];
+        const ContactConstraint& c = constraints_[k];
+        const bool fixedA = fixed(d.colliderA), fixedB = fixed(d.colliderB);
+        if (fixedA == fixedB) continue;
+        bool touching = false;
+        for (int i = 0; i < c.pointCount; ++i)
+            touching = touching || d.separation[i] < kLinearSlop || c.points[i].normalImpulse > 0.0;
+        if (!touching) continue;
+        // The normal runs from A to B: it pushes B along it and A against it.
+        Support s;
+        s.body = std::uint32_t(colliders_[fixedA ? d.colliderB : d.colliderA].body);
+        s.normal = fixedA ? c.normal : -c.normal;
+        s.friction = c.friction;
+        s.points = c.pointCount;
+        for (int i = 0; i < c.pointCount; ++i) {
+            const ContactPoint& p = c.points[i];
+            s.along[i] = fixedA ? p.rnB : -p.rnA;
+            s.up[i] = fixedA ? p.dnB : -p.dnA;
+        }
+        out.push_back(s);
+    }
+    for (const joints::JointConstraint& j : joints_) {
+        if (j.broken) continue;
+        const bool worldA = j.a.collider < 0 || fixed(std::uint32_t(j.a.collider));
+        const bool worldB = j.b.collider < 0 || fixed(std::uint32_t(j.b.collider));
+        if (worldA && !worldB) held[std::size_t(colliders_[std::size_t(j.b.collider)].body)] = 1;
+        if (worldB && !worldA) held[std::size_t(colliders_[std::size_t(j.a.collider)].body)] = 1;
+    }
+}
+
 bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, Vec2 ref1) {
     awakeBoxes_.resize(awakeProxies_.size());
     awakeCores_.resize(awakeProxies_.size());

@@ -12,6 +12,7 @@
 #include "collision/frozen_boxes.hpp"
 #include "collision/narrow_phase.hpp"
 #include "collision/position_correction.hpp"
+#include "collision/static_support.hpp"
 #include "joints/direct_joints.hpp"
 #include "joints/joint_bundles.hpp"
 #include "joints/joint_solver.hpp"
@@ -290,6 +291,12 @@ public:
     /// Pairs of dynamic bodies (state-vector indices) joined by a manifold of
     /// the last step or by a joint: the island edges this system knows of.
     void bodyEdges(std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
+    /// The last step's touching contacts between a dynamic body and a
+    /// static or kinematic shape (as bodyEdges judges touching), and in
+    /// `held` (one per body, set to 1) the bodies a joint ties to the world,
+    /// a static or a kinematic body: what sleep asks before freezing an
+    /// island (world/rest_balance.hpp).
+    void staticSupports(std::vector<Support>& out, std::vector<std::uint8_t>& held) const;
     /// Gives collider i (a dynamic body's own, or a compound body's hub) a
     /// new mass, as add() would have: `inertia` is taken as given for a
     /// solver-only collider (a hub, a shapeless body), else computed from the

@@ -141,7 +141,8 @@ bool SleepIslands::speedingUp(std::size_t b, const double* v,
     return accel > 0.5 * fieldAccel(b);
 }
 
-std::vector<std::uint32_t> SleepIslands::fallAsleep(std::span<const std::pair<std::uint32_t, std::uint32_t>> edges) {
+std::vector<std::uint32_t> SleepIslands::fallAsleep(std::span<const std::pair<std::uint32_t, std::uint32_t>> edges,
+                                                    const std::function<bool(std::span<const std::uint32_t>)>& couldRest) {
     std::vector<std::uint32_t> fell;
     const std::size_t n = timer.size();
     // Union-find over the awake bodies; the root is always the lowest
@@ -166,13 +167,30 @@ std::vector<std::uint32_t> SleepIslands::fallAsleep(std::span<const std::pair<st
     for (std::size_t b = 0; b < n; ++b)
         if (island[b] < 0 && !(timer[b] >= readyAt)) blocked[findRoot(parent, std::uint32_t(b))] = 1;
     for (const std::uint32_t b : touchesSleeper) blocked[findRoot(parent, b)] = 1;
-    for (std::size_t b = 0; b < n; ++b) {
-        if (island[b] >= 0) continue;
-        const std::uint32_t root = findRoot(parent, std::uint32_t(b));
-        if (blocked[root]) continue;
-        island[b] = std::int32_t(root);
-        fell.push_back(std::uint32_t(b));
+    // The islands ready to sleep, each one's bodies together (ascending
+    // within an island): a counting sort by root.
+    std::vector<std::uint32_t> start(n + 1, 0u), members;
+    for (std::size_t b = 0; b < n; ++b) parent[b] = findRoot(parent, std::uint32_t(b));
+    for (std::size_t b = 0; b < n; ++b)
+        if (island[b] < 0 && !blocked[parent[b]]) ++start[parent[b] + 1];
+    for (std::size_t r = 0; r < n; ++r) start[r + 1] += start[r];
+    members.resize(start[n]);
+    std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
+    for (std::size_t b = 0; b < n; ++b)
+        if (island[b] < 0 && !blocked[parent[b]]) members[at[parent[b]]++] = std::uint32_t(b);
+    for (std::size_t root = 0; root < n; ++root) {
+        const std::span<const std::uint32_t> bodies(members.data() + start[root], start[root + 1] - start[root]);
+        if (bodies.empty()) continue;
+        if (!couldRest(bodies)) {
+            for (const std::uint32_t b : bodies) restart(b);
+            continue;
+        }
+        for (const std::uint32_t b : bodies) {
+            island[b] = std::int32_t(root);
+            fell.push_back(b);
+        }
     }
+    std::sort(fell.begin(), fell.end());
     if (!fell.empty()) refresh();
     return fell;
 }

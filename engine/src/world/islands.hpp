@@ -98,8 +98,11 @@ struct SleepIslands {
                     const std::function<double(std::size_t)>& fieldAccel) const;
     /// Builds the islands of the awake bodies from `edges` (pairs of
     /// bodies) and puts to sleep every island whose bodies have all been
-    /// still for `time`. Returns the bodies that fell asleep, ascending.
-    std::vector<std::uint32_t> fallAsleep(std::span<const std::pair<std::uint32_t, std::uint32_t>> edges);
+    /// still for `time`, unless `couldRest(bodies)` (the island's bodies,
+    /// ascending) says its forces do not balance: then its timers start
+    /// again. Returns the bodies that fell asleep, ascending.
+    std::vector<std::uint32_t> fallAsleep(std::span<const std::pair<std::uint32_t, std::uint32_t>> edges,
+                                          const std::function<bool(std::span<const std::uint32_t>)>& couldRest);
 };
 
 } // namespace stepwise::detail

@@ -2,6 +2,7 @@
 // the islands, and which islands an edit wakes.
 
 #include "world/world_collisions.hpp"
+#include "world/rest_balance.hpp"
 #include "world/world_impl.hpp"
 
 #include <algorithm>
@@ -60,7 +61,30 @@ void WorldImpl::updateSleep(const double* startX, const double* startV) {
     // An island falls asleep as it is: velocities and spins (all under
     // sleep_velocity) are kept, frozen, so a wake resumes it exactly where
     // it paused, and a saved file shows the state it paused in.
-    if (sleep.fallAsleep(edges).empty()) return;
+    // What holds each body up: its touching contacts with the static world
+    // and whether a joint or a spring ties it there. Asked only on the steps
+    // some island is ready to sleep.
+    std::vector<collision::Support> supports;
+    std::vector<std::uint8_t> held(n, 0);
+    if (collision) collision->staticSupports(supports, held);
+    for (const detail::SpringData& s : model.springs)
+        if (s.b == detail::kNoBody) held[s.a] = 1;
+    std::sort(supports.begin(), supports.end(),
+              [](const collision::Support& a, const collision::Support& b) { return a.body < b.body; });
+    std::vector<collision::Support> islandSupports;
+    const auto couldRest = [&](std::span<const std::uint32_t> bodies) {
+        islandSupports.clear();
+        Vec2 pull{};
+        for (const std::uint32_t b : bodies) {
+            if (held[b]) return true;  // a joint or spring may hold any pull: the velocity rule decides
+            pull += model.mass[b] * model.fieldAt(px[2 * b], px[2 * b + 1], b, px);
+            const auto first = std::lower_bound(supports.begin(), supports.end(), b,
+                                                [](const collision::Support& s, std::uint32_t body) { return s.body < body; });
+            for (auto it = first; it != supports.end() && it->body == b; ++it) islandSupports.push_back(*it);
+        }
+        return detail::couldRest(islandSupports, pull, bodies.size() == 1);
+    };
+    if (sleep.fallAsleep(edges, couldRest).empty()) return;
     sleepChanged();
 }
 
