@@ -712,6 +712,8 @@ std::string ContactSettingsChoice::reason() const {
             (impactMassRatio > 1.0 ? ", mass ratio " + (std::isinf(impactMassRatio) ? std::string("kinematic")
                                                                                     : number(impactMassRatio) + ":1")
                                    : std::string()));
+    if (jointSupportSubsteps > 1 && jointSupportSubsteps == substeps)
+        add("bodies " + number(jointSupportRatio) + " times as heavy as jointed bodies they can rest on");
     if (jointLoopSubsteps > 1 && jointLoopSubsteps == substeps)
         add(std::to_string(jointLoops) + " joint" + (jointLoops == 1 ? "" : "s") + " in loops at " +
             number(jointLoopHertz) + " Hz");
@@ -1087,12 +1089,27 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         const double perStep = dt * choice.jointLoopHertz / kLoopJointHertzFraction;
         if (perStep > 0.0) choice.jointLoopSubsteps = detail::wholeSubsteps(perStep, 16.0);
     }
+    // A body that can pile onto a joint group hung from the world (a crate
+    // on a bridge) against the lightest body of such groups
+    // (kJointSupportRatio).
+    double lightestHung = 0.0;
+    for (std::uint32_t i = 0; i < bodies.size(); ++i)
+        if (jointed[i] && groupAnchored[findRoot(parent, i)] && hasShape(bodies[i])) {
+            const double m = massOf(bodies[i]);
+            if (m > 0.0) lightestHung = lightestHung > 0.0 ? std::min(lightestHung, m) : m;
+        }
+    if (switches.collisions && choice.gravity > 0.0 && lightestHung > 0.0 && heaviestMass > 0.0) {
+        choice.jointSupportRatio = heaviestMass / lightestHung;
+        int s = 1;
+        while (s < 16 && choice.jointSupportRatio > kJointSupportRatio * double(s) * double(s)) s *= 2;
+        choice.jointSupportSubsteps = s;
+    }
     choice.springRate = springRate(scene, switches);
     choice.springSubsteps = detail::wholeSubsteps(dt * choice.springRate, 1000.0);
     impactRule(scene, switches, dt, choice);
     choice.substeps =
         std::max({choice.pileSubsteps, choice.loadSubsteps, choice.springSubsteps, choice.impactSubsteps,
-                  choice.jointLoopSubsteps});
+                  choice.jointLoopSubsteps, choice.jointSupportSubsteps});
     choice.iterations = choice.substeps == 1 ? 8 : 2;
     return choice;
 }
