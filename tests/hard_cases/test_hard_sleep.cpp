@@ -36,16 +36,28 @@ Entity named(const Scene& s, const std::string& name) {
     throw std::runtime_error("no entity " + name);
 }
 
-/// A 1 x 0.5 m box lying on a static plane tilted by `degrees` (the plane
-/// through the origin, normal (-sin, cos)), from rest, with `friction`.
-std::string slope(double degrees, double friction) {
+/// A plane through the origin tilted by `degrees` (normal (-sin, cos)) and
+/// one body `name` resting on it from rest, its centre `lift` above the
+/// plane; `shape` is the body's shape members. Both have `friction`.
+std::string onSlope(double degrees, double friction, const std::string& name, double lift, const std::string& shape) {
     const double t = degrees * kPi / 180.0;
     const double nx = -std::sin(t), ny = std::cos(t);
     return R"({"entities": [
         {"name": "ground", "plane": {"normal": {"x": )" + num(nx) + R"(, "y": )" + num(ny) + R"(}, "offset": 0},
          "friction": )" + num(friction) + R"(},
-        {"name": "box", "position": {"x": )" + num(0.25 * nx) + R"(, "y": )" + num(0.25 * ny) + R"(},
-         "angle": )" + num(t) + R"(, "box": {"width": 1, "height": 0.5}, "friction": )" + num(friction) + "}]}";
+        {"name": ")" + name + R"(", "position": {"x": )" + num(lift * nx) + R"(, "y": )" + num(lift * ny) + R"(},
+         )" + shape + R"(, "friction": )" + num(friction) + "}]}";
+}
+
+/// A 1 x 0.5 m box lying on the plane of onSlope().
+std::string slope(double degrees, double friction) {
+    return onSlope(degrees, friction, "box", 0.25,
+                   R"("angle": )" + num(degrees * kPi / 180.0) + R"(, "box": {"width": 1, "height": 0.5})");
+}
+
+/// A disc of radius 0.5 m resting on the plane of onSlope().
+std::string ballOnSlope(double degrees, double friction) {
+    return onSlope(degrees, friction, "ball", 0.5, R"("radius": 0.5)");
 }
 
 } // namespace
@@ -84,20 +96,9 @@ TEST(HardSleep, FrictionlessSlopeOfAnyGentleAngleKeepsAcceleratingAtGSinTheta) {
 
 namespace {
 
-/// A disc of radius 0.5 m resting on the plane of slope(), from rest.
-std::string ballOnSlope(double degrees, double friction) {
-    const double t = degrees * kPi / 180.0;
-    const double nx = -std::sin(t), ny = std::cos(t);
-    return R"({"entities": [
-        {"name": "ground", "plane": {"normal": {"x": )" + num(nx) + R"(, "y": )" + num(ny) + R"(}, "offset": 0},
-         "friction": )" + num(friction) + R"(},
-        {"name": "ball", "position": {"x": )" + num(0.5 * nx) + R"(, "y": )" + num(0.5 * ny) + R"(},
-         "radius": 0.5, "friction": )" + num(friction) + "}]}";
-}
-
-/// How far `name` moved down the slope of `degrees` from `start`, m, and its
-/// speed that way, m/s, after `steps`; `asleepSteps` counts the steps any
-/// body slept.
+/// How far body `name` of `scene` has moved down the slope of `degrees`
+/// from where the scene places it, m, and its speed that way, m/s, after
+/// `steps`; `asleepSteps` counts the steps any body slept.
 struct Slide {
     double travelled = 0.0, speed = 0.0;
     int asleepSteps = 0;
