@@ -69,7 +69,7 @@ void WorldImpl::updateSleep(const double* startX, const double* startV) {
     if (collision) collision->staticSupports(supports, held);
     for (const detail::SpringData& s : model.springs)
         if (s.b == detail::kNoBody) held[s.a] = 1;
-    std::sort(supports.begin(), supports.end(),
+    std::stable_sort(supports.begin(), supports.end(),
               [](const collision::Support& a, const collision::Support& b) { return a.body < b.body; });
     std::vector<collision::Support> islandSupports;
     const auto couldRest = [&](std::span<const std::uint32_t> bodies) {
