@@ -231,6 +231,8 @@ int run(const RunOptions& options) {
         std::cerr << options.level << ": warning: " << impact->message() << "\n";
     if (const std::optional<JointLoopHint> loops = world.jointLoopHint())
         std::cerr << options.level << ": warning: " << loops->message() << "\n";
+    if (const std::optional<JointSupportHint> load = world.jointSupportHint())
+        std::cerr << options.level << ": warning: " << load->message() << "\n";
     if (const std::optional<DroppedImpulses> dropped = world.droppedImpulses())
         std::cerr << options.level << ": warning: " << dropped->message() << "\n";
 

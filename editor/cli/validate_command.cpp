@@ -110,6 +110,8 @@ void addValidateCommand(CLI::App& app, int& exitCode) {
                 std::cerr << *level << ": warning: " << impact->message() << "\n";
             if (const std::optional<JointLoopHint> loops = world->jointLoopHint())
                 std::cerr << *level << ": warning: " << loops->message() << "\n";
+            if (const std::optional<JointSupportHint> load = world->jointSupportHint())
+                std::cerr << *level << ": warning: " << load->message() << "\n";
             if (const std::optional<DroppedImpulses> dropped = world->droppedImpulses())
                 std::cerr << *level << ": warning: " << dropped->message() << "\n";
             for (const std::string& note : ineffectiveComponents(*scene))

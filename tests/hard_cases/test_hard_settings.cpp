@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -527,6 +528,28 @@ TEST(HardSettings, ACrateOnABridgeGetsTheSubstepsThatHoldIt) {
         }
         EXPECT_GT(closest, 0.2) << label << ": the crate's centre came this close to the lowest plank's";
     }
+}
+
+// A level that gives fewer substeps than the crate needs is warned, with
+// the number that holds it; one that gives enough is not.
+TEST(HardSettings, TooFewSubstepsForALoadOnJointsAreNamed) {
+    Scene scene = parse(bridgeLevel(20.0));
+    scene.world.substeps = 1;
+    const std::optional<JointSupportHint> one = build(scene).jointSupportHint();
+    ASSERT_TRUE(one);
+    EXPECT_EQ(one->message(),
+              "bodies 10 times as heavy as jointed bodies they can rest on: at 1 substep a load over 3 times can "
+              "spring on the joints and fall through them; substeps 2 would hold it");
+    scene.world.substeps = 2;
+    EXPECT_FALSE(build(scene).jointSupportHint());
+    scene = parse(bridgeLevel(500.0));
+    scene.world.substeps = 4;
+    ASSERT_TRUE(build(scene).jointSupportHint());
+    EXPECT_EQ(build(scene).jointSupportHint()->message(),
+              "bodies 250 times as heavy as jointed bodies they can rest on: at 4 substeps a load over 48 times can "
+              "spring on the joints and fall through them; substeps 10 would hold it");
+    scene.world.substeps = 0;  // the engine's choice warns of nothing
+    EXPECT_FALSE(build(scene).jointSupportHint());
 }
 
 /// A chain of `links` 1 kg beads on springs of stiffness k (1 m rest), the

@@ -93,6 +93,11 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                 ImGui::TextColored(kGold, "%s", loops->message().c_str());
                 ImGui::PopTextWrapPos();
             }
+            if (const std::optional<JointSupportHint> load = world->jointSupportHint()) {
+                ImGui::PushTextWrapPos(0.0f);
+                ImGui::TextColored(kGold, "%s", load->message().c_str());
+                ImGui::PopTextWrapPos();
+            }
         }
         ImGui::PopItemWidth();
 

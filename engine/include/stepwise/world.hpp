@@ -388,6 +388,16 @@ struct JointLoopHint {
     std::string message() const;
 };
 
+/// A warning before a run whose given substeps are too few for the heaviest
+/// body that can rest on a joint group hung from the world
+/// (kJointSupportRatio: s substeps hold a mass ratio up to 3 s^2).
+struct JointSupportHint {
+    double ratio = 0.0;      ///< the heaviest such body over the lightest jointed one
+    int substeps = 1;        ///< the level's
+    int substepsNeeded = 1;  ///< the fewest that hold the ratio
+    std::string message() const;
+};
+
 /// A warning after a resume: saved contact impulses larger than any run of
 /// this scene can write were dropped (World::setSolverState), so the run
 /// starts those contacts cold and is not an exact resume.
@@ -568,6 +578,9 @@ public:
     /// Joints in loops the level's own substeps cannot hold (JointLoopHint);
     /// never about substeps the engine chose or a run recorded.
     std::optional<JointLoopHint> jointLoopHint() const;
+    /// Set when the level gives its substeps and they are fewer than a body
+    /// resting on a hung joint group needs (JointSupportHint).
+    std::optional<JointSupportHint> jointSupportHint() const;
     /// Set when the last setSolverState dropped impulses no run could write.
     std::optional<DroppedImpulses> droppedImpulses() const;
 

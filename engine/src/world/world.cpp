@@ -1119,6 +1119,27 @@ std::optional<JointLoopHint> World::jointLoopHint() const {
     return hint;
 }
 
+std::optional<JointSupportHint> World::jointSupportHint() const {
+    const WorldImpl& w = *impl_;
+    const ContactSettingsChoice& c = w.contactChoice;
+    const double s = double(w.settings.substeps);
+    if (!w.substepsGiven || !(c.jointSupportRatio > kJointSupportRatio * s * s * (1.0 + 1e-12))) return std::nullopt;
+    JointSupportHint hint;
+    hint.ratio = c.jointSupportRatio;
+    hint.substeps = w.settings.substeps;
+    hint.substepsNeeded = detail::wholeSubsteps(std::sqrt(c.jointSupportRatio / kJointSupportRatio), 1e6);
+    return hint;
+}
+
+std::string JointSupportHint::message() const {
+    char text[360];
+    std::snprintf(text, sizeof text,
+                  "bodies %.3g times as heavy as jointed bodies they can rest on: at %d substep%s a load over "
+                  "%.3g times can spring on the joints and fall through them; substeps %d would hold it",
+                  ratio, substeps, substeps == 1 ? "" : "s", kJointSupportRatio * substeps * substeps, substepsNeeded);
+    return text;
+}
+
 std::string JointLoopHint::message() const {
     char text[360];
     std::snprintf(text, sizeof text,
