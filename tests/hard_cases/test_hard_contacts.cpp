@@ -193,9 +193,11 @@ TEST(HardContacts, DeepPileAtAnySettingsKeepsItsBottomOnTheFloor) {
 
 // Bodies started on top of each other push apart by their positions: no
 // body is flung. The soft contacts push out at up to 3 m/s each (Box2D's
-// cap), and a body at the crowd's rim, out of the crowd, takes pushes from
-// a few neighbours: measured at most 11.4 m/s (300 bodies at 4 substeps);
-// moved by velocity, not by position only, 100 bodies reach 116 m/s.
+// cap), and once the crowd has opened into a pack of shallower overlaps,
+// its pushes add up along a few neighbours: measured at most 4.2 m/s
+// (1,000 bodies at 4 substeps). While a body at the crowd's rim kept the
+// pushes its crowded neighbours gave it, 300 reached 11.6 m/s; moved by
+// velocity, not by position only, 100 bodies reach 116 m/s.
 TEST(HardContacts, CrowdStartedAtOnePointSeparatesAtABoundedSpeed) {
     for (const int n : {2, 10, 64, 100, 300, 1000}) {
         for (const int substeps : {0, 1, 4}) {
@@ -213,7 +215,7 @@ TEST(HardContacts, CrowdStartedAtOnePointSeparatesAtABoundedSpeed) {
             double spread = 0.0;
             for (std::size_t b = 0; b < w->bodyCount(); ++b) spread = std::max(spread, length(w->bodyPosition(b)));
             SCOPED_TRACE(std::to_string(n) + " bodies, substeps " + label(substeps));
-            EXPECT_LE(fastest, 12.0);
+            EXPECT_LE(fastest, 5.0);
             // n discs of radius 0.25 need a disc of radius 0.25 sqrt(n / 0.9)
             // to lie apart; in 3 s they have spread over half of it at least.
             if (n >= 10) EXPECT_GT(spread, 0.5 * 0.25 * std::sqrt(n / 0.9));
@@ -221,12 +223,52 @@ TEST(HardContacts, CrowdStartedAtOnePointSeparatesAtABoundedSpeed) {
     }
 }
 
+// The same at 8 iterations, for discs, boxes and capsules: measured at
+// most 6.1 m/s (300 capsules at 4 substeps). A body just outside the crowd
+// kept the pushes its crowded neighbours gave it (their own velocities go
+// back), and the passes, run to convergence, summed them along chains of
+// such bodies: 300 capsules reached 15.6 m/s at 4 substeps, 300 boxes 11.5.
+TEST(HardContacts, CrowdsOfEveryShapeSeparateAtABoundedSpeedAtEightIterations) {
+    enum class Kind { Disc, Box, Capsule };
+    for (const Kind kind : {Kind::Disc, Kind::Box, Kind::Capsule}) {
+        for (const int n : {10, 100, 300}) {
+            for (const int substeps : {1, 4, 8}) {
+                Scene s = world({0.0, 0.0}, substeps, 8);
+                s.world.sleep = false;
+                for (int i = 0; i < n; ++i) {
+                    if (kind == Kind::Disc) {
+                        disc(s, {0.0, 0.0}, 0.25, 0.2);
+                    } else if (kind == Kind::Box) {
+                        crate(s, {0.0, 0.0}, 0.5);
+                    } else {
+                        const Entity e = crate(s, {0.0, 0.0}, 0.5);
+                        s.registry.remove<Box>(e);
+                        s.registry.emplace<Capsule>(e, Capsule{{-0.2, 0.0}, {0.2, 0.0}, 0.15});
+                    }
+                }
+                Result<World> w = World::build(s);
+                ASSERT_TRUE(w) << w.error();
+                double fastest = 0.0;
+                for (int i = 0; i < 180; ++i) {
+                    ASSERT_TRUE(w->step());
+                    for (std::size_t b = 0; b < w->bodyCount(); ++b)
+                        fastest = std::max(fastest, length(w->bodyVelocity(b)));
+                }
+                const char* names[] = {"discs", "boxes", "capsules"};
+                EXPECT_LE(fastest, 7.0) << n << " " << names[int(kind)] << ", substeps " << substeps
+                                        << ", 8 iterations";
+            }
+        }
+    }
+}
+
 // The same crowd under gravity above a floor: no body is pushed higher
-// than the crowd's unfolded radius (plus a body) above where it started.
+// than the crowd's unfolded radius (plus a body) above where it started, at
+// the engine's iterations and at 8.
 TEST(HardContacts, CrowdStartedAtOnePointAboveAFloorIsNotThrownUp) {
     for (const int n : {10, 64, 100, 300}) {
-        for (const int substeps : {0, 1, 4}) {
-            Scene s = world({0.0, -9.81}, substeps);
+        for (const auto [substeps, iterations] : {std::pair{0, 0}, {1, 0}, {4, 0}, {4, 8}, {8, 8}}) {
+            Scene s = world({0.0, -9.81}, substeps, iterations);
             floorBox(s, 400.0, 1.0);
             for (int i = 0; i < n; ++i) disc(s, {0.0, 5.0}, 0.25, 0.2);
             Result<World> w = World::build(s);
@@ -237,7 +279,8 @@ TEST(HardContacts, CrowdStartedAtOnePointAboveAFloorIsNotThrownUp) {
                 for (std::size_t b = 0; b < w->bodyCount(); ++b)
                     highest = std::max(highest, w->bodyPosition(b).y);
             }
-            EXPECT_LT(highest, 5.0 + 0.25 * std::sqrt(n / 0.9) + 0.5) << n << " bodies, substeps " << label(substeps);
+            EXPECT_LT(highest, 5.0 + 0.25 * std::sqrt(n / 0.9) + 0.5)
+                << n << " bodies, substeps " << label(substeps) << ", iterations " << label(iterations);
         }
     }
 }

@@ -571,6 +571,7 @@ private:
     double dt_ = 0.0;
     int substeps_ = 1;
     std::vector<std::uint8_t> inCrowd_;  // per solver body: in crowdBodies_
+    std::vector<std::uint8_t> takeBack_;  // per solver body: its pushes across the crowd's edge go back
     std::vector<std::uint32_t> deepContacts_;  // this step's moving contacts deeper than a quarter reach
     std::vector<double> crowdImpulses_;  // the crowd contacts' impulses after the warm start, while a crowd is solved
     int substepsDone_ = 0;  // of this step, counted by solveSubstep

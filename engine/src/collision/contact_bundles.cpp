@@ -2,6 +2,7 @@
 
 #include "collision/simd_lanes.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cstddef>
 #include <cstring>
@@ -329,7 +330,8 @@ void forEachLane(Bundles& bundles, Visit&& visit) {
         for (int l = 0; l < kContactLanes; ++l) {
             if (b.source[l] == ~0u) continue;
             for (int i = 0; i < Points; ++i)
-                visit(b.bodyA[l], b.bodyB[l], b.points[i].normalImpulse[l], b.points[i].tangentImpulse[l]);
+                visit(b.bodyA[l], b.bodyB[l], b.source[l], i, b.points[i].normalImpulse[l],
+                      b.points[i].tangentImpulse[l]);
         }
 }
 
@@ -473,24 +475,25 @@ void ColouredContacts::solve(std::span<ContactConstraint> contacts, std::span<So
 
 template <class Self, class Contacts, class Visit>
 void ColouredContacts::forEachHeld(Self& self, Contacts& contacts, Visit&& visit) {
-    const auto points = [&](auto& c) {
+    const auto points = [&](std::uint32_t k) {
+        auto& c = contacts[k];
         for (int i = 0; i < c.pointCount; ++i)
-            visit(c.bodyA, c.bodyB, c.points[i].normalImpulse, c.points[i].tangentImpulse);
+            visit(c.bodyA, c.bodyB, k, i, c.points[i].normalImpulse, c.points[i].tangentImpulse);
     };
     if (!self.simd_) {
-        for (auto& c : contacts) points(c);
+        for (std::uint32_t k = 0; k < contacts.size(); ++k) points(k);
         return;
     }
     forEachLane<1>(self.one_, visit);
     forEachLane<2>(self.two_, visit);
     const std::span<const std::uint32_t> order(self.order_);
-    for (const std::uint32_t k : order.subspan(self.colourStart_[std::size_t(self.colourCount_)])) points(contacts[k]);
+    for (const std::uint32_t k : order.subspan(self.colourStart_[std::size_t(self.colourCount_)])) points(k);
 }
 
 void ColouredContacts::saveImpulses(std::span<const ContactConstraint> contacts, std::span<const std::uint8_t> marked,
                                     std::vector<double>& out) const {
     out.clear();
-    const auto save = [&](std::uint32_t a, std::uint32_t b, double normal, double tangent) {
+    const auto save = [&](std::uint32_t a, std::uint32_t b, std::uint32_t, int, double normal, double tangent) {
         if (!marked[a] && !marked[b]) return;
         out.push_back(normal);
         out.push_back(tangent);
@@ -499,15 +502,39 @@ void ColouredContacts::saveImpulses(std::span<const ContactConstraint> contacts,
 }
 
 void ColouredContacts::restoreImpulses(std::span<ContactConstraint> contacts, std::span<const std::uint8_t> marked,
-                                       std::span<const double> saved) {
+                                       std::span<const double> saved, std::span<SolverBody> bodies,
+                                       std::span<const std::uint8_t> takeBack) {
     std::size_t at = 0;
-    const auto restore = [&](std::uint32_t a, std::uint32_t b, double& normal, double& tangent) {
+    takenBack_.clear();
+    const auto restore = [&](std::uint32_t a, std::uint32_t b, std::uint32_t k, int i, double& normal,
+                             double& tangent) {
         if (!marked[a] && !marked[b]) return;
+        if (marked[a] != marked[b] && (takeBack[a] || takeBack[b]))
+            takenBack_.push_back({2 * k + std::uint32_t(i), normal - saved[at], tangent - saved[at + 1]});
         normal = saved[at];
         tangent = saved[at + 1];
         at += 2;
     };
     forEachHeld(*this, contacts, restore);
+    // In contact order, whichever path holds the impulses: a body's
+    // velocity then sums the same terms in the same order (the same bits).
+    std::sort(takenBack_.begin(), takenBack_.end(),
+              [](const TakenBack& x, const TakenBack& y) { return x.point < y.point; });
+    for (const TakenBack& e : takenBack_) {
+        const ContactConstraint& c = contacts[e.point / 2];
+        const ContactPoint& p = c.points[e.point % 2];
+        const Vec2 t{c.normal.y, -c.normal.x};
+        const Vec2 impulse = e.normal * c.normal + e.tangent * t;
+        if (takeBack[c.bodyA]) {
+            SolverBody& body = bodies[c.bodyA];
+            body.v += body.invMass * impulse;
+            body.w += body.invInertia * (p.rnA * e.normal - p.dnA * e.tangent);
+        } else {
+            SolverBody& body = bodies[c.bodyB];
+            body.v -= body.invMass * impulse;
+            body.w -= body.invInertia * (p.rnB * e.normal - p.dnB * e.tangent);
+        }
+    }
 }
 
 void ColouredContacts::storeImpulses(std::span<ContactConstraint> contacts) const {

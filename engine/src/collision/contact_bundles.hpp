@@ -93,9 +93,12 @@ public:
     /// a body with `marked[body]` set, in the order forEachHeld visits them.
     void saveImpulses(std::span<const ContactConstraint> contacts, std::span<const std::uint8_t> marked,
                       std::vector<double>& out) const;
-    /// Puts back what saveImpulses saved with the same `marked`.
+    /// Puts back what saveImpulses saved with the same `marked`. What the
+    /// passes added to a contact from a marked body to one with
+    /// `takeBack[body]` set is taken back from that body's velocity too.
     void restoreImpulses(std::span<ContactConstraint> contacts, std::span<const std::uint8_t> marked,
-                         std::span<const double> saved);
+                         std::span<const double> saved, std::span<SolverBody> bodies,
+                         std::span<const std::uint8_t> takeBack);
 
     /// Contact indices colour by colour, then the overflow: the order both
     /// paths solve in.
@@ -104,14 +107,22 @@ public:
     std::size_t overflowCount() const { return order_.size() - colourStart_[std::size_t(colourCount_)]; }
 
 private:
-    /// Calls visit(bodyA, bodyB, normal, tangent) with references to the
-    /// impulses where the solve keeps them: the bundles' lanes and then the
-    /// overflow's contacts (SIMD), or every contact (scalar). A bundled
+    /// Calls visit(bodyA, bodyB, contact, point, normal, tangent), the last
+    /// two references to the impulses where the solve keeps them: the
+    /// bundles' lanes and then the overflow's contacts (SIMD), or every
+    /// contact (scalar); `contact` indexes `contacts`. A bundled
     /// contact's own impulses are left alone by the passes until
     /// storeImpulses, so they are not visited.
     /// (`self` is *this, const or not: restoring writes through it.)
     template <class Self, class Contacts, class Visit>
     static void forEachHeld(Self& self, Contacts& contacts, Visit&& visit);
+    /// restoreImpulses' scratch: a point (2 contact + point) and what the
+    /// passes added to its impulses.
+    struct TakenBack {
+        std::uint32_t point;
+        double normal, tangent;
+    };
+    std::vector<TakenBack> takenBack_;
     bool simd_ = true;
     int colourCount_ = 0;
     std::vector<std::uint32_t> order_;

@@ -29,11 +29,27 @@ inline PositionImpulse splitCorrection(double move, double inverseMass, double l
 bool correctPositions(std::span<const ContactConstraint> contacts, std::span<SolverBody> bodies,
                       std::span<const std::uint8_t> crowd, const PositionCorrectionSettings& settings,
                       PositionCorrectionScratch& scratch) {
+    // A manifold's point lies midway between the two surfaces, half its
+    // step-start separation s0 off each side's feature along the normal;
+    // turned by t, an anchor there reads the gap (s0 / 2)(1 - cos t) off
+    // the gap at the feature. The velocity passes work with that (as Box2D
+    // v3: the turn within a step is small); against the static world, where
+    // this pass promises the slop at the end of every step, a plank that
+    // closed a 31 cm speculative gap while turning 6 mrad ended 2.6
+    // micrometres past the slop. The turned sides' terms are added back
+    // there (a round side's anchor does not turn).
+    const auto separationOf = [&](const SolverBody& a, const SolverBody& b, const ContactConstraint& c,
+                                  const ContactPoint& p) {
+        const double s = currentSeparation(a, b, c, p);
+        if (!c.touchesStatic) return s;
+        const double halfStart = 0.5 * (p.adjustedSeparation + (p.dnB - p.dnA));
+        return s + halfStart * ((c.roundA ? 0.0 : a.dq.c - 1.0) + (c.roundB ? 0.0 : b.dq.c - 1.0));
+    };
     const auto deepest = [&](const ContactConstraint& c) {
         const SolverBody& a = bodies[c.bodyA];
         const SolverBody& b = bodies[c.bodyB];
-        double s = currentSeparation(a, b, c, c.points[0]);
-        if (c.pointCount == 2) s = std::min(s, currentSeparation(a, b, c, c.points[1]));
+        double s = separationOf(a, b, c, c.points[0]);
+        if (c.pointCount == 2) s = std::min(s, separationOf(a, b, c, c.points[1]));
         return s;
     };
     // Moving pairs past the slop; the static contacts, kept to see which
@@ -66,7 +82,7 @@ bool correctPositions(std::span<const ContactConstraint> contacts, std::span<Sol
         double worst = 0.0;
         for (int i = 0; i < c.pointCount; ++i) {
             const ContactPoint& p = c.points[i];
-            const double excess = currentSeparation(a, b, c, p) + settings.slop;  // < 0: too deep
+            const double excess = separationOf(a, b, c, p) + settings.slop;  // < 0: too deep
             if (excess >= 0.0) continue;
             worst = std::min(worst, excess);
             const double move = std::min(-fraction * excess, cap);
