@@ -373,6 +373,14 @@ private:
     void prepareStaticSweep();
     /// Adds the bodies of deeply overlapping moving pairs to crowdBodies_.
     void addDeepOverlapsToCrowd();
+    /// Adds to crowdBodies_ the jointed bodies touching it, transitively.
+    void addJointedNeighboursToCrowd();
+    /// Lists the joints within the crowd, and those from it to a moving
+    /// body outside, and saves their impulses (after the warm start);
+    /// restoreCrowdJoints puts the first back and takes back what the
+    /// second gave (after the biased passes).
+    void saveCrowdJoints();
+    void restoreCrowdJoints();
 
     void addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m, std::span<const Vec2> centres);
     /// Broad phase while some bodies sleep: the awake boxes among themselves
@@ -574,6 +582,13 @@ private:
     std::vector<std::uint8_t> takeBack_;  // per solver body: its pushes across the crowd's edge go back
     std::vector<std::uint32_t> deepContacts_;  // this step's moving contacts deeper than a quarter reach
     std::vector<double> crowdImpulses_;  // the crowd contacts' impulses after the warm start, while a crowd is solved
+    std::vector<std::uint32_t> crowdJoints_;  // the awake joints within the crowd, this substep
+    std::vector<JointImpulse> crowdJointImpulses_;  // theirs after the warm start
+    std::vector<std::uint32_t> crowdRimJoints_;  // the awake joints from the crowd to a moving body outside it
+    std::vector<JointImpulse> crowdRimImpulses_;  // theirs after the warm start
+    std::vector<std::uint8_t> crowdSupport_;  // per solver body: a crowd body carrying a heavy one out (addJointedNeighboursToCrowd)
+    std::vector<std::uint8_t> jointedBody_;  // per solver body: has an unbroken joint (addJointedNeighboursToCrowd)
+    std::vector<std::uint32_t> neighbourStart_, neighbourFill_, neighbours_;  // contacts of jointed bodies, by body
     int substepsDone_ = 0;  // of this step, counted by solveSubstep
     PositionCorrectionSettings positionCorrection_;
     PositionCorrectionScratch positionScratch_;

@@ -224,4 +224,13 @@ void JointBundles::storeImpulses(std::span<JointConstraint> joints) const {
             if (h.joint[m] != HingeBundle::kNoJoint) joints[h.joint[m]].linearImpulse = {h.impulseX[m], h.impulseY[m]};
 }
 
+void JointBundles::loadImpulses(std::span<const JointConstraint> joints) {
+    for (HingeBundle& h : bundles_)
+        for (int m = 0; m < HingeBundle::kLanes; ++m)
+            if (h.joint[m] != HingeBundle::kNoJoint) {
+                h.impulseX[m] = joints[h.joint[m]].linearImpulse.x;
+                h.impulseY[m] = joints[h.joint[m]].linearImpulse.y;
+            }
+}
+
 } // namespace stepwise::joints

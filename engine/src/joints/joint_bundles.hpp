@@ -52,6 +52,9 @@ public:
                const collision::Softness& loopSoft, const collision::Softness& directSoft, bool useBias);
     /// Copies the bundles' impulses back to their joints.
     void storeImpulses(std::span<JointConstraint> joints) const;
+    /// Copies the joints' impulses into the bundles (after a change to them
+    /// mid-step).
+    void loadImpulses(std::span<const JointConstraint> joints);
     std::size_t bundledCount() const { return bundled_; }
     std::size_t oneAtATimeCount() const { return rest_.size(); }
 

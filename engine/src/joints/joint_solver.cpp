@@ -337,6 +337,24 @@ void setImpulses(JointConstraint& j, const JointImpulse& in) {
     }
 }
 
+void takeBackJointImpulses(std::span<JointConstraint> joints, std::span<const std::uint32_t> marked,
+                           std::span<const JointImpulse> saved, std::span<SolverBody> bodies) {
+    for (std::size_t m = 0; m < marked.size(); ++m) {
+        JointConstraint& j = joints[marked[m]];
+        const JointImpulse now = impulsesOf(j), before = saved[m];
+        const JointImpulse back{j.entity,           before.linear - now.linear, before.angular - now.angular,
+                                before.axial - now.axial, before.motor - now.motor, before.lower - now.lower,
+                                before.upper - now.upper};
+        // The warm start applies a joint's impulses with its geometry; on a
+        // copy holding the gain's opposite it takes the gain back.
+        JointConstraint undo = j;
+        setImpulses(undo, back);
+        const std::uint32_t only = 0;
+        warmStartJoints(std::span<JointConstraint>(&undo, 1), std::span<const std::uint32_t>(&only, 1), bodies);
+        setImpulses(j, before);
+    }
+}
+
 namespace {
 
 /// The joint's centres, anchors and angles from its bodies' centres and

@@ -139,6 +139,13 @@ JointImpulse impulsesOf(const JointConstraint& joint);
 /// the warm start would otherwise apply every substep with nothing to undo it.
 void setImpulses(JointConstraint& joint, const JointImpulse& impulses);
 
+/// For each joint listed in `marked`: applies to its bodies the opposite of
+/// what its impulses gained since `saved` (its impulses then, in the same
+/// order), and sets them back to `saved`: what the joint gave since is
+/// undone on both ends.
+void takeBackJointImpulses(std::span<JointConstraint> joints, std::span<const std::uint32_t> marked,
+                           std::span<const JointImpulse> saved, std::span<collision::SolverBody> bodies);
+
 /// Computes the step-start anchors, centres and angles. `centres` and
 /// `angles` are per collider (step start).
 void prepareJoints(std::span<JointConstraint> joints, std::span<const collision::SolverBody> bodies,
