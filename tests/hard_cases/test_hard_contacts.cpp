@@ -307,7 +307,7 @@ Scene chainInACrowd(int links, double linkMass, int discs, int substeps, int ite
 // speed, whatever its links weigh against the crowd's bodies. Its links
 // join the crowd (their push is a position change) and its joints within
 // the crowd give back what the biased passes added. Measured at most
-// 3.7 m/s (ten 0.1 kg links, 8 substeps, 8 iterations). Before, a link
+// 3.0 m/s (two 1 kg links, 8 substeps, 8 iterations). Before, a link
 // touching the crowd kept its pushes and passed them on through its
 // joints, and the joints' impulses carried the crowd's push into the
 // next substep's warm start: the same scenes through `stepwise run` gave

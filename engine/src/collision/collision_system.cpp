@@ -1337,9 +1337,14 @@ void CollisionSystem::addJointedNeighboursToCrowd() {
     // plank's mass (16 relax passes held it at 10, not at 25). A support
     // that joined here leaves the crowd again, and one the crowd rule put
     // in it keeps its joints' answer.
+    //
+    // Jointed here means jointed to another moving body: a body held only
+    // to the static world (a motor-driven drum or spinner) passes no push
+    // on, and stays out as before.
+    const auto moving = [&](std::uint32_t b) { return bodies_[b].invMass > 0.0 || bodies_[b].invInertia > 0.0; };
     jointedBody_.assign(bodies_.size(), 0);
     for (const joints::JointConstraint& j : joints_) {
-        if (j.broken) continue;
+        if (j.broken || !moving(j.a.solverBody) || !moving(j.b.solverBody)) continue;
         jointedBody_[j.a.solverBody] = jointedBody_[j.b.solverBody] = 1;
     }
     // The contacts touching a jointed body, by body, both ends listed.

@@ -587,7 +587,7 @@ private:
     std::vector<std::uint32_t> crowdRimJoints_;  // the awake joints from the crowd to a moving body outside it
     std::vector<JointImpulse> crowdRimImpulses_;  // theirs after the warm start
     std::vector<std::uint8_t> crowdSupport_;  // per solver body: a crowd body carrying a heavy one out (addJointedNeighboursToCrowd)
-    std::vector<std::uint8_t> jointedBody_;  // per solver body: has an unbroken joint (addJointedNeighboursToCrowd)
+    std::vector<std::uint8_t> jointedBody_;  // per solver body: jointed to another moving body (addJointedNeighboursToCrowd)
     std::vector<std::uint32_t> neighbourStart_, neighbourFill_, neighbours_;  // contacts of jointed bodies, by body
     int substepsDone_ = 0;  // of this step, counted by solveSubstep
     PositionCorrectionSettings positionCorrection_;
