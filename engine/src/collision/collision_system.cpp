@@ -1343,10 +1343,14 @@ void CollisionSystem::addJointedNeighboursToCrowd() {
     // on, and stays out as before.
     const auto moving = [&](std::uint32_t b) { return bodies_[b].invMass > 0.0 || bodies_[b].invInertia > 0.0; };
     jointedBody_.assign(bodies_.size(), 0);
+    bool anyJointed = false;
     for (const joints::JointConstraint& j : joints_) {
         if (j.broken || !moving(j.a.solverBody) || !moving(j.b.solverBody)) continue;
         jointedBody_[j.a.solverBody] = jointedBody_[j.b.solverBody] = 1;
+        anyJointed = true;
     }
+    crowdSupport_.assign(bodies_.size(), 0);
+    if (!anyJointed) return;  // a drum or spinner: nothing to join, and no pass over the contacts
     // The contacts touching a jointed body, by body, both ends listed.
     neighbourStart_.assign(bodies_.size() + 1, 0);
     const auto touchesJointed = [&](const ContactConstraint& c) {
