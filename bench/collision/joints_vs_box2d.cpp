@@ -23,6 +23,7 @@
 // times, alternating, and its fastest run counts (--quick: once, a fifth of
 // the steps).
 
+#include "generated_scenes.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
@@ -85,15 +86,7 @@ Scene jointGrid(int n, int substeps, int iterations) {
                 // Box2D keeps a joint between two static anchors and never
                 // solves it; Stepwise refuses one, so it is left out.
                 if (r.has<Static>(a) && r.has<Static>(e)) return;
-                const Entity j = r.create();
-                Joint joint;
-                joint.type = "hinge";
-                joint.a = a;
-                joint.b = e;
-                joint.localA = localA;
-                joint.localB = localB;
-                joint.referenceAngle = 0.0;
-                r.emplace<Joint>(j, joint);
+                scenes::addHinge(r, a, e, localA, localB);
             };
             if (i > 0) hinge(bodies.back(), {0.0, -0.5}, {0.0, 0.5});
             if (k > 0) hinge(bodies[bodies.size() - std::size_t(n)], {0.5, 0.0}, {-0.5, 0.0});

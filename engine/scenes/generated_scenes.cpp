@@ -102,6 +102,19 @@ Entity addStaticBox(Scene& s, Vec2 centre, double width, double height) {
     return e;
 }
 
+Entity addHinge(Registry& r, Entity a, Entity b, Vec2 localA, Vec2 localB) {
+    Joint joint;
+    joint.type = "hinge";
+    joint.a = a;
+    joint.b = b;
+    joint.localA = localA;
+    joint.localB = localB;
+    joint.referenceAngle = 0.0;
+    const Entity j = r.create();
+    r.emplace<Joint>(j, joint);
+    return j;
+}
+
 Scene circlesInBox(int count) {
     Scene s;
     contactWorld(s, 4, 2);

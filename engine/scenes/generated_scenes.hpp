@@ -65,6 +65,10 @@ void addCircleGrid(Scene& scene, const CircleGrid& grid);
 /// `height` m, with nothing else.
 Entity addStaticBox(Scene& scene, Vec2 centre, double width, double height);
 
+/// A hinge joint from `a` to `b` (null: the world) at anchors `localA` and
+/// `localB` in their frames, reference angle 0, as a new entity.
+Entity addHinge(Registry& registry, Entity a, Entity b, Vec2 localA, Vec2 localB);
+
 // ---- the collision benchmark's scenes (also levels/pile, pyramid, rain) ----
 
 /// 2,000 circles (radius 0.25 m) in a grid, falling into a 30 m wide box.

@@ -284,20 +284,12 @@ Scene chainInACrowd(int links, double linkMass, int discs, int substeps, int ite
         s.registry.tryGet<Box>(e)->height = 0.1;
         chain.push_back(e);
     }
-    const auto hinge = [&](Entity a, Entity b, Vec2 localA, Vec2 localB) {
-        Joint j;
-        j.type = "hinge";
-        j.a = a;
-        j.b = b;
-        j.localA = localA;
-        j.localB = localB;
-        s.registry.emplace<Joint>(s.registry.create(), j);
-    };
     const double half = pinned ? 0.25 : 0.125;
-    for (int i = 1; i < links; ++i) hinge(chain[std::size_t(i)], chain[std::size_t(i - 1)], {-half, 0.0}, {half, 0.0});
+    for (int i = 1; i < links; ++i)
+        scenes::addHinge(s.registry, chain[std::size_t(i)], chain[std::size_t(i - 1)], {-half, 0.0}, {half, 0.0});
     if (pinned) {
         const Entity post = scenes::addStaticBox(s, {-2.5, 0.0}, 0.1, 0.1);
-        hinge(chain[0], post, {-half, 0.0}, {0.0, 0.0});
+        scenes::addHinge(s.registry, chain[0], post, {-half, 0.0}, {0.0, 0.0});
     }
     return s;
 }

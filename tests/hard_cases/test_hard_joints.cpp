@@ -4,6 +4,7 @@
 // a joint that opens by more than about 1% of a link is visible, and a
 // pendulum that gains energy swings ever higher.
 
+#include "generated_scenes.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
 #include "stepwise/world.hpp"
@@ -345,14 +346,7 @@ Scene hingeGrid(int n, int substeps, int iterations) {
             else r.emplace<Mass>(e, Mass{0.16 * 3.141592653589793});
             const auto hinge = [&](Entity a, Vec2 localA, Vec2 localB) {
                 if (r.has<Static>(a) && anchor) return;
-                Joint j;
-                j.type = "hinge";
-                j.a = a;
-                j.b = e;
-                j.localA = localA;
-                j.localB = localB;
-                j.referenceAngle = 0.0;
-                r.emplace<Joint>(r.create(), j);
+                scenes::addHinge(r, a, e, localA, localB);
             };
             if (i > 0) hinge(bodies.back(), {0.0, -0.5}, {0.0, 0.5});
             if (k > 0) hinge(bodies[bodies.size() - std::size_t(n)], {0.5, 0.0}, {-0.5, 0.0});
