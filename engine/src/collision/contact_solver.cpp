@@ -53,6 +53,7 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
                      std::span<const SolverBody> bodies, ContactPairs& pairs) {
     pairs.bodies.resize(2 * contacts.size());
     pairs.twoPoints.resize(contacts.size());
+    pairs.approach.resize(contacts.size());
     pairs.reach.assign(bodies.size(), 0.0);
     for (std::size_t k = 0; k < contacts.size(); ++k) {
         ContactConstraint& c = contacts[k];
@@ -61,6 +62,13 @@ void prepareContacts(std::span<ContactConstraint> contacts, std::span<const Cont
         pairs.bodies[2 * k] = c.bodyA;
         pairs.bodies[2 * k + 1] = c.bodyB;
         pairs.twoPoints[k] = c.pointCount == 2 ? 1 : 0;
+        ContactPairs::ApproachRow& row = pairs.approach[k];
+        row.normal = c.normal;
+        for (int i = 0; i < 2; ++i) {
+            const ContactPoint& p = c.points[c.pointCount == 2 ? i : 0];
+            row.rnA[i] = p.rnA;
+            row.rnB[i] = p.rnB;
+        }
         for (int i = 0; i < c.pointCount; ++i) {
             ContactPoint& p = c.points[i];
             pairs.reach[c.bodyA] = std::max(pairs.reach[c.bodyA], std::abs(p.rnA));
@@ -209,26 +217,56 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
         if (!passedOver(k)) now[k / 64] |= std::uint64_t(1) << (k % 64);
     // Contact k changed its bodies: every contact on them looks again, later
     // in this pass if it comes after k, else in the next pass (k included).
+    // A pile's body changes several times a pass. Its later contacts are
+    // marked at its first change (a later change's are among them, not yet
+    // looked at), its earlier ones once at the end of the pass, up to its
+    // last change: the marks of marking at every change, at a fraction of
+    // the writes (a churned pile made a dozen per impulse).
+    scratch.changedInPass.resize(bodies.size(), 0);
+    scratch.lastChange.resize(bodies.size(), 0);
     const auto touched = [&](std::uint32_t body, std::size_t k) {
         if (body == 0) return;
+        scratch.lastChange[body] = std::uint32_t(k);
+        if (scratch.changedInPass[body] == scratch.passCount) return;
+        scratch.changedInPass[body] = scratch.passCount;
+        scratch.changed.push_back(body);
         if (!scratch.incidentReady) indexIncident(pairs.bodies, bodies.size(), scratch);
-        for (std::uint32_t i = scratch.start[body]; i < scratch.start[body + 1]; ++i) {
-            const std::uint32_t m = scratch.incident[i];
-            (m > k ? now : next)[m / 64] |= std::uint64_t(1) << (m % 64);
+        for (std::uint32_t i = scratch.start[body + 1]; i > scratch.start[body];) {
+            const std::uint32_t m = scratch.incident[--i];
+            if (m <= k) break;  // ascending: the rest come before k
+            now[m / 64] |= std::uint64_t(1) << (m % 64);
         }
+    };
+    const auto markEarlierContacts = [&] {
+        for (const std::uint32_t body : scratch.changed) {
+            const std::uint32_t last = scratch.lastChange[body];
+            for (std::uint32_t i = scratch.start[body]; i < scratch.start[body + 1]; ++i) {
+                const std::uint32_t m = scratch.incident[i];
+                if (m > last) break;
+                next[m / 64] |= std::uint64_t(1) << (m % 64);
+            }
+        }
+        scratch.changed.clear();
     };
     for (int pass = 0; pass < maxPasses; ++pass) {
         bool any = false;
         next.assign(words, 0);
+        ++scratch.passCount;  // starts above the zeros changedInPass is filled with
         for (std::size_t word = 0; word < words; ++word) {
             while (now[word] != 0) {
                 const std::size_t k = word * 64 + std::size_t(std::countr_zero(now[word]));
                 now[word] &= now[word] - 1;
                 if (passedOver(k)) continue;
                 ++scratch.looked;
+                SolverBody& a = bodies[pairs.bodies[2 * k]];
+                SolverBody& b = bodies[pairs.bodies[2 * k + 1]];
+                // The same test as the points' loop below, on the packed row:
+                // a contact none of whose points approaches does nothing.
+                const ContactPairs::ApproachRow& row = pairs.approach[k];
+                if (normalSpeed(a, b, row.normal, row.rnA[0], row.rnB[0]) >= -threshold &&
+                    normalSpeed(a, b, row.normal, row.rnA[1], row.rnB[1]) >= -threshold)
+                    continue;
                 ContactConstraint& c = contacts[k];
-                SolverBody& a = bodies[c.bodyA];
-                SolverBody& b = bodies[c.bodyB];
                 // The approaching points that touch within this substep; the
                 // impulse acts at their centroid (the projections are linear in
                 // the anchor, so the centroid's are the mean) so a flat landing
@@ -269,6 +307,7 @@ void propagateImpacts(std::span<ContactConstraint> contacts, std::span<ContactDe
                 any = true;
             }
         }
+        markEarlierContacts();
         if (!any) break;
         if (every) {
             std::fill(next.begin(), next.end(), ~std::uint64_t(0));

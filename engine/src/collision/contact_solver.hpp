@@ -138,8 +138,18 @@ double currentSeparation(const SolverBody& a, const SolverBody& b, const Contact
 /// whole array for its bodies and point count read it from memory again
 /// (on Box2D's many pyramids, 13 MB for 0.5 MB of pairs).
 struct ContactPairs {
+    /// What the impact passes need to tell whether a contact approaches:
+    /// its normal and its points' lever arms about it (rn of
+    /// ContactPoint; a one-point contact repeats its point). Most contacts
+    /// of a churned pile do not approach, and a row is a quarter of the
+    /// constraint the passes would otherwise stream twice a substep.
+    struct ApproachRow {
+        Vec2 normal;
+        double rnA[2] = {0.0, 0.0}, rnB[2] = {0.0, 0.0};
+    };
     std::vector<std::uint32_t> bodies;    ///< contact k's bodyA, bodyB at 2k, 2k + 1
     std::vector<std::uint8_t> twoPoints;  ///< 1 when contact k has two points
+    std::vector<ApproachRow> approach;    ///< contact k's normal and lever arms
     /// Per solver body: the largest |rn| of its contact points this step (m).
     std::vector<double> reach;
 };
@@ -180,6 +190,12 @@ struct ImpactScratch {
     std::vector<std::uint32_t> incident;  ///< contact indices, ascending per body
     std::vector<std::uint64_t> now, next;  ///< contacts to look at in this pass and the next (bit sets)
     std::vector<std::uint32_t> now32;      ///< the listing's cursor per body
+    /// Per solver body: the pass (a count over all calls) in which it last
+    /// changed velocity, and the contact of its last change in that pass.
+    std::vector<std::uint64_t> changedInPass;
+    std::vector<std::uint32_t> lastChange;
+    std::vector<std::uint32_t> changed;  ///< the bodies changed in this pass
+    std::uint64_t passCount = 0;
     /// Per solver body, at the start of a substep: a bound on the normal
     /// speed any of its points can have, |v.x - u.x| + |v.y - u.y| + |w|
     /// reach (m/s).
