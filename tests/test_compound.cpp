@@ -389,11 +389,21 @@ TEST(CompoundWorld, AMotorTurnsADynamicDrumOnAHinge) {
                                       "\"anchor\": {\"x\": 0, \"y\": 0}, \"motor_speed\": " + exactNumber(speed) +
                                       ", \"max_motor_torque\": 1e6}}");
         Sim sim(text);
-        ASSERT_TRUE(sim.step(300));
+        ASSERT_TRUE(sim.step(240));
+        // The speed as the mean over the last second: the items striking the
+        // walls jolt the drum off the motor's speed for a step and the motor
+        // brings it back. The jolts are chaotic: moving one item by a
+        // micrometre at the start changes the largest in that second from
+        // 5% to 9% or 15%, so a reading at one step says which step it is.
+        double sum = 0.0;
+        ASSERT_TRUE(sim.step(60, [&] {
+            sim.world->writeBack(sim.scene);
+            sum += sim.angularVelocity("drum");
+        }));
         // The motor sets b's speed relative to a: the world (b) against the
         // drum (a) at +speed turns the drum at -speed.
         EXPECT_NEAR(sim.angle("drum"), -speed * 5.0, 0.02 * speed * 5.0) << speed;
-        EXPECT_NEAR(sim.angularVelocity("drum"), -speed, 0.03 * speed) << speed;
+        EXPECT_NEAR(sum / 60.0, -speed, 0.01 * speed) << speed;
         EXPECT_LT(length(sim.position("drum")), 1e-3) << speed;
         for (int i = 0; i < 24; ++i)
             EXPECT_LT(length(sim.position("b" + std::to_string(i))), 2.0 * std::sqrt(2.0)) << i << " at " << speed;

@@ -1645,6 +1645,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // heavy end) without touching the velocities.
     if (jointed && directJoints_.directJointCount() > 0) {
         directJoints_.project(joints_, bodies_, jointMoves_, jointMoved_);
+        const bool riders = !jointMoved_.empty() && noteRiders();
         if (!jointMoved_.empty())
             for (const SolvedBody& sb : awakeSolved_) {
                 const joints::DirectJoints::Move& m = jointMoves_[sb.solver];
@@ -1660,6 +1661,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
                 b.dp += m.dp;
                 b.dq = rotationBy(angles_[i] - stepStartAngle_[i]);
             }
+        if (riders) carryRiders(x);
     }
     for (const SolvedBody& sb : awakeSolved_) {
         v[sb.body] = bodies_[sb.solver].v;
@@ -1672,6 +1674,95 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         if (anySensor_) updateSensors(x);
     }
     timings_.solveMs += msSince(start);
+}
+
+bool CollisionSystem::noteRiders() {
+    // The projection moves a group's bodies onto its joints without
+    // touching velocities, and the contacts never see the move: a plank
+    // lifted back onto its pins rises into the crate resting on it, and
+    // the crate's soft contact takes out a few per cent of that overlap a
+    // substep. Under a steady load the group sags and is lifted back by the
+    // same amount every substep, so a crate of half a plank's mass settled
+    // 4.6 cm into the planks of a bridge (7.6 cm at twice a plank's mass),
+    // and heavier ones bounced on it.
+    carryRole_.assign(bodies_.size(), kLoose);
+    for (const joints::JointConstraint& j : joints_)
+        if (j.direct) carryRole_[j.a.solverBody] = carryRole_[j.b.solverBody] = kInGroup;
+    const auto loose = [&](std::uint32_t b) { return carryRole_[b] == kLoose && bodies_[b].invMass > 0.0; };
+    riderContacts_.clear();
+    bool touchesGroup = false;
+    for (std::size_t k = 0; k < constraints_.size(); ++k) {
+        const ContactConstraint& c = constraints_[k];
+        const bool looseA = loose(c.bodyA), looseB = loose(c.bodyB);
+        if (!looseA && !looseB) continue;
+        // A loose body against a static one, or against a moving body that
+        // no projection moves (kinematic, or loose but across the contact
+        // only once carried: listed below), is no rider's contact.
+        if (looseA != looseB) {
+            if (carryRole_[looseA ? c.bodyB : c.bodyA] != kInGroup) continue;
+            touchesGroup = true;
+        }
+        RiderContact& r = riderContacts_.emplace_back();
+        r.contact = std::uint32_t(k);
+        for (int i = 0; i < c.pointCount; ++i)
+            r.before[i] = currentSeparation(bodies_[c.bodyA], bodies_[c.bodyB], c, c.points[i]);
+    }
+    if (!touchesGroup) return false;
+    riderLoad_.assign(bodies_.size(), Vec2{});
+    for (const SolvedBody& sb : awakeSolved_) riderLoad_[sb.solver] = endV_[sb.collider] - startV_[sb.collider];
+    return true;
+}
+
+void CollisionSystem::carryRiders(std::span<Vec2> x) {
+    // Each rider moves out along a contact's normal until the contact is no
+    // deeper than before the projection (or than touching, had it a gap),
+    // when the body across has moved (a group's body, or a rider carried
+    // already: a box on the crate goes up with it) and the move holds the
+    // rider against its load (a box a ragdoll lies on is not pushed into
+    // the floor). The groups do not move back: their joints stay where the
+    // projection put them, as a static support would. Only positions move,
+    // as in the projection. Passes repeat while a rider moves, to a bound;
+    // a pile deeper than that is left to its soft contacts.
+    carried_.assign(bodies_.size(), Vec2{});
+    constexpr int kMaxPasses = 8;
+    for (int pass = 0; pass < kMaxPasses; ++pass) {
+        bool any = false;
+        for (const RiderContact& r : riderContacts_) {
+            const ContactConstraint& c = constraints_[r.contact];
+            const std::uint8_t roleA = carryRole_[c.bodyA], roleB = carryRole_[c.bodyB];
+            // The side pushed: a rider (not a group's body) whose neighbour
+            // across has moved.
+            const bool pushA = roleA != kInGroup && roleB != kLoose;
+            const bool pushB = roleB != kInGroup && roleA != kLoose;
+            if (!pushA && !pushB) continue;
+            double deficit = 0.0;
+            for (int i = 0; i < c.pointCount; ++i) {
+                const double now = currentSeparation(bodies_[c.bodyA], bodies_[c.bodyB], c, c.points[i]);
+                deficit = std::max(deficit, std::min(r.before[i], 0.0) - now);
+            }
+            if (!(deficit > 0.0)) continue;
+            // The normal runs from A to B: B moves along it, A against it.
+            // Two carried riders carried into each other (boxes lifted along
+            // the two sides of a sagging bridge) share the move by inverse
+            // mass; a loose body is carried only against its load.
+            const double shareB = pushA && pushB ? bodies_[c.bodyB].invMass /
+                                                       (bodies_[c.bodyA].invMass + bodies_[c.bodyB].invMass)
+                                                 : (pushB ? 1.0 : 0.0);
+            const Vec2 moveA = (-(1.0 - shareB) * deficit) * c.normal, moveB = (shareB * deficit) * c.normal;
+            if (!(pushA && pushB) && !(dot(pushB ? moveB : moveA, riderLoad_[pushB ? c.bodyB : c.bodyA]) < 0.0))
+                continue;
+            for (const auto& [rider, move] : {std::pair{c.bodyA, moveA}, std::pair{c.bodyB, moveB}}) {
+                if (move == Vec2{}) continue;
+                bodies_[rider].dp += move;
+                carried_[rider] += move;
+                carryRole_[rider] = kCarried;
+            }
+            any = true;
+        }
+        if (!any) break;
+    }
+    for (const SolvedBody& sb : awakeSolved_)
+        if (const Vec2 m = carried_[sb.solver]; m != Vec2{}) x[sb.body] += m;
 }
 
 void CollisionSystem::correctStepPositions(std::span<Vec2> x) {

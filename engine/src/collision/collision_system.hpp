@@ -381,6 +381,14 @@ private:
     /// second gave (after the biased passes).
     void saveCrowdJoints();
     void restoreCrowdJoints();
+    /// Riders: moving bodies outside every exactly solved joint group that
+    /// rest on such a group or on another rider (a crate on a bridge, a box
+    /// on the crate). noteRiders lists their contacts and separations before
+    /// the groups' projection moves them; carryRiders then moves each rider
+    /// out by what the projection (or a carried neighbour) pushed into it.
+    /// noteRiders returns false when no loose body touches a group.
+    bool noteRiders();
+    void carryRiders(std::span<Vec2> x);
 
     void addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m, std::span<const Vec2> centres);
     /// Broad phase while some bodies sleep: the awake boxes among themselves
@@ -499,6 +507,17 @@ private:
     bool jointBundlesReady_ = false;              // built this step
     std::vector<joints::DirectJoints::Move> jointMoves_;  // per solver body: its projection (directJoints_.project)
     std::vector<std::uint32_t> jointMoved_;
+    struct RiderContact {
+        std::uint32_t contact;
+        double before[2];  // each point's separation before the projection, metres
+    };
+    std::vector<RiderContact> riderContacts_;  // noteRiders
+    /// Per solver body, for carryRiders: kLoose, kInGroup (an end of an
+    /// exactly solved joint) or kCarried (a rider moved this substep).
+    enum CarryRole : std::uint8_t { kLoose, kInGroup, kCarried };
+    std::vector<std::uint8_t> carryRole_;
+    std::vector<Vec2> riderLoad_;  // per solver body: its velocity change from outside forces this step, m/s
+    std::vector<Vec2> carried_;    // per solver body: what carryRiders moved it by, metres
     std::vector<std::pair<std::uint32_t, double>> stiffened_;  // bodies whose inertia a joint raised this substep
     std::vector<double> stiffenScratch_;
     std::vector<std::uint64_t> noCollide_;  // sorted (min collider << 32 | max collider)
