@@ -38,6 +38,9 @@ constexpr double kRelaxRegularisation = 1e-9;
 /// diagonal entry (the relax pass's regularisation) marks redundant rows.
 constexpr double kPivotFloor = kRelaxRegularisation;
 
+/// How many times the projection halves a step that would leave its joints
+/// further open than it found them, before dropping it.
+constexpr int kProjectionHalvings = 6;
 /// The projection leaves this much of a joint's error to the soft rows
 /// (metres; rad for a weld's angle). A projection moves positions without
 /// turning the velocities with them, and the next substep's rows then take
@@ -614,6 +617,7 @@ void DirectJoints::project(std::span<const JointConstraint> joints, std::span<co
         }
         if (!any) continue;  // every joint within the slop: nothing moves
         g.solveFactored();
+        const std::size_t first = moved.size();
         for (std::size_t k = 0; k < g.joints.size(); ++k) {
             const JointConstraint& j = joints[g.joints[k]];
             const std::uint32_t o = g.offset[k];
@@ -630,6 +634,41 @@ void DirectJoints::project(std::span<const JointConstraint> joints, std::span<co
             push(j.a.solverBody, -1.0, g.rA[k]);
             push(j.b.solverBody, 1.0, g.rB[k]);
         }
+        // The step is linear in the moves; the joints are not. Where the
+        // linear step is a poor guide it can leave the joints further open
+        // than it found them: a chain laid straight between pins closer
+        // together than its length can shorten only by buckling, which the
+        // linear step cannot see, and along the nearly singular straight
+        // line it answered a centimetre of error with most of a metre, torn
+        // open again at once. So the joints' points are checked at the moved
+        // pose, and a step that opens them further is halved until it does
+        // not (a few times at most; then it is dropped).
+        const auto openingAt = [&](double scale) {
+            double open = 0.0;
+            for (std::size_t k = 0; k < g.joints.size(); ++k) {
+                const JointConstraint& j = joints[g.joints[k]];
+                const auto moved = [&](std::uint32_t body, Vec2 r, Vec2& dp) {
+                    dp = bodies[body].dp;
+                    if (body == 0) return r;
+                    dp += scale * moves[body].dp;
+                    return collision::rotate(collision::rotationBy(scale * moves[body].dq), r);
+                };
+                Vec2 dpA, dpB;
+                const Vec2 rA = moved(j.a.solverBody, g.rA[k], dpA);
+                const Vec2 rB = moved(j.b.solverBody, g.rB[k], dpB);
+                open += length((dpB - dpA) + (rB - rA) + j.deltaCenter);
+            }
+            return open;
+        };
+        const double before = openingAt(0.0);
+        double scale = 1.0;
+        for (int halving = 0; halving < kProjectionHalvings && openingAt(scale) > before; ++halving) scale *= 0.5;
+        if (openingAt(scale) > before) scale = 0.0;
+        if (scale != 1.0)
+            for (std::size_t i = first; i < moved.size(); ++i) {
+                moves[moved[i]].dp = scale * moves[moved[i]].dp;
+                moves[moved[i]].dq *= scale;
+            }
     }
     std::sort(moved.begin(), moved.end());
     moved.erase(std::unique(moved.begin(), moved.end()), moved.end());
