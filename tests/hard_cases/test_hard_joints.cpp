@@ -4,6 +4,7 @@
 // a joint that opens by more than about 1% of a link is visible, and a
 // pendulum that gains energy swings ever higher.
 
+#include "bridge_level.hpp"
 #include "generated_scenes.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/scene_io.hpp"
@@ -623,44 +624,8 @@ TEST(HardJointsSolver, RedundantRowsInATreeAreStillSolved) {
 
 namespace {
 
-/// Twelve 2 kg planks (1 m x 0.2 m) hinged end to end between two static
-/// piers whose pins are `halfSpan` m either side of the middle, laid out as
-/// a V that meets them (6 m: taut; less: slack), and a 1.2 m crate of
-/// `crateMass` kg dropped on it from 2.6 m above the pins, with `boxes`
-/// 0.8 m boxes of half its mass stacked above it.
-Scene crateOnBridge(double crateMass, double halfSpan, int substeps, int boxes = 0) {
-    std::ostringstream s;
-    s << R"({"world": {"gravity": {"x": 0, "y": -10})";
-    if (substeps > 0) s << R"(, "substeps": )" << substeps;
-    s << R"(}, "entities": [
-        {"name": "ground", "position": {"x": 0, "y": -4.5}, "static": true, "box": {"width": 40, "height": 1}},
-        {"name": "left pier", "position": {"x": )" << num(-halfSpan - 1.0) << R"(, "y": -2}, "static": true, "box": {"width": 2, "height": 4}},
-        {"name": "right pier", "position": {"x": )" << num(halfSpan + 1.0) << R"(, "y": -2}, "static": true, "box": {"width": 2, "height": 4}},
-        {"name": "crate", "position": {"x": 0.5, "y": 2.5}, "mass": )" << num(crateMass)
-      << R"(, "box": {"width": 1.2, "height": 1.2}, "friction": 0.6})";
-    for (int i = 0; i < boxes; ++i)
-        s << R"(, {"name": "box )" << i << R"(", "position": {"x": 0.5, "y": )" << num(3.8 + 0.9 * i) << R"(}, "mass": )"
-          << num(0.5 * crateMass) << R"(, "box": {"width": 0.8, "height": 0.8}, "friction": 0.6})";
-    const double slope = std::acos(std::min(1.0, halfSpan / 6.0));
-    Vec2 pin{-halfSpan, -0.1};
-    for (int i = 0; i < 12; ++i) {
-        const double angle = i < 6 ? -slope : slope;
-        const Vec2 along{std::cos(angle), std::sin(angle)};
-        const Vec2 centre = pin + 0.5 * along;
-        s << R"(, {"name": "plank )" << i << R"(", "position": {"x": )" << num(centre.x) << R"(, "y": )" << num(centre.y)
-          << R"(}, "angle": )" << num(angle) << R"(, "mass": 2, "box": {"width": 1, "height": 0.2}, "friction": 0.6})";
-        pin = pin + along;
-    }
-    const auto hinge = [&](int i, const std::string& a, const std::string& b, double ax, double bx, double by) {
-        s << R"(, {"name": "pin )" << i << R"(", "joint": {"type": "hinge", "a": ")" << a << R"(", "b": ")" << b
-          << R"(", "local_a": {"x": )" << num(ax) << R"(, "y": 0}, "local_b": {"x": )" << num(bx) << R"(, "y": )"
-          << num(by) << "}}}";
-    };
-    hinge(0, "plank 0", "left pier", -0.5, 1.0, 1.9);
-    for (int i = 1; i < 12; ++i) hinge(i, "plank " + std::to_string(i), "plank " + std::to_string(i - 1), -0.5, 0.5, 0.0);
-    hinge(12, "plank 11", "right pier", 0.5, -1.0, 1.9);
-    s << "]}";
-    Result<Scene> scene = parseScene(s.str(), "bridge.json");
+Scene parseBridge(const stepwise::test::BridgeLevel& layout) {
+    Result<Scene> scene = parseScene(stepwise::test::bridgeJson(layout), "bridge.json");
     EXPECT_TRUE(scene) << (scene ? "" : scene.error());
     return scene ? std::move(*scene) : Scene{};
 }
@@ -683,7 +648,7 @@ TEST(HardJointsLoads, ACrateRestsOnABridgeWithoutSinkingIntoItsPlanks) {
     for (const double halfSpan : {6.0, 5.6})
         for (const int substeps : {0, 4})
             for (const double ratio : {0.5, 2.0, 10.0, 50.0}) {
-                Scene scene = crateOnBridge(2.0 * ratio, halfSpan, substeps);
+                Scene scene = parseBridge({.halfSpan = halfSpan, .crateMass = 2.0 * ratio, .substeps = substeps, .gravity = true});
                 scene.world.sleep = false;
                 Result<World> built = World::build(scene);
                 ASSERT_TRUE(built) << built.error();
@@ -722,7 +687,7 @@ TEST(HardJointsLoads, ACrateRestsOnABridgeWithoutSinkingIntoItsPlanks) {
 TEST(HardJointsLoads, AStackOnACrateOnABridgeRidesWithIt) {
     for (const double halfSpan : {6.0, 5.6})
         for (const double ratio : {2.0, 10.0}) {
-            Scene scene = crateOnBridge(2.0 * ratio, halfSpan, 0, 3);
+            Scene scene = parseBridge({.halfSpan = halfSpan, .crateMass = 2.0 * ratio, .boxes = 3, .gravity = true});
             scene.world.sleep = false;
             Result<World> built = World::build(scene);
             ASSERT_TRUE(built) << built.error();
@@ -742,33 +707,6 @@ TEST(HardJointsLoads, AStackOnACrateOnABridgeRidesWithIt) {
 
 // ------------------------------------------------------------ a chain laid short
 
-namespace {
-
-/// Twelve 2 kg planks (1 m x 0.2 m) laid straight from x = -6 to 6 and
-/// hinged end to end, their ends pinned to two static piers whose pins are
-/// `halfSpan` m either side of the middle: under 6 m, the chain is longer
-/// than the gap and starts with both end pins open by 6 - halfSpan.
-Scene straightBridge(double halfSpan, int substeps) {
-    std::ostringstream s;
-    s << R"({"world": {"gravity": {"x": 0, "y": -10})";
-    if (substeps > 0) s << R"(, "substeps": )" << substeps;
-    s << R"(}, "entities": [
-        {"name": "left pier", "position": {"x": )" << num(-halfSpan - 1.0) << R"(, "y": -2}, "static": true, "box": {"width": 2, "height": 4}},
-        {"name": "right pier", "position": {"x": )" << num(halfSpan + 1.0) << R"(, "y": -2}, "static": true, "box": {"width": 2, "height": 4}})";
-    for (int i = 0; i < 12; ++i)
-        s << R"(, {"name": "plank )" << i << R"(", "position": {"x": )" << num(-5.5 + i)
-          << R"(, "y": -0.1}, "mass": 2, "box": {"width": 1, "height": 0.2}})";
-    s << R"(, {"name": "pin 0", "joint": {"type": "hinge", "a": "plank 0", "b": "left pier", "local_a": {"x": -0.5, "y": 0}, "local_b": {"x": 1, "y": 1.9}}})";
-    for (int i = 1; i < 12; ++i)
-        s << R"(, {"name": "pin )" << i << R"(", "joint": {"type": "hinge", "a": "plank )" << i << R"(", "b": "plank )"
-          << (i - 1) << R"(", "local_a": {"x": -0.5, "y": 0}, "local_b": {"x": 0.5, "y": 0}}})";
-    s << R"(, {"name": "pin 12", "joint": {"type": "hinge", "a": "plank 11", "b": "right pier", "local_a": {"x": 0.5, "y": 0}, "local_b": {"x": -1, "y": 1.9}}}]})";
-    Result<Scene> scene = parseScene(s.str(), "bridge.json");
-    EXPECT_TRUE(scene) << (scene ? "" : scene.error());
-    return scene ? std::move(*scene) : Scene{};
-}
-
-} // namespace
 
 // A bridge laid straight between piers a little too close (a designer who
 // moved a pier): the chain can only close its end pins by buckling, which
@@ -782,7 +720,8 @@ Scene straightBridge(double halfSpan, int substeps) {
 TEST(HardJointsLoads, ABridgeLaidShortBucklesWithoutCreatingEnergy) {
     for (const double shortBy : {0.001, 0.01, 0.05, 0.1})
         for (const int substeps : {0, 1, 2, 4}) {
-            Scene scene = straightBridge(6.0 - shortBy, substeps);
+            Scene scene =
+                parseBridge({.halfSpan = 6.0 - shortBy, .laidStraight = true, .substeps = substeps, .gravity = true});
             scene.world.sleep = false;
             Result<World> built = World::build(scene);
             ASSERT_TRUE(built) << built.error();

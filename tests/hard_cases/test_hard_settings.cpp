@@ -8,6 +8,7 @@
 #include "stepwise/world.hpp"
 
 #include "../test_support.hpp"
+#include "bridge_level.hpp"
 
 #include <gtest/gtest.h>
 
@@ -464,31 +465,9 @@ TEST(HardSettings, ChainOfHingedBoxesNeedsNoExtraSubsteps) {
 }
 
 namespace {
-/// Twelve 2 kg planks (1 m x 0.2 m) hinged end to end between two static
-/// piers, and a 1.2 m crate of `crateMass` kg dropped onto the middle from
+/// The bridge with a crate of `crateMass` kg dropped onto the middle from
 /// 2.6 m; no settings.
-std::string bridgeLevel(double crateMass) {
-    std::ostringstream s;
-    s << R"({"entities": [
-        {"name": "ground", "position": {"x": 0, "y": -4.5}, "static": true, "box": {"width": 40, "height": 1}},
-        {"name": "left pier", "position": {"x": -7, "y": -2}, "static": true, "box": {"width": 2, "height": 4}},
-        {"name": "right pier", "position": {"x": 7, "y": -2}, "static": true, "box": {"width": 2, "height": 4}},
-        {"name": "crate", "position": {"x": 0.5, "y": 2.5}, "mass": )"
-      << num(crateMass) << R"(, "box": {"width": 1.2, "height": 1.2}, "friction": 0.6})";
-    for (int i = 0; i < 12; ++i)
-        s << R"(, {"name": "plank )" << i << R"(", "position": {"x": )" << num(-5.5 + i) << R"(, "y": -0.1}, "mass": 2,
-                   "box": {"width": 1, "height": 0.2}, "friction": 0.6})";
-    const auto pin = [&](int i, const std::string& a, const std::string& b, double ax, double bx, double by) {
-        s << R"(, {"name": "pin )" << i << R"(", "joint": {"type": "hinge", "a": ")" << a << R"(", "b": ")" << b
-          << R"(", "local_a": {"x": )" << num(ax) << R"(, "y": 0}, "local_b": {"x": )" << num(bx) << R"(, "y": )"
-          << num(by) << "}}}";
-    };
-    pin(0, "plank 0", "left pier", -0.5, 1.0, 1.9);
-    for (int i = 1; i < 12; ++i) pin(i, "plank " + std::to_string(i), "plank " + std::to_string(i - 1), -0.5, 0.5, 0.0);
-    pin(12, "plank 11", "right pier", 0.5, -1.0, 1.9);
-    s << "]}";
-    return s.str();
-}
+std::string bridgeLevel(double crateMass) { return test::bridgeJson({.crateMass = crateMass}); }
 } // namespace
 
 // A crate on a bridge presses one light plank the joints hold up; at one
