@@ -639,7 +639,7 @@ Scene parseBridge(const stepwise::test::BridgeLevel& layout) {
 // crate's mass (half a plank's to 50 times), a taut and a slack bridge,
 // and the engine's settings or 4 substeps given: once the crate has
 // landed, it lies no deeper in the planks than 8 mm (the contact slop is
-// 5 mm; 6.5 mm measured, 50:1 on the slack bridge) and no pin opens past
+// 5 mm; 5.3 mm measured, 10:1 on the slack bridge) and no pin opens past
 // 1 mm (the projection's slop is 0.5 mm). Measured before, at the engine's
 // settings: 46 mm deep at half a plank's mass, taut; 424 mm at twice, its
 // pins 138 mm open; 588 mm at ten times (pins 183 mm); slack, 49 to
@@ -682,7 +682,7 @@ TEST(HardJointsLoads, ACrateRestsOnABridgeWithoutSinkingIntoItsPlanks) {
 // and 211 mm slack. The same 8 mm bound as a crate alone, but for the heavy
 // stack on the slack bridge: its boxes topple into a row down one side of
 // the V, pressed against the crate at the bottom, and a box squeezed there
-// reaches 15 mm into a plank (a squeeze the contacts' passes carry, not the
+// reaches 12.5 mm into a plank (a squeeze the contacts' passes carry, not the
 // projection).
 TEST(HardJointsLoads, AStackOnACrateOnABridgeRidesWithIt) {
     for (const double halfSpan : {6.0, 5.6})
