@@ -1683,8 +1683,9 @@ bool CollisionSystem::noteRiders() {
     // the crate's soft contact takes out a few per cent of that overlap a
     // substep. Under a steady load the group sags and is lifted back by the
     // same amount every substep, so a crate of half a plank's mass settled
-    // 4.6 cm into the planks of a bridge (7.6 cm at twice a plank's mass),
-    // and heavier ones bounced on it.
+    // 46 mm into the planks of a taut bridge, and heavier ones bounced on
+    // it and tore its pins open (424 mm deep, the pins 138 mm open, at
+    // twice a plank's mass).
     carryRole_.assign(bodies_.size(), kLoose);
     for (const joints::JointConstraint& j : joints_)
         if (j.direct) carryRole_[j.a.solverBody] = carryRole_[j.b.solverBody] = kInGroup;
@@ -1714,8 +1715,8 @@ bool CollisionSystem::noteRiders() {
 }
 
 void CollisionSystem::carryRiders(std::span<Vec2> x) {
-    // Each rider moves out along a contact's normal until the contact is no
-    // deeper than before the projection (or than touching, had it a gap),
+    // Each rider moves out of a contact until it is no deeper than before
+    // the projection (or than touching, had it a gap),
     // when the body across has moved (a group's body, or a rider carried
     // already: a box on the crate goes up with it) and the move holds the
     // rider against its load (a box a ragdoll lies on is not pushed into

@@ -640,30 +640,37 @@ void DirectJoints::project(std::span<const JointConstraint> joints, std::span<co
         // together than its length can shorten only by buckling, which the
         // linear step cannot see, and along the nearly singular straight
         // line it answered a centimetre of error with most of a metre, torn
-        // open again at once. So the joints' points are checked at the moved
-        // pose, and a step that opens them further is halved until it does
-        // not (a few times at most; then it is dropped).
-        const auto openingAt = [&](double scale) {
-            double open = 0.0;
+        // open again at once. So the errors past the slop are measured again
+        // at the moved pose (a weld's angle counted at its arms' length),
+        // and a step that leaves more of them is halved until it does not (a
+        // few times at most; then it is dropped).
+        const auto excessAt = [&](double scale) {
+            double excess = 0.0;
             for (std::size_t k = 0; k < g.joints.size(); ++k) {
                 const JointConstraint& j = joints[g.joints[k]];
-                const auto moved = [&](std::uint32_t body, Vec2 r, Vec2& dp) {
+                const auto movedPose = [&](std::uint32_t body, Vec2 r, Vec2& dp, double& turn) {
                     dp = bodies[body].dp;
+                    turn = std::atan2(bodies[body].dq.s, bodies[body].dq.c);
                     if (body == 0) return r;
                     dp += scale * moves[body].dp;
+                    turn += scale * moves[body].dq;
                     return collision::rotate(collision::rotationBy(scale * moves[body].dq), r);
                 };
                 Vec2 dpA, dpB;
-                const Vec2 rA = moved(j.a.solverBody, g.rA[k], dpA);
-                const Vec2 rB = moved(j.b.solverBody, g.rB[k], dpB);
-                open += length((dpB - dpA) + (rB - rA) + j.deltaCenter);
+                double turnA = 0.0, turnB = 0.0;
+                const Vec2 rA = movedPose(j.a.solverBody, g.rA[k], dpA, turnA);
+                const Vec2 rB = movedPose(j.b.solverBody, g.rB[k], dpB, turnB);
+                excess += std::max(length((dpB - dpA) + (rB - rA) + j.deltaCenter) - kProjectionSlop, 0.0);
+                if (directRows(j) == 3)
+                    excess += std::max(std::abs(j.deltaAngle + turnB - turnA) - kAngularProjectionSlop, 0.0) *
+                              (length(g.rA[k]) + length(g.rB[k]));
             }
-            return open;
+            return excess;
         };
-        const double before = openingAt(0.0);
+        const double before = excessAt(0.0);
         double scale = 1.0;
-        for (int halving = 0; halving < kProjectionHalvings && openingAt(scale) > before; ++halving) scale *= 0.5;
-        if (openingAt(scale) > before) scale = 0.0;
+        for (int halving = 0; halving < kProjectionHalvings && excessAt(scale) > before; ++halving) scale *= 0.5;
+        if (excessAt(scale) > before) scale = 0.0;
         if (scale != 1.0)
             for (std::size_t i = first; i < moved.size(); ++i) {
                 moves[moved[i]].dp = scale * moves[moved[i]].dp;
