@@ -668,9 +668,12 @@ void DirectJoints::project(std::span<const JointConstraint> joints, std::span<co
             return excess;
         };
         const double before = excessAt(0.0);
-        double scale = 1.0;
-        for (int halving = 0; halving < kProjectionHalvings && excessAt(scale) > before; ++halving) scale *= 0.5;
-        if (excessAt(scale) > before) scale = 0.0;
+        double scale = 1.0, after = excessAt(scale);
+        for (int halving = 0; halving < kProjectionHalvings && after > before; ++halving) {
+            scale *= 0.5;
+            after = excessAt(scale);
+        }
+        if (after > before) scale = 0.0;
         if (scale != 1.0)
             for (std::size_t i = first; i < moved.size(); ++i) {
                 moves[moved[i]].dp = scale * moves[moved[i]].dp;
