@@ -1342,11 +1342,10 @@ void CollisionSystem::addJointedNeighboursToCrowd() {
     // Jointed here means jointed to another moving body: a body held only
     // to the static world (a motor-driven drum or spinner) passes no push
     // on, and stays out as before.
-    const auto moving = [&](std::uint32_t b) { return bodies_[b].invMass > 0.0 || bodies_[b].invInertia > 0.0; };
     jointedBody_.assign(bodies_.size(), 0);
     bool anyJointed = false;
     for (const joints::JointConstraint& j : joints_) {
-        if (j.broken || !moving(j.a.solverBody) || !moving(j.b.solverBody)) continue;
+        if (j.broken || fixedBody(j.a.solverBody) || fixedBody(j.b.solverBody)) continue;
         jointedBody_[j.a.solverBody] = jointedBody_[j.b.solverBody] = 1;
         anyJointed = true;
     }
@@ -1446,13 +1445,12 @@ void CollisionSystem::saveCrowdJoints() {
     crowdRimImpulses_.clear();
     if (crowdBodies_.empty()) return;
     const auto member = [&](std::uint32_t b) { return inCrowd_[b] && !crowdSupport_[b]; };
-    const auto fixed = [&](std::uint32_t b) { return bodies_[b].invMass == 0.0 && bodies_[b].invInertia == 0.0; };
     const auto outside = [&](std::uint32_t b) { return !inCrowd_[b] && bodies_[b].invMass > 0.0; };
     for (std::uint32_t k = 0; k < joints_.size(); ++k) {
         const joints::JointConstraint& j = joints_[k];
         if (j.asleep) continue;
         const std::uint32_t a = j.a.solverBody, b = j.b.solverBody;
-        if ((member(a) || fixed(a)) && (member(b) || fixed(b)) && (member(a) || member(b)))
+        if ((member(a) || fixedBody(a)) && (member(b) || fixedBody(b)) && (member(a) || member(b)))
             crowdJoints_.push_back(k);
         else if ((member(a) && outside(b)) || (member(b) && outside(a)))
             crowdRimJoints_.push_back(k);
@@ -1609,9 +1607,10 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // edge goes back from the outside body's velocity too, and the push
     // moved only positions on both sides. Not from a jointed body left
     // outside (a support, see addJointedNeighboursToCrowd): its joints
-    // answered the push in the same passes, and with the push taken back alone their answer stayed,
-    // lifting the planks under a crate the crowd rule had caught sunk into
-    // one of them (it fell through the bridge from 2.5 times a plank's mass).
+    // answered the push in the same passes, and with the push taken back
+    // alone their answer stayed, lifting the planks under a crate the crowd
+    // rule had caught sunk into one of them (it fell through the bridge
+    // from 2.5 times a plank's mass).
     if (!crowdBodies_.empty()) {
         takeBack_.assign(bodies_.size(), 0);
         for (std::size_t b = 1; b < bodies_.size(); ++b) takeBack_[b] = !inCrowd_[b] && bodies_[b].invMass > 0.0;
@@ -1696,9 +1695,9 @@ bool CollisionSystem::noteRiders() {
         const ContactConstraint& c = constraints_[k];
         const bool looseA = loose(c.bodyA), looseB = loose(c.bodyB);
         if (!looseA && !looseB) continue;
-        // A loose body against a static one, or against a moving body that
-        // no projection moves (kinematic, or loose but across the contact
-        // only once carried: listed below), is no rider's contact.
+        // A loose body against a static or kinematic one is no rider's
+        // contact. Against a group's body it may be; against another
+        // loose body it is listed too, for when one of them is carried.
         if (looseA != looseB) {
             if (carryRole_[looseA ? c.bodyB : c.bodyA] != kInGroup) continue;
             touchesGroup = true;
@@ -1716,14 +1715,14 @@ bool CollisionSystem::noteRiders() {
 
 void CollisionSystem::carryRiders(std::span<Vec2> x) {
     // Each rider moves out of a contact until it is no deeper than before
-    // the projection (or than touching, had it a gap),
-    // when the body across has moved (a group's body, or a rider carried
-    // already: a box on the crate goes up with it) and the move holds the
-    // rider against its load (a box a ragdoll lies on is not pushed into
-    // the floor). The groups do not move back: their joints stay where the
-    // projection put them, as a static support would. Only positions move,
-    // as in the projection. Passes repeat while a rider moves, to a bound;
-    // a pile deeper than that is left to its soft contacts.
+    // the projection (or than touching, had it a gap), when the body across
+    // has moved (a group's body, or a rider carried already: a box on the
+    // crate goes up with it) and the move holds the rider against its load
+    // (a box a ragdoll lies on is not pushed into the floor). The groups do
+    // not move back: their joints stay where the projection put them, as a
+    // static support would. Only positions move, as in the projection.
+    // Passes repeat while a rider moves, to a bound; a pile deeper than
+    // that is left to its soft contacts.
     carried_.assign(bodies_.size(), Vec2{});
     constexpr int kMaxPasses = 8;
     for (int pass = 0; pass < kMaxPasses; ++pass) {

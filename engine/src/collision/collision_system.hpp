@@ -381,6 +381,9 @@ private:
     /// second gave (after the biased passes).
     void saveCrowdJoints();
     void restoreCrowdJoints();
+    /// Whether solver body b takes no impulse: the static entry 0, and
+    /// kinematic bodies.
+    bool fixedBody(std::uint32_t b) const { return bodies_[b].invMass == 0.0 && bodies_[b].invInertia == 0.0; }
     /// Riders: moving bodies outside every exactly solved joint group that
     /// rest on such a group or on another rider (a crate on a bridge, a box
     /// on the crate). noteRiders lists their contacts and separations before
