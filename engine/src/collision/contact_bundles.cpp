@@ -352,7 +352,7 @@ void storeLanes(std::span<const ContactBundle<Points>> bundles, std::span<Contac
 } // namespace
 
 void ColouredContacts::build(std::span<const ContactConstraint> contacts, const ContactPairs& pairs,
-                             std::span<const SolverBody> bodies, bool simd) {
+                             std::span<const SolverBody> bodies, bool simd, std::span<const std::uint8_t> heldOut) {
     simd_ = simd;
     const std::size_t n = contacts.size();
     colourMask_.assign(bodies.size(), 0u);
@@ -361,7 +361,13 @@ void ColouredContacts::build(std::span<const ContactConstraint> contacts, const 
     std::uint32_t counts[kContactColours + 1][2] = {};
     constexpr std::uint32_t kAllColours = (1u << kContactColours) - 1u;
     // From the packed pairs, not the 232-byte contacts (ContactPairs).
+    std::size_t held = 0;
     for (std::size_t k = 0; k < n; ++k) {
+        if (!heldOut.empty() && heldOut[k]) {
+            colourOf_[k] = kHeldOut;
+            ++held;
+            continue;
+        }
         const std::uint32_t bodyA = pairs.bodies[2 * k], bodyB = pairs.bodies[2 * k + 1];
         const bool two = pairs.twoPoints[k] != 0;
         // Static body 0 is in no colour: any number of contacts of one colour
@@ -410,12 +416,12 @@ void ColouredContacts::build(std::span<const ContactConstraint> contacts, const 
     colourStart_.resize(std::size_t(colourCount_) + 1);
     for (int colour = 0; colour < colourCount_; ++colour) colourStart_[std::size_t(colour)] = start[colour][0];
     colourStart_[std::size_t(colourCount_)] = start[kContactColours][0];
-    order_.resize(n);
+    order_.resize(n - held);
     {
         std::uint32_t cursor[kContactColours + 1][2];
         std::memcpy(cursor, start, sizeof cursor);
         for (std::size_t k = 0; k < n; ++k)
-            order_[cursor[colourOf_[k]][pairs.twoPoints[k]]++] = std::uint32_t(k);
+            if (colourOf_[k] != kHeldOut) order_[cursor[colourOf_[k]][pairs.twoPoints[k]]++] = std::uint32_t(k);
     }
     one_.clear();
     two_.clear();
@@ -481,7 +487,8 @@ void ColouredContacts::forEachHeld(Self& self, Contacts& contacts, Visit&& visit
             visit(c.bodyA, c.bodyB, k, i, c.points[i].normalImpulse, c.points[i].tangentImpulse);
     };
     if (!self.simd_) {
-        for (std::uint32_t k = 0; k < contacts.size(); ++k) points(k);
+        for (std::uint32_t k = 0; k < contacts.size(); ++k)
+            if (self.colourOf_[k] != kHeldOut) points(k);
         return;
     }
     forEachLane<1>(self.one_, visit);

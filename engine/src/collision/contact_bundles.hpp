@@ -80,9 +80,11 @@ public:
     /// Colours the contacts greedily in their (deterministic) order: each
     /// takes the first colour that neither of its dynamic bodies has yet;
     /// static body 0 never blocks a colour. `simd` picks the path for the
-    /// whole step (SolverSettings::simd).
+    /// whole step (SolverSettings::simd). The contacts marked in `heldOut`
+    /// (empty: none) are left out: another solve takes them
+    /// (joints/tree_contacts.hpp), and their impulses stay in the contacts.
     void build(std::span<const ContactConstraint> contacts, const ContactPairs& pairs,
-               std::span<const SolverBody> bodies, bool simd);
+               std::span<const SolverBody> bodies, bool simd, std::span<const std::uint8_t> heldOut = {});
     void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies);
     /// One pass over the colours (then the overflow), or backwards.
     void solve(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h, const Softness& soft,
@@ -129,6 +131,7 @@ private:
     std::vector<std::uint32_t> colourStart_;  ///< colourCount_ + 1 offsets into order_
     std::vector<std::uint32_t> colourMask_;   ///< per solver body: colours it is in
     std::vector<std::uint8_t> colourOf_;      ///< per contact; kContactColours = overflow
+    static constexpr std::uint8_t kHeldOut = kContactColours + 1;  ///< colourOf_ of a contact left out
     std::vector<ContactBundle<1>> one_;
     std::vector<ContactBundle<2>> two_;
     /// Per colour: its one-point bundles one_[oneStart_[c], oneStart_[c+1]) and

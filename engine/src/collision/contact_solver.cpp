@@ -368,79 +368,24 @@ void solveContacts(std::span<ContactConstraint> contacts, std::span<const std::u
         // since the step began; the Jacobian keeps the step-start anchors
         // (as Box2D v3): the rotation within one step is small.
         const double baseGap = dot(b.dp - a.dp, n);
-        // Velocity bias (m/s) and soft scaling of one point from its current
-        // separation: a speculative point may close its gap this substep; an
-        // overlapping one is pushed out softly (biased passes only).
-        struct Target {
-            double bias = 0.0, massScale = 1.0, impulseScale = 0.0;
-        };
         const Rot qA = c.roundA ? Rot{} : a.dq, qB = c.roundB ? Rot{} : b.dq;
         const auto targetOf = [&](const ContactPoint& p) {
             const double separation =
                 baseGap + (qB.c * p.dnB + qB.s * p.rnB) - (qA.c * p.dnA + qA.s * p.rnA) + p.adjustedSeparation;
-            Target t;
-            if (separation > 0.0) {
-                t.bias = separation * invH;
-            } else if (useBias &&
-                       (!(separation > -s.rigidDepth) ||
-                        !((separation + (dot(vB - vA, n) + wB * p.rnB - wA * p.rnA) / invH) >
-                          -(s.rigidDepth + s.rigidDepth)))) {
-                // Past rigidDepth, or an approach that would carry the point
-                // past twice that within this substep: a soft contact lets a
-                // few percent of the approach through (8 m in one substep at
-                // 10^6 m/s^2), so it turns rigid, closing at most to that
-                // depth and pushing out only what lies past it. (Twice: a
-                // resting point near the depth, approaching at g h, would
-                // otherwise switch between soft and rigid every substep and
-                // never sleep.)
-                const double toDepth = separation + s.rigidDepth;
-                t.bias = toDepth > 0.0 ? toDepth * invH : std::max(s.biasRate * toDepth, -pushMaxVelocity);
-            } else if (useBias) {
-                t.bias = std::max(s.biasRate * separation, -pushMaxVelocity);
-                t.massScale = s.massScale;
-                t.impulseScale = s.impulseScale;
-            }
-            return t;
+            return pointTarget(
+                separation, [&] { return dot(vB - vA, n) + wB * p.rnB - wA * p.rnA; }, s, invH, pushMaxVelocity,
+                useBias);
         };
-        const Target t0 = targetOf(c.points[0]);
-        const Target t1 = c.pointCount == 2 ? targetOf(c.points[1]) : Target{};
+        const PointTarget t0 = targetOf(c.points[0]);
+        const PointTarget t1 = c.pointCount == 2 ? targetOf(c.points[1]) : PointTarget{};
         if (c.block && t0.massScale == t1.massScale) {
-            // Block solve of both normal rows: the new accumulated impulses
-            // y >= 0 make the normal velocities w = K (y - a) + vn + bias
-            // non-negative with y_i w_i = 0 (a 2x2 linear complementarity
-            // problem, solved by trying its four cases: both points pushing,
-            // only the first, only the second, neither). The soft rule
-            // new = massScale * (a - K^-1 (vn + bias)) of the one-point
-            // solve becomes new = massScale * y (massScale + impulseScale = 1).
             ContactPoint& p1 = c.points[0];
             ContactPoint& p2 = c.points[1];
-            const BlockMass& bm = c.blockMass;
             const Vec2 dv = vB - vA;
             const double a1 = p1.normalImpulse, a2 = p2.normalImpulse;
             const double vn1 = dot(dv, n) + wB * p1.rnB - wA * p1.rnA;
             const double vn2 = dot(dv, n) + wB * p2.rnB - wA * p2.rnA;
-            const double q1 = vn1 + t0.bias - (bm.k11 * a1 + bm.k12 * a2);
-            const double q2 = vn2 + t1.bias - (bm.k12 * a1 + bm.k22 * a2);
-            double y1 = -(bm.i11 * q1 + bm.i12 * q2);
-            double y2 = -(bm.i12 * q1 + bm.i22 * q2);
-            if (!(y1 >= 0.0 && y2 >= 0.0)) {
-                y1 = -q1 / bm.k11;
-                y2 = 0.0;
-                if (!(y1 >= 0.0 && bm.k12 * y1 + q2 >= 0.0)) {
-                    y1 = 0.0;
-                    y2 = -q2 / bm.k22;
-                    if (!(y2 >= 0.0 && bm.k12 * y2 + q1 >= 0.0)) {
-                        // Neither point pushes; q >= 0 then, for K positive
-                        // definite (anything else is rounding: keep a).
-                        y2 = 0.0;
-                        if (!(q1 >= 0.0 && q2 >= 0.0)) {
-                            y1 = a1 / t0.massScale;
-                            y2 = a2 / t0.massScale;
-                        }
-                    }
-                }
-            }
-            const double x1 = t0.massScale * y1, x2 = t0.massScale * y2;
+            const auto [x1, x2] = solveNormalBlock(c.blockMass, vn1, vn2, t0, t1, a1, a2);
             const double d1 = x1 - a1, d2 = x2 - a2;
             p1.normalImpulse = x1;
             p2.normalImpulse = x2;
@@ -452,7 +397,7 @@ void solveContacts(std::span<ContactConstraint> contacts, std::span<const std::u
         } else {
             for (int i = 0; i < c.pointCount; ++i) {
                 ContactPoint& p = c.points[i];
-                const Target& tg = i == 0 ? t0 : t1;
+                const PointTarget& tg = i == 0 ? t0 : t1;
                 const double vn = dot(vB - vA, n) + wB * p.rnB - wA * p.rnA;
                 double impulse = -p.normalMass * tg.massScale * (vn + tg.bias) - tg.impulseScale * p.normalImpulse;
                 const double total = std::max(p.normalImpulse + impulse, 0.0);

@@ -7,6 +7,7 @@
 
 #include "collision/collision_types.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <span>
@@ -132,6 +133,77 @@ struct SolverSettings {
 /// The separation of point `p` of contact `c` at the bodies' current dp, dq
 /// (metres, negative when overlapping).
 double currentSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c, const ContactPoint& p);
+
+/// Velocity bias (m/s) and soft scaling of one contact point.
+struct PointTarget {
+    double bias = 0.0, massScale = 1.0, impulseScale = 0.0;
+};
+/// The target of a point at `separation` (m): a speculative point may close
+/// its gap this substep; an overlapping one is pushed out softly (biased
+/// passes only), or rigidly past the softness's rigidDepth. `normalSpeed()`
+/// gives the point's current approach (m/s), read only when needed.
+template <class Speed>
+inline PointTarget pointTarget(double separation, Speed&& normalSpeed, const Softness& s, double invH,
+                               double pushMaxVelocity, bool useBias) {
+    PointTarget t;
+    if (separation > 0.0) {
+        t.bias = separation * invH;
+    } else if (useBias && (!(separation > -s.rigidDepth) ||
+                           !((separation + normalSpeed() / invH) > -(s.rigidDepth + s.rigidDepth)))) {
+        // Past rigidDepth, or an approach that would carry the point past
+        // twice that within this substep: a soft contact lets a few percent
+        // of the approach through (8 m in one substep at 10^6 m/s^2), so it
+        // turns rigid, closing at most to that depth and pushing out only
+        // what lies past it. (Twice: a resting point near the depth,
+        // approaching at g h, would otherwise switch between soft and rigid
+        // every substep and never sleep.)
+        const double toDepth = separation + s.rigidDepth;
+        t.bias = toDepth > 0.0 ? toDepth * invH : std::max(s.biasRate * toDepth, -pushMaxVelocity);
+    } else if (useBias) {
+        t.bias = std::max(s.biasRate * separation, -pushMaxVelocity);
+        t.massScale = s.massScale;
+        t.impulseScale = s.impulseScale;
+    }
+    return t;
+}
+
+/// Block solve of a two-point manifold's normal rows, both at one massScale:
+/// the new accumulated impulses y >= 0 make the normal velocities
+/// w = K (y - a) + vn + bias non-negative with y_i w_i = 0 (a 2x2 linear
+/// complementarity problem, solved by trying its four cases: both points
+/// pushing, only the first, only the second, neither). The soft rule
+/// new = massScale * (a - K^-1 (vn + bias)) of the one-point solve becomes
+/// new = massScale * y (massScale + impulseScale = 1). Returns the new
+/// accumulated impulses; `vn1`, `vn2` are the points' normal speeds (m/s),
+/// `a1`, `a2` their impulses so far (N*s).
+struct BlockImpulses {
+    double x1, x2;
+};
+inline BlockImpulses solveNormalBlock(const BlockMass& bm, double vn1, double vn2, const PointTarget& t0,
+                                      const PointTarget& t1, double a1, double a2) {
+    const double q1 = vn1 + t0.bias - (bm.k11 * a1 + bm.k12 * a2);
+    const double q2 = vn2 + t1.bias - (bm.k12 * a1 + bm.k22 * a2);
+    double y1 = -(bm.i11 * q1 + bm.i12 * q2);
+    double y2 = -(bm.i12 * q1 + bm.i22 * q2);
+    if (!(y1 >= 0.0 && y2 >= 0.0)) {
+        y1 = -q1 / bm.k11;
+        y2 = 0.0;
+        if (!(y1 >= 0.0 && bm.k12 * y1 + q2 >= 0.0)) {
+            y1 = 0.0;
+            y2 = -q2 / bm.k22;
+            if (!(y2 >= 0.0 && bm.k12 * y2 + q1 >= 0.0)) {
+                // Neither point pushes; q >= 0 then, for K positive definite
+                // (anything else is rounding: keep a).
+                y2 = 0.0;
+                if (!(q1 >= 0.0 && q2 >= 0.0)) {
+                    y1 = a1 / t0.massScale;
+                    y2 = a2 / t0.massScale;
+                }
+            }
+        }
+    }
+    return {t0.massScale * y1, t0.massScale * y2};
+}
 
 /// What the colouring and the impact passes read of every contact, packed
 /// side by side. A ContactConstraint is 232 bytes: a pass that streamed the

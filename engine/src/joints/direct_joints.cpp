@@ -403,7 +403,17 @@ void DirectJoints::build(std::span<JointConstraint> joints, std::span<const Solv
         j.direct = true;
         ++directCount_;
     }
-    for (const std::unique_ptr<Group>& gp : groups_) order(*gp, joints);
+    bodyGroup_.assign(n, -1);
+    bodyPlace_.assign(n, 0);
+    for (std::size_t gi = 0; gi < groups_.size(); ++gi) {
+        Group& g = *groups_[gi];
+        order(g, joints);
+        for (std::uint32_t place = 0; place + 1 < g.bodyStart.size(); ++place) {
+            const std::uint32_t body = g.ends[g.bodyStart[place]].body;
+            bodyGroup_[body] = std::int32_t(gi);
+            bodyPlace_[body] = place;
+        }
+    }
 }
 
 void DirectJoints::order(Group& g, std::span<const JointConstraint> joints) {
@@ -505,6 +515,7 @@ void DirectJoints::order(Group& g, std::span<const JointConstraint> joints) {
 void DirectJoints::factor(std::span<JointConstraint> joints, std::span<const SolverBody> bodies, const Softness& soft,
                           bool biased) {
     ensureBuilt(joints, bodies);
+    ++factorCount_;
     // Fixed point of the soft Gauss-Seidel row: J v + bias + (1/c) K lambda
     // = 0 with massScale = c / (1 + c), impulseScale = 1 / (1 + c).
     biased_ = biased;
@@ -584,6 +595,75 @@ void DirectJoints::solve(std::span<JointConstraint> joints, std::span<SolverBody
             b.v += b.invMass * p;
             b.w += b.invInertia * (cross(g.rB[k], p) + turn);
         }
+    }
+}
+
+bool DirectJoints::factored(int group) const { return groups_[std::size_t(group)]->factored; }
+
+std::size_t DirectJoints::responseSize(int group) const {
+    const Group& g = *groups_[std::size_t(group)];
+    return 3 * (g.bodyStart.size() - 1 + g.joints.size());
+}
+
+void DirectJoints::respond(int group, std::uint32_t body, Vec2 dir, double arm, std::span<const SolverBody> bodies,
+                           std::span<double> out) {
+    Group& g = *groups_[std::size_t(group)];
+    const SolverBody& b = bodies[body];
+    const Vec2 dv = b.invMass * dir;
+    const double dw = b.invInertia * arm;
+    // The rows see only the joints at `body`: -(J dv) there, zero elsewhere.
+    std::fill(g.rhs.begin(), g.rhs.end(), 0.0);
+    const std::uint32_t place = bodyPlace_[body];
+    for (std::uint32_t e = g.bodyStart[place]; e < g.bodyStart[place + 1]; ++e) {
+        const std::uint32_t k = g.ends[e].k;
+        const double sign = g.ends[e].side == 0 ? -1.0 : 1.0;
+        const Vec2 r = g.ends[e].side == 0 ? g.rA[k] : g.rB[k];
+        const Vec2 cdot = sign * (dv + crossSV(dw, r));
+        g.rhs[g.offset[k]] = -cdot.x;
+        g.rhs[g.offset[k] + 1] = -cdot.y;
+        if (g.rowsOf[k] == 3) g.rhs[g.offset[k] + 2] = -sign * dw;
+    }
+    g.solveFactored();
+    const std::size_t bodyCount = g.bodyStart.size() - 1;
+    std::fill(out.begin(), out.begin() + std::ptrdiff_t(responseSize(group)), 0.0);
+    out[3 * place] = dv.x;
+    out[3 * place + 1] = dv.y;
+    out[3 * place + 2] = dw;
+    for (std::uint32_t e = 0; e < g.ends.size(); ++e) {
+        const std::uint32_t k = g.ends[e].k, o = g.offset[k];
+        const double sign = g.ends[e].side == 0 ? -1.0 : 1.0;
+        const Vec2 p{g.x[o], g.x[o + 1]};
+        const double turn = g.rowsOf[k] == 3 ? g.x[o + 2] : 0.0;
+        const SolverBody& sb = bodies[g.ends[e].body];
+        const Vec2 r = g.ends[e].side == 0 ? g.rA[k] : g.rB[k];
+        const std::uint32_t at = 3 * bodyPlace_[g.ends[e].body];
+        out[at] += sign * sb.invMass * p.x;
+        out[at + 1] += sign * sb.invMass * p.y;
+        out[at + 2] += sign * sb.invInertia * (cross(r, p) + turn);
+    }
+    for (std::size_t k = 0; k < g.joints.size(); ++k) {
+        const std::uint32_t o = g.offset[k];
+        double* j = &out[3 * (bodyCount + k)];
+        j[0] = g.x[o];
+        j[1] = g.x[o + 1];
+        j[2] = g.rowsOf[k] == 3 ? g.x[o + 2] : 0.0;
+    }
+}
+
+void DirectJoints::applyResponse(int group, std::span<const double> response, double scale,
+                                 std::span<JointConstraint> joints, std::span<SolverBody> bodies) const {
+    const Group& g = *groups_[std::size_t(group)];
+    const std::size_t bodyCount = g.bodyStart.size() - 1;
+    for (std::size_t place = 0; place < bodyCount; ++place) {
+        SolverBody& b = bodies[g.ends[g.bodyStart[place]].body];
+        b.v += scale * Vec2{response[3 * place], response[3 * place + 1]};
+        b.w += scale * response[3 * place + 2];
+    }
+    for (std::size_t k = 0; k < g.joints.size(); ++k) {
+        JointConstraint& j = joints[g.joints[k]];
+        const double* d = &response[3 * (bodyCount + k)];
+        j.linearImpulse += scale * Vec2{d[0], d[1]};
+        j.angularImpulse += scale * d[2];
     }
 }
 

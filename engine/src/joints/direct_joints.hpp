@@ -72,6 +72,35 @@ public:
     };
     void project(std::span<const JointConstraint> joints, std::span<const collision::SolverBody> bodies,
                  std::vector<Move>& moves, std::vector<std::uint32_t>& moved);
+    /// The response of a group to an impulse on one of its bodies, for the
+    /// contacts solved with the group (tree_contacts.hpp): with it, an
+    /// impulse on one body moves the whole group at once as its rows allow.
+    /// The group (an index) holding solver body `body`, or -1.
+    int groupOf(std::uint32_t body) const {
+        return body < bodyGroup_.size() ? bodyGroup_[body] : -1;
+    }
+    /// The group was factored in this pass (it is awake and its rows solve).
+    bool factored(int group) const;
+    /// Counts the factor() calls: responses are the same between two.
+    std::uint64_t factorCount() const { return factorCount_; }
+    /// Doubles in one response of `group`: (dvx, dvy, dw) of each of its
+    /// bodies, in the order of their places, then the change (x, y, angle)
+    /// of each of its joints' impulses.
+    std::size_t responseSize(int group) const;
+    /// A body's place in its group: its velocity change in a response is
+    /// at 3 * place.
+    std::uint32_t placeOf(std::uint32_t body) const { return bodyPlace_[body]; }
+    /// Writes to `out` the response of `group` to a unit impulse along `dir`
+    /// on solver body `body` whose angular part is `arm` (cross(r, dir), r
+    /// from the body's centre): the body's own change, plus what the
+    /// group's rows then do, solved exactly with this pass's factor.
+    void respond(int group, std::uint32_t body, Vec2 dir, double arm, std::span<const collision::SolverBody> bodies,
+                 std::span<double> out);
+    /// Adds `scale` times a response of `group` to its bodies' velocities
+    /// and its joints' impulses.
+    void applyResponse(int group, std::span<const double> response, double scale, std::span<JointConstraint> joints,
+                       std::span<collision::SolverBody> bodies) const;
+
     /// Forgets the grouping (the joints changed).
     void reset() { built_ = false; }
     /// Groups the joints now if they changed since the last grouping, which
@@ -93,7 +122,10 @@ private:
     std::size_t builtFor_ = 0;
     std::size_t directCount_ = 0;
     std::vector<std::unique_ptr<Group>> groups_;
+    std::vector<std::int32_t> bodyGroup_;   // per solver body: its group, or -1
+    std::vector<std::uint32_t> bodyPlace_;  // per solver body in a group: its place there
     double gamma_ = 0.0, biasRate_ = 0.0;
+    std::uint64_t factorCount_ = 0;
     bool biased_ = false;
 };
 
