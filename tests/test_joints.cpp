@@ -10,6 +10,7 @@
 
 #include "test_support.hpp"
 
+#include <array>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -843,6 +844,47 @@ TEST(JointBreaking, AHangingWeightBreaksItsJointExactlyWhenItsWeightExceedsMaxFo
         }
     }
     std::printf("hanging weights: largest joint force within %.3g of m g\n", worstForceError);
+}
+
+/// Two chains hang at rest from static anchors, each of three 1 kg links
+/// and a 10 kg weight on hinges, with g = 10: from the top, their pins pull
+/// 130, 120, 110 and 100 N from the first substep. Every pin is past its
+/// max_force, but a step's forces are those of whole chains, and the first
+/// pin to fail unloads the rest of its chain: each chain loses one pin in
+/// the first step, the one most past its max_force (the top one of the left
+/// chain, all at 90 N; the second of the right chain, at 125, 100, 100 and
+/// 95 N), and no other afterwards, as what hangs on holds and what fell
+/// pulls on nothing.
+TEST(JointBreaking, OnlyTheJointMostPastItsMaxForceBreaksInAChainInOneStep) {
+    const auto chain = [](const std::string& side, double x, const std::array<double, 4>& maxForce) {
+        std::string s;
+        for (int i = 0; i < 4; ++i) {
+            const bool weight = i == 3;
+            s += R"(, {"name": ")" + side + " link " + std::to_string(i) + R"(", "position": {"x": )" + num(x) +
+                 R"(, "y": )" + num(-0.5 * (i + 1)) + R"(}, "mass": )" + (weight ? "10" : "1") +
+                 R"(, "radius": )" + (weight ? "0.2" : "0.1") + "}";
+            const std::string above = i == 0 ? "" : R"(, "b": ")" + side + " link " + std::to_string(i - 1) + R"(")";
+            s += R"(, {"name": ")" + side + " pin " + std::to_string(i) + R"(", "joint": {"type": "hinge", "a": ")" +
+                 side + " link " + std::to_string(i) + R"(")" + above + R"(, "anchor": {"x": )" + num(x) +
+                 R"(, "y": )" + num(-0.5 * i) + R"(}, "max_force": )" + num(maxForce[std::size_t(i)]) + "}}";
+        }
+        return s;
+    };
+    for (const int substeps : {1, 4}) {
+        const Scene scene = load("{" + world(substeps, -10.0) + R"(, "entities": [)" +
+                                 chain("left", -3.0, {90.0, 90.0, 90.0, 90.0}).substr(2) +
+                                 chain("right", 3.0, {125.0, 100.0, 100.0, 95.0}) + "]}");
+        World w = build(scene);
+        ASSERT_TRUE(w.step());
+        const std::string what = std::to_string(substeps) + " substeps";
+        ASSERT_EQ(w.jointBreaks().size(), 2u) << what;
+        EXPECT_EQ(w.jointBreaks()[0].joint, named(scene, "left pin 0")) << what;
+        EXPECT_NEAR(w.jointBreaks()[0].force, 130.0, 1e-6 * 130.0) << what;
+        EXPECT_EQ(w.jointBreaks()[1].joint, named(scene, "right pin 1")) << what;
+        EXPECT_NEAR(w.jointBreaks()[1].force, 120.0, 1e-6 * 120.0) << what;
+        for (int i = 0; i < 60; ++i) ASSERT_TRUE(w.step());
+        EXPECT_EQ(w.jointBreaks().size(), 2u) << what << ": what fell pulls on nothing, what hangs holds";
+    }
 }
 
 namespace {

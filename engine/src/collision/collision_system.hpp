@@ -16,6 +16,7 @@
 #include "joints/direct_joints.hpp"
 #include "joints/joint_bundles.hpp"
 #include "joints/joint_solver.hpp"
+#include "joints/tree_contacts.hpp"
 
 #include "stepwise/components.hpp"
 #include "stepwise/entity.hpp"
@@ -392,6 +393,19 @@ private:
     /// noteRiders returns false when no loose body touches a group.
     bool noteRiders();
     void carryRiders(std::span<Vec2> x);
+    /// The move of a loose rider (body B of `c` when `pushB`, else A) out
+    /// of its contact by `deficit` (m, at point `deepest`): false when it
+    /// would not hold the rider against its load; else `move` (along the
+    /// normal on entry) becomes the move to make.
+    bool carryAgainstLoad(const ContactConstraint& c, int deepest, bool pushB, double deficit, Vec2& move) const;
+    /// Moves the riders that static friction holds with their supports
+    /// (carryRiders' first part).
+    void followRiders();
+    /// How far the projection (a group's body) or the carry (a rider) moved
+    /// `support`'s side of point `point` of contact `c`.
+    Vec2 supportMove(const ContactConstraint& c, int point, std::uint32_t support) const;
+    std::vector<Vec2> followSum_;       // followRiders: per solver body, the weighted sum of its supports' moves
+    std::vector<double> followWeight_;  // and of their weights (normal impulses, N*s)
 
     void addManifold(std::uint32_t a, std::uint32_t b, const Manifold& m, std::span<const Vec2> centres);
     /// Broad phase while some bodies sleep: the awake boxes among themselves
@@ -503,6 +517,8 @@ private:
     std::vector<joints::JointConstraint> joints_;
     joints::JointSettings jointSettings_;
     joints::DirectJoints directJoints_;  // the tree-shaped groups' exact solve
+    joints::TreeContacts treeContacts_;  // contacts of loose bodies on those groups, solved with them
+    std::vector<std::uint8_t> heldOut_;  // per contact: solved by treeContacts_, not in the colours
     std::vector<std::uint32_t> jointOrder_;  // the joint passes' order (colourJoints)
     bool jointOrderReady_ = false;           // false: a joint was added, broke or mended since it was made
     std::vector<std::uint32_t> jointColourEnds_;  // where each colour ends in jointOrder_ (colourJoints)
@@ -565,6 +581,13 @@ private:
         return !filtered_ || shouldCollide(filters_[a], filters_[b]);
     }
     std::vector<std::uint32_t> breakable_;  // joints with a max_force, ascending
+    /// breakJoints' scratch: a joint past its max_force, its force (N) and
+    /// how far past (force / max_force).
+    struct BreakCandidate {
+        std::uint32_t joint;
+        double force, excess;
+    };
+    std::vector<BreakCandidate> breakCandidates_;
     /// Drops broken joints' records and their no-collide entries, and
     /// regroups the direct solve.
     void jointsBroke();
