@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace stepwise::joints {
 
@@ -28,7 +29,14 @@ constexpr double kSweepTolerance = 1e-9;
 /// Rounds of normal then friction solves a pass (fewer once a round leaves
 /// every impulse within kSweepTolerance), and friction sweeps a round.
 constexpr int kRounds = 4;
+constexpr double kRoundTolerance = 1e-3;
 constexpr int kFrictionSweeps = 8;
+/// Riders lighter than this share of the group's body they touch are left
+/// to the ordinary contacts (their ghost velocity stays well under one
+/// substep of gravity there).
+constexpr double kLightestRider = 0.25;
+/// Rows (two a point) a group solves with its contacts in each pass.
+constexpr std::uint32_t kRowsPerGroup = 16;
 
 /// Solves K_SS y_S = -q_S for the rows S in `mask` (y zero elsewhere) by
 /// Gaussian elimination with partial pivoting; false when a pivot vanishes
@@ -143,33 +151,74 @@ bool TreeContacts::select(std::span<const ContactConstraint> contacts, const Dir
     const auto groupOf = [&](const ContactConstraint& c) {
         return std::max(direct.groupOf(c.bodyA), direct.groupOf(c.bodyB));
     };
+    std::vector<std::uint32_t>& picked = scratch_;
+    picked.clear();
     for (std::uint32_t k = 0; k < contacts.size(); ++k) {
         const ContactConstraint& c = contacts[k];
         const bool groupA = direct.groupOf(c.bodyA) >= 0, groupB = direct.groupOf(c.bodyB) >= 0;
         if (groupA == groupB) continue;  // neither in a group, or both (two groups, or one group's own bodies)
-        const std::uint32_t loose = looseOf(c);
+        const std::uint32_t loose = looseOf(c), member = groupA ? c.bodyA : c.bodyB;
         if (loose == 0 || !(bodies[loose].invMass > 0.0)) continue;  // static or kinematic: nothing rides
         if (crowded(c.bodyA) || crowded(c.bodyB)) continue;  // a crowd's contacts take its push-out rule
-        list_.push_back(k);
-        heldOut[k] = 1;
+        // A light rider's weight reaches the pins in the ordinary passes.
+        if (bodies[member].invMass < kLightestRider * bodies[loose].invMass) continue;
+        picked.push_back(k);
     }
     // Sets: one loose body against one group, its contacts in their order.
-    std::stable_sort(list_.begin(), list_.end(), [&](std::uint32_t x, std::uint32_t y) {
+    std::stable_sort(picked.begin(), picked.end(), [&](std::uint32_t x, std::uint32_t y) {
         const int gx = groupOf(contacts[x]), gy = groupOf(contacts[y]);
         if (gx != gy) return gx < gy;
         return looseOf(contacts[x]) < looseOf(contacts[y]);
     });
+    struct Candidate {
+        std::uint32_t first, last, rows;
+        double mass;  // the loose body's, kg
+    };
+    std::vector<Candidate> candidates;
+    for (std::uint32_t at = 0; at < picked.size();) {
+        const ContactConstraint& c = contacts[picked[at]];
+        Candidate candidate{at, at, 0, 1.0 / bodies[looseOf(c)].invMass};
+        while (candidate.last < picked.size() && groupOf(contacts[picked[candidate.last]]) == groupOf(c) &&
+               looseOf(contacts[picked[candidate.last]]) == looseOf(c))
+            candidate.rows += 2 * std::uint32_t(contacts[picked[candidate.last++]].pointCount);
+        candidates.push_back(candidate);
+        at = candidate.last;
+    }
+    // Each group takes its heaviest riders' sets, up to kRowsPerGroup rows:
+    // every row costs a solve of the whole group in each pass, and the
+    // heaviest riders are the ones the ordinary passes hold worst.
+    std::vector<std::uint32_t> order(candidates.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) {
+        const int gx = groupOf(contacts[picked[candidates[x].first]]), gy = groupOf(contacts[picked[candidates[y].first]]);
+        if (gx != gy) return gx < gy;
+        return candidates[x].mass > candidates[y].mass;
+    });
+    std::vector<std::uint8_t> taken(candidates.size(), 0);
+    int group = -1;
+    std::uint32_t rows = 0;
+    for (const std::uint32_t i : order) {
+        const int g = groupOf(contacts[picked[candidates[i].first]]);
+        if (g != group) {
+            group = g;
+            rows = 0;
+        }
+        if (rows + candidates[i].rows > kRowsPerGroup) continue;
+        rows += candidates[i].rows;
+        taken[i] = 1;
+    }
     std::size_t responseAt = 0;
-    for (std::uint32_t at = 0; at < list_.size();) {
-        const ContactConstraint& c = contacts[list_[at]];
-        Set set{at, at, groupOf(c), looseOf(c), responseAt};
-        std::size_t rows = 0;
-        while (set.last < list_.size() && groupOf(contacts[list_[set.last]]) == set.group &&
-               looseOf(contacts[list_[set.last]]) == set.loose)
-            rows += 2 * std::size_t(contacts[list_[set.last++]].pointCount);
-        responseAt += rows * direct.responseSize(set.group);
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+        if (!taken[i]) continue;
+        const ContactConstraint& c = contacts[picked[candidates[i].first]];
+        Set set{std::uint32_t(list_.size()), 0, groupOf(c), looseOf(c), responseAt};
+        for (std::uint32_t at = candidates[i].first; at < candidates[i].last; ++at) {
+            list_.push_back(picked[at]);
+            heldOut[picked[at]] = 1;
+        }
+        set.last = std::uint32_t(list_.size());
+        responseAt += candidates[i].rows * direct.responseSize(set.group);
         sets_.push_back(set);
-        at = set.last;
     }
     responses_.resize(responseAt);
     return !list_.empty();
@@ -343,7 +392,7 @@ void TreeContacts::solveSet(const Set& set, std::span<ContactConstraint> contact
         roundChange = roundLargest = 0.0;
         solveNormals();
         solveFriction();
-        if (roundChange <= kSweepTolerance * roundLargest) break;
+        if (roundChange <= kRoundTolerance * roundLargest) break;
     }
 }
 

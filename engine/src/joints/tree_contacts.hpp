@@ -80,6 +80,7 @@ private:
                   double pushMaxVelocity, bool useBias, bool respond);
 
     std::vector<std::uint32_t> list_;  ///< sorted by set
+    std::vector<std::uint32_t> scratch_;  ///< select's candidates
     std::vector<Set> sets_;
     std::vector<Row> rows_;  ///< scratch: one set's rows, normals first
     /// Each set's rows' responses (DirectJoints::respond), back to back, for
