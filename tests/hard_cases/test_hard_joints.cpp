@@ -749,6 +749,27 @@ TEST(HardJointsLoads, ACrateAtRestOnABridgeMovesAsItsVelocitySays) {
     std::printf("a crate at rest on a bridge: velocity and motion differ by at most %.2f of g h\n", worst);
 }
 
+// The riders' carry reads their contacts' impulses mid-step, and the SIMD
+// passes keep a bundled contact's impulses in its bundle: a bridge with a
+// stack on its crate, the crate heavy (its contacts with the planks solved
+// with the bridge, the boxes' contacts bundled) or light (every contact
+// bundled), gives the same bits with the bundles as one contact at a time.
+TEST(HardJointsLoads, RidersOnABridgeGiveTheSameBitsBundledOrOneAtATime) {
+    for (const double crateMass : {0.2, 20.0}) {
+        const Scene scene = parseBridge({.crateMass = crateMass, .boxes = 3});
+        const auto run = [&](bool simd) {
+            Result<World> built = World::build(scene);
+            EXPECT_TRUE(built) << built.error();
+            internals(*built).collision->settings().simd = simd;
+            for (int i = 0; i < 240; ++i) EXPECT_TRUE(built->step());
+            Scene out = scene;
+            built->writeBack(out);
+            return sceneToJsonText(out);
+        };
+        EXPECT_TRUE(run(true) == run(false)) << crateMass << " kg crate";
+    }
+}
+
 // The shipped bridge: the crate dropped on it comes to rest where it
 // landed, and the level falls asleep. Lifted out of the planks straight up
 // by what the projection pushed into it, the crate shifted along the

@@ -1777,6 +1777,9 @@ void CollisionSystem::followRiders() {
     // shifted along the support by each lift's sideways part, which its
     // velocity did not take back: a 20 kg crate on a taut bridge crept
     // 5 cm in 20 s. Riders on riders follow in later passes.
+    // The impulses as the passes left them, bundled or not (the bundles
+    // hold theirs until the step ends), so both paths follow alike.
+    coloured_.storeImpulses(constraints_);
     followSum_.assign(bodies_.size(), Vec2{});
     followWeight_.assign(bodies_.size(), 0.0);
     constexpr int kMaxPasses = 8;
