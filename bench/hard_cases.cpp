@@ -780,6 +780,16 @@ std::string measuredOn(int argc, char** argv) {
            " hardware threads) by `" + command + "`.";
 }
 
+/// Text for a Markdown table cell: a '|' (as in "|v - w|") would end the cell.
+std::string cell(const std::string& text) {
+    std::string out;
+    for (const char ch : text) {
+        if (ch == '|') out += '\\';
+        out += ch;
+    }
+    return out;
+}
+
 std::string num(double x) {
     if (std::isnan(x)) return "NaN";
     char b[32];
@@ -998,7 +1008,7 @@ int main(int argc, char** argv) {
         }
         if (!v3 && !def && !peer) continue;
         const auto ms = [](const Row* r) { return r ? fmt("%.3g", r->ms) : std::string("–"); };
-        const auto what = [](const Row* r) { return r ? r->detail : std::string("–"); };
+        const auto what = [](const Row* r) { return r ? cell(r->detail) : std::string("–"); };
         md << "| " << ref.scene << " | " << ms(v3) << " | " << ms(def) << " | " << ms(peer) << " | "
            << (std::isnan(ref.v3Ms) ? std::string("–") : fmt("%.3g", ref.v3Ms)) << " | "
            << (std::isnan(ref.stepwiseMs) ? std::string("–") : fmt("%.3g", ref.stepwiseMs)) << " | " << what(v3)
@@ -1008,8 +1018,8 @@ int main(int argc, char** argv) {
           "left after 500 steps.\n\n## Every run\n\n"
        << "| case | engine | substeps | ms/step | error | error is | figures |\n|---|---|---|---|---|---|---|\n";
     for (const Row& r : rows)
-        md << "| " << r.name << " | " << r.engine << " | " << r.setting << " | " << fmt("%.3g", r.ms) << " | "
-           << num(r.error) << " | " << r.errorLabel << " | " << r.detail << " |\n";
+        md << "| " << cell(r.name) << " | " << r.engine << " | " << r.setting << " | " << fmt("%.3g", r.ms) << " | "
+           << num(r.error) << " | " << cell(r.errorLabel) << " | " << cell(r.detail) << " |\n";
     for (const auto& [name, text] :
          {std::pair<std::string, std::string>{"hard_cases.csv", csv.str()}, {"hard_cases.md", md.str()}})
         if (Result<void> r = writeFileAtomically(dir / name, text); !r) {
