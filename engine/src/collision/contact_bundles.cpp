@@ -13,7 +13,7 @@ namespace {
 
 using namespace simd;
 
-static_assert(kContactLanes == kLanes, "a bundle fills the vector types of simd_lanes.hpp");
+static_assert(kContactLanes % kLanes == 0, "a bundle is whole vectors of simd_lanes.hpp");
 
 struct PassArgs {
     SolverBody* bodies;
@@ -25,228 +25,47 @@ struct PassArgs {
     double invH, pushMaxVelocity;
 };
 
-// The velocity state of a bundle's two sides while it is solved.
-struct Velocities {
-    D4 vAx, vAy, wA, vBx, vBy, wB;
-};
+// Each copy of the kernels in a namespace of its own, apart from PassArgs:
+// argument-dependent lookup would otherwise see both.
+namespace narrow {
+#include "collision/contact_kernels.inl"
+} // namespace narrow
 
-// Each formula below is solveContacts' (contact_solver.cpp), with the same
-// operations in the same order; comments there say why.
+} // namespace
 
-/// The inverse masses (1/kg) and inertias (1/(kg m^2)) of a bundle's two sides.
-struct Masses {
-    D4 mA, iA, mB, iB;
-};
+#ifdef STEPWISE_SIMD_DISPATCH
+#pragma GCC push_options
+#pragma GCC target("avx512f,avx512dq")
+namespace {
+namespace wide {
+#include "collision/contact_kernels.inl"
 
-/// Impulse j (N*s) along (dx, dy) with lever arms armA, armB: applyImpulse
-/// of contact_solver.cpp. Friction passes the arms -dnA, -dnB, where
-/// solveContacts writes wA + iA dnA j: negation is exact, so the bits agree.
-[[gnu::always_inline]] inline void applyLanes(Velocities& v, const Masses& m, D4 dx, D4 dy, D4 armA, D4 armB, D4 j) {
-    v.vAx = v.vAx - (m.mA * j) * dx;
-    v.vAy = v.vAy - (m.mA * j) * dy;
-    v.wA = v.wA - (m.iA * armA) * j;
-    v.vBx = v.vBx + (m.mB * j) * dx;
-    v.vBy = v.vBy + (m.mB * j) * dy;
-    v.wB = v.wB + (m.iB * armB) * j;
+template <int Mode>
+__attribute__((target("avx512f,avx512dq"))) void onAvx512Dq(const PassArgs& args) {
+    colourPass<Mode, D8>(args);
 }
+} // namespace wide
+} // namespace
+#pragma GCC pop_options
+#endif
 
-template <int Points>
-[[gnu::always_inline]] inline void warmStartBundle(ContactBundle<Points>& c, SolverBody* bodies) {
-    const BodyLanes a = gather(bodies, c.bodyA), b = gather(bodies, c.bodyB);
-    Velocities v{a.vx, a.vy, a.w, b.vx, b.vy, b.w};
-    const Masses m{a.invMass, load(c.invInertiaA), b.invMass, load(c.invInertiaB)};
-    const D4 nx = load(c.nx), ny = load(c.ny);
-    const D4 tx = ny, ty = -nx;
-    for (int i = 0; i < Points; ++i) {
-        const PointLanes& p = c.points[i];
-        const D4 ni = load(p.normalImpulse), ti = load(p.tangentImpulse);
-        const D4 rnA = load(p.rnA), rnB = load(p.rnB), dnA = load(p.dnA), dnB = load(p.dnB);
-        applyLanes(v, m, nx, ny, rnA, rnB, ni);
-        applyLanes(v, m, tx, ty, -dnA, -dnB, ti);
-    }
-    scatter(bodies, c.bodyA, v.vAx, v.vAy, v.wA, a.invMass);
-    scatter(bodies, c.bodyB, v.vBx, v.vBy, v.wB, b.invMass);
-}
-
-/// Bias and soft scaling of one point (solveContacts' targetOf).
-struct Target {
-    D4 bias, massScale, impulseScale;
-};
-
-/// One point's sequential normal update (solveContacts' else branch).
-[[gnu::always_inline]] inline void normalPoint(Velocities& v, PointLanes& p, const Target& t, D4 nx, D4 ny,
-                                               const Masses& m) {
-    const D4 rnA = load(p.rnA), rnB = load(p.rnB);
-    const D4 ni = load(p.normalImpulse);
-    const D4 vn = (((v.vBx - v.vAx) * nx + (v.vBy - v.vAy) * ny) + v.wB * rnB) - v.wA * rnA;
-    D4 impulse = ((-load(p.normalMass)) * t.massScale) * (vn + t.bias) - t.impulseScale * ni;
-    const D4 total = maxOf(ni + impulse, splat(0.0));
-    impulse = total - ni;
-    store(p.normalImpulse, total);
-    applyLanes(v, m, nx, ny, rnA, rnB, impulse);
-}
-
-template <int Points, bool UseBias>
-[[gnu::always_inline]] inline void solveBundle(ContactBundle<Points>& c, const PassArgs& args) {
-    SolverBody* bodies = args.bodies;
-    const BodyLanes a = gather(bodies, c.bodyA), b = gather(bodies, c.bodyB);
-    Velocities v{a.vx, a.vy, a.w, b.vx, b.vy, b.w};
-    const Masses m{a.invMass, load(c.invInertiaA), b.invMass, load(c.invInertiaB)};
-    const D4 mA = m.mA, iA = m.iA, mB = m.mB, iB = m.iB;
-    const D4 nx = load(c.nx), ny = load(c.ny);
-    const M4 flags = loadMask(c.flags);
-    const M4 isStatic = (flags & kTouchesStatic) != 0;
-    const D4 biasRate = isStatic ? splat(args.staticSoft.biasRate) : splat(args.soft.biasRate);
-    const D4 massScale = isStatic ? splat(args.staticSoft.massScale) : splat(args.soft.massScale);
-    const D4 impulseScale = isStatic ? splat(args.staticSoft.impulseScale) : splat(args.soft.impulseScale);
-    const D4 rigidDepth = isStatic ? splat(args.staticSoft.rigidDepth) : splat(args.soft.rigidDepth);
-    const D4 baseGap = (b.dpx - a.dpx) * nx + (b.dpy - a.dpy) * ny;
-    const D4 zero = splat(0.0), one = splat(1.0);
-    const M4 roundA = (flags & kRoundA) != 0, roundB = (flags & kRoundB) != 0;
-    const D4 qcA = roundA ? one : a.qc, qsA = roundA ? zero : a.qs;
-    const D4 qcB = roundB ? one : b.qc, qsB = roundB ? zero : b.qs;
-    Target t[2];
-    for (int i = 0; i < Points; ++i) {
-        const PointLanes& p = c.points[i];
-        const D4 separation = ((baseGap + (qcB * load(p.dnB) + qsB * load(p.rnB))) -
-                               (qcA * load(p.dnA) + qsA * load(p.rnA))) +
-                              load(p.adjustedSeparation);
-        const M4 apart = separation > zero;
-        const D4 speculative = separation * splat(args.invH);
-        if constexpr (UseBias) {
-            // Rigid past rigidDepth, or when the approach would carry the
-            // point past twice that within this substep (solveContacts says
-            // why).
-            const D4 vn = (((v.vBx - v.vAx) * nx + (v.vBy - v.vAy) * ny) + v.wB * load(p.rnB)) - v.wA * load(p.rnA);
-            const M4 rigid =
-                (!(separation > -rigidDepth)) | (!((separation + vn / splat(args.invH)) > -(rigidDepth + rigidDepth)));
-            const D4 toDepth = separation + rigidDepth;
-            const D4 rigidBias = toDepth > zero ? toDepth * splat(args.invH)
-                                                : maxOf(biasRate * toDepth, splat(-args.pushMaxVelocity));
-            const D4 push = maxOf(biasRate * separation, splat(-args.pushMaxVelocity));
-            t[i] = {apart ? speculative : (rigid ? rigidBias : push), apart ? one : (rigid ? one : massScale),
-                    apart ? zero : (rigid ? zero : impulseScale)};
-        } else {
-            t[i] = {apart ? speculative : zero, one, zero};
-        }
-    }
-    if constexpr (Points == 1) {
-        normalPoint(v, c.points[0], t[0], nx, ny, m);
-    } else {
-        const M4 block = (flags & kBlock) != 0;
-        const M4 useBlock = block & (t[0].massScale == t[1].massScale);
-        Velocities blockV = v;
-        D4 blockX1 = zero, blockX2 = zero;
-        if (anyLane(useBlock)) {
-            PointLanes& p1 = c.points[0];
-            PointLanes& p2 = c.points[1];
-            const D4 k11 = load(c.k11), k12 = load(c.k12), k22 = load(c.k22);
-            // K^-1 as prepareContacts forms it; zero in the lanes without a
-            // block (as BlockMass leaves it there).
-            const D4 invDet = one / (k11 * k22 - k12 * k12);
-            const D4 i11 = block ? k22 * invDet : zero, i12 = block ? -k12 * invDet : zero,
-                     i22 = block ? k11 * invDet : zero;
-            const D4 rnA1 = load(p1.rnA), rnB1 = load(p1.rnB), rnA2 = load(p2.rnA), rnB2 = load(p2.rnB);
-            const D4 dvx = v.vBx - v.vAx, dvy = v.vBy - v.vAy;
-            const D4 a1 = load(p1.normalImpulse), a2 = load(p2.normalImpulse);
-            const D4 vn1 = ((dvx * nx + dvy * ny) + v.wB * rnB1) - v.wA * rnA1;
-            const D4 vn2 = ((dvx * nx + dvy * ny) + v.wB * rnB2) - v.wA * rnA2;
-            const D4 q1 = (vn1 + t[0].bias) - (k11 * a1 + k12 * a2);
-            const D4 q2 = (vn2 + t[1].bias) - (k12 * a1 + k22 * a2);
-            // The four cases of the 2x2 complementarity problem, taken in
-            // solveContacts' order: both push, only the first, only the
-            // second, neither.
-            const D4 both1 = -(i11 * q1 + i12 * q2);
-            const D4 both2 = -(i12 * q1 + i22 * q2);
-            const M4 bothOk = (both1 >= zero) & (both2 >= zero);
-            D4 y1 = both1, y2 = both2;
-            if (!allLanes(bothOk)) {
-                // Only lanes where both points cannot push need the other
-                // cases (and their divisions): settled stacks rarely do.
-                const D4 first1 = -q1 / k11;
-                const M4 firstOk = (first1 >= zero) & (k12 * first1 + q2 >= zero);
-                const D4 second2 = -q2 / k22;
-                const M4 secondOk = (second2 >= zero) & (k12 * second2 + q1 >= zero);
-                const M4 noneOk = (q1 >= zero) & (q2 >= zero);
-                const D4 none1 = noneOk ? zero : a1 / t[0].massScale;
-                const D4 none2 = noneOk ? zero : a2 / t[0].massScale;
-                y1 = bothOk ? both1 : firstOk ? first1 : secondOk ? zero : none1;
-                y2 = bothOk ? both2 : firstOk ? zero : secondOk ? second2 : none2;
-            }
-            blockX1 = t[0].massScale * y1;
-            blockX2 = t[0].massScale * y2;
-            const D4 d1 = blockX1 - a1, d2 = blockX2 - a2;
-            const D4 d = d1 + d2;
-            blockV.vAx = v.vAx - (mA * d) * nx;
-            blockV.vAy = v.vAy - (mA * d) * ny;
-            blockV.wA = v.wA - iA * (rnA1 * d1 + rnA2 * d2);
-            blockV.vBx = v.vBx + (mB * d) * nx;
-            blockV.vBy = v.vBy + (mB * d) * ny;
-            blockV.wB = v.wB + iB * (rnB1 * d1 + rnB2 * d2);
-        }
-        if (allLanes(useBlock)) {
-            v = blockV;
-            store(c.points[0].normalImpulse, blockX1);
-            store(c.points[1].normalImpulse, blockX2);
-        } else {
-            // Some lanes solve the points one after the other; the block
-            // lanes keep their block result.
-            normalPoint(v, c.points[0], t[0], nx, ny, m);
-            normalPoint(v, c.points[1], t[1], nx, ny, m);
-            if (anyLane(useBlock)) {
-                v.vAx = useBlock ? blockV.vAx : v.vAx;
-                v.vAy = useBlock ? blockV.vAy : v.vAy;
-                v.wA = useBlock ? blockV.wA : v.wA;
-                v.vBx = useBlock ? blockV.vBx : v.vBx;
-                v.vBy = useBlock ? blockV.vBy : v.vBy;
-                v.wB = useBlock ? blockV.wB : v.wB;
-                store(c.points[0].normalImpulse, useBlock ? blockX1 : load(c.points[0].normalImpulse));
-                store(c.points[1].normalImpulse, useBlock ? blockX2 : load(c.points[1].normalImpulse));
-            }
-        }
-    }
-    // Friction: t = (n.y, -n.x), cross(r, t) = -dot(r, n).
-    const D4 tx = ny, ty = -nx;
-    const D4 friction = load(c.friction);
-    for (int i = 0; i < Points; ++i) {
-        PointLanes& p = c.points[i];
-        const D4 dnA = load(p.dnA), dnB = load(p.dnB);
-        const D4 ti = load(p.tangentImpulse);
-        const D4 vt = (((v.vBx - v.vAx) * tx + (v.vBy - v.vAy) * ty) - v.wB * dnB) + v.wA * dnA;
-        const D4 maxFriction = friction * load(p.normalImpulse);
-        D4 impulse = (-load(p.tangentMass)) * vt;
-        const D4 total = minOf(maxOf(ti + impulse, -maxFriction), maxFriction);  // std::clamp
-        impulse = total - ti;
-        store(p.tangentImpulse, total);
-        applyLanes(v, m, tx, ty, -dnA, -dnB, impulse);
-    }
-    scatter(bodies, c.bodyA, v.vAx, v.vAy, v.wA, a.invMass);
-    scatter(bodies, c.bodyB, v.vBx, v.vBy, v.wB, b.invMass);
-}
-
-// One colour: its one-point bundles, then its two-point bundles (any order
-// gives the same bits, since no two of its contacts share a dynamic body).
-template <int Mode>  // 0 warm start, 1 biased solve, 2 relax
-[[gnu::always_inline]] inline void colourPass(const PassArgs& args) {
-    for (std::size_t k = 0; k < args.oneCount; ++k) {
-        if constexpr (Mode == 0)
-            warmStartBundle(args.one[k], args.bodies);
-        else
-            solveBundle<1, Mode == 1>(args.one[k], args);
-    }
-    for (std::size_t k = 0; k < args.twoCount; ++k) {
-        if constexpr (Mode == 0)
-            warmStartBundle(args.two[k], args.bodies);
-        else
-            solveBundle<2, Mode == 1>(args.two[k], args);
-    }
-}
+namespace {
 
 using PassKernel = void (*)(const PassArgs&);
 
+/// Eight lanes in one register on AVX-512; four at a time elsewhere.
 template <int Mode>
 PassKernel passKernel() {
-    return kernelFor<PassArgs, colourPass<Mode>>();
+#ifdef STEPWISE_SIMD_DISPATCH
+    static const bool dq = __builtin_cpu_supports("avx512dq");
+    switch (detail::simdLevel()) {
+        case detail::SimdLevel::Avx512:
+            return dq ? wide::onAvx512Dq<Mode> : onAvx512<PassArgs, narrow::colourPass<Mode, D4>>;
+        case detail::SimdLevel::Avx2: return onAvx2<PassArgs, narrow::colourPass<Mode, D4>>;
+        default: break;
+    }
+#endif
+    return onBaseline<PassArgs, narrow::colourPass<Mode, D4>>;
 }
 
 template <int Points>

@@ -7,11 +7,11 @@
 // contact in vector registers: its lanes touch different bodies, so solving
 // them together gives what solving them one after another gives.
 //
-// Bit-identical on every instruction set: the lane width is fixed at four
-// doubles whatever the machine (SSE2 does it as two halves, AVX2 and
-// AVX-512 in one register), each lane does the scalar solver's operations
-// in the scalar solver's order (selects replace its branches), and the
-// engine is built without fused multiply-add. The same coloured order,
+// Bit-identical on every instruction set: a bundle holds eight contacts
+// whatever the machine (AVX-512 solves them in one register, AVX2 four at a
+// time, SSE2 two), each lane does the scalar solver's operations in the
+// scalar solver's order (selects replace its branches), and the engine is
+// built without fused multiply-add. The same coloured order,
 // solved one contact at a time by solveContacts (SolverSettings::simd off),
 // gives the same bits; the tests check both.
 
@@ -24,19 +24,21 @@
 
 namespace stepwise::collision {
 
-/// Contacts solved together. Fixed (not the machine's vector width) so the
-/// colouring, and so the results, are the same everywhere.
-constexpr int kContactLanes = 4;
+/// Contacts in one bundle: fixed (not the machine's vector width) so the
+/// bundles are the same everywhere. Eight fill an AVX-512 register, which
+/// takes half the instructions of two fours (the passes' arithmetic, not
+/// memory, bounds a pile of boxes: perf).
+constexpr int kContactLanes = 8;
 /// Colours tried before a contact goes to the overflow, which is solved one
 /// contact at a time after the colours (a crowd at one point overflows).
 constexpr int kContactColours = 24;
 
 /// One contact point of kContactLanes contacts (see ContactPoint).
 struct PointLanes {
-    alignas(32) double rnA[kContactLanes], rnB[kContactLanes], dnA[kContactLanes], dnB[kContactLanes];
-    alignas(32) double adjustedSeparation[kContactLanes];
-    alignas(32) double normalMass[kContactLanes], tangentMass[kContactLanes];
-    alignas(32) double normalImpulse[kContactLanes], tangentImpulse[kContactLanes];
+    alignas(64) double rnA[kContactLanes], rnB[kContactLanes], dnA[kContactLanes], dnB[kContactLanes];
+    alignas(64) double adjustedSeparation[kContactLanes];
+    alignas(64) double normalMass[kContactLanes], tangentMass[kContactLanes];
+    alignas(64) double normalImpulse[kContactLanes], tangentImpulse[kContactLanes];
 };
 
 /// The block solve's K (BlockMass) of kContactLanes two-point contacts; its
@@ -44,7 +46,7 @@ struct PointLanes {
 /// so the same bits), which costs a division a bundle against 96 bytes more
 /// to stream through every pass.
 struct BlockLanes {
-    alignas(32) double k11[kContactLanes], k12[kContactLanes], k22[kContactLanes];
+    alignas(64) double k11[kContactLanes], k12[kContactLanes], k22[kContactLanes];
 };
 struct NoBlockLanes {};
 
@@ -67,9 +69,9 @@ struct ContactBundle : std::conditional_t<Points == 2, BlockLanes, NoBlockLanes>
     ContactBundle() noexcept {}
     std::uint32_t bodyA[kContactLanes], bodyB[kContactLanes];
     std::uint32_t source[kContactLanes];  ///< index in the step's contacts; ~0u for an unused lane
-    alignas(32) double nx[kContactLanes], ny[kContactLanes], friction[kContactLanes];
-    alignas(32) double invInertiaA[kContactLanes], invInertiaB[kContactLanes];  ///< 1/(kg m^2)
-    alignas(32) std::int64_t flags[kContactLanes];  ///< kTouchesStatic, kBlock, kRoundA, kRoundB
+    alignas(64) double nx[kContactLanes], ny[kContactLanes], friction[kContactLanes];
+    alignas(64) double invInertiaA[kContactLanes], invInertiaB[kContactLanes];  ///< 1/(kg m^2)
+    alignas(64) std::int64_t flags[kContactLanes];  ///< kTouchesStatic, kBlock, kRoundA, kRoundB
     PointLanes points[Points];
 };
 

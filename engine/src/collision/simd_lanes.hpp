@@ -1,6 +1,6 @@
 #pragma once
-// Four solver lanes in vector registers, shared by the contact and joint
-// bundles: the vector types, loads and stores, and the gather and scatter
+// Solver lanes in vector registers (four, or eight for the contact passes
+// on AVX-512), shared by the contact and joint bundles: the vector types, loads and stores, and the gather and scatter
 // of the lanes' bodies. Each helper is one IEEE operation per lane (or pure
 // data movement), so a bundle's lanes get the bits of the scalar solve.
 
@@ -18,8 +18,7 @@
 
 namespace stepwise::collision::simd {
 
-/// Lanes in one vector: fixed (not the machine's width) so the results are
-/// the same everywhere.
+/// Lanes in one D4 vector, the width every instruction set runs.
 constexpr int kLanes = 4;
 
 // Four doubles in one GCC/Clang vector: SSE2 runs it as two halves, AVX2
@@ -27,6 +26,24 @@ constexpr int kLanes = 4;
 // operation everywhere (no FMA: -ffp-contract=off on the engine).
 typedef double D4 __attribute__((vector_size(32)));
 typedef std::int64_t M4 __attribute__((vector_size(32)));  // a comparison's result: lanes all ones or zeros
+// Eight doubles: one AVX-512 register. A kernel written over a lane type
+// `D` (D4 or D8) runs eight contacts at once there and four elsewhere;
+// lanes never mix, so the width changes no bit.
+typedef double D8 __attribute__((vector_size(64)));
+typedef std::int64_t M8 __attribute__((vector_size(64)));
+
+template <class D>
+constexpr int lanesOf = int(sizeof(D) / sizeof(double));
+template <class D>
+struct MaskOf;
+template <>
+struct MaskOf<D4> {
+    using type = M4;
+};
+template <>
+struct MaskOf<D8> {
+    using type = M8;
+};
 
 [[gnu::always_inline]] inline D4 load(const double* p) {
     D4 v;
@@ -40,17 +57,57 @@ typedef std::int64_t M4 __attribute__((vector_size(32)));  // a comparison's res
 }
 [[gnu::always_inline]] inline void store(double* p, D4 v) { std::memcpy(p, &v, sizeof v); }
 [[gnu::always_inline]] inline D4 splat(double x) { return D4{x, x, x, x}; }
+template <class D>
+[[gnu::always_inline]] inline D loadAs(const double* p) {
+    D v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+template <class D>
+[[gnu::always_inline]] inline typename MaskOf<D>::type loadMaskAs(const std::int64_t* p) {
+    typename MaskOf<D>::type v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+template <class D>
+[[gnu::always_inline]] inline void storeLanes(double* p, D v) {
+    std::memcpy(p, &v, sizeof v);
+}
+template <class D>
+[[gnu::always_inline]] inline D splatAs(double x) {
+    D v;
+    for (int l = 0; l < lanesOf<D>; ++l) v[l] = x;
+    return v;
+}
 /// std::max(a, b) and std::min(a, b) lane by lane, to the bit (also for
 /// NaN and signed zeros): (a < b) ? b : a and (b < a) ? b : a.
-[[gnu::always_inline]] inline D4 maxOf(D4 a, D4 b) { return a < b ? b : a; }
-[[gnu::always_inline]] inline D4 minOf(D4 a, D4 b) { return b < a ? b : a; }
-[[gnu::always_inline]] inline bool anyLane(M4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
-[[gnu::always_inline]] inline bool allLanes(M4 m) { return (m[0] & m[1] & m[2] & m[3]) != 0; }
+template <class D>
+[[gnu::always_inline]] inline D maxOf(D a, D b) {
+    return a < b ? b : a;
+}
+template <class D>
+[[gnu::always_inline]] inline D minOf(D a, D b) {
+    return b < a ? b : a;
+}
+template <class M>
+[[gnu::always_inline]] inline bool anyLane(M m) {
+    std::int64_t any = 0;
+    for (int l = 0; l < int(sizeof(M) / sizeof(std::int64_t)); ++l) any |= m[l];
+    return any != 0;
+}
+template <class M>
+[[gnu::always_inline]] inline bool allLanes(M m) {
+    std::int64_t all = -1;
+    for (int l = 0; l < int(sizeof(M) / sizeof(std::int64_t)); ++l) all &= m[l];
+    return all != 0;
+}
 
-/// Velocities of the four lanes' bodies, and their motion since the step began.
-struct BodyLanes {
-    D4 vx, vy, w, invMass, dpx, dpy, qc, qs;
+/// Velocities of the lanes' bodies, and their motion since the step began.
+template <class D>
+struct BodyLanesOf {
+    D vx, vy, w, invMass, dpx, dpy, qc, qs;
 };
+using BodyLanes = BodyLanesOf<D4>;
 // SolverBody holds (v.x, v.y, w, invMass) and (dp.x, dp.y, dq.c, dq.s) as
 // four consecutive doubles each: one load per lane and a 4x4 transpose
 // (pure data movement, so it changes no bit) give the lanes.
@@ -89,6 +146,33 @@ static_assert(offsetof(SolverBody, w) == 2 * sizeof(double) && offsetof(SolverBo
     store(&bodies[index[1]].v.x, r1);
     store(&bodies[index[2]].v.x, r2);
     store(&bodies[index[3]].v.x, r3);
+}
+
+/// Eight lanes as two runs of four: the same loads, transposes and stores.
+[[gnu::always_inline]] inline D8 joined(D4 low, D4 high) {
+    return __builtin_shufflevector(low, high, 0, 1, 2, 3, 4, 5, 6, 7);
+}
+[[gnu::always_inline]] inline D4 lowHalf(D8 v) { return __builtin_shufflevector(v, v, 0, 1, 2, 3); }
+[[gnu::always_inline]] inline D4 highHalf(D8 v) { return __builtin_shufflevector(v, v, 4, 5, 6, 7); }
+template <class D>
+[[gnu::always_inline]] inline BodyLanesOf<D> gatherAs(const SolverBody* bodies, const std::uint32_t* index) {
+    if constexpr (lanesOf<D> == 4) {
+        return gather(bodies, index);
+    } else {
+        const BodyLanes l = gather(bodies, index), h = gather(bodies, index + 4);
+        return {joined(l.vx, h.vx),   joined(l.vy, h.vy),   joined(l.w, h.w),   joined(l.invMass, h.invMass),
+                joined(l.dpx, h.dpx), joined(l.dpy, h.dpy), joined(l.qc, h.qc), joined(l.qs, h.qs)};
+    }
+}
+template <class D>
+[[gnu::always_inline]] inline void scatterAs(SolverBody* bodies, const std::uint32_t* index, const D& vx, const D& vy,
+                                             const D& w, const D& invMass) {
+    if constexpr (lanesOf<D> == 4) {
+        scatter(bodies, index, vx, vy, w, invMass);
+    } else {
+        scatter(bodies, index, lowHalf(vx), lowHalf(vy), lowHalf(w), lowHalf(invMass));
+        scatter(bodies, index + 4, highHalf(vx), highHalf(vy), highHalf(w), highHalf(invMass));
+    }
 }
 
 /// The pass `Pass` (always inlined) compiled for SSE2, AVX2 and AVX-512 from
