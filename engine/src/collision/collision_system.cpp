@@ -17,7 +17,7 @@ namespace {
 constexpr double kLinearSlop = 0.005;
 constexpr double kSpeculativeBase = 4.0 * kLinearSlop;
 /// How far past the momentum and forces that can reach one contact its
-/// warm start may be (capWarmStart): the loader's factor for its own bound.
+/// warm start may be (warmStartBound): the loader's factor for its own bound.
 constexpr double kWarmStartMargin = 4.0;
 
 double msSince(std::chrono::steady_clock::time_point start) {
@@ -910,6 +910,7 @@ void CollisionSystem::addManifold(std::uint32_t a, std::uint32_t b, const Manifo
         p.dnA = dot(anchorA, m.normal);
         p.dnB = dot(anchorB, m.normal);
     }
+    contactPairs_.add(c);
     // Noted here, where the separations are at hand, rather than by a pass
     // over every contact (addDeepOverlapsToCrowd).
     if (!c.touchesStatic) {
@@ -1154,6 +1155,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
     const auto narrowStart = std::chrono::steady_clock::now();
     constraints_.clear();
     details_.clear();
+    contactPairs_.clear(bodies_.size());
     deepContacts_.clear();
     sensorCandidates_.clear();
     // At most one manifold a pair (and a plane against each movable shape):
@@ -1241,9 +1243,7 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
         // solves it (the SIMD bundles copy the inertias here).
         joints::stiffenRotation(joints_, bodies_, h, stiffened_, stiffenScratch_);
     }
-    prepareContacts(constraints_, details_, bodies_, contactPairs_);
     impactScratch_.startStep();
-    if (settings_.warmStart && !cache_.empty()) capWarmStart(firstSubstepV);
     // Contacts of loose bodies on an exactly solved group are solved with
     // the group (tree_contacts.hpp), not in the colours.
     bool treeContacts = false;
@@ -1253,7 +1253,11 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
                        treeContacts_.select(constraints_, directJoints_, bodies_, inCrowd_, heldOut_);
     }
     if (!treeContacts) treeContacts_.clear();
-    coloured_.build(constraints_, contactPairs_, bodies_, settings_.simd,
+    // The colouring prepares the contacts (their masses, from the inertia
+    // the joints' stiffening set above) and bounds their warm start.
+    ColouredContacts::Preparation preparation{details_, std::nullopt};
+    if (settings_.warmStart && !cache_.empty()) preparation.warmStartBound = warmStartBound(firstSubstepV);
+    coloured_.build(constraints_, preparation, contactPairs_, bodies_, settings_.simd,
                     treeContacts ? std::span<const std::uint8_t>(heldOut_) : std::span<const std::uint8_t>{});
     timings_.narrowPhaseMs = msSince(narrowStart);
 }
@@ -1274,6 +1278,10 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
 // a body squeezed between static and kinematic sides, can press a contact
 // harder than the sum; there the bound replaces part of the warm start, the
 // same way in a straight run and a resumed one, so a resume stays exact.
+// Straight and resumed runs are bounded alike, so a saved state still
+// resumes bit for bit; a run's own impulses are within the bound and
+// already non-negative with friction within the cone (the solve clamps
+// them so), so they keep their bits.
 double CollisionSystem::warmStartBound(std::span<const Vec2> firstSubstepV) const {
     const std::vector<double>& reach = contactPairs_.reach;
     // The fastest point of a kinematic body that touches something: a body
@@ -1315,23 +1323,6 @@ double CollisionSystem::warmStartBound(std::span<const Vec2> firstSubstepV) cons
         }
     }
     return kWarmStartMargin * bound;
-}
-
-// Straight and resumed runs pass here alike, so a saved state still resumes
-// bit for bit; a run's own impulses are within the bound and already
-// non-negative with friction within the cone (the solve clamps them so), so
-// they keep their bits.
-void CollisionSystem::capWarmStart(std::span<const Vec2> firstSubstepV) {
-    const double most = warmStartBound(firstSubstepV);
-    for (ContactConstraint& c : constraints_)
-        for (int i = 0; i < c.pointCount; ++i) {
-            ContactPoint& p = c.points[i];
-            if (!(p.normalImpulse >= 0.0)) p.normalImpulse = 0.0;
-            if (p.normalImpulse > most) p.normalImpulse = most;
-            const double friction = c.friction * p.normalImpulse;
-            if (p.tangentImpulse > friction) p.tangentImpulse = friction;
-            if (p.tangentImpulse < -friction) p.tangentImpulse = -friction;
-        }
 }
 
 void CollisionSystem::addDeepOverlapsToCrowd() {

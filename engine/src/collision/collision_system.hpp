@@ -428,11 +428,9 @@ private:
     void detect(std::span<const Vec2> firstSubstepV, double h);
     /// The most normal impulse this step's first substep can need at one
     /// contact point (N*s), from the awake bodies' motion and forces at the
-    /// step's start (see capWarmStart).
+    /// step's start. The colouring bounds each contact's warm start by it
+    /// (boundWarmStart).
     double warmStartBound(std::span<const Vec2> firstSubstepV) const;
-    /// Bounds the warm start of this step's contacts: a normal impulse in
-    /// [0, warmStartBound], a friction impulse within friction times it.
-    void capWarmStart(std::span<const Vec2> firstSubstepV);
     static Vec2 coincidentNormal(std::uint32_t a, std::uint32_t b);
     /// What a system made by changed() starts without, dropped in place:
     /// the last step's contacts and records, the sweep's lazily built static
@@ -490,7 +488,7 @@ private:
     std::vector<ContactConstraint> constraints_;
     std::vector<ContactDetail> details_;  // parallel to constraints_
     ColouredContacts coloured_;           // constraints_ in colours and SIMD bundles
-    ContactPairs contactPairs_;           // constraints_' bodies and point counts, packed (prepareContacts)
+    ContactPairs contactPairs_;           // constraints_' bodies and point counts, packed (the narrow phase)
     ImpactScratch impactScratch_;         // which constraints_ touch which body (propagateImpacts)
     std::vector<CachedImpulse> cache_;
     std::vector<CachedImpulse> previousCache_;     // the cache the last step started from (undoSolverState)

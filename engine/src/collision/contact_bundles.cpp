@@ -105,25 +105,39 @@ void fillLane(ContactBundle<Points>& bundle, int lane, const ContactConstraint& 
 
 /// Bundles the contacts `order` (all with `Points` points) at the end of
 /// `out`; lanes left over stay unused (all zero: static body 0 against itself).
+/// ColouredContacts::Preparation's work on one contact.
+void prepare(ContactConstraint& c, std::size_t k, const ColouredContacts::Preparation& preparation,
+             std::span<const SolverBody> bodies) {
+    prepareContact(c, preparation.details[k], bodies[c.bodyA], bodies[c.bodyB]);
+    if (preparation.warmStartBound) boundWarmStart(c, *preparation.warmStartBound);
+}
+
 template <int Points>
 void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32_t> order,
-            std::span<const ContactConstraint> contacts, std::span<const std::uint32_t> pairBodies,
-            std::span<const SolverBody> bodies) {
+            std::span<ContactConstraint> contacts, const ColouredContacts::Preparation& preparation,
+            std::span<const std::uint32_t> pairBodies, std::span<const SolverBody> bodies) {
     const std::size_t first = out.size(), count = (order.size() + kContactLanes - 1) / kContactLanes;
     out.resize(first + count);
     // fillLane sets every field of a used lane; only the last bundle can
     // have unused lanes, which must be all zero.
     if (count > 0) std::memset(static_cast<void*>(&out.back()), 0, sizeof(ContactBundle<Points>));
     // A colour's contacts are scattered through `contacts` (about 240 bytes
-    // each) and their bodies through `bodies`: the copy waits on memory, not
-    // arithmetic. Fetch the contacts a few lanes ahead, and the bodies a few
-    // lanes ahead too, named by the packed pairs (reading them from a contact
-    // fetched only lanes before waited on that contact).
+    // each), their details through `details` and their bodies through
+    // `bodies`: the preparation and the copy wait on memory, not
+    // arithmetic. Fetch the contacts and the separations of their details
+    // a few lanes ahead, and the bodies a few lanes ahead too, named by the
+    // packed pairs (reading them from a contact fetched only lanes before
+    // waited on that contact).
     constexpr std::size_t kContactAhead = 8, kBodiesAhead = 4;
     for (std::size_t k = 0; k < order.size(); ++k) {
         if (k + kContactAhead < order.size()) {
-            const char* line = reinterpret_cast<const char*>(&contacts[order[k + kContactAhead]]);
+            const std::size_t ahead = order[k + kContactAhead];
+            const char* line = reinterpret_cast<const char*>(&contacts[ahead]);
             for (std::size_t at = 0; at < sizeof(ContactConstraint); at += 64) __builtin_prefetch(line + at);
+            __builtin_prefetch(line + sizeof(ContactConstraint) - 1);  // the last line, when the contact straddles one more
+            const ContactDetail& detail = preparation.details[ahead];
+            __builtin_prefetch(&detail.separation[0]);
+            __builtin_prefetch(&detail.separation[1]);
         }
         if (k + kBodiesAhead < order.size()) {
             // Both lines of each body: the inverse inertia sits on the
@@ -136,7 +150,9 @@ void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32
             __builtin_prefetch(&b);
             __builtin_prefetch(&b.invInertia);
         }
-        fillLane(out[first + k / kContactLanes], int(k % kContactLanes), contacts[order[k]], order[k], bodies);
+        ContactConstraint& c = contacts[order[k]];
+        prepare(c, order[k], preparation, bodies);
+        fillLane(out[first + k / kContactLanes], int(k % kContactLanes), c, order[k], bodies);
     }
     for (std::size_t k = order.size(); k < count * kContactLanes; ++k)
         out[first + k / kContactLanes].source[k % kContactLanes] = ~0u;
@@ -170,8 +186,9 @@ void storeLanes(std::span<const ContactBundle<Points>> bundles, std::span<Contac
 
 } // namespace
 
-void ColouredContacts::build(std::span<const ContactConstraint> contacts, const ContactPairs& pairs,
-                             std::span<const SolverBody> bodies, bool simd, std::span<const std::uint8_t> heldOut) {
+void ColouredContacts::build(std::span<ContactConstraint> contacts, const Preparation& preparation,
+                             const ContactPairs& pairs, std::span<const SolverBody> bodies, bool simd,
+                             std::span<const std::uint8_t> heldOut) {
     simd_ = simd;
     const std::size_t n = contacts.size();
     colourMask_.assign(bodies.size(), 0u);
@@ -246,13 +263,21 @@ void ColouredContacts::build(std::span<const ContactConstraint> contacts, const 
     two_.clear();
     oneStart_.assign(std::size_t(colourCount_) + 1, 0u);
     twoStart_.assign(std::size_t(colourCount_) + 1, 0u);
-    if (!simd_) return;
+    // Unbundled contacts are prepared in contact order; the bundles'
+    // contacts as they are bundled. Each contact's preparation reads only
+    // itself and its bodies, so the order changes no bit.
+    if (!simd_) {
+        for (std::size_t k = 0; k < n; ++k) prepare(contacts[k], k, preparation, bodies);
+        return;
+    }
+    for (std::size_t k = 0; k < n; ++k)
+        if (colourOf_[k] >= kContactColours) prepare(contacts[k], k, preparation, bodies);  // overflow, held out
     for (int colour = 0; colour < colourCount_; ++colour) {
         oneStart_[std::size_t(colour)] = std::uint32_t(one_.size());
         twoStart_[std::size_t(colour)] = std::uint32_t(two_.size());
         const std::span<const std::uint32_t> all(order_);
-        bundle<1>(one_, all.subspan(start[colour][0], counts[colour][0]), contacts, pairs.bodies, bodies);
-        bundle<2>(two_, all.subspan(start[colour][1], counts[colour][1]), contacts, pairs.bodies, bodies);
+        bundle<1>(one_, all.subspan(start[colour][0], counts[colour][0]), contacts, preparation, pairs.bodies, bodies);
+        bundle<2>(two_, all.subspan(start[colour][1], counts[colour][1]), contacts, preparation, pairs.bodies, bodies);
     }
     oneStart_[std::size_t(colourCount_)] = std::uint32_t(one_.size());
     twoStart_[std::size_t(colourCount_)] = std::uint32_t(two_.size());

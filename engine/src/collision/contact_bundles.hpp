@@ -18,6 +18,7 @@
 #include "collision/contact_solver.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -42,7 +43,7 @@ struct PointLanes {
 };
 
 /// The block solve's K (BlockMass) of kContactLanes two-point contacts; its
-/// inverse is formed in the pass (the same operations as prepareContacts',
+/// inverse is formed in the pass (the same operations as prepareContact's,
 /// so the same bits), which costs a division a bundle against 96 bytes more
 /// to stream through every pass.
 struct BlockLanes {
@@ -76,16 +77,25 @@ struct ContactBundle : std::conditional_t<Points == 2, BlockLanes, NoBlockLanes>
 };
 
 /// The step's contacts in colours and bundles. Built once a step, after
-/// prepareContacts; the impulses live in the bundles until storeImpulses.
+/// the narrow phase; the impulses live in the bundles until storeImpulses.
 class ColouredContacts {
 public:
+    /// What build() does to every contact (held out ones too) before any
+    /// pass reads it: prepareContact with the step's bodies, then
+    /// boundWarmStart when `warmStartBound` is set. A bundled contact is
+    /// prepared as it is copied into its lane, in the one pass over the
+    /// 232-byte contacts that bundling makes anyway.
+    struct Preparation {
+        std::span<const ContactDetail> details;
+        std::optional<double> warmStartBound;  ///< N*s
+    };
     /// Colours the contacts greedily in their (deterministic) order: each
     /// takes the first colour that neither of its dynamic bodies has yet;
     /// static body 0 never blocks a colour. `simd` picks the path for the
     /// whole step (SolverSettings::simd). The contacts marked in `heldOut`
     /// (empty: none) are left out: another solve takes them
     /// (joints/tree_contacts.hpp), and their impulses stay in the contacts.
-    void build(std::span<const ContactConstraint> contacts, const ContactPairs& pairs,
+    void build(std::span<ContactConstraint> contacts, const Preparation& preparation, const ContactPairs& pairs,
                std::span<const SolverBody> bodies, bool simd, std::span<const std::uint8_t> heldOut = {});
     void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies);
     /// One pass over the colours (then the overflow), or backwards.

@@ -49,58 +49,71 @@ Softness Softness::make(double hertz, double dampingRatio, double h) {
     return {omega / a1, a2 * a3, a3};
 }
 
-void prepareContacts(std::span<ContactConstraint> contacts, std::span<const ContactDetail> details,
-                     std::span<const SolverBody> bodies, ContactPairs& pairs) {
-    pairs.bodies.resize(2 * contacts.size());
-    pairs.twoPoints.resize(contacts.size());
-    pairs.approach.resize(contacts.size());
-    pairs.reach.assign(bodies.size(), 0.0);
-    for (std::size_t k = 0; k < contacts.size(); ++k) {
-        ContactConstraint& c = contacts[k];
-        const SolverBody& a = bodies[c.bodyA];
-        const SolverBody& b = bodies[c.bodyB];
-        pairs.bodies[2 * k] = c.bodyA;
-        pairs.bodies[2 * k + 1] = c.bodyB;
-        pairs.twoPoints[k] = c.pointCount == 2 ? 1 : 0;
-        ContactPairs::ApproachRow& row = pairs.approach[k];
-        row.normal = c.normal;
-        for (int i = 0; i < 2; ++i) {
-            const ContactPoint& p = c.points[c.pointCount == 2 ? i : 0];
-            row.rnA[i] = p.rnA;
-            row.rnB[i] = p.rnB;
+void ContactPairs::clear(std::size_t bodyCount) {
+    bodies.clear();
+    twoPoints.clear();
+    approach.clear();
+    reach.assign(bodyCount, 0.0);
+}
+
+void ContactPairs::add(const ContactConstraint& c) {
+    bodies.push_back(c.bodyA);
+    bodies.push_back(c.bodyB);
+    twoPoints.push_back(c.pointCount == 2 ? 1 : 0);
+    ApproachRow& row = approach.emplace_back();
+    row.normal = c.normal;
+    for (int i = 0; i < 2; ++i) {
+        const ContactPoint& p = c.points[c.pointCount == 2 ? i : 0];
+        row.rnA[i] = p.rnA;
+        row.rnB[i] = p.rnB;
+    }
+    for (int i = 0; i < c.pointCount; ++i) {
+        reach[c.bodyA] = std::max(reach[c.bodyA], std::abs(c.points[i].rnA));
+        reach[c.bodyB] = std::max(reach[c.bodyB], std::abs(c.points[i].rnB));
+    }
+}
+
+void prepareContact(ContactConstraint& c, const ContactDetail& detail, const SolverBody& a, const SolverBody& b) {
+    for (int i = 0; i < c.pointCount; ++i) {
+        ContactPoint& p = c.points[i];
+        p.normalMass = effectiveMass(a, b, p.rnA, p.rnB);
+        p.tangentMass = effectiveMass(a, b, -p.dnA, -p.dnB);
+        p.adjustedSeparation = detail.separation[i] - (p.dnB - p.dnA);
+    }
+    c.block = false;
+    if (c.pointCount == 2) {
+        // K of the two normal rows. A box resting on a face gives two
+        // strongly coupled rows (k12 close to k11): solving them
+        // together settles a stack in far fewer passes than one point
+        // after the other. Two points nearly on top of each other make K
+        // almost singular; those stay sequential (condition number cap
+        // 1000, the usual rule for this block solve).
+        const ContactPoint& p1 = c.points[0];
+        const ContactPoint& p2 = c.points[1];
+        BlockMass& bm = c.blockMass;
+        bm.k11 = a.invMass + b.invMass + a.invInertia * p1.rnA * p1.rnA + b.invInertia * p1.rnB * p1.rnB;
+        bm.k22 = a.invMass + b.invMass + a.invInertia * p2.rnA * p2.rnA + b.invInertia * p2.rnB * p2.rnB;
+        bm.k12 = a.invMass + b.invMass + a.invInertia * p1.rnA * p2.rnA + b.invInertia * p1.rnB * p2.rnB;
+        const double det = bm.k11 * bm.k22 - bm.k12 * bm.k12;
+        constexpr double kMaxCondition = 1000.0;
+        if (bm.k11 > 0.0 && bm.k11 * bm.k11 < kMaxCondition * det) {
+            const double invDet = 1.0 / det;
+            bm.i11 = bm.k22 * invDet;
+            bm.i22 = bm.k11 * invDet;
+            bm.i12 = -bm.k12 * invDet;
+            c.block = true;
         }
-        for (int i = 0; i < c.pointCount; ++i) {
-            ContactPoint& p = c.points[i];
-            pairs.reach[c.bodyA] = std::max(pairs.reach[c.bodyA], std::abs(p.rnA));
-            pairs.reach[c.bodyB] = std::max(pairs.reach[c.bodyB], std::abs(p.rnB));
-            p.normalMass = effectiveMass(a, b, p.rnA, p.rnB);
-            p.tangentMass = effectiveMass(a, b, -p.dnA, -p.dnB);
-            p.adjustedSeparation = details[k].separation[i] - (p.dnB - p.dnA);
-        }
-        c.block = false;
-        if (c.pointCount == 2) {
-            // K of the two normal rows. A box resting on a face gives two
-            // strongly coupled rows (k12 close to k11): solving them
-            // together settles a stack in far fewer passes than one point
-            // after the other. Two points nearly on top of each other make K
-            // almost singular; those stay sequential (condition number cap
-            // 1000, the usual rule for this block solve).
-            const ContactPoint& p1 = c.points[0];
-            const ContactPoint& p2 = c.points[1];
-            BlockMass& bm = c.blockMass;
-            bm.k11 = a.invMass + b.invMass + a.invInertia * p1.rnA * p1.rnA + b.invInertia * p1.rnB * p1.rnB;
-            bm.k22 = a.invMass + b.invMass + a.invInertia * p2.rnA * p2.rnA + b.invInertia * p2.rnB * p2.rnB;
-            bm.k12 = a.invMass + b.invMass + a.invInertia * p1.rnA * p2.rnA + b.invInertia * p1.rnB * p2.rnB;
-            const double det = bm.k11 * bm.k22 - bm.k12 * bm.k12;
-            constexpr double kMaxCondition = 1000.0;
-            if (bm.k11 > 0.0 && bm.k11 * bm.k11 < kMaxCondition * det) {
-                const double invDet = 1.0 / det;
-                bm.i11 = bm.k22 * invDet;
-                bm.i22 = bm.k11 * invDet;
-                bm.i12 = -bm.k12 * invDet;
-                c.block = true;
-            }
-        }
+    }
+}
+
+void boundWarmStart(ContactConstraint& c, double most) {
+    for (int i = 0; i < c.pointCount; ++i) {
+        ContactPoint& p = c.points[i];
+        if (!(p.normalImpulse >= 0.0)) p.normalImpulse = 0.0;
+        if (p.normalImpulse > most) p.normalImpulse = most;
+        const double friction = c.friction * p.normalImpulse;
+        if (p.tangentImpulse > friction) p.tangentImpulse = friction;
+        if (p.tangentImpulse < -friction) p.tangentImpulse = -friction;
     }
 }
 

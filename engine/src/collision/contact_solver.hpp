@@ -224,13 +224,24 @@ struct ContactPairs {
     std::vector<ApproachRow> approach;    ///< contact k's normal and lever arms
     /// Per solver body: the largest |rn| of its contact points this step (m).
     std::vector<double> reach;
+
+    /// Empties the pairs for a step of `bodyCount` solver bodies.
+    void clear(std::size_t bodyCount);
+    /// Appends contact `c` (the next one) and raises its bodies' reach. The
+    /// narrow phase packs each manifold as it makes it, where its values are
+    /// at hand: a pass of its own read the 232-byte contacts again.
+    void add(const ContactConstraint& c);
 };
 
-/// Prepares masses, the block solve's 2x2 systems and adjusted separations
-/// (once per step, after the narrow phase), and packs `pairs` in the same
-/// pass over the contacts.
-void prepareContacts(std::span<ContactConstraint> contacts, std::span<const ContactDetail> details,
-                     std::span<const SolverBody> bodies, ContactPairs& pairs);
+/// Prepares one contact's masses, the block solve's 2x2 system and its
+/// adjusted separations, once a step, from its bodies' masses as the step
+/// solves with them. ColouredContacts::build prepares each contact as it
+/// reaches it.
+void prepareContact(ContactConstraint& c, const ContactDetail& detail, const SolverBody& a, const SolverBody& b);
+/// Keeps a warm start the step can use: normal impulses in [0, most] (N*s)
+/// and tangent impulses within the friction cone (see
+/// CollisionSystem::warmStartBound).
+void boundWarmStart(ContactConstraint& c, double most);
 
 /// Impact propagation, run at the start of each substep on the
 /// unconstrained velocities: repeatedly applies a pairwise impact

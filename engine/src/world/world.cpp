@@ -656,7 +656,7 @@ void World::setSolverState(const SolverState& state) {
     // fastest the other way, plus a step of gravity; four times that. A
     // saved impulse past it is no run's, so it is dropped with a warning;
     // what is kept the engine bounds again at each step's start, from the
-    // bodies' motion then (CollisionSystem::capWarmStart).
+    // bodies' motion then (CollisionSystem::warmStartBound).
     const detail::ForceModel& f = w.model;
     const bool bounded = f.springs.empty() && f.attractors.empty() && f.boids.body.empty() &&
                          w.collision->jointConstraints().empty();
