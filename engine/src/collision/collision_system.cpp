@@ -1664,12 +1664,22 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
         b.dp = centreOfMass(i, std::span<const Vec2>(x.data(), x.size())) - stepStart_[i];
     }
     if (jointed) directJoints_.factor(joints_, bodies_, directSoft, false);
+    // The step's last relax pass measures each bundled contact's deepest
+    // point for the position pass (correctStepPositions), which then need
+    // not read the contacts: the positions are final here unless an exactly
+    // solved joint group's projection (and the riders' carry) moves them.
+    const bool measure = substepsDone_ + 1 == substeps_ && settings_.simd && settings_.relaxIterations > 0 &&
+                         !(jointed && directJoints_.directJointCount() > 0);
+    if (measure) endSeparations_.resize(constraints_.size());
+    endSeparationsMeasured_ = measure;
     for (int it = 0; it < settings_.relaxIterations; ++it, reverse = alternate && !reverse) {
         if (jointed) {
             jointBundles_.solve(joints_, bodies_, h, jointSoft, directSoft, false);
             directJoints_.solve(joints_, bodies_);
         }
-        coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse);
+        const bool last = it + 1 == settings_.relaxIterations;
+        coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse,
+                        measure && last ? std::span<double>(endSeparations_) : std::span<double>{});
         if (!treeContacts_.empty())
             treeContacts_.solve(constraints_, joints_, bodies_, directJoints_, h, soft, staticSoft,
                                 settings_.pushMaxVelocity, false, reverse);
@@ -1900,7 +1910,19 @@ void CollisionSystem::carryRiders(std::span<Vec2> x) {
 }
 
 void CollisionSystem::correctStepPositions(std::span<Vec2> x) {
-    const bool corrected = correctPositions(constraints_, bodies_, inCrowd_, positionCorrection_, positionScratch_);
+    // What the last relax pass measured, and the contacts it did not
+    // solve (the colours' overflow) measured here.
+    std::span<const double> measured;
+    if (endSeparationsMeasured_) {
+        const std::span<const std::uint32_t> order = coloured_.order();
+        for (const std::uint32_t k : order.subspan(order.size() - coloured_.overflowCount())) {
+            const ContactConstraint& c = constraints_[k];
+            endSeparations_[k] = deepestSeparation(bodies_[c.bodyA], bodies_[c.bodyB], c);
+        }
+        measured = endSeparations_;
+    }
+    const bool corrected =
+        correctPositions(constraints_, bodies_, inCrowd_, positionCorrection_, positionScratch_, measured);
     const bool turned = correctTurnedAgainstStatic(corrected);
     if (!corrected && !turned) return;
     // Back from the centre of mass's move and the turn to the body's
@@ -1965,16 +1987,19 @@ bool CollisionSystem::correctTurnedAgainstStatic(bool scratchReady) {
         return (angles_[owner] - stepStartAngle_[owner]) + (scratchReady ? positionScratch_.turned[solver] : 0.0);
     };
     turnedBodies_.clear();
+    // The bodies from the packed pairs: most contacts join two moving
+    // bodies, and the 232-byte contacts are not read for them.
+    const std::vector<std::uint32_t>& pairBodies = contactPairs_.bodies;
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
-        const ContactConstraint& c = constraints_[k];
+        const std::uint32_t bodyA = pairBodies[2 * k], bodyB = pairBodies[2 * k + 1];
         // One side truly static: a kinematic side moved this step too.
-        if ((c.bodyA == 0) == (c.bodyB == 0)) continue;
+        if ((bodyA == 0) == (bodyB == 0)) continue;
         const ContactDetail& d = details_[k];
-        const bool staticFirst = c.bodyA == 0;
+        const bool staticFirst = bodyA == 0;
         const std::uint32_t moving = staticFirst ? d.colliderB : d.colliderA;
         const Collider& shape = colliders_[moving];
         if (shape.shape.kind == ShapeKind::Circle && shape.hub < 0) continue;
-        const std::uint32_t solver = staticFirst ? c.bodyB : c.bodyA;
+        const std::uint32_t solver = staticFirst ? bodyB : bodyA;
         const double turn = turnOf(ownerOf(moving), solver);
         // A corner the contacts do not hold comes at most turn x reach
         // nearer; a rounded part's nearest point moves off its anchor, which

@@ -488,6 +488,11 @@ private:
     std::vector<ContactConstraint> constraints_;
     std::vector<ContactDetail> details_;  // parallel to constraints_
     ColouredContacts coloured_;           // constraints_ in colours and SIMD bundles
+    /// Per contact: its deepest point's separation at the step's end, as
+    /// the last relax pass measured it (solveSubstep); valid while
+    /// endSeparationsMeasured_.
+    std::vector<double> endSeparations_;
+    bool endSeparationsMeasured_ = false;
     ContactPairs contactPairs_;           // constraints_' bodies and point counts, packed (the narrow phase)
     ImpactScratch impactScratch_;         // which constraints_ touch which body (propagateImpacts)
     std::vector<CachedImpulse> cache_;

@@ -23,6 +23,7 @@ struct PassArgs {
     std::size_t twoCount;
     Softness soft, staticSoft;
     double invH, pushMaxVelocity;
+    double* deepest;  ///< per contact, or null: see ColouredContacts::solve
 };
 
 // Each copy of the kernels in a namespace of its own, apart from PassArgs:
@@ -292,7 +293,7 @@ void ColouredContacts::warmStart(std::span<ContactConstraint> contacts, std::spa
     for (int colour = 0; colour < colourCount_; ++colour) {
         const std::size_t c = std::size_t(colour);
         PassArgs args{bodies.data(), one_.data() + oneStart_[c], oneStart_[c + 1] - oneStart_[c],
-                      two_.data() + twoStart_[c], twoStart_[c + 1] - twoStart_[c], {}, {}, 0.0, 0.0};
+                      two_.data() + twoStart_[c], twoStart_[c + 1] - twoStart_[c], {}, {}, 0.0, 0.0, nullptr};
         kernel(args);
     }
     const std::span<const std::uint32_t> overflow = std::span<const std::uint32_t>(order_).subspan(colourStart_[std::size_t(colourCount_)]);
@@ -301,11 +302,12 @@ void ColouredContacts::warmStart(std::span<ContactConstraint> contacts, std::spa
 
 void ColouredContacts::solve(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h,
                              const Softness& soft, const Softness& staticSoft, double pushMaxVelocity, bool useBias,
-                             bool reverse) {
+                             bool reverse, std::span<double> deepest) {
     if (!simd_) {
         solveContacts(contacts, order_, bodies, h, soft, staticSoft, pushMaxVelocity, useBias, reverse);
         return;
     }
+    double* const deepestOut = useBias || deepest.empty() ? nullptr : deepest.data();
     const std::span<const std::uint32_t> overflow = std::span<const std::uint32_t>(order_).subspan(colourStart_[std::size_t(colourCount_)]);
     const auto solveOverflow = [&] {
         if (!overflow.empty())
@@ -317,7 +319,7 @@ void ColouredContacts::solve(std::span<ContactConstraint> contacts, std::span<So
         const std::size_t c = std::size_t(reverse ? colourCount_ - 1 - k : k);
         PassArgs args{bodies.data(), one_.data() + oneStart_[c], oneStart_[c + 1] - oneStart_[c],
                       two_.data() + twoStart_[c], twoStart_[c + 1] - twoStart_[c], soft, staticSoft, 1.0 / h,
-                      pushMaxVelocity};
+                      pushMaxVelocity, deepestOut};
         kernel(args);
     }
     if (!reverse) solveOverflow();

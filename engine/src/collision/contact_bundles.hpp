@@ -98,9 +98,14 @@ public:
     void build(std::span<ContactConstraint> contacts, const Preparation& preparation, const ContactPairs& pairs,
                std::span<const SolverBody> bodies, bool simd, std::span<const std::uint8_t> heldOut = {});
     void warmStart(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies);
-    /// One pass over the colours (then the overflow), or backwards.
+    /// One pass over the colours (then the overflow), or backwards. A relax
+    /// pass (useBias off) given `deepest` (one entry per contact) writes
+    /// there each bundled contact's deepest point's separation at the
+    /// bodies' present positions (correctPositions' reading, the same bits);
+    /// the other entries are left alone.
     void solve(std::span<ContactConstraint> contacts, std::span<SolverBody> bodies, double h, const Softness& soft,
-               const Softness& staticSoft, double pushMaxVelocity, bool useBias, bool reverse);
+               const Softness& staticSoft, double pushMaxVelocity, bool useBias, bool reverse,
+               std::span<double> deepest = {});
     /// Copies the bundles' impulses back to the contacts (warm starting, records).
     void storeImpulses(std::span<ContactConstraint> contacts) const;
     /// The accumulated (normal, tangent) impulses of every contact that has

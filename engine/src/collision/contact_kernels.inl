@@ -110,9 +110,10 @@ template <class D, int Points, bool UseBias>
     const D qcA = roundA ? one : a.qc, qsA = roundA ? zero : a.qs;
     const D qcB = roundB ? one : b.qc, qsB = roundB ? zero : b.qs;
     Target<D> t[2];
+    D separations[2];
     for (int i = 0; i < Points; ++i) {
         const PointLanes& p = c.points[i];
-        const D separation = ((baseGap + (qcB * ld(p.dnB) + qsB * ld(p.rnB))) -
+        const D separation = separations[i] = ((baseGap + (qcB * ld(p.dnB) + qsB * ld(p.rnB))) -
                                (qcA * ld(p.dnA) + qsA * ld(p.rnA))) +
                               ld(p.adjustedSeparation);
         const M apart = separation > zero;
@@ -132,6 +133,18 @@ template <class D, int Points, bool UseBias>
                     apart ? zero : (rigid ? zero : impulseScale)};
         } else {
             t[i] = {apart ? speculative : zero, one, zero};
+        }
+    }
+    if constexpr (!UseBias) {
+        // Asked for in the step's last relax pass, whose positions are the
+        // step's last: the position pass then reads each contact's deepest
+        // point here (deepest() of correctPositions, the same bits) rather
+        // than from the contact.
+        if (args.deepest != nullptr) {
+            D deepest = separations[0];
+            if constexpr (Points == 2) deepest = minOf(separations[0], separations[1]);
+            for (int l = 0; l < lanesOf<D>; ++l)
+                if (const std::uint32_t k = c.source[off + l]; k != ~0u) args.deepest[k] = deepest[l];
         }
     }
     if constexpr (Points == 1) {

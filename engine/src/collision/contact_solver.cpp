@@ -40,6 +40,12 @@ double currentSeparation(const SolverBody& a, const SolverBody& b, const Contact
            p.adjustedSeparation;
 }
 
+double deepestSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c) {
+    double s = currentSeparation(a, b, c, c.points[0]);
+    if (c.pointCount == 2) s = std::min(s, currentSeparation(a, b, c, c.points[1]));
+    return s;
+}
+
 Softness Softness::make(double hertz, double dampingRatio, double h) {
     if (hertz == 0.0) return {0.0, 1.0, 0.0};
     const double omega = 2.0 * kPi * hertz;

@@ -133,6 +133,8 @@ struct SolverSettings {
 /// The separation of point `p` of contact `c` at the bodies' current dp, dq
 /// (metres, negative when overlapping).
 double currentSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c, const ContactPoint& p);
+/// The least currentSeparation of contact c's points (metres).
+double deepestSeparation(const SolverBody& a, const SolverBody& b, const ContactConstraint& c);
 
 /// Velocity bias (m/s) and soft scaling of one contact point.
 struct PointTarget {

@@ -1,6 +1,8 @@
 #include "collision/position_correction.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -28,7 +30,7 @@ inline PositionImpulse splitCorrection(double move, double inverseMass, double l
 
 bool correctPositions(std::span<const ContactConstraint> contacts, std::span<SolverBody> bodies,
                       std::span<const std::uint8_t> crowd, const PositionCorrectionSettings& settings,
-                      PositionCorrectionScratch& scratch) {
+                      PositionCorrectionScratch& scratch, std::span<const double> measured) {
     // A manifold's point lies midway between the two surfaces, half its
     // step-start separation s0 off each side's feature along the normal;
     // turned by t, an anchor there reads the gap (s0 / 2)(1 - cos t) off
@@ -59,12 +61,15 @@ bool correctPositions(std::span<const ContactConstraint> contacts, std::span<Sol
     scratch.touchingStatic.clear();
     bool any = false;  // a point this pass will move
     for (std::size_t k = 0; k < contacts.size(); ++k) {
-        const double s = deepest(contacts[k]);
         if (contacts[k].touchesStatic) {
             scratch.touchingStatic.push_back(std::uint32_t(k));
-            any = any || s < -settings.slop;
-        } else if (s < -settings.slop &&
-                   (crowd.empty() || crowd[contacts[k].bodyA] || crowd[contacts[k].bodyB])) {
+            any = any || deepest(contacts[k]) < -settings.slop;
+            continue;
+        }
+        const double s = measured.empty() ? deepest(contacts[k]) : measured[k];
+        assert(measured.empty() || std::bit_cast<std::uint64_t>(s) == std::bit_cast<std::uint64_t>(deepest(contacts[k])) ||
+               (std::isnan(s) && std::isnan(deepest(contacts[k]))));
+        if (s < -settings.slop && (crowd.empty() || crowd[contacts[k].bodyA] || crowd[contacts[k].bodyB])) {
             scratch.deepMoving.push_back(std::uint32_t(k));
             any = true;
         }

@@ -46,9 +46,13 @@ struct PositionCorrectionScratch {
 /// with a body marked in `crowd` (per solver body; an empty span marks all).
 /// Returns false, having touched nothing, when no point is deeper than the
 /// slop: the common case costs one look at each contact's separations.
+/// `measured` (empty, or one entry per contact) holds the deepestSeparation
+/// of every contact between moving bodies at the bodies' present poses, as
+/// the solve's last pass measured it: those contacts are then not read
+/// unless they are too deep.
 bool correctPositions(std::span<const ContactConstraint> contacts, std::span<SolverBody> bodies,
                       std::span<const std::uint8_t> crowd, const PositionCorrectionSettings& settings,
-                      PositionCorrectionScratch& scratch);
+                      PositionCorrectionScratch& scratch, std::span<const double> measured = {});
 
 /// Where a body, at its pose once the passes above have run, meets a static
 /// shape: a point of a manifold found afresh by the narrow phase.
