@@ -173,7 +173,15 @@ void forEachLane(Bundles& bundles, Visit&& visit) {
 
 template <int Points>
 void storeLanes(std::span<const ContactBundle<Points>> bundles, std::span<ContactConstraint> contacts) {
-    for (const ContactBundle<Points>& b : bundles) {
+    // The contacts are written in colour order, scattered through the
+    // array: ask for the impulses' lines of the bundle two ahead.
+    constexpr std::size_t kAhead = 2;
+    for (std::size_t k = 0; k < bundles.size(); ++k) {
+        if (k + kAhead < bundles.size())
+            for (const std::uint32_t source : bundles[k + kAhead].source)
+                if (source != ~0u)
+                    for (int i = 0; i < Points; ++i) __builtin_prefetch(&contacts[source].points[i].normalImpulse, 1);
+        const ContactBundle<Points>& b = bundles[k];
         for (int l = 0; l < kContactLanes; ++l) {
             if (b.source[l] == ~0u) continue;
             ContactConstraint& c = contacts[b.source[l]];
