@@ -59,8 +59,7 @@ constexpr std::int64_t kTouchesStatic = 1, kBlock = 2, kRoundA = 4, kRoundB = 8;
 /// Unused lanes join static body 0 to itself with zero masses: they compute
 /// zeros and write nothing that matters. Only what the passes cannot take
 /// from the bodies they gather is here (the inverse masses come with the
-/// velocities): the passes stream every bundle a dozen times a step, and
-/// in a large pile they wait on memory, not arithmetic.
+/// velocities): the passes stream every bundle a dozen times a step.
 template <int Points>
 struct ContactBundle : std::conditional_t<Points == 2, BlockLanes, NoBlockLanes> {
     /// Leaves the lanes unset: the bundles are rebuilt every step, every

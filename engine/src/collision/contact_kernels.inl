@@ -158,7 +158,7 @@ template <class D, int Points, bool UseBias>
             PointLanes& p1 = c.points[0];
             PointLanes& p2 = c.points[1];
             const D k11 = ld(c.k11), k12 = ld(c.k12), k22 = ld(c.k22);
-            // K^-1 as prepareContacts forms it; zero in the lanes without a
+            // K^-1 as prepareContact forms it; zero in the lanes without a
             // block (as BlockMass leaves it there).
             const D invDet = one / (k11 * k22 - k12 * k12);
             const D i11 = block ? k22 * invDet : zero, i12 = block ? -k12 * invDet : zero,
