@@ -104,8 +104,6 @@ void fillLane(ContactBundle<Points>& bundle, int lane, const ContactConstraint& 
     }
 }
 
-/// Bundles the contacts `order` (all with `Points` points) at the end of
-/// `out`; lanes left over stay unused (all zero: static body 0 against itself).
 /// ColouredContacts::Preparation's work on one contact.
 void prepare(ContactConstraint& c, std::size_t k, const ColouredContacts::Preparation& preparation,
              std::span<const SolverBody> bodies) {
@@ -113,6 +111,9 @@ void prepare(ContactConstraint& c, std::size_t k, const ColouredContacts::Prepar
     if (preparation.warmStartBound) boundWarmStart(c, *preparation.warmStartBound);
 }
 
+/// Bundles the contacts `order` (all with `Points` points) at the end of
+/// `out`, preparing each; lanes left over stay unused (all zero: static
+/// body 0 against itself).
 template <int Points>
 void bundle(std::vector<ContactBundle<Points>>& out, std::span<const std::uint32_t> order,
             std::span<ContactConstraint> contacts, const ColouredContacts::Preparation& preparation,

@@ -18,7 +18,7 @@ struct LaneAccess {
     [[gnu::always_inline]] typename MaskOf<D>::type mask(const std::int64_t* p) const {
         return loadMaskAs<D>(p + off);
     }
-    [[gnu::always_inline]] void store(double* p, D v) const { storeLanes(p + off, v); }
+    [[gnu::always_inline]] void store(double* p, D v) const { storeAs(p + off, v); }
 };
 
 // The velocity state of a bundle's two sides while it is solved.

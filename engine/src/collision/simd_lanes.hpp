@@ -1,8 +1,9 @@
 #pragma once
 // Solver lanes in vector registers (four, or eight for the contact passes
-// on AVX-512), shared by the contact and joint bundles: the vector types, loads and stores, and the gather and scatter
-// of the lanes' bodies. Each helper is one IEEE operation per lane (or pure
-// data movement), so a bundle's lanes get the bits of the scalar solve.
+// on AVX-512), shared by the contact and joint bundles: the vector types,
+// loads and stores, and the gather and scatter of the lanes' bodies. Each
+// helper is one IEEE operation per lane (or pure data movement), so a
+// bundle's lanes get the bits of the scalar solve.
 
 #include "collision/contact_solver.hpp"
 #include "integrators/integrator.hpp"  // detail::simdLevel: the instruction set the integrators use
@@ -70,7 +71,7 @@ template <class D>
     return v;
 }
 template <class D>
-[[gnu::always_inline]] inline void storeLanes(double* p, D v) {
+[[gnu::always_inline]] inline void storeAs(double* p, D v) {
     std::memcpy(p, &v, sizeof v);
 }
 template <class D>
