@@ -536,6 +536,7 @@ void CollisionSystem::refreshSleeping(std::span<const Vec2> x) {
     startV_.resize(n);
     spin_.resize(n);
     margins_.resize(n);
+    shapeBoxes_.resize(n);
     awakeProxies_.clear();
     std::vector<Aabb> frozenBoxes;
     std::vector<std::uint32_t> frozenProxies;
@@ -552,7 +553,7 @@ void CollisionSystem::refreshSleeping(std::span<const Vec2> x) {
         endV_[i] = startV_[i] = Vec2{};
         spin_[i] = 0.0;
         margins_[i] = kSpeculativeBase;
-        Aabb box = computeAabb(colliders_[i].shape, centres_[i], rotScratch_[i]);
+        Aabb box = shapeBoxes_[i] = computeAabb(colliders_[i].shape, centres_[i], rotScratch_[i]);
         box.lower -= Vec2{kSpeculativeBase, kSpeculativeBase};
         box.upper += Vec2{kSpeculativeBase, kSpeculativeBase};
         frozenBoxes.push_back(box);
@@ -683,7 +684,7 @@ bool CollisionSystem::sleepingBroadPhase(std::span<const Rot> rots, Vec2 ref0, V
     awakeMovable_.assign(awakeProxies_.size(), 1);
     for (std::size_t j = 0; j < awakeProxies_.size(); ++j) {
         const std::uint32_t i = finite_[awakeProxies_[j]];
-        Aabb box = computeAabb(colliders_[i].shape, centres_[i], rots[i]);
+        Aabb box = shapeBoxes_[i] = computeAabb(colliders_[i].shape, centres_[i], rots[i]);
         awakeCores_[j] = (box.upper.x - box.lower.x) * (box.upper.y - box.lower.y);
         const Vec2 fat{margins_[i], margins_[i]};
         box.lower -= fat;
@@ -984,6 +985,31 @@ void CollisionSystem::beginStep(std::span<const Vec2> x, std::span<const Vec2> v
     }
 }
 
+bool CollisionSystem::canTouch(std::size_t a, std::size_t b) const {
+    // a's box swept by its motion relative to b (linear in time, as in
+    // sweptGrowth), grown all round by both shapes' reach (the slop and their
+    // spin), against b's box: the same whichever frame the broad phase grew
+    // its boxes in. A hair under the boxes' growth, whose sums round
+    // differently.
+    const Vec2 r0 = startV_[a] - startV_[b], r1 = endV_[a] - endV_[b];
+    const double around = (2.0 * kSpeculativeBase + spin_[a] + spin_[b]) * (1.0 - 1e-6);
+    const double dt = dt_;
+    const Aabb& boxA = shapeBoxes_[a];
+    const Aabb& boxB = shapeBoxes_[b];
+    const double lowX = boxA.lower.x - around + dt * std::min(0.0, std::min(r0.x, r1.x));
+    const double highX = boxA.upper.x + around + dt * std::max(0.0, std::max(r0.x, r1.x));
+    const double lowY = boxA.lower.y - around + dt * std::min(0.0, std::min(r0.y, r1.y));
+    const double highY = boxA.upper.y + around + dt * std::max(0.0, std::max(r0.y, r1.y));
+    return lowX <= boxB.upper.x && boxB.lower.x <= highX && lowY <= boxB.upper.y && boxB.lower.y <= highY;
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> CollisionSystem::candidateColliderPairs() const {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+    out.reserve(pairs_.size());
+    for (const ProxyPair& p : pairs_) out.emplace_back(finite_[p.a], finite_[p.b]);
+    return out;
+}
+
 double CollisionSystem::closingSpeed(std::size_t a, std::size_t b) const {
     // Relative speed is convex in time under constant acceleration, so the
     // larger of the two ends bounds it over the step. sqrt is monotonic and
@@ -1028,16 +1054,37 @@ void CollisionSystem::rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFram
     // radian the divisor 1 - dt |omega| grows without limit.
     if (!(sweep > 0.0 && sweep <= 0.25)) return;
     const double widen = 1.0 / (1.0 - sweep);
-    rotatedMargins_.resize(colliders_.size());
+    rotatedLow_.resize(colliders_.size());
+    rotatedHigh_.resize(colliders_.size());
     double sum = 0.0;
     for (std::size_t i = 0; i < colliders_.size(); ++i) {
         const Vec2 r = centres_[i] - centroid;
         const Vec2 u0 = ref0 + Vec2{-omega0 * r.y, omega0 * r.x}, u1 = ref1 + Vec2{-omega1 * r.y, omega1 * r.x};
-        const double drift = std::sqrt(std::max(lengthSquared(startV_[i] - u0), lengthSquared(endV_[i] - u1)));
-        rotatedMargins_[i] = (kSpeculativeBase + dt_ * drift + sweep * maxExtent_[i] + spin_[i]) * widen;
-        sum += rotatedMargins_[i];
+        const Vec2 w0 = startV_[i] - u0, w1 = endV_[i] - u1;
+        const double drift = std::sqrt(std::max(lengthSquared(w0), lengthSquared(w1)));
+        sweptGrowth(w0, w1, drift, kSpeculativeBase + sweep * maxExtent_[i] + spin_[i], widen, rotatedLow_[i],
+                    rotatedHigh_[i]);
+        sum += (rotatedLow_[i].x + rotatedLow_[i].y) + (rotatedHigh_[i].x + rotatedHigh_[i].y);
     }
-    if (sum < meanFrameSum) margins_.swap(rotatedMargins_);
+    if (sum < meanFrameSum) {
+        growLow_.swap(rotatedLow_);
+        growHigh_.swap(rotatedHigh_);
+    }
+}
+
+void CollisionSystem::sweptGrowth(Vec2 w0, Vec2 w1, double drift, double around, double widen, Vec2& low,
+                                  Vec2& high) const {
+    // The body's velocity against the frame is linear in time over the step
+    // (w0 at its start, w1 at its end, constant acceleration), so on each
+    // axis its displacement lies between 0 and dt times the least and the
+    // greatest of the two: the box grows that way only. The rest grows all
+    // round: `around` and what widening adds to the symmetric margin
+    // (rotatingFrameMargins), (widen - 1) dt drift, which covers the turn of
+    // the frame across the gap.
+    const double dt = dt_;
+    const double all = around * widen + (widen - 1.0) * (dt * drift);
+    low = {all + dt * std::max(0.0, -std::min(w0.x, w1.x)), all + dt * std::max(0.0, -std::min(w0.y, w1.y))};
+    high = {all + dt * std::max(0.0, std::max(w0.x, w1.x)), all + dt * std::max(0.0, std::max(w0.y, w1.y))};
 }
 
 void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
@@ -1089,15 +1136,20 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
     }
     margins_.resize(n);
     spin_.resize(n);
+    shapeBoxes_.resize(n);
+    growLow_.resize(n);
+    growHigh_.resize(n);
     double meanFrameSum = 0.0;
     forEachActive([&](std::size_t i) {
         // How far any point of the shape can swing about its centre (m).
         spin_[i] = dt * std::abs(angularVelocities_[i]) * maxExtent_[i];
         // sqrt is monotonic and correctly rounded: the root of the larger
         // square is the larger root, one square root instead of two.
-        const double drift = std::sqrt(std::max(lengthSquared(startV_[i] - ref0), lengthSquared(endV_[i] - ref1)));
+        const Vec2 w0 = startV_[i] - ref0, w1 = endV_[i] - ref1;
+        const double drift = std::sqrt(std::max(lengthSquared(w0), lengthSquared(w1)));
         margins_[i] = kSpeculativeBase + dt * drift + spin_[i];
-        meanFrameSum += margins_[i];
+        sweptGrowth(w0, w1, drift, kSpeculativeBase + spin_[i], 1.0, growLow_[i], growHigh_[i]);
+        meanFrameSum += (growLow_[i].x + growLow_[i].y) + (growHigh_[i].x + growHigh_[i].y);
     });
     if (turningFrame_ && !anySleeping_ && moving > 1) rotatingFrameMargins(ref0, ref1, meanFrameSum);
 
@@ -1126,11 +1178,10 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
     movable_.resize(finite_.size());
     for (std::size_t k = 0; k < finite_.size(); ++k) {
         const std::uint32_t i = finite_[k];
-        Aabb box = computeAabb(colliders_[i].shape, centres_[i], rots[i]);
+        Aabb box = shapeBoxes_[i] = computeAabb(colliders_[i].shape, centres_[i], rots[i]);
         cores_[k] = (box.upper.x - box.lower.x) * (box.upper.y - box.lower.y);
-        const Vec2 fat{margins_[i], margins_[i]};
-        box.lower -= fat;
-        box.upper += fat;
+        box.lower -= growLow_[i];
+        box.upper += growHigh_[i];
         boxes_[k] = box;
         movable_[k] = colliders_[i].body >= 0 ? 1 : 0;
     }

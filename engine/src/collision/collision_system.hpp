@@ -233,6 +233,14 @@ public:
     /// Broad-phase pairs and narrow-phase manifolds of the last detection.
     std::size_t candidatePairCount() const { return pairs_.size(); }
     std::size_t manifoldCount() const { return constraints_.size(); }
+    /// The last detection's broad-phase pairs, as collider indices.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> candidateColliderPairs() const;
+    /// Whether the finite colliders a and b, all awake, could come within
+    /// the slop of each other in the last detection's step, by their shapes'
+    /// boxes and their motion relative to each other (velocity linear in
+    /// time, spin all round). The broad phase pairs every two for which it
+    /// holds, in whichever frame it grew its boxes (tests check it).
+    bool canTouch(std::size_t a, std::size_t b) const;
     const CollisionTimings& timings() const { return timings_; }
     /// The last step's contacts in colours (counts, order), for tests and benchmarks.
     const ColouredContacts& colouredContacts() const { return coloured_; }
@@ -417,9 +425,16 @@ private:
     /// The larger of colliders a and b's relative speeds at the two ends of
     /// the step (m/s): how fast their gap can close within it.
     double closingSpeed(std::size_t a, std::size_t b) const;
+
     /// Replaces margins_ by margins in a frame that turns with the bodies,
     /// when those add up to less than meanFrameSum (all colliders awake).
     void rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFrameSum);
+    /// How far a box grows below (`low`) and above (`high`) its shape on
+    /// each axis, for a body whose velocity against the broad phase's frame
+    /// is w0 at the step's start and w1 at its end (`drift`: the larger
+    /// length); `around` grows it all round, and the lot is widened for a
+    /// turning frame.
+    void sweptGrowth(Vec2 w0, Vec2 w1, double drift, double around, double widen, Vec2& low, Vec2& high) const;
     /// Moves cache entries that touch a sleeping collider to sleepingCache_
     /// and the others back to cache_ (each stays sorted).
     void splitCache();
@@ -476,6 +491,11 @@ private:
     std::vector<Vec2> centres_, stepStart_;
     std::vector<double> stepStartAngle_, margins_, spin_;
     std::vector<double> rotatedMargins_;  ///< rotatingFrameMargins' candidates
+    /// Per collider, all awake: how far its box grows below and above its
+    /// shape's on each axis (m), the motion's part only in its direction.
+    std::vector<Vec2> growLow_, growHigh_;
+    std::vector<Aabb> shapeBoxes_;  ///< per collider in the broad phase: its shape's box, no margin
+    std::vector<Vec2> rotatedLow_, rotatedHigh_;  ///< rotatingFrameMargins' candidates
     std::vector<Vec2> startV_, endV_;  // per collider: velocity at step start, predicted at step end (m/s)
     bool detected_ = false;
     struct SavedVelocity {
