@@ -1789,26 +1789,44 @@ bool CollisionSystem::noteRiders() {
     const auto loose = [&](std::uint32_t b) { return carryRole_[b] == kLoose && bodies_[b].invMass > 0.0; };
     riderContacts_.clear();
     bool touchesGroup = false;
+    const std::vector<std::uint32_t>& pairBodies = contactPairs_.bodies;
     for (std::size_t k = 0; k < constraints_.size(); ++k) {
-        const ContactConstraint& c = constraints_[k];
-        const bool looseA = loose(c.bodyA), looseB = loose(c.bodyB);
+        const std::uint32_t bodyA = pairBodies[2 * k], bodyB = pairBodies[2 * k + 1];
+        const bool looseA = loose(bodyA), looseB = loose(bodyB);
         if (!looseA && !looseB) continue;
         // A loose body against a static or kinematic one is no rider's
         // contact. Against a group's body it may be; against another
         // loose body it is listed too, for when one of them is carried.
         if (looseA != looseB) {
-            if (carryRole_[looseA ? c.bodyB : c.bodyA] != kInGroup) continue;
+            if (carryRole_[looseA ? bodyB : bodyA] != kInGroup) continue;
             touchesGroup = true;
         }
         RiderContact& r = riderContacts_.emplace_back();
         r.contact = std::uint32_t(k);
+        r.bodyA = bodyA;
+        r.bodyB = bodyB;
+        r.betweenLoose = looseA && looseB;
+        if (r.betweenLoose) continue;
+        const ContactConstraint& c = constraints_[k];
         for (int i = 0; i < c.pointCount; ++i)
             r.before[i] = currentSeparation(bodies_[c.bodyA], bodies_[c.bodyB], c, c.points[i]);
     }
     if (!touchesGroup) return false;
+    // Carries only translate, so the loose bodies' step-so-far moves are all
+    // that riderBefore needs to measure a contact between two of them later.
+    dpBeforeCarry_.resize(bodies_.size());
+    for (std::size_t b = 0; b < bodies_.size(); ++b) dpBeforeCarry_[b] = bodies_[b].dp;
     riderLoad_.assign(bodies_.size(), Vec2{});
     for (const SolvedBody& sb : awakeSolved_) riderLoad_[sb.solver] = endV_[sb.collider] - startV_[sb.collider];
     return true;
+}
+
+double CollisionSystem::riderBefore(const RiderContact& r, const ContactConstraint& c, int i) const {
+    if (!r.betweenLoose) return r.before[i];
+    SolverBody a = bodies_[r.bodyA], b = bodies_[r.bodyB];
+    a.dp = dpBeforeCarry_[r.bodyA];
+    b.dp = dpBeforeCarry_[r.bodyB];
+    return currentSeparation(a, b, c, c.points[i]);
 }
 
 Vec2 CollisionSystem::supportMove(const ContactConstraint& c, int point, std::uint32_t support) const {
@@ -1838,12 +1856,12 @@ void CollisionSystem::followRiders() {
     for (int pass = 0; pass < kMaxPasses; ++pass) {
         bool any = false;
         for (const RiderContact& r : riderContacts_) {
-            const ContactConstraint& c = constraints_[r.contact];
-            const bool riderA = carryRole_[c.bodyA] == kLoose && !fixedBody(c.bodyA);
-            const bool riderB = carryRole_[c.bodyB] == kLoose && !fixedBody(c.bodyB);
+            const bool riderA = carryRole_[r.bodyA] == kLoose && !fixedBody(r.bodyA);
+            const bool riderB = carryRole_[r.bodyB] == kLoose && !fixedBody(r.bodyB);
             if (riderA == riderB) continue;
-            const std::uint32_t rider = riderA ? c.bodyA : c.bodyB, support = riderA ? c.bodyB : c.bodyA;
+            const std::uint32_t rider = riderA ? r.bodyA : r.bodyB, support = riderA ? r.bodyB : r.bodyA;
             if (carryRole_[support] == kLoose) continue;  // not moved (yet)
+            const ContactConstraint& c = constraints_[r.contact];
             double weight = 0.0;
             bool sticks = true;
             Vec2 move;
@@ -1862,8 +1880,7 @@ void CollisionSystem::followRiders() {
             followWeight_[rider] += weight;
         }
         for (const RiderContact& r : riderContacts_) {
-            const ContactConstraint& c = constraints_[r.contact];
-            for (const std::uint32_t rider : {c.bodyA, c.bodyB}) {
+            for (const std::uint32_t rider : {r.bodyA, r.bodyB}) {
                 if (carryRole_[rider] != kLoose || !(followWeight_[rider] > 0.0)) continue;
                 const Vec2 move = (1.0 / followWeight_[rider]) * followSum_[rider];
                 bodies_[rider].dp += move;
@@ -1917,19 +1934,20 @@ void CollisionSystem::carryRiders(std::span<Vec2> x) {
     for (int pass = 0; pass < kMaxPasses; ++pass) {
         bool any = false;
         for (const RiderContact& r : riderContacts_) {
-            const ContactConstraint& c = constraints_[r.contact];
-            const std::uint8_t roleA = carryRole_[c.bodyA], roleB = carryRole_[c.bodyB];
+            const std::uint8_t roleA = carryRole_[r.bodyA], roleB = carryRole_[r.bodyB];
             // The side pushed: a rider (not a group's body) whose neighbour
             // across has moved.
             const bool pushA = roleA != kInGroup && roleB != kLoose;
             const bool pushB = roleB != kInGroup && roleA != kLoose;
             if (!pushA && !pushB) continue;
+            const ContactConstraint& c = constraints_[r.contact];
             double deficit = 0.0;
             int deepest = 0;
             for (int i = 0; i < c.pointCount; ++i) {
                 const double now = currentSeparation(bodies_[c.bodyA], bodies_[c.bodyB], c, c.points[i]);
-                if (std::min(r.before[i], 0.0) - now > deficit) {
-                    deficit = std::min(r.before[i], 0.0) - now;
+                const double before = riderBefore(r, c, i);
+                if (std::min(before, 0.0) - now > deficit) {
+                    deficit = std::min(before, 0.0) - now;
                     deepest = i;
                 }
             }

@@ -551,8 +551,19 @@ private:
     std::vector<std::uint32_t> jointMoved_;
     struct RiderContact {
         std::uint32_t contact;
-        double before[2];  // each point's separation before the projection, metres
+        /// Its bodies, copied: the carry's passes test their roles first, and
+        /// read the 232-byte contact only where one has moved.
+        std::uint32_t bodyA, bodyB;
+        /// Each point's separation before the projection, metres. Between two
+        /// loose bodies (`betweenLoose`), whose separation the projection
+        /// does not change, it is measured only if one of them is carried
+        /// (riderBefore): most of a pile's contacts never are.
+        double before[2];
+        bool betweenLoose;
     };
+    /// What r.before[i] holds, or for a contact between loose bodies what it
+    /// would: the separation at the positions the bodies had before any carry.
+    double riderBefore(const RiderContact& r, const ContactConstraint& c, int i) const;
     std::vector<RiderContact> riderContacts_;  // noteRiders
     /// Per solver body, for carryRiders: kLoose, kInGroup (an end of an
     /// exactly solved joint) or kCarried (a rider moved this substep).
@@ -560,6 +571,7 @@ private:
     std::vector<std::uint8_t> carryRole_;
     std::vector<Vec2> riderLoad_;  // per solver body: its velocity change from outside forces this step, m/s
     std::vector<Vec2> carried_;    // per solver body: what carryRiders moved it by, metres
+    std::vector<Vec2> dpBeforeCarry_;  // per solver body: its dp when noteRiders ran
     std::vector<std::pair<std::uint32_t, double>> stiffened_;  // bodies whose inertia a joint raised this substep
     std::vector<double> stiffenScratch_;
     std::vector<std::uint64_t> noCollide_;  // sorted (min collider << 32 | max collider)
