@@ -1029,8 +1029,9 @@ void CollisionSystem::rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFram
     //   (slop + dt drift + dt |omega| e + spin) / (1 - dt |omega|)
     // add up to at least the pair's speculative margin whenever g is within
     // it, and every pair that can touch this step still has overlapping
-    // boxes. The frame is kept only where its margins add up to less than
-    // the mean frame's.
+    // boxes. Of the drift, only its way on each axis is needed (sweptGrowth);
+    // the rest of the margin grows all round. The frame is kept only where
+    // its growth adds up to less than the mean frame's.
     Vec2 centroid{};
     std::size_t moving = 0;
     for (std::size_t i = 0; i < colliders_.size(); ++i) {
@@ -1119,9 +1120,10 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
     // Broad phase in a frame moving with the bodies' mean velocity (at both
     // ends of the step): what matters for contact is relative motion, so a
     // crowd moving together (or falling together) is fattened as if at rest
-    // and costs what it costs at rest. Each box grows by how far its body
-    // moves in that frame; any pair whose gap can close this step then has
-    // overlapping boxes, since |u_a - u_b| <= |u_a - ref| + |u_b - ref|.
+    // and costs what it costs at rest. Each box grows the way its body moves
+    // in that frame, by as far (sweptGrowth); any pair that can touch this
+    // step then has overlapping boxes (canTouch), since its relative motion
+    // is the difference of the two motions in the frame.
     Vec2 ref0{}, ref1{};
     std::size_t moving = 0;
     forEachActive([&](std::size_t i) {

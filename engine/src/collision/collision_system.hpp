@@ -425,9 +425,9 @@ private:
     /// The larger of colliders a and b's relative speeds at the two ends of
     /// the step (m/s): how fast their gap can close within it.
     double closingSpeed(std::size_t a, std::size_t b) const;
-
-    /// Replaces margins_ by margins in a frame that turns with the bodies,
-    /// when those add up to less than meanFrameSum (all colliders awake).
+    /// Replaces growLow_ and growHigh_ by the growth in a frame that turns
+    /// with the bodies, when it adds up to less than meanFrameSum (all
+    /// colliders awake).
     void rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFrameSum);
     /// How far a box grows below (`low`) and above (`high`) its shape on
     /// each axis, for a body whose velocity against the broad phase's frame
@@ -489,8 +489,9 @@ private:
     std::vector<std::uint8_t> movable_;
     std::vector<ProxyPair> pairs_;
     std::vector<Vec2> centres_, stepStart_;
+    /// margins_: per collider, its box's growth all round in the mean frame
+    /// (m), for the broad phase while islands sleep.
     std::vector<double> stepStartAngle_, margins_, spin_;
-    std::vector<double> rotatedMargins_;  ///< rotatingFrameMargins' candidates
     /// Per collider, all awake: how far its box grows below and above its
     /// shape's on each axis (m), the motion's part only in its direction.
     std::vector<Vec2> growLow_, growHigh_;
