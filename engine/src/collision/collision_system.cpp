@@ -1017,6 +1017,26 @@ double CollisionSystem::closingSpeed(std::size_t a, std::size_t b) const {
     return std::sqrt(std::max(lengthSquared(startV_[a] - startV_[b]), lengthSquared(endV_[a] - endV_[b])));
 }
 
+namespace {
+/// How far a box grows below (`low`) and above (`high`) its shape on each
+/// axis over a step of dt, for a body whose velocity against the broad
+/// phase's frame is w0 at the step's start and w1 at its end (`drift`: the
+/// larger length); `around` grows it all round, and the lot is widened for
+/// a turning frame.
+inline void sweptGrowth(double dt, Vec2 w0, Vec2 w1, double drift, double around, double widen, Vec2& low,
+                        Vec2& high) {
+    // The velocity against the frame is linear in time over the step
+    // (constant acceleration), so on each axis the displacement lies between
+    // 0 and dt times the least and the greatest of w0 and w1: the box grows
+    // that way only. The rest grows all round: `around` and what widening
+    // adds to the symmetric margin (rotatingFrameMargins), (widen - 1) dt
+    // drift, which covers the turn of the frame across the gap.
+    const double all = around * widen + (widen - 1.0) * (dt * drift);
+    low = {all + dt * std::max(0.0, -std::min(w0.x, w1.x)), all + dt * std::max(0.0, -std::min(w0.y, w1.y))};
+    high = {all + dt * std::max(0.0, std::max(w0.x, w1.x)), all + dt * std::max(0.0, std::max(w0.y, w1.y))};
+}
+} // namespace
+
 void CollisionSystem::rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFrameSum) {
     // A pile swept round a drum moves at tens of m/s in any translating
     // frame, though neighbours barely move against each other: in the mean
@@ -1063,29 +1083,14 @@ void CollisionSystem::rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFram
         const Vec2 u0 = ref0 + Vec2{-omega0 * r.y, omega0 * r.x}, u1 = ref1 + Vec2{-omega1 * r.y, omega1 * r.x};
         const Vec2 w0 = startV_[i] - u0, w1 = endV_[i] - u1;
         const double drift = std::sqrt(std::max(lengthSquared(w0), lengthSquared(w1)));
-        sweptGrowth(w0, w1, drift, kSpeculativeBase + sweep * maxExtent_[i] + spin_[i], widen, rotatedLow_[i],
-                    rotatedHigh_[i]);
+        sweptGrowth(dt_, w0, w1, drift, kSpeculativeBase + sweep * maxExtent_[i] + spin_[i], widen,
+                    rotatedLow_[i], rotatedHigh_[i]);
         sum += (rotatedLow_[i].x + rotatedLow_[i].y) + (rotatedHigh_[i].x + rotatedHigh_[i].y);
     }
     if (sum < meanFrameSum) {
         growLow_.swap(rotatedLow_);
         growHigh_.swap(rotatedHigh_);
     }
-}
-
-void CollisionSystem::sweptGrowth(Vec2 w0, Vec2 w1, double drift, double around, double widen, Vec2& low,
-                                  Vec2& high) const {
-    // The body's velocity against the frame is linear in time over the step
-    // (w0 at its start, w1 at its end, constant acceleration), so on each
-    // axis its displacement lies between 0 and dt times the least and the
-    // greatest of the two: the box grows that way only. The rest grows all
-    // round: `around` and what widening adds to the symmetric margin
-    // (rotatingFrameMargins), (widen - 1) dt drift, which covers the turn of
-    // the frame across the gap.
-    const double dt = dt_;
-    const double all = around * widen + (widen - 1.0) * (dt * drift);
-    low = {all + dt * std::max(0.0, -std::min(w0.x, w1.x)), all + dt * std::max(0.0, -std::min(w0.y, w1.y))};
-    high = {all + dt * std::max(0.0, std::max(w0.x, w1.x)), all + dt * std::max(0.0, std::max(w0.y, w1.y))};
 }
 
 void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
@@ -1145,12 +1150,17 @@ void CollisionSystem::detect(std::span<const Vec2> firstSubstepV, double h) {
     forEachActive([&](std::size_t i) {
         // How far any point of the shape can swing about its centre (m).
         spin_[i] = dt * std::abs(angularVelocities_[i]) * maxExtent_[i];
-        // sqrt is monotonic and correctly rounded: the root of the larger
-        // square is the larger root, one square root instead of two.
         const Vec2 w0 = startV_[i] - ref0, w1 = endV_[i] - ref1;
-        const double drift = std::sqrt(std::max(lengthSquared(w0), lengthSquared(w1)));
-        margins_[i] = kSpeculativeBase + dt * drift + spin_[i];
-        sweptGrowth(w0, w1, drift, kSpeculativeBase + spin_[i], 1.0, growLow_[i], growHigh_[i]);
+        if (anySleeping_) {
+            // sleepingBroadPhase grows boxes all round. sqrt is monotonic and
+            // correctly rounded: the root of the larger square is the larger
+            // root, one square root instead of two.
+            const double drift = std::sqrt(std::max(lengthSquared(w0), lengthSquared(w1)));
+            margins_[i] = kSpeculativeBase + dt * drift + spin_[i];
+            return;
+        }
+        // The mean frame does not turn: no widening, so no drift's length.
+        sweptGrowth(dt, w0, w1, 0.0, kSpeculativeBase + spin_[i], 1.0, growLow_[i], growHigh_[i]);
         meanFrameSum += (growLow_[i].x + growLow_[i].y) + (growHigh_[i].x + growHigh_[i].y);
     });
     if (turningFrame_ && !anySleeping_ && moving > 1) rotatingFrameMargins(ref0, ref1, meanFrameSum);

@@ -429,12 +429,6 @@ private:
     /// with the bodies, when it adds up to less than meanFrameSum (all
     /// colliders awake).
     void rotatingFrameMargins(Vec2 ref0, Vec2 ref1, double meanFrameSum);
-    /// How far a box grows below (`low`) and above (`high`) its shape on
-    /// each axis, for a body whose velocity against the broad phase's frame
-    /// is w0 at the step's start and w1 at its end (`drift`: the larger
-    /// length); `around` grows it all round, and the lot is widened for a
-    /// turning frame.
-    void sweptGrowth(Vec2 w0, Vec2 w1, double drift, double around, double widen, Vec2& low, Vec2& high) const;
     /// Moves cache entries that touch a sleeping collider to sleepingCache_
     /// and the others back to cache_ (each stays sorted).
     void splitCache();
@@ -493,7 +487,8 @@ private:
     /// (m), for the broad phase while islands sleep.
     std::vector<double> stepStartAngle_, margins_, spin_;
     /// Per collider, all awake: how far its box grows below and above its
-    /// shape's on each axis (m), the motion's part only in its direction.
+    /// shape's on each axis (m), the motion's part only in its direction
+    /// (sweptGrowth).
     std::vector<Vec2> growLow_, growHigh_;
     std::vector<Aabb> shapeBoxes_;  ///< per collider in the broad phase: its shape's box, no margin
     std::vector<Vec2> rotatedLow_, rotatedHigh_;  ///< rotatingFrameMargins' candidates
