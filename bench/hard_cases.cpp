@@ -591,12 +591,13 @@ Case crateOnBridge(double mass) {
     return c;
 }
 
-/// Ten 1 m boxes stacked edge to edge on the ground.
-Case stackOf10() {
+/// Ten 1 m boxes stacked edge to edge on the ground, under gravity g.
+Case stackOf10(double g) {
     Case c;
     c.panel = c.name = "stack of 10 boxes";
+    if (g != 10.0) c.name += ", g " + fmt("%g", g);
     c.errorLabel = "sinkage of the top box, m";
-    Scene& s = c.scene = baseWorld();
+    Scene& s = c.scene = baseWorld(g);
     addStatic(s, {0.0, -0.5}, 20.0, 1.0, 0.6);
     for (int k = 0; k < 10; ++k) {
         const Entity box = add(s, {0.0, 0.5 + k});
@@ -921,7 +922,7 @@ int main(int argc, char** argv) {
     cases.push_back(heavyOnChain());
     cases.push_back(chainOf20());
     for (double mass : {4.0, 100.0}) cases.push_back(crateOnBridge(mass));
-    cases.push_back(stackOf10());
+    for (double g : {10.0, 1e4}) cases.push_back(stackOf10(g));
     for (int n : {64, 1000, 10000})
         if (!(quick && n > 1000)) cases.push_back(crowd(n));
     cases.push_back(pile300());

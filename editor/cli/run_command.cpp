@@ -227,6 +227,8 @@ int run(const RunOptions& options) {
     // the summary on stdout stays one line).
     if (const std::optional<PileHint> pile = world.pileHint())
         std::cerr << options.level << ": warning: " << pile->message() << "\n";
+    if (const std::optional<ContactStiffnessHint> stiffness = world.contactStiffnessHint())
+        std::cerr << options.level << ": warning: " << stiffness->message() << "\n";
     if (const std::optional<ImpactHint> impact = world.impactHint())
         std::cerr << options.level << ": warning: " << impact->message() << "\n";
     if (const std::optional<JointLoopHint> loops = world.jointLoopHint())

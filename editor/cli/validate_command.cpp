@@ -106,6 +106,8 @@ void addValidateCommand(CLI::App& app, int& exitCode) {
                 std::cerr << *level << ": warning: " << hint.message() << "\n";
             if (const std::optional<PileHint> pile = world->pileHint())
                 std::cerr << *level << ": warning: " << pile->message() << "\n";
+            if (const std::optional<ContactStiffnessHint> stiffness = world->contactStiffnessHint())
+                std::cerr << *level << ": warning: " << stiffness->message() << "\n";
             if (const std::optional<ImpactHint> impact = world->impactHint())
                 std::cerr << *level << ": warning: " << impact->message() << "\n";
             if (const std::optional<JointLoopHint> loops = world->jointLoopHint())

@@ -588,7 +588,7 @@ SolverState readSolverState(const Json& v, const Registry& registry) {
                               chosen.contactHertz = readNumber(fv, fa, NumberRange{kContactHertz, 1e9, false});
                               return;
                           }
-                          const int count = int(readInteger(fv, fa, 1, 1000));
+                          const int count = int(readInteger(fv, fa, 1, kMaxLevelSubsteps));
                           if (field == "substeps") chosen.substeps = count;
                           else chosen.solverIterations = count;
                       });

@@ -31,13 +31,13 @@ std::vector<WorldFieldInfo> buildTable() {
         {integrator},
         {.field = makeField<&WorldSettings::dt>("dt", {0.0, 10.0, true}, "s", "seconds per step"),
          .maxGuardsInputOnly = true},
-        {makeField<&WorldSettings::substeps>("substeps", {1.0, 1000.0}, "",
+        {makeField<&WorldSettings::substeps>("substeps", {1.0, double(kMaxLevelSubsteps)}, "",
                                              "each step is substeps steps of dt/substeps; absent: chosen from "
                                              "the scene's structure (its pile, load and joints) and recorded "
                                              "in a saved run's solver_state.chosen"),
          true},
         {makeField<&WorldSettings::time>("time", kAnyMagnitude, "s", "simulated seconds so far")},
-        {makeField<&WorldSettings::solverIterations>("solver_iterations", {1.0, 1000.0}, "",
+        {makeField<&WorldSettings::solverIterations>("solver_iterations", {1.0, double(kMaxLevelSubsteps)}, "",
                                                      "contact solver velocity iterations per substep; absent: 8, "
                                                      "or chosen with substeps when that is absent too"),
          true},

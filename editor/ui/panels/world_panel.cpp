@@ -83,6 +83,11 @@ void worldPanel(UiState& ui, Editor& ed, const PanelRects& r) {
                 ImGui::TextColored(kGold, "%s", pile->message().c_str());
                 ImGui::PopTextWrapPos();
             }
+            if (const std::optional<ContactStiffnessHint> stiffness = world->contactStiffnessHint()) {
+                ImGui::PushTextWrapPos(0.0f);
+                ImGui::TextColored(kGold, "%s", stiffness->message().c_str());
+                ImGui::PopTextWrapPos();
+            }
             if (const std::optional<ImpactHint> impact = world->impactHint()) {
                 ImGui::PushTextWrapPos(0.0f);
                 ImGui::TextColored(kGold, "%s", impact->message().c_str());

@@ -199,6 +199,16 @@ inline constexpr double kContactHertz = 60.0;
 /// The gravity kContactHertz serves, m/s^2: a stronger load may stiffen the
 /// contacts by up to sqrt(g / kReferenceGravity) (ContactSettingsChoice).
 inline constexpr double kReferenceGravity = 10.0;
+/// sqrt(g / kReferenceGravity), at least 1: how much faster a scene under
+/// `gravity` (m/s^2) runs than the same scene at the reference. A pile
+/// under g is the reference pile sped up by this factor: the same
+/// overlaps with contacts this much stiffer, and every speed this much
+/// higher. So a strong load may stiffen the contacts by up to it
+/// (ContactSettingsChoice::contactHertz), and the contacts push overlaps
+/// out up to this much faster than their 3 m/s at the reference. Held at 3
+/// m/s, the push could not keep up with what gravity adds each substep:
+/// two boxes under 10^6 m/s^2 sank 27 cm into each other, five flew apart.
+double loadSpeedup(double gravity);
 
 /// What the engine runs when a level gives no `substeps` (and no
 /// `solver_iterations`), decided from the scene's structure (its bodies,
@@ -206,7 +216,8 @@ inline constexpr double kReferenceGravity = 10.0;
 /// level as authored (where its boxes stand, its velocities and which bodies
 /// touch). A run that saved its state records the choice, so a resumed run
 /// runs what the long run chose.
-/// The fewest substeps (1, 2, 4, 8 or 16) that hold:
+/// The fewest substeps (1, 2, 4, 8, ...; the joint rules up to 16, the
+/// contact rules up to kMaxContactSubsteps) that hold:
 ///  * the pile: the deepest the N dynamic shapes can pile (a heap k deep,
 ///    k (k + 1) / 2 >= N, no wider than floor(W / d) bodies on ground W
 ///    wide, or ceil(N / floor(W / d)) full rows), its deepest overlap under
@@ -230,7 +241,7 @@ inline constexpr double kReferenceGravity = 10.0;
 /// load stronger than kReferenceGravity, a contact rule that cannot hold at
 /// 60 Hz (a tall stack, a strong load) raises the stiffness to what holds
 /// it, by up to sqrt(g / kReferenceGravity) (contactHertz), and takes the
-/// substeps that carry it, up to 16.
+/// substeps that carry it, up to kMaxContactSubsteps.
 /// docs/collisions.md "Substeps when the level gives none".
 struct ContactSettingsChoice {
     int substeps = 1;
@@ -333,6 +344,14 @@ inline constexpr double kJointSupportRatio = 3.0;
 /// The most substeps the impact rule asks for: past it a level must give
 /// its own (the rule's warning names the number).
 inline constexpr int kImpactMaxSubsteps = 8;
+/// The most substeps the contact rules (pile, column, load) ask for. Only a
+/// load past kReferenceGravity gets past 16: the stiffness it needs, at
+/// most kContactHertz sqrt(g / kReferenceGravity), is carried by
+/// contactHertz / (hertzFraction / dt) substeps (at 60 steps a second, 64
+/// at 1000 m/s^2, 128 at 10^4, 512 from 4 10^4 for a deep column). Capped
+/// at 16, ten boxes flew apart from 7000 m/s^2 and twenty from 3000: their
+/// overlaps grew past what the contacts hold.
+inline constexpr int kMaxContactSubsteps = 512;
 /// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
 /// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
 /// compresses by load / (m_n omega^2), omega = 2 pi min(contactHertz, f / h)
@@ -359,8 +378,23 @@ struct PileHint {
     double expectedOverlap = 0.0;  ///< metres
     double diameter = 0.0;         ///< metres
     int substeps = 1;              ///< the level's
-    int substepsNeeded = 1;        ///< the fewest that keep it under 2% (16 at most; 0: none does)
-    double overlapAtMost = 0.0;    ///< metres, at 16 substeps when none keeps it under 2%
+    int substepsNeeded = 1;        ///< the fewest that keep it under 2% (kMaxContactSubsteps at most; 0: none does)
+    double overlapAtMost = 0.0;    ///< metres, at kMaxContactSubsteps when none keeps it under 2%
+    std::string message() const;
+};
+
+/// A warning before playing: under a load stronger than kReferenceGravity
+/// the contact rules ask for stiffer contacts (ContactSettingsChoice::
+/// contactHertz) than the running substeps carry (hertzFraction of the
+/// substep rate), so a stack or pile sinks into itself past the rules'
+/// bounds, and a tall one can collapse. Said of the level's own substeps,
+/// and of the engine's when even kMaxContactSubsteps fall short.
+struct ContactStiffnessHint {
+    double gravity = 0.0;       ///< m/s^2
+    double hertzNeeded = 0.0;   ///< Hz, what the rules ask for
+    double hertzCarried = 0.0;  ///< Hz, what the running substeps carry
+    int substeps = 1;           ///< running
+    int substepsNeeded = 0;     ///< the fewest that carry it (0: more than a level can give)
     std::string message() const;
 };
 
@@ -572,6 +606,9 @@ public:
     /// Set when the scene's deepest pile would sink more than 2% of a
     /// diameter at the running substeps (see PileHint).
     std::optional<PileHint> pileHint() const;
+    /// Set when the running substeps carry less contact stiffness than a
+    /// strong load needs (ContactStiffnessHint).
+    std::optional<ContactStiffnessHint> contactStiffnessHint() const;
     /// An impact the level's own substeps cannot hold (ImpactHint); never
     /// about substeps the engine chose or a run recorded.
     std::optional<ImpactHint> impactHint() const;

@@ -19,6 +19,10 @@
 
 namespace stepwise {
 
+/// The most substeps (and solver iterations) a level may give: far past
+/// any useful level, it keeps a typo (1e9 substeps) from freezing a run.
+inline constexpr int kMaxLevelSubsteps = 1000;
+
 /// dopri5's smallest internal step, as a fraction of the frame (dt): below
 /// it the step is refused as one that cannot meet the tolerance.
 inline constexpr double kSmallestAdaptiveStep = 1e-12;

@@ -43,6 +43,7 @@
 #include "stepwise/component_table.hpp"
 #include "stepwise/components.hpp"
 #include "stepwise/integrators.hpp"
+#include "stepwise/world_fields.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -1070,10 +1071,10 @@ std::optional<PileHint> World::pileHint() const {
     hint.expectedOverlap = overlap;
     hint.diameter = c.diameter;
     hint.substeps = substeps;
-    // None up to 16 may hold it (a load past what the chosen stiffness
-    // carries): then the warning says what 16 leave.
+    // None up to kMaxContactSubsteps may hold it (a load past what the
+    // chosen stiffness carries): then the warning says what those leave.
     hint.substepsNeeded = 0;
-    for (int s = substeps + 1; s <= 16; ++s)
+    for (int s = substeps + 1; s <= kMaxContactSubsteps; ++s)
         if (expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(s), 1.0, c.hertzFraction,
                                 c.contactHertz) <= limit) {
             hint.substepsNeeded = s;
@@ -1081,7 +1082,30 @@ std::optional<PileHint> World::pileHint() const {
         }
     if (hint.substepsNeeded == 0)
         hint.overlapAtMost =
-            expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / 16.0, 1.0, c.hertzFraction, c.contactHertz);
+            expectedPileOverlap(c.stackDepth, c.gravity, w.settings.dt / double(kMaxContactSubsteps), 1.0,
+                                c.hertzFraction, c.contactHertz);
+    return hint;
+}
+
+static_assert(kMaxContactSubsteps <= kMaxLevelSubsteps, "a run records its choice, which a reload reads as a count in the level's range");
+
+std::optional<ContactStiffnessHint> World::contactStiffnessHint() const {
+    const WorldImpl& w = *impl_;
+    const ContactSettingsChoice& c = w.contactChoice;
+    // At kContactHertz a rule that fails is the pile's or the column's,
+    // whose own hint (pileHint) names the substeps; only a strong load
+    // raises the stiffness.
+    if (!w.collision || !(c.contactHertz > kContactHertz)) return std::nullopt;
+    const double dt = w.settings.dt;
+    const double carried = c.hertzFraction * double(w.settings.substeps) / dt;
+    if (!(c.contactHertz > carried * (1.0 + 1e-12))) return std::nullopt;
+    ContactStiffnessHint hint;
+    hint.gravity = c.gravity;
+    hint.hertzNeeded = c.contactHertz;
+    hint.hertzCarried = carried;
+    hint.substeps = w.settings.substeps;
+    const int needed = detail::wholeSubsteps(c.contactHertz * dt / c.hertzFraction, 1e6);
+    hint.substepsNeeded = needed <= kMaxLevelSubsteps ? needed : 0;
     return hint;
 }
 
@@ -1150,6 +1174,22 @@ std::string JointLoopHint::message() const {
     return text;
 }
 
+std::string ContactStiffnessHint::message() const {
+    char text[400];
+    const int written = std::snprintf(
+        text, sizeof text,
+        "a load of %.3g m/s^2 needs contacts of %.0f Hz, and %d substep%s carry %.0f Hz: stacks and piles sink into "
+        "themselves and a tall one can collapse; ",
+        gravity, hertzNeeded, substeps, substeps == 1 ? "" : "s", hertzCarried);
+    const std::size_t at = std::size_t(std::max(written, 0));
+    if (substepsNeeded > 0)
+        std::snprintf(text + at, sizeof text - at, "substeps %d would carry them", substepsNeeded);
+    else
+        std::snprintf(text + at, sizeof text - at, "no substep count up to %d carries them: lower the load",
+                      kMaxLevelSubsteps);
+    return text;
+}
+
 std::string ImpactHint::message() const {
     char text[320];
     std::snprintf(text, sizeof text,
@@ -1171,8 +1211,8 @@ std::string PileHint::message() const {
         std::snprintf(text + at, sizeof text - at, "%d substeps would hold it under 2%%", substepsNeeded);
     else
         std::snprintf(text + at, sizeof text - at,
-                      "no substep count up to 16 holds it under 2%% (16 leave %.0f mm): lower the load or the pile",
-                      1e3 * overlapAtMost);
+                      "no substep count up to %d holds it under 2%% (%d leave %.0f mm): lower the load or the pile",
+                      kMaxContactSubsteps, kMaxContactSubsteps, 1e3 * overlapAtMost);
     return text;
 }
 

@@ -694,6 +694,8 @@ double expectedSupportOverlap(int depth, double gravity, double h, double massRa
 
 double derivedRestitutionThreshold(double gravity, double h) { return 4.0 * gravity * h; }
 
+double loadSpeedup(double gravity) { return std::sqrt(std::max(1.0, gravity / kReferenceGravity)); }
+
 std::string ContactSettingsChoice::reason() const {
     std::string out;
     const auto add = [&](const std::string& part) { out += (out.empty() ? "" : "; ") + part; };
@@ -1021,7 +1023,8 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     choice.hertzFraction = choice.gravity > 0.0 && choice.stackHeight > kDeepColumn ? 0.125 : 0.25;
     const double fraction = choice.hertzFraction;
 
-    // The fewest substeps (up to 16) that hold every rule.
+    // The fewest substeps that hold every rule: up to kMaxContactSubsteps
+    // for the contact rules, 16 for the joints'.
     const double dt = scene.world.dt;
     // Each contact rule asks that an overlap, load / (m omega^2), stay
     // under a limit: overlap(h, hertz) for substeps of h and stiffness
@@ -1062,7 +1065,7 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         };
         const double needed = std::max({base, needs(pileOverlap, pileLimit), needs(loadOverlap, loadLimit),
                                         needs(columnOverlap, columnLimit)});
-        choice.contactHertz = std::min(needed, base * std::sqrt(std::max(1.0, choice.gravity / kReferenceGravity)));
+        choice.contactHertz = std::min(needed, base * loadSpeedup(choice.gravity));
     }
     const double hertz = choice.contactHertz;
     const auto pileHolds = [&](int s) { return pileOverlap(dt / s, hertz) <= pileLimit; };
@@ -1075,7 +1078,7 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     };
     const auto fewest = [&](const auto& holds, bool contact) {
         int s = 1;
-        for (; s < 16; s *= 2)
+        for (; s < kMaxContactSubsteps; s *= 2)
             if (holds(s) || (contact && contactsSaturated(s))) break;
         return s;
     };

@@ -50,7 +50,10 @@ std::optional<Error> WorldImpl::keepChoiceFor(const Scene& scene, const SystemSw
         !sameBits(stiffness(choice), stiffness(contactChoice)))
         return Error{"the edit changes the settings the engine chooses"};
     contactChoice = choice;
-    if (collision) collision->settings().contactHertz = choice.contactHertz;
+    if (collision) {
+        collision->settings().contactHertz = choice.contactHertz;
+        collision->settings().pushMaxVelocity = collision::SolverSettings{}.pushMaxVelocity * loadSpeedup(choice.gravity);
+    }
     hertzFractionRecorded = false;
     if (settingsSource == World::SettingsSource::Recorded) settingsSource = World::SettingsSource::Chosen;
     return std::nullopt;
