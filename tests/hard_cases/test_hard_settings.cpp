@@ -254,6 +254,16 @@ TEST(HardSettings, ContactStiffnessHintNamesTheSubstepsThatCarryIt) {
     EXPECT_EQ(most->substepsNeeded, 0);
     EXPECT_NE(most->message().find("no substep count up to 1000 carries them: lower the load"), std::string::npos)
         << most->message();
+    // A lone body rests only on static ground, whose contacts turn rigid
+    // before the slop: it holds at any substeps (the ball on a 2 cm box,
+    // HardContacts), and nothing is said.
+    Scene lone = parse(stackLevel(1, 1e5));
+    lone.world.substeps = 1;
+    ASSERT_GT(chooseContactSettings(lone).contactHertz, kContactHertz);
+    World loneWorld = build(lone);
+    EXPECT_FALSE(loneWorld.contactStiffnessHint());
+    for (int i = 0; i < 120; ++i) ASSERT_TRUE(loneWorld.step().ok());
+    EXPECT_LT(0.5 - loneWorld.bodyPosition(0).y, 0.005);
     // At the reference gravity nothing is stiffened, and nothing is said
     // even at 1 substep (the pile's own hint covers that).
     Scene light = parse(stackLevel(10, 9.81));

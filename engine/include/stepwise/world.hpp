@@ -388,7 +388,9 @@ struct PileHint {
 /// contactHertz) than the running substeps carry (hertzFraction of the
 /// substep rate), so a stack or pile sinks into itself past the rules'
 /// bounds, and a tall one can collapse. Said of the level's own substeps,
-/// and of the engine's when even kMaxContactSubsteps fall short.
+/// and of the engine's when even kMaxContactSubsteps fall short; never of
+/// a scene whose bodies cannot rest on one another (static contacts turn
+/// rigid before the slop at any stiffness).
 struct ContactStiffnessHint {
     double gravity = 0.0;       ///< m/s^2
     double hertzNeeded = 0.0;   ///< Hz, what the rules ask for

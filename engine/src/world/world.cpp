@@ -1094,8 +1094,11 @@ std::optional<ContactStiffnessHint> World::contactStiffnessHint() const {
     const ContactSettingsChoice& c = w.contactChoice;
     // At kContactHertz a rule that fails is the pile's or the column's,
     // whose own hint (pileHint) names the substeps; only a strong load
-    // raises the stiffness.
+    // raises the stiffness. Bodies that cannot rest on one another meet
+    // only static supports, whose contacts turn rigid before the slop
+    // (Softness::rigidDepth) whatever the stiffness.
     if (!w.collision || !(c.contactHertz > kContactHertz)) return std::nullopt;
+    if (c.stackDepth < 2 && c.columnHeight < 2) return std::nullopt;
     const double dt = w.settings.dt;
     const double carried = c.hertzFraction * double(w.settings.substeps) / dt;
     if (!(c.contactHertz > carried * (1.0 + 1e-12))) return std::nullopt;
