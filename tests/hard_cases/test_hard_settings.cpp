@@ -231,6 +231,57 @@ TEST(HardSettings, StacksUnderStrongLoadsGetTheStiffnessThatHoldsThem) {
     }
 }
 
+// A steady load need not be gravity: a static attractor (a planet under
+// the level) loads a stack as gravity does, and the choice reads its field
+// where it is strongest on a body. Ten boxes on a floor 100 m above a
+// planet, no gravity, swept over the field at the floor from 10 to 10^4
+// m/s^2, with the planet straight below and 3 m to the side (the field
+// 1.7 degrees off -y, which the boxes' friction holds): the choice's load
+// is the bottom box's field, and after 2 s the top box is within 1.5 cm
+// of where it is under uniform gravity equal to that field, and no more
+// than 1.5 cm lower than it started. Read as no load (the choice saw
+// gravity only), ten boxes got 1 substep and collapsed from 1000 m/s^2.
+TEST(HardSettings, AStaticAttractorLoadsAStackAsGravityDoes) {
+    const auto stack = [](Vec2 gravity, const std::string& planet) {
+        std::ostringstream text;
+        text << R"({"world": {"gravity": {"x": )" << num(gravity.x) << R"(, "y": )" << num(gravity.y)
+             << R"(}, "G": 1}, "entities": [)" << planet
+             << R"({"name": "floor", "plane": {"normal": {"x": 0, "y": 1}, "offset": 0}, "friction": 0.6})";
+        for (int k = 0; k < 10; ++k)
+            text << R"(, {"name": "box)" << k << R"(", "position": {"x": 0, "y": )" << num(0.5 + k)
+                 << R"(}, "mass": 1, "friction": 0.6, "box": {"width": 1, "height": 1}})";
+        text << "]}";
+        return parse(text.str());
+    };
+    const auto topAfter = [](const Scene& scene, const std::string& label) {
+        World w = build(scene);
+        for (int i = 0; i < 120; ++i) EXPECT_TRUE(w.step().ok()) << label;
+        return w.bodyPosition(9);
+    };
+    for (const double field : {10.0, 1000.0, 1e4}) {
+        for (const double side : {0.0, 3.0}) {
+            const double r = 100.0;
+            const Vec2 planet{side, -std::sqrt(r * r - side * side)};
+            const Scene pulled =
+                stack({}, R"({"name": "planet", "position": {"x": )" + num(planet.x) + R"(, "y": )" + num(planet.y) +
+                              R"(}, "static": true, "mass": )" + num(field * r * r) +
+                              R"(, "attractor": {"softening": 0}}, )");
+            const ContactSettingsChoice choice = chooseContactSettings(pulled);
+            const std::string label = "field " + num(field) + ", planet at x " + num(side) + " (" + choice.reason() + ")";
+            // The bottom box, 0.5 m nearer the planet than the floor.
+            const Vec2 toPlanet = planet - Vec2{0.0, 0.5};
+            const Vec2 bottomField = (field * r * r / std::pow(length(toPlanet), 3.0)) * toPlanet;
+            EXPECT_NEAR(choice.gravity, length(bottomField), 1e-9 * field) << label;
+            EXPECT_EQ(choice.stackHeight, 10) << label;
+            const Vec2 top = topAfter(pulled, label);
+            const Vec2 uniform = topAfter(stack(bottomField, ""), label + ", as gravity");
+            EXPECT_LT(length(top - uniform), 0.015) << label << ": top at " << top.x << ", " << top.y
+                                                    << "; under gravity " << uniform.x << ", " << uniform.y;
+            EXPECT_LT(9.5 - top.y, 0.015) << label;
+        }
+    }
+}
+
 // The warning names the substeps that would carry the stiffness a load
 // needs, for a level's own substeps and for the engine's past its cap.
 TEST(HardSettings, ContactStiffnessHintNamesTheSubstepsThatCarryIt) {
