@@ -202,12 +202,10 @@ inline constexpr double kReferenceGravity = 10.0;
 /// sqrt(g / kReferenceGravity), at least 1: how much faster a scene under
 /// `gravity` (m/s^2) runs than the same scene at the reference. A pile
 /// under g is the reference pile sped up by this factor: the same
-/// overlaps with contacts this much stiffer, and every speed this much
+/// overlaps with contacts this much stiffer (and pushing out this much
+/// faster, collision::SolverSettings::pushCap), every speed this much
 /// higher. So a strong load may stiffen the contacts by up to it
-/// (ContactSettingsChoice::contactHertz), and the contacts push overlaps
-/// out up to this much faster than their 3 m/s at the reference. Held at 3
-/// m/s, the push could not keep up with what gravity adds each substep:
-/// two boxes under 10^6 m/s^2 sank 27 cm into each other, five flew apart.
+/// (ContactSettingsChoice::contactHertz).
 double loadSpeedup(double gravity);
 
 /// What the engine runs when a level gives no `substeps` (and no

@@ -1363,7 +1363,7 @@ double CollisionSystem::warmStartBound(std::span<const Vec2> firstSubstepV) cons
         const Vec2 v0 = startV_[i];
         const Vec2 forced = firstSubstepV[std::size_t(colliders_[i].body)] - v0;
         bound += (length(v0) + std::abs(angularVelocities_[i]) * reach[s] + length(forced) + driven +
-                  settings_.pushMaxVelocity) /
+                  settings_.pushCap(settings_.contactHertz)) /
                  invMass;
     }
     // A joint presses its bodies with what its rows carry; the rows in N*s
@@ -1598,6 +1598,7 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
     // with static bodies may be twice as stiff, but under the same cap:
     // above it a heavy box on light boxes never comes to rest.
     const double hertz = std::min(settings_.contactHertz, settings_.hertzFraction / h);
+    const double pushCap = settings_.pushCap(hertz);
     const Softness soft = Softness::make(hertz, settings_.dampingRatio, h);
     Softness staticSoft = Softness::make(std::min(2.0 * hertz, 0.25 / h), settings_.dampingRatio, h);
     // Contacts with the static world turn rigid before the slop
@@ -1666,10 +1667,10 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
             jointBundles_.solve(joints_, bodies_, h, jointSoft, directSoft, true);
             directJoints_.solve(joints_, bodies_);
         }
-        coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, true, reverse);
+        coloured_.solve(constraints_, bodies_, h, soft, staticSoft, pushCap, true, reverse);
         if (!treeContacts_.empty())
             treeContacts_.solve(constraints_, joints_, bodies_, directJoints_, h, soft, staticSoft,
-                                settings_.pushMaxVelocity, true, reverse);
+                                pushCap, true, reverse);
     }
 
     offsetAngleBefore_.resize(offsetBodies_.size());
@@ -1741,11 +1742,11 @@ void CollisionSystem::solveSubstep(std::span<Vec2> x, std::span<Vec2> v, double 
             directJoints_.solve(joints_, bodies_);
         }
         const bool last = it + 1 == settings_.relaxIterations;
-        coloured_.solve(constraints_, bodies_, h, soft, staticSoft, settings_.pushMaxVelocity, false, reverse,
+        coloured_.solve(constraints_, bodies_, h, soft, staticSoft, pushCap, false, reverse,
                         measure && last ? std::span<double>(endSeparations_) : std::span<double>{});
         if (!treeContacts_.empty())
             treeContacts_.solve(constraints_, joints_, bodies_, directJoints_, h, soft, staticSoft,
-                                settings_.pushMaxVelocity, false, reverse);
+                                pushCap, false, reverse);
     }
 
     // Tree-shaped joint groups: their positions projected onto the joints

@@ -100,11 +100,13 @@ struct ContactDetail {
 };
 
 struct SolverSettings {
+    /// The default contact stiffness, Hz: Box2D v3's default is 30 Hz; 60
+    /// gives 4x less overlap in a 25-deep circle pile at the same cost.
+    static constexpr double kDefaultHertz = 60.0;
     /// Contact stiffness, Hz, capped at a quarter of the substep rate (so 60
     /// Hz needs 4 substeps at 60 steps/s; Box2D v3.0's cap, v3.1 uses an
-    /// eighth). Box2D v3's default is 30 Hz; 60 gives 4x less overlap in a
-    /// 25-deep circle pile at the same cost.
-    double contactHertz = 60.0;
+    /// eighth). Raised past kDefaultHertz under strong loads.
+    double contactHertz = kDefaultHertz;
     /// The cap on contactHertz, as a fraction of the substep rate: a quarter
     /// (Box2D v3.0's), or an eighth (v3.1's) for a scene with a column of
     /// boxes deeper than kDeepColumn, where at a quarter (h omega = pi/2)
@@ -119,7 +121,13 @@ struct SolverSettings {
     /// one order).
     bool oneColourOrder = false;
     double dampingRatio = 10.0;        ///< heavily over-damped: pushes out without bounce
-    double pushMaxVelocity = 3.0;      ///< m/s; caps the speed of overlap recovery
+    /// m/s: caps the speed of overlap recovery at kDefaultHertz (Box2D's
+    /// 3 m/s). Stiffer contacts push proportionally faster (pushCap): the
+    /// push that holds an overlap at a given depth grows with the
+    /// stiffness, and held at 3 m/s it could not make up what a strong load
+    /// adds in a substep (two boxes under 10^6 m/s^2 sank 27 cm into each
+    /// other, five flew apart).
+    double pushMaxVelocity = 3.0;
     double restitutionThreshold = 1.0; ///< m/s; slower impacts do not bounce (resting contact stays put)
     int iterations = 2;                ///< biased solve iterations per substep (world.solver_iterations)
     int relaxIterations = 1;           ///< unbiased iterations per substep
@@ -128,6 +136,9 @@ struct SolverSettings {
     /// the same contacts in the same coloured order, one at a time through
     /// solveContacts below; both give the same bits (tests compare them).
     bool simd = true;
+    /// The push cap (m/s) at a stiffness of `hertz` (the one a substep
+    /// applies, or any bound on it).
+    double pushCap(double hertz) const { return pushMaxVelocity * std::max(1.0, hertz / kDefaultHertz); }
 };
 
 /// The separation of point `p` of contact `c` at the bodies' current dp, dq

@@ -324,7 +324,6 @@ std::optional<Error> compileCollisions(const Scene& scene, const SystemSwitches&
     // From the scene's structure, whatever substeps the level gives.
     w.collision->settings().hertzFraction = w.contactChoice.hertzFraction;
     w.collision->settings().contactHertz = w.contactChoice.contactHertz;
-    w.collision->settings().pushMaxVelocity = collision::SolverSettings{}.pushMaxVelocity * loadSpeedup(w.contactChoice.gravity);
     w.collision->settings().oneColourOrder = w.contactChoice.hertzFraction < 0.25;
     if (ws.jointHz) w.collision->jointSettings().hertz = *ws.jointHz;
     if (ws.jointDampingRatio) w.collision->jointSettings().dampingRatio = *ws.jointDampingRatio;

@@ -50,10 +50,7 @@ std::optional<Error> WorldImpl::keepChoiceFor(const Scene& scene, const SystemSw
         !sameBits(stiffness(choice), stiffness(contactChoice)))
         return Error{"the edit changes the settings the engine chooses"};
     contactChoice = choice;
-    if (collision) {
-        collision->settings().contactHertz = choice.contactHertz;
-        collision->settings().pushMaxVelocity = collision::SolverSettings{}.pushMaxVelocity * loadSpeedup(choice.gravity);
-    }
+    if (collision) collision->settings().contactHertz = choice.contactHertz;
     hertzFractionRecorded = false;
     if (settingsSource == World::SettingsSource::Recorded) settingsSource = World::SettingsSource::Chosen;
     return std::nullopt;
