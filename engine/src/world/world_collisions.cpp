@@ -669,43 +669,6 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
     choice.impactSubsteps = s;
 }
 
-/// The steady load the contact rules read as gravity (m/s^2): the world's
-/// gravity, plus the field of the attractors that do not move under it
-/// (static or kinematic ones, a planet under a level) where that sum is
-/// strongest on a dynamic body as the level places it. A stack on such a
-/// planet bears the field as it would bear gravity; a dynamic attractor's
-/// pull moves with it and is left to the impacts it causes.
-template <class IsStatic, class Dynamic, class MassOf>
-Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStatic& isStatic,
-                const Dynamic& dynamic, const MassOf& massOf) {
-    const Registry& reg = scene.registry;
-    const Vec2 gravity = switches.gravity ? scene.world.gravity : Vec2{};
-    if (!switches.attractors) return gravity;
-    struct Source {
-        Vec2 at;
-        double gm, eps2;
-    };
-    std::vector<Source> sources;
-    for (const Entity e : reg.entities())
-        if (const Attractor* a = reg.tryGet<Attractor>(e); a && reg.alive(e) && isStatic(e) && reg.has<Position>(e))
-            sources.push_back({reg.tryGet<Position>(e)->value, scene.world.G * massOf(e), a->softening * a->softening});
-    if (sources.empty()) return gravity;
-    Vec2 strongest = gravity;
-    for (const Entity e : reg.entities()) {
-        if (!dynamic(e)) continue;
-        const Vec2 p = reg.tryGet<Position>(e)->value;
-        Vec2 field = gravity;
-        for (const Source& s : sources) {
-            const Vec2 r = s.at - p;
-            const double d2 = lengthSquared(r) + s.eps2;
-            if (d2 > 0.0) field += (s.gm / (d2 * std::sqrt(d2))) * r;
-        }
-        if (std::isfinite(field.x) && std::isfinite(field.y) && lengthSquared(field) > lengthSquared(strongest))
-            strongest = field;
-    }
-    return strongest;
-}
-
 } // namespace
 
 double expectedPileOverlap(int depth, double gravity, double h, double massRatio, double hertzFraction,
@@ -764,6 +727,10 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     ContactSettingsChoice choice;
     const Registry& reg = scene.registry;
     const auto& order = reg.entities();
+    const Vec2 gravity = switches.gravity ? scene.world.gravity : Vec2{};
+    choice.gravity = length(gravity);
+    const Vec2 down = choice.gravity > 0.0 ? gravity / choice.gravity : Vec2{0.0, -1.0};
+    const Vec2 across{-down.y, down.x};
     // A kinematic body carries loads like a static one.
     const auto isStatic = [&](Entity e) {
         const Static* st = reg.tryGet<Static>(e);
@@ -786,10 +753,6 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         const Shapes* shapes = reg.tryGet<Shapes>(e);
         return shapes ? compoundMassProperties(*shapes, std::nullopt).mass : 1.0;
     };
-    const Vec2 gravity = steadyLoad(scene, switches, isStatic, dynamic, massOf);
-    choice.gravity = length(gravity);
-    const Vec2 down = choice.gravity > 0.0 ? gravity / choice.gravity : Vec2{0.0, -1.0};
-    const Vec2 across{-down.y, down.x};
     const auto sizeOf = [&](Entity e) {
         return hasShape(e) ? 2.0 * std::max(halfExtentAlong(reg, e, across), halfExtentAlong(reg, e, down))
                            : 2.0 * detail::kShapelessRadius;
