@@ -1087,7 +1087,8 @@ std::optional<PileHint> World::pileHint() const {
     return hint;
 }
 
-static_assert(kMaxContactSubsteps <= kMaxLevelSubsteps, "a run records its choice, which a reload reads as a count in the level's range");
+// A run records its choice, which a reload reads as a count in the level's range.
+static_assert(kMaxContactSubsteps <= kMaxLevelSubsteps);
 
 std::optional<ContactStiffnessHint> World::contactStiffnessHint() const {
     const WorldImpl& w = *impl_;
