@@ -342,14 +342,16 @@ inline constexpr double kJointSupportRatio = 3.0;
 /// The most substeps the impact rule asks for: past it a level must give
 /// its own (the rule's warning names the number).
 inline constexpr int kImpactMaxSubsteps = 8;
-/// The most substeps the contact rules (pile, column, load) ask for. Only a
-/// load past kReferenceGravity gets past 16: the stiffness it needs, at
+/// The most substeps the contact rules (pile, column, load) ask for: the
+/// most a level may give (kMaxLevelSubsteps), so the engine never names a
+/// count it could have taken itself. They double from 1 and stop here. Only
+/// a load past kReferenceGravity gets past 16: the stiffness it needs, at
 /// most kContactHertz sqrt(g / kReferenceGravity), is carried by
 /// contactHertz / (hertzFraction / dt) substeps (at 60 steps a second, 64
-/// at 1000 m/s^2, 128 at 10^4, 512 from 4 10^4 for a deep column). Capped
+/// at 1000 m/s^2, 128 at 10^4, 1000 past 4 10^4 for a deep column). Capped
 /// at 16, ten boxes flew apart from 7000 m/s^2 and twenty from 3000: their
 /// overlaps grew past what the contacts hold.
-inline constexpr int kMaxContactSubsteps = 512;
+inline constexpr int kMaxContactSubsteps = 1000;
 /// Expected deepest resting overlap (metres) in a pile `depth` bodies deep
 /// under `gravity` (m/s^2) with substeps of `h` seconds: the soft contact
 /// compresses by load / (m_n omega^2), omega = 2 pi min(contactHertz, f / h)

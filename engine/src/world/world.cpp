@@ -1087,8 +1087,9 @@ std::optional<PileHint> World::pileHint() const {
     return hint;
 }
 
-// A run records its choice, which a reload reads as a count in the level's range.
-static_assert(kMaxContactSubsteps <= kMaxLevelSubsteps);
+// The engine takes up to what a level may give (a run records its choice,
+// which a reload reads as a count in the level's range).
+static_assert(kMaxContactSubsteps == kMaxLevelSubsteps);
 
 std::optional<ContactStiffnessHint> World::contactStiffnessHint() const {
     const WorldImpl& w = *impl_;

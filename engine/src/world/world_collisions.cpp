@@ -1078,7 +1078,7 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     };
     const auto fewest = [&](const auto& holds, bool contact) {
         int s = 1;
-        for (; s < kMaxContactSubsteps; s *= 2)
+        for (; s < kMaxContactSubsteps; s = std::min(2 * s, kMaxContactSubsteps))
             if (holds(s) || (contact && contactsSaturated(s))) break;
         return s;
     };
