@@ -514,6 +514,27 @@ double springRate(const Scene& scene, const SystemSwitches& switches) {
     return rate;
 }
 
+/// Marks the boxes (lo, hi, size, touching) that touch another as placed:
+/// a gap under a quarter of the smaller one's size. Sweeps along x.
+template <class PlacedBox>
+void markTouching(std::vector<PlacedBox>& boxes) {
+    std::vector<std::uint32_t> byLeft(boxes.size());
+    for (std::uint32_t i = 0; i < byLeft.size(); ++i) byLeft[i] = i;
+    std::sort(byLeft.begin(), byLeft.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return boxes[a].lo.x != boxes[b].lo.x ? boxes[a].lo.x < boxes[b].lo.x : a < b;
+    });
+    for (std::size_t i = 0; i < byLeft.size(); ++i) {
+        PlacedBox& a = boxes[byLeft[i]];
+        for (std::size_t k = i + 1; k < byLeft.size(); ++k) {
+            PlacedBox& b = boxes[byLeft[k]];
+            if (b.lo.x - a.hi.x > 0.25 * a.size) break;  // and every later one
+            const double gap = 0.25 * std::min(a.size, b.size);
+            if (b.lo.x - a.hi.x > gap || b.lo.y - a.hi.y > gap || a.lo.y - b.hi.y > gap) continue;
+            a.touching = b.touching = true;
+        }
+    }
+}
+
 /// The impact rule (ContactSettingsChoice::impactSubsteps). A body moving
 /// at v (its centre's speed plus its spin times its reach) with mass M and
 /// restitution e_a strikes a body of mass m, size d and restitution e_b:
@@ -584,22 +605,7 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
     // one pass over the bodies.
     if (!(fastest * (1.0 + bounciest) * dt > kImpactTravel * smallest)) return;
 
-    // Which bodies touch another as placed: sweep along x.
-    std::vector<std::uint32_t> byLeft(bodies.size());
-    for (std::uint32_t i = 0; i < byLeft.size(); ++i) byLeft[i] = i;
-    std::sort(byLeft.begin(), byLeft.end(), [&](std::uint32_t a, std::uint32_t b) {
-        return bodies[a].lo.x != bodies[b].lo.x ? bodies[a].lo.x < bodies[b].lo.x : a < b;
-    });
-    for (std::size_t i = 0; i < byLeft.size(); ++i) {
-        Body& a = bodies[byLeft[i]];
-        for (std::size_t k = i + 1; k < byLeft.size(); ++k) {
-            Body& b = bodies[byLeft[k]];
-            if (b.lo.x - a.hi.x > 0.25 * a.size) break;  // and every later one
-            const double gap = 0.25 * std::min(a.size, b.size);
-            if (b.lo.x - a.hi.x > gap || b.lo.y - a.hi.y > gap || a.lo.y - b.hi.y > gap) continue;
-            a.touching = b.touching = true;
-        }
-    }
+    markTouching(bodies);
 
     struct Struck {
         double size, mass, restitution;
@@ -669,6 +675,95 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
     choice.impactSubsteps = s;
 }
 
+/// The steady load the contact rules read as gravity (m/s^2): the world's
+/// gravity, plus the field of the attractors that do not move under it
+/// (static or kinematic ones, a planet under a level), where that sum is
+/// strongest on a dynamic body that rests on something as the level places
+/// it: touches another shape, a chain or a plane. A stack on such a planet
+/// bears the field as it would bear gravity; a body in orbit bears none of
+/// it, however strong the pull. A dynamic attractor's pull moves with it
+/// and is left to the impacts it causes.
+template <class IsStatic, class Dynamic, class MassOf, class HasShape>
+Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStatic& isStatic,
+                const Dynamic& dynamic, const MassOf& massOf, const HasShape& hasShape) {
+    const Registry& reg = scene.registry;
+    const Vec2 gravity = switches.gravity ? scene.world.gravity : Vec2{};
+    if (!switches.attractors || !switches.collisions) return gravity;
+    struct Source {
+        Vec2 at;
+        double gm, eps2;
+    };
+    std::vector<Source> sources;
+    for (const Entity e : reg.entities())
+        if (const Attractor* a = reg.tryGet<Attractor>(e); a && reg.alive(e) && isStatic(e) && reg.has<Position>(e))
+            sources.push_back({reg.tryGet<Position>(e)->value, scene.world.G * massOf(e), a->softening * a->softening});
+    if (sources.empty()) return gravity;
+
+    // Every shape as placed, static ones and chain segments included; only
+    // a dynamic one's field is read.
+    struct Placed {
+        Vec2 lo, hi;
+        double size;
+        bool touching;
+        Entity body;  // null for static shapes
+    };
+    std::vector<Placed> placed;
+    struct Halfspace {
+        Vec2 normal;
+        double offset;
+    };
+    std::vector<Halfspace> planes;
+    const Vec2 xAxis{1.0, 0.0}, yAxis{0.0, 1.0};
+    for (const Entity e : reg.entities()) {
+        if (!reg.alive(e)) continue;
+        if (const Plane* p = reg.tryGet<Plane>(e)) {
+            if (const double len = length(p->normal); len > 0.0) planes.push_back({p->normal / len, p->offset});
+            continue;
+        }
+        if (!reg.has<Position>(e)) continue;
+        const Vec2 pos = reg.tryGet<Position>(e)->value;
+        if (const Chain* chain = reg.tryGet<Chain>(e); chain && isStatic(e)) {
+            const collision::Rot q = collision::Rot::fromAngle(reg.has<Angle>(e) ? reg.tryGet<Angle>(e)->value : 0.0);
+            const std::size_t n = chain->points.size(), segments = chain->loop ? n : n - 1;
+            for (std::size_t k = 0; k < segments && n >= 2; ++k) {
+                const Vec2 a = pos + collision::rotate(q, chain->points[k]);
+                const Vec2 b = pos + collision::rotate(q, chain->points[(k + 1) % n]);
+                const Vec2 lo{std::min(a.x, b.x), std::min(a.y, b.y)}, hi{std::max(a.x, b.x), std::max(a.y, b.y)};
+                placed.push_back({lo, hi, length(b - a), false, Entity{}});
+            }
+            continue;
+        }
+        if (!hasShape(e) || !(isStatic(e) || dynamic(e))) continue;
+        if (const Sensor* se = reg.tryGet<Sensor>(e); se && se->value) continue;  // holds nothing up
+        const Vec2 half{halfExtentAlong(reg, e, xAxis), halfExtentAlong(reg, e, yAxis)};
+        const Vec2 centre = pos + Vec2{centreAlong(reg, e, xAxis), centreAlong(reg, e, yAxis)};
+        placed.push_back({centre - half, centre + half, 2.0 * std::max(half.x, half.y), false,
+                          isStatic(e) ? Entity{} : e});
+    }
+    markTouching(placed);
+
+    Vec2 strongest = gravity;
+    for (const Placed& b : placed) {
+        if (b.body.isNull()) continue;
+        const auto onPlane = [&](const Halfspace& h) {
+            const Vec2 centre = 0.5 * (b.lo + b.hi), half = 0.5 * (b.hi - b.lo);
+            const double reach = std::abs(h.normal.x) * half.x + std::abs(h.normal.y) * half.y;
+            return dot(h.normal, centre) - h.offset - reach <= 0.25 * b.size;
+        };
+        if (!b.touching && std::none_of(planes.begin(), planes.end(), onPlane)) continue;
+        const Vec2 p = reg.tryGet<Position>(b.body)->value;
+        Vec2 field = gravity;
+        for (const Source& s : sources) {
+            const Vec2 r = s.at - p;
+            const double d2 = lengthSquared(r) + s.eps2;
+            if (d2 > 0.0) field += (s.gm / (d2 * std::sqrt(d2))) * r;
+        }
+        if (std::isfinite(field.x) && std::isfinite(field.y) && lengthSquared(field) > lengthSquared(strongest))
+            strongest = field;
+    }
+    return strongest;
+}
+
 } // namespace
 
 double expectedPileOverlap(int depth, double gravity, double h, double massRatio, double hertzFraction,
@@ -704,6 +799,7 @@ std::string ContactSettingsChoice::reason() const {
         add("pile " + std::to_string(stackDepth) + " deep" +
             (massRatio > 1.0 ? ", mass ratio " + number(massRatio) + ":1" : std::string()));
     if (columnHeight > stackDepth) add("stack " + std::to_string(columnHeight) + " high");
+    if (attractorLoad) add("attractors load resting bodies at up to " + number(gravity) + " m/s^2");
     if (loadSubsteps > 1 && loadSubsteps == substeps)
         add("load " + number(gravity) + " m/s^2 on " + number(diameter) + " m bodies" +
             (support > 0.0 ? ", supports " + number(support) + " m thick" : std::string()));
@@ -727,10 +823,6 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     ContactSettingsChoice choice;
     const Registry& reg = scene.registry;
     const auto& order = reg.entities();
-    const Vec2 gravity = switches.gravity ? scene.world.gravity : Vec2{};
-    choice.gravity = length(gravity);
-    const Vec2 down = choice.gravity > 0.0 ? gravity / choice.gravity : Vec2{0.0, -1.0};
-    const Vec2 across{-down.y, down.x};
     // A kinematic body carries loads like a static one.
     const auto isStatic = [&](Entity e) {
         const Static* st = reg.tryGet<Static>(e);
@@ -753,6 +845,11 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         const Shapes* shapes = reg.tryGet<Shapes>(e);
         return shapes ? compoundMassProperties(*shapes, std::nullopt).mass : 1.0;
     };
+    const Vec2 gravity = steadyLoad(scene, switches, isStatic, dynamic, massOf, hasShape);
+    choice.gravity = length(gravity);
+    choice.attractorLoad = gravity != (switches.gravity ? scene.world.gravity : Vec2{});
+    const Vec2 down = choice.gravity > 0.0 ? gravity / choice.gravity : Vec2{0.0, -1.0};
+    const Vec2 across{-down.y, down.x};
     const auto sizeOf = [&](Entity e) {
         return hasShape(e) ? 2.0 * std::max(halfExtentAlong(reg, e, across), halfExtentAlong(reg, e, down))
                            : 2.0 * detail::kShapelessRadius;
