@@ -591,6 +591,22 @@ Case crateOnBridge(double mass) {
     return c;
 }
 
+/// Ten 1 m boxes stacked edge to edge from y = 0 up, on ground below.
+void addTenBoxes(Scene& s) {
+    for (int k = 0; k < 10; ++k) {
+        const Entity box = add(s, {0.0, 0.5 + k});
+        s.registry.emplace<Box>(box, Box{1.0, 1.0});
+        s.registry.emplace<Friction>(box, Friction{0.6});
+    }
+}
+
+/// How far the top box (the last body) sank, and how far it moved sideways.
+Figures topBoxSinkage(const Bodies& b, const Run& r) {
+    const Vec2 top = r.final.back().p, start = b.start.back();
+    return Figures{std::max(0.0, start.y - top.y), fmt("sank %.3g mm, sideways %.3g mm", 1e3 * (start.y - top.y),
+                                                       1e3 * std::abs(top.x - start.x))};
+}
+
 /// Ten 1 m boxes stacked edge to edge on the ground, under gravity g.
 Case stackOf10(double g) {
     Case c;
@@ -599,17 +615,28 @@ Case stackOf10(double g) {
     c.errorLabel = "sinkage of the top box, m";
     Scene& s = c.scene = baseWorld(g);
     addStatic(s, {0.0, -0.5}, 20.0, 1.0, 0.6);
-    for (int k = 0; k < 10; ++k) {
-        const Entity box = add(s, {0.0, 0.5 + k});
-        s.registry.emplace<Box>(box, Box{1.0, 1.0});
-        s.registry.emplace<Friction>(box, Friction{0.6});
-    }
+    addTenBoxes(s);
     c.steps = 180;
-    c.measure = [](const Bodies& b, const Run& r) {
-        const Vec2 top = r.final.back().p, start = b.start.back();
-        return Figures{std::max(0.0, start.y - top.y), fmt("sank %.3g mm, sideways %.3g mm", 1e3 * (start.y - top.y),
-                                                           1e3 * std::abs(top.x - start.x))};
-    };
+    c.measure = topBoxSinkage;
+    return c;
+}
+
+/// The same stack standing on a planet: a static attractor of radius
+/// 100 m, no gravity, pulling `pull` m/s^2 at its surface. Box2D has no
+/// attractors.
+Case stackOnAPlanet(double pull) {
+    Case c = stackOf10(10.0);
+    c.name = "stack of 10 boxes on a planet, pull " + fmt("%g", pull);
+    Scene& s = c.scene = baseWorld(0.0);
+    const double radius = 100.0;
+    const Entity planet = add(s, {0.0, -radius});
+    s.registry.emplace<Static>(planet, Static{true});
+    s.registry.emplace<Radius>(planet, Radius{radius});
+    s.registry.emplace<Mass>(planet, Mass{pull * radius * radius});  // G = 1
+    s.registry.emplace<Attractor>(planet, Attractor{0.0});
+    s.registry.emplace<Friction>(planet, Friction{0.6});
+    addTenBoxes(s);
+    c.box2d = false;
     return c;
 }
 
@@ -923,6 +950,7 @@ int main(int argc, char** argv) {
     cases.push_back(chainOf20());
     for (double mass : {4.0, 100.0}) cases.push_back(crateOnBridge(mass));
     for (double g : {10.0, 1e4}) cases.push_back(stackOf10(g));
+    cases.push_back(stackOnAPlanet(1000.0));
     for (int n : {64, 1000, 10000})
         if (!(quick && n > 1000)) cases.push_back(crowd(n));
     cases.push_back(pile300());
