@@ -291,16 +291,43 @@ TEST(HardSettings, AStaticAttractorLoadsAStackAsGravityDoes) {
     }
 }
 
-// A body in orbit rests on nothing: however strong its pull, it is no
-// load for the contact rules. The stack above a planet (10 m/s^2 at its
-// floor), plus a moon (a 0.2 m ball) 2 m from a sun 1.4 km away that
-// pulls it at 10^4 m/s^2 and touches nothing: the choice is the stack's
-// alone. Read where strongest on any body, the level was taken
-// as under 10^4 m/s^2, "down" towards the second attractor (a planet
-// orbiting a sun in render_showcase.json was read so). And a stack that
-// stands on the attractor's own surface (a planet with a radius, no
-// floor) bears its field: after 2 s at 1000 m/s^2 its top is within
-// 1.5 cm of where it started.
+/// Ten 1 m boxes in a column on (or, with `gap` > 0, dropped from 1 m
+/// above, `gap` metres apart) a planet of radius 100 m pulling `field`
+/// m/s^2 at its surface, no gravity.
+std::string onPlanetLevel(double field, double gap = 0.0, int boxes = 10) {
+    const double r = 100.0;
+    std::ostringstream level;
+    level << R"({"world": {"gravity": {"x": 0, "y": 0}, "G": 1}, "entities": [)"
+          << R"({"name": "planet", "position": {"x": 0, "y": )" << num(-r) << R"(}, "static": true, "mass": )"
+          << num(field * r * r) << R"(, "radius": )" << num(r) << R"(, "friction": 0.6, "attractor": {"softening": 0}})";
+    const double bottom = gap > 0.0 ? 1.5 : 0.5;
+    for (int k = 0; k < boxes; ++k)
+        level << R"(, {"name": "box)" << k << R"(", "position": {"x": 0, "y": )" << num(bottom + k * (1.0 + gap))
+              << R"(}, "mass": 1, "friction": 0.6, "box": {"width": 1, "height": 1}})";
+    level << "]}";
+    return level.str();
+}
+
+// Only bodies that rest on or under another bear a load the contact rules
+// need: a body in orbit rests on nothing, and a lone body on static ground
+// holds at any load (its contacts turn rigid before the slop).
+// - The stack above a planet (10 m/s^2 at its floor), plus a moon (a 0.2 m
+//   ball) 2 m from a sun 1.4 km away that pulls it at 10^4 m/s^2 and
+//   touches nothing: the choice is the stack's alone. Read where strongest
+//   on any body, the level was taken as under 10^4 m/s^2.
+// - render_showcase.json: its planet lands alone on the sun within a
+//   second and rests there under 233 m/s^2; the level is read under
+//   gravity, as before. Read on every body that lands, it was warned that
+//   10 substeps would carry a load its one pile does not bear.
+// - A stack standing on the planet's own surface (no floor) bears its
+//   field: after 2 s at 10 and 1000 m/s^2 its top is within 1.5 cm of
+//   where it started.
+// - The same boxes dropped from 1 m above it, half a metre apart, land
+//   where the stack stands: the choice reads the field there and chooses
+//   the stack's substeps. Read as placed (apart, in the air), they got 1
+//   substep and fell through the planet at 1000 m/s^2.
+// - One box resting on the planet at 10^4 m/s^2 is no load, and rests
+//   within the slop.
 TEST(HardSettings, OnlyBodiesThatRestOnSomethingBearASteadyLoad) {
     const std::string alone = planetStackLevel({}, 10.0, 0.0);
     std::string withMoon = alone;
@@ -316,18 +343,16 @@ TEST(HardSettings, OnlyBodiesThatRestOnSomethingBearASteadyLoad) {
     EXPECT_EQ(got.contactHertz, expected.contactHertz) << got.reason();
     EXPECT_EQ(got.columnHeight, 10) << got.reason();
 
+    Result<Scene> showcase = loadSceneFile(std::string(STEPWISE_SOURCE_DIR) + "/levels/render_showcase.json");
+    ASSERT_TRUE(showcase) << showcase.error();
+    const ContactSettingsChoice showcaseChoice = chooseContactSettings(*showcase);
+    EXPECT_EQ(showcaseChoice.gravity, 9.81) << showcaseChoice.reason();
+    EXPECT_FALSE(showcaseChoice.attractorLoad) << showcaseChoice.reason();
+    EXPECT_FALSE(build(*showcase).contactStiffnessHint());
+
+    const double r = 100.0;
     for (const double field : {10.0, 1000.0}) {
-        const double r = 100.0;
-        std::ostringstream level;
-        level << R"({"world": {"gravity": {"x": 0, "y": 0}, "G": 1}, "entities": [)"
-              << R"({"name": "planet", "position": {"x": 0, "y": )" << num(-r) << R"(}, "static": true, "mass": )"
-              << num(field * r * r) << R"(, "radius": )" << num(r)
-              << R"(, "friction": 0.6, "attractor": {"softening": 0}})";
-        for (int k = 0; k < 10; ++k)
-            level << R"(, {"name": "box)" << k << R"(", "position": {"x": 0, "y": )" << num(0.5 + k)
-                  << R"(}, "mass": 1, "friction": 0.6, "box": {"width": 1, "height": 1}})";
-        level << "]}";
-        const Scene onPlanet = parse(level.str());
+        const Scene onPlanet = parse(onPlanetLevel(field));
         const ContactSettingsChoice choice = chooseContactSettings(onPlanet);
         const std::string label = "field " + num(field) + " (" + choice.reason() + ")";
         EXPECT_NEAR(choice.gravity, field * r * r / ((r + 0.5) * (r + 0.5)), 1e-9 * field) << label;
@@ -339,7 +364,24 @@ TEST(HardSettings, OnlyBodiesThatRestOnSomethingBearASteadyLoad) {
         for (int i = 0; i < 120; ++i) ASSERT_TRUE(w.step().ok()) << label;
         EXPECT_LT(9.5 - w.bodyPosition(9).y, 0.015) << label;
         EXPECT_LT(std::abs(w.bodyPosition(9).x), 0.01) << label;
+
+        const Scene dropped = parse(onPlanetLevel(field, 0.5));
+        const ContactSettingsChoice landed = chooseContactSettings(dropped);
+        const std::string droppedLabel = "dropped, field " + num(field) + " (" + landed.reason() + ")";
+        // Where the path first comes within a quarter box of the planet.
+        EXPECT_NEAR(landed.gravity, field, 0.02 * field) << droppedLabel;
+        EXPECT_EQ(landed.substeps, choice.substeps) << droppedLabel;
+        World fell = build(dropped);
+        for (int i = 0; i < 300; ++i) ASSERT_TRUE(fell.step().ok()) << droppedLabel;
+        EXPECT_LT(std::abs(9.5 - fell.bodyPosition(9).y), 0.015) << droppedLabel;
     }
+
+    const Scene lone = parse(onPlanetLevel(1e4, 0.0, 1));
+    const ContactSettingsChoice loneChoice = chooseContactSettings(lone);
+    EXPECT_EQ(loneChoice.gravity, 0.0) << loneChoice.reason();
+    World w = build(lone);
+    for (int i = 0; i < 120; ++i) ASSERT_TRUE(w.step().ok());
+    EXPECT_LT(0.5 - w.bodyPosition(0).y, 0.005);
 }
 
 // The warning names the substeps that would carry the stiffness a load

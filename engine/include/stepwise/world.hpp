@@ -247,7 +247,7 @@ struct ContactSettingsChoice {
     int stackDepth = 0;        ///< bodies in the deepest column the scene can pile up
     double diameter = 0.0;     ///< metres, the median dynamic shape's size
     /// m/s^2, the steady load: |world.gravity|, plus static attractors'
-    /// pull where the sum is strongest on a body resting on something
+    /// pull where the sum is strongest on a body resting with another
     double gravity = 0.0;
     bool attractorLoad = false;  ///< the load includes attractors' pull
     double massRatio = 1.0;    ///< heaviest / lightest dynamic shape that can pile

@@ -678,11 +678,12 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
 /// The steady load the contact rules read as gravity (m/s^2): the world's
 /// gravity, plus the field of the attractors that do not move under it
 /// (static or kinematic ones, a planet under a level), where that sum is
-/// strongest on a dynamic body that rests on something as the level places
-/// it: touches another shape, a chain or a plane. A stack on such a planet
-/// bears the field as it would bear gravity; a body in orbit bears none of
-/// it, however strong the pull. A dynamic attractor's pull moves with it
-/// and is left to the impacts it causes.
+/// strongest on a dynamic body resting with another: touching another
+/// moving body as the level places it, or coming to rest on static
+/// geometry (a shape, a chain or a plane) where another does. A stack on
+/// such a planet bears the field as it would bear gravity; a body in orbit
+/// bears none of it, however strong the pull. A dynamic attractor's pull
+/// moves with it and is left to the impacts it causes.
 template <class IsStatic, class Dynamic, class MassOf, class HasShape>
 Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStatic& isStatic,
                 const Dynamic& dynamic, const MassOf& massOf, const HasShape& hasShape) {
@@ -740,24 +741,91 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
         placed.push_back({centre - half, centre + half, 2.0 * std::max(half.x, half.y), false,
                           isStatic(e) ? Entity{} : e});
     }
-    markTouching(placed);
 
-    Vec2 strongest = gravity;
-    for (const Placed& b : placed) {
-        if (b.body.isNull()) continue;
-        const auto onPlane = [&](const Halfspace& h) {
-            const Vec2 centre = 0.5 * (b.lo + b.hi), half = 0.5 * (b.hi - b.lo);
-            const double reach = std::abs(h.normal.x) * half.x + std::abs(h.normal.y) * half.y;
-            return dot(h.normal, centre) - h.offset - reach <= 0.25 * b.size;
-        };
-        if (!b.touching && std::none_of(planes.begin(), planes.end(), onPlane)) continue;
-        const Vec2 p = reg.tryGet<Position>(b.body)->value;
+    const auto fieldAt = [&](Vec2 p) {
         Vec2 field = gravity;
         for (const Source& s : sources) {
             const Vec2 r = s.at - p;
             const double d2 = lengthSquared(r) + s.eps2;
             if (d2 > 0.0) field += (s.gm / (d2 * std::sqrt(d2))) * r;
         }
+        return field;
+    };
+    std::vector<const Placed*> statics;
+    std::size_t dynamicCount = 0;
+    for (const Placed& b : placed) {
+        if (b.body.isNull()) statics.push_back(&b);
+        else ++dynamicCount;
+    }
+    // A box (lo, hi) of a shape `size` across within a quarter of its size
+    // of static geometry.
+    const auto meetsStatic = [&](Vec2 lo, Vec2 hi, double size) {
+        const double gap = 0.25 * size;
+        for (const Placed* o : statics)
+            if (o->lo.x - hi.x <= gap && lo.x - o->hi.x <= gap && o->lo.y - hi.y <= gap && lo.y - o->hi.y <= gap)
+                return true;
+        const Vec2 centre = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
+        return std::any_of(planes.begin(), planes.end(), [&](const Halfspace& h) {
+            const double reach = std::abs(h.normal.x) * half.x + std::abs(h.normal.y) * half.y;
+            return dot(h.normal, centre) - h.offset - reach <= gap;
+        });
+    };
+    // A body placed apart lands when its path under the steady fields (a
+    // point's, from its velocity as placed) meets static geometry within
+    // kHorizon: boxes dropped onto a planet bear its pull where they land.
+    // One in orbit never meets any. Each step of the path is swept, so a
+    // fast body does not skip a thin support. Past kMostPathWork box tests
+    // (bodies x steps x static shapes) the paths are not followed, and only
+    // the bodies placed resting count.
+    constexpr double kHorizon = 2.0;  // s
+    constexpr int kPathSteps = 256;
+    constexpr double kMostPathWork = 5e7;
+    const bool followPaths =
+        double(dynamicCount) * kPathSteps * double(statics.size() + planes.size() + 1) <= kMostPathWork;
+    // Where a body placed apart from the others comes to rest, if it does.
+    const auto landing = [&](const Placed& b) -> std::optional<Vec2> {
+        const Vec2 at = reg.tryGet<Position>(b.body)->value;
+        if (meetsStatic(b.lo, b.hi, b.size)) return at;
+        if (!followPaths) return std::nullopt;
+        const Velocity* given = reg.tryGet<Velocity>(b.body);
+        Vec2 x = at, v = given ? given->value : Vec2{};
+        const Vec2 half = 0.5 * (b.hi - b.lo), offset = 0.5 * (b.lo + b.hi) - at;
+        const double h = kHorizon / kPathSteps;
+        for (int i = 0; i < kPathSteps; ++i) {
+            v += h * fieldAt(x);
+            const Vec2 next = x + h * v;
+            if (!std::isfinite(next.x) || !std::isfinite(next.y)) return std::nullopt;
+            const Vec2 lo{std::min(x.x, next.x), std::min(x.y, next.y)}, hi{std::max(x.x, next.x), std::max(x.y, next.y)};
+            if (meetsStatic(lo + offset - half, hi + offset + half, b.size)) return next;
+            x = next;
+        }
+        return std::nullopt;
+    };
+    // Only bodies that rest on or under another bear a load the contact
+    // rules need: a lone body on static ground holds at any load (its
+    // contacts turn rigid before the slop), so a planet that lands alone
+    // on its sun does not make the level heavy. A body counts where it
+    // rests when it touches another moving body as placed, or when it
+    // lands (or rests alone) where another such body is.
+    std::vector<Placed> moving;
+    for (const Placed& b : placed)
+        if (!b.body.isNull()) moving.push_back(b);
+    markTouching(moving);
+    std::vector<Placed> resting;  // touching: rests with another
+    std::vector<Vec2> restsAt;    // where each of `resting` rests
+    for (const Placed& b : moving) {
+        const Vec2 placedAt = reg.tryGet<Position>(b.body)->value;
+        const std::optional<Vec2> at = b.touching ? std::optional<Vec2>(placedAt) : landing(b);
+        if (!at) continue;
+        const Vec2 move = *at - placedAt;
+        resting.push_back({b.lo + move, b.hi + move, b.size, b.touching, b.body});
+        restsAt.push_back(*at);
+    }
+    markTouching(resting);
+    Vec2 strongest = gravity;
+    for (std::size_t i = 0; i < resting.size(); ++i) {
+        if (!resting[i].touching) continue;
+        const Vec2 field = fieldAt(restsAt[i]);
         if (std::isfinite(field.x) && std::isfinite(field.y) && lengthSquared(field) > lengthSquared(strongest))
             strongest = field;
     }
