@@ -326,6 +326,8 @@ std::string onPlanetLevel(double field, double gap = 0.0, int boxes = 10) {
 //   where the stack stands: the choice reads the field there and chooses
 //   the stack's substeps. Read as placed (apart, in the air), they got 1
 //   substep and fell through the planet at 1000 m/s^2.
+// - Two boxes placed touching in orbit fall together and never land: no
+//   load. (Read as placed, touching each other, they were 694 m/s^2.)
 // - One box resting on the planet at 10^4 m/s^2 is no load, and rests
 //   within the slop.
 TEST(HardSettings, OnlyBodiesThatRestOnSomethingBearASteadyLoad) {
@@ -375,6 +377,22 @@ TEST(HardSettings, OnlyBodiesThatRestOnSomethingBearASteadyLoad) {
         for (int i = 0; i < 300; ++i) ASSERT_TRUE(fell.step().ok()) << droppedLabel;
         EXPECT_LT(std::abs(9.5 - fell.bodyPosition(9).y), 0.015) << droppedLabel;
     }
+
+    // Two boxes placed touching in a circular orbit 120 m from the planet's
+    // centre, at 45 degrees (inside the corner of the planet's bounding
+    // box): they fall together and never land, so they bear nothing.
+    std::string orbiting = onPlanetLevel(1000.0, 0.0, 0);
+    const double v = std::sqrt(1000.0 * r * r / 120.0);
+    for (const double at : {120.0, 121.0}) {
+        const double c = std::sqrt(0.5);
+        orbiting.insert(orbiting.rfind("]}"), R"(, {"name": "r)" + num(at) + R"(", "position": {"x": )" +
+                                                  num(at * c) + R"(, "y": )" + num(-r + at * c) +
+                                                  R"(}, "velocity": {"x": )" + num(-v * c) + R"(, "y": )" +
+                                                  num(v * c) + R"(}, "mass": 1, "box": {"width": 1, "height": 1}})");
+    }
+    const ContactSettingsChoice inOrbit = chooseContactSettings(parse(orbiting));
+    EXPECT_EQ(inOrbit.gravity, 0.0) << inOrbit.reason();
+    EXPECT_FALSE(inOrbit.attractorLoad) << inOrbit.reason();
 
     const Scene lone = parse(onPlanetLevel(1e4, 0.0, 1));
     const ContactSettingsChoice loneChoice = chooseContactSettings(lone);

@@ -514,25 +514,32 @@ double springRate(const Scene& scene, const SystemSwitches& switches) {
     return rate;
 }
 
-/// Marks the boxes (lo, hi, size, touching) that touch another as placed:
-/// a gap under a quarter of the smaller one's size. Sweeps along x.
-template <class PlacedBox>
-void markTouching(std::vector<PlacedBox>& boxes) {
+/// Calls touch(i, j) for each pair of the boxes (lo, hi, size) that touch
+/// as placed: a gap under a quarter of the smaller one's size. Sweeps
+/// along x.
+template <class PlacedBox, class Touch>
+void forEachTouchingPair(const std::vector<PlacedBox>& boxes, const Touch& touch) {
     std::vector<std::uint32_t> byLeft(boxes.size());
     for (std::uint32_t i = 0; i < byLeft.size(); ++i) byLeft[i] = i;
     std::sort(byLeft.begin(), byLeft.end(), [&](std::uint32_t a, std::uint32_t b) {
         return boxes[a].lo.x != boxes[b].lo.x ? boxes[a].lo.x < boxes[b].lo.x : a < b;
     });
     for (std::size_t i = 0; i < byLeft.size(); ++i) {
-        PlacedBox& a = boxes[byLeft[i]];
+        const PlacedBox& a = boxes[byLeft[i]];
         for (std::size_t k = i + 1; k < byLeft.size(); ++k) {
-            PlacedBox& b = boxes[byLeft[k]];
+            const PlacedBox& b = boxes[byLeft[k]];
             if (b.lo.x - a.hi.x > 0.25 * a.size) break;  // and every later one
             const double gap = 0.25 * std::min(a.size, b.size);
             if (b.lo.x - a.hi.x > gap || b.lo.y - a.hi.y > gap || a.lo.y - b.hi.y > gap) continue;
-            a.touching = b.touching = true;
+            touch(byLeft[i], byLeft[k]);
         }
     }
+}
+
+/// Marks the boxes (lo, hi, size, touching) that touch another as placed.
+template <class PlacedBox>
+void markTouching(std::vector<PlacedBox>& boxes) {
+    forEachTouchingPair(boxes, [&](std::uint32_t i, std::uint32_t j) { boxes[i].touching = boxes[j].touching = true; });
 }
 
 /// The impact rule (ContactSettingsChoice::impactSubsteps). A body moving
@@ -678,9 +685,10 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
 /// The steady load the contact rules read as gravity (m/s^2): the world's
 /// gravity, plus the field of the attractors that do not move under it
 /// (static or kinematic ones, a planet under a level), where that sum is
-/// strongest on a dynamic body resting with another: touching another
-/// moving body as the level places it, or coming to rest on static
-/// geometry (a shape, a chain or a plane) where another does. A stack on
+/// strongest on a dynamic body resting with another: in a group placed
+/// touching that meets static geometry (a shape, a chain or a plane) as
+/// placed or along its members' paths, or alone, coming to rest beside
+/// another. A stack on
 /// such a planet bears the field as it would bear gravity; a body in orbit
 /// bears none of it, however strong the pull. A dynamic attractor's pull
 /// moves with it and is left to the impacts it causes.
@@ -706,7 +714,8 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
         Vec2 lo, hi;
         double size;
         bool touching;
-        Entity body;  // null for static shapes
+        Entity body;         // null for static shapes
+        double radius = 0.0;  // a static circle's (a round planet), tested exactly
     };
     std::vector<Placed> placed;
     struct Halfspace {
@@ -738,8 +747,10 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
         if (const Sensor* se = reg.tryGet<Sensor>(e); se && se->value) continue;  // holds nothing up
         const Vec2 half{halfExtentAlong(reg, e, xAxis), halfExtentAlong(reg, e, yAxis)};
         const Vec2 centre = pos + Vec2{centreAlong(reg, e, xAxis), centreAlong(reg, e, yAxis)};
+        const bool circle = reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) && !reg.has<Capsule>(e) &&
+                            !reg.has<Shapes>(e);
         placed.push_back({centre - half, centre + half, 2.0 * std::max(half.x, half.y), false,
-                          isStatic(e) ? Entity{} : e});
+                          isStatic(e) ? Entity{} : e, isStatic(e) && circle ? half.x : 0.0});
     }
 
     const auto fieldAt = [&](Vec2 p) {
@@ -761,9 +772,15 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
     // of static geometry.
     const auto meetsStatic = [&](Vec2 lo, Vec2 hi, double size) {
         const double gap = 0.25 * size;
-        for (const Placed* o : statics)
-            if (o->lo.x - hi.x <= gap && lo.x - o->hi.x <= gap && o->lo.y - hi.y <= gap && lo.y - o->hi.y <= gap)
-                return true;
+        for (const Placed* o : statics) {
+            if (!(o->lo.x - hi.x <= gap && lo.x - o->hi.x <= gap && o->lo.y - hi.y <= gap && lo.y - o->hi.y <= gap))
+                continue;
+            if (o->radius == 0.0) return true;
+            // A circle: the box's nearest point to its centre.
+            const Vec2 c = 0.5 * (o->lo + o->hi);
+            const Vec2 nearest{std::clamp(c.x, lo.x, hi.x), std::clamp(c.y, lo.y, hi.y)};
+            if (length(nearest - c) - o->radius <= gap) return true;
+        }
         const Vec2 centre = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
         return std::any_of(planes.begin(), planes.end(), [&](const Halfspace& h) {
             const double reach = std::abs(h.normal.x) * half.x + std::abs(h.normal.y) * half.y;
@@ -776,13 +793,14 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
     // One in orbit never meets any. Each step of the path is swept, so a
     // fast body does not skip a thin support. Past kMostPathWork box tests
     // (bodies x steps x static shapes) the paths are not followed, and only
-    // the bodies placed resting count.
+    // the groups placed on static geometry count.
     constexpr double kHorizon = 2.0;  // s
     constexpr int kPathSteps = 256;
     constexpr double kMostPathWork = 5e7;
     const bool followPaths =
         double(dynamicCount) * kPathSteps * double(statics.size() + planes.size() + 1) <= kMostPathWork;
-    // Where a body placed apart from the others comes to rest, if it does.
+    // Where a body meets static geometry, as placed or along its path, if
+    // it does.
     const auto landing = [&](const Placed& b) -> std::optional<Vec2> {
         const Vec2 at = reg.tryGet<Position>(b.body)->value;
         if (meetsStatic(b.lo, b.hi, b.size)) return at;
@@ -804,18 +822,31 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
     // Only bodies that rest on or under another bear a load the contact
     // rules need: a lone body on static ground holds at any load (its
     // contacts turn rigid before the slop), so a planet that lands alone
-    // on its sun does not make the level heavy. A body counts where it
-    // rests when it touches another moving body as placed, or when it
-    // lands (or rests alone) where another such body is.
+    // on its sun does not make the level heavy. Moving bodies placed
+    // touching make groups (union-find). A group in the air (falling
+    // together, or in orbit) bears nothing from within itself: it rests
+    // where it meets static geometry, as placed or along its members'
+    // paths. A body placed alone counts where it rests beside another.
     std::vector<Placed> moving;
     for (const Placed& b : placed)
         if (!b.body.isNull()) moving.push_back(b);
-    markTouching(moving);
+    std::vector<std::uint32_t> group(moving.size());
+    for (std::uint32_t i = 0; i < group.size(); ++i) group[i] = i;
+    forEachTouchingPair(moving, [&](std::uint32_t i, std::uint32_t j) {
+        moving[i].touching = moving[j].touching = true;
+        const std::uint32_t ri = findRoot(group, i), rj = findRoot(group, j);
+        if (ri != rj) group[std::max(ri, rj)] = std::min(ri, rj);
+    });
+    std::vector<std::uint8_t> groupOnGround(moving.size(), 0);
+    for (std::uint32_t i = 0; i < moving.size(); ++i)
+        if (moving[i].touching && meetsStatic(moving[i].lo, moving[i].hi, moving[i].size))
+            groupOnGround[findRoot(group, i)] = 1;
     std::vector<Placed> resting;  // touching: rests with another
     std::vector<Vec2> restsAt;    // where each of `resting` rests
-    for (const Placed& b : moving) {
+    for (std::uint32_t i = 0; i < moving.size(); ++i) {
+        const Placed& b = moving[i];
         const Vec2 placedAt = reg.tryGet<Position>(b.body)->value;
-        const std::optional<Vec2> at = b.touching ? std::optional<Vec2>(placedAt) : landing(b);
+        const std::optional<Vec2> at = groupOnGround[findRoot(group, i)] ? std::optional<Vec2>(placedAt) : landing(b);
         if (!at) continue;
         const Vec2 move = *at - placedAt;
         resting.push_back({b.lo + move, b.hi + move, b.size, b.touching, b.body});
