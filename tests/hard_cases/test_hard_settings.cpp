@@ -293,13 +293,16 @@ TEST(HardSettings, AStaticAttractorLoadsAStackAsGravityDoes) {
 
 /// Ten 1 m boxes in a column on (or, with `gap` > 0, dropped from 1 m
 /// above, `gap` metres apart) a planet of radius 100 m pulling `field`
-/// m/s^2 at its surface, no gravity.
-std::string onPlanetLevel(double field, double gap = 0.0, int boxes = 10) {
+/// m/s^2 at its surface, static unless `dynamicPlanet`, under `gravity`
+/// m/s^2 (down).
+std::string onPlanetLevel(double field, double gap = 0.0, int boxes = 10, bool dynamicPlanet = false,
+                          double gravity = 0.0) {
     const double r = 100.0;
     std::ostringstream level;
-    level << R"({"world": {"gravity": {"x": 0, "y": 0}, "G": 1}, "entities": [)"
-          << R"({"name": "planet", "position": {"x": 0, "y": )" << num(-r) << R"(}, "static": true, "mass": )"
-          << num(field * r * r) << R"(, "radius": )" << num(r) << R"(, "friction": 0.6, "attractor": {"softening": 0}})";
+    level << R"({"world": {"gravity": {"x": 0, "y": )" << num(-gravity) << R"(}, "G": 1}, "entities": [)"
+          << R"({"name": "planet", "position": {"x": 0, "y": )" << num(-r) << "}"
+          << (dynamicPlanet ? "" : R"(, "static": true)") << R"(, "mass": )" << num(field * r * r)
+          << R"(, "radius": )" << num(r) << R"(, "friction": 0.6, "attractor": {"softening": 0}})";
     const double bottom = gap > 0.0 ? 1.5 : 0.5;
     for (int k = 0; k < boxes; ++k)
         level << R"(, {"name": "box)" << k << R"(", "position": {"x": 0, "y": )" << num(bottom + k * (1.0 + gap))
@@ -400,6 +403,78 @@ TEST(HardSettings, OnlyBodiesThatRestOnSomethingBearASteadyLoad) {
     World w = build(lone);
     for (int i = 0; i < 120; ++i) ASSERT_TRUE(w.step().ok());
     EXPECT_LT(0.5 - w.bodyPosition(0).y, 0.005);
+}
+
+// A planet left dynamic is ground to what rests on it when it outweighs
+// the level's bodies: it barely moves under them, and they bear its pull
+// less its own acceleration (under gravity both fall, and the stack bears
+// the pull alone). Swept over the pull (10, 1000 and 10^4 m/s^2) and
+// gravity (0, and 10 with the planet falling): ten boxes standing on it
+// bear the field at the bottom box, and after 2 s the top is within 1.5
+// cm of 9.5 m above the planet's surface and 1 cm of upright; dropped
+// half a metre apart (up to 1000 m/s^2; at 10^4 they strike at 100 m/s
+// and more, which the impact rule reads), they get the standing stack's
+// substeps and stand. Read as no load (static attractors only), the stack
+// got 1 substep and fell through the planet at 1000 m/s^2; under gravity
+// it got 4, and its top sank 16 cm at 1000 and fell through at 10^4.
+// - The same planet resting on a static floor under gravity does not
+//   fall: the stack bears the pull and gravity together.
+// - A cluster of equal attracting discs (none outweighs the rest) is read
+//   as before: no attractor load.
+TEST(HardSettings, AHeavyDynamicAttractorIsGroundToWhatRestsOnIt) {
+    const double r = 100.0;
+    const auto topAbovePlanet = [&](World& w, int steps, const std::string& label) {
+        for (int i = 0; i < steps; ++i) EXPECT_TRUE(w.step().ok()) << label;
+        return w.bodyPosition(10) - w.bodyPosition(0) - Vec2{0.0, r};
+    };
+    for (const double field : {10.0, 1000.0, 1e4}) {
+        for (const double gravity : {0.0, 10.0}) {
+            const Scene standing = parse(onPlanetLevel(field, 0.0, 10, true, gravity));
+            const ContactSettingsChoice choice = chooseContactSettings(standing);
+            const std::string label =
+                "field " + num(field) + ", gravity " + num(gravity) + " (" + choice.reason() + ")";
+            const double bottomField = field * r * r / ((r + 0.5) * (r + 0.5));
+            // Under gravity the baseline is gravity itself, which the
+            // weakest pull does not exceed.
+            EXPECT_NEAR(choice.gravity, std::max(bottomField, gravity), 1e-9 * field) << label;
+            EXPECT_TRUE(choice.attractorLoad || bottomField < gravity) << label;
+            EXPECT_EQ(choice.stackHeight, 10) << label;
+            World w = build(standing);
+            const Vec2 top = topAbovePlanet(w, 120, label);
+            EXPECT_LT(std::abs(9.5 - top.y), 0.015) << label << ": top " << top.y;
+            EXPECT_LT(std::abs(top.x), 0.01) << label;
+
+            if (field > 1000.0) continue;
+            const Scene dropped = parse(onPlanetLevel(field, 0.5, 10, true, gravity));
+            const ContactSettingsChoice landed = chooseContactSettings(dropped);
+            const std::string droppedLabel = "dropped, " + label + " (" + landed.reason() + ")";
+            EXPECT_NEAR(landed.gravity, std::max(field, gravity), 0.02 * field) << droppedLabel;
+            EXPECT_EQ(landed.substeps, choice.substeps) << droppedLabel;
+            World fell = build(dropped);
+            const Vec2 fellTop = topAbovePlanet(fell, 300, droppedLabel);
+            EXPECT_LT(std::abs(9.5 - fellTop.y), 0.015) << droppedLabel << ": top " << fellTop.y;
+        }
+    }
+
+    std::string held = onPlanetLevel(1000.0, 0.0, 10, true, 10.0);
+    held.insert(held.rfind("]}"), R"(, {"name": "floor", "position": {"x": 0, "y": -200.5}, "static": true,)"
+                                  R"( "box": {"width": 400, "height": 1}})");
+    const Scene onFloor = parse(held);
+    const ContactSettingsChoice heldChoice = chooseContactSettings(onFloor);
+    EXPECT_NEAR(heldChoice.gravity, 1000.0 * r * r / ((r + 0.5) * (r + 0.5)) + 10.0, 1e-9) << heldChoice.reason();
+    World w = build(onFloor);
+    for (int i = 0; i < 120; ++i) ASSERT_TRUE(w.step().ok());
+    EXPECT_LT(std::abs(9.5 - (w.bodyPosition(10).y - w.bodyPosition(0).y - r)), 0.015);
+
+    std::ostringstream cluster;
+    cluster << R"({"world": {"gravity": {"x": 0, "y": 0}, "G": 1}, "entities": [)";
+    for (int k = 0; k < 20; ++k)
+        cluster << (k ? ", " : "") << R"({"name": "disc)" << k << R"(", "position": {"x": )" << num(k % 5) << R"(, "y": )"
+                << num(k / 5) << R"(}, "mass": 1e6, "radius": 0.5, "attractor": {"softening": 0}})";
+    cluster << "]}";
+    const ContactSettingsChoice clusterChoice = chooseContactSettings(parse(cluster.str()));
+    EXPECT_EQ(clusterChoice.gravity, 0.0) << clusterChoice.reason();
+    EXPECT_FALSE(clusterChoice.attractorLoad) << clusterChoice.reason();
 }
 
 // The warning names the substeps that would carry the stiffness a load

@@ -684,14 +684,16 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
 
 /// The steady load the contact rules read as gravity (m/s^2): the world's
 /// gravity, plus the field of the attractors that do not move under it
-/// (static or kinematic ones, a planet under a level), where that sum is
+/// (static or kinematic ones, a planet under a level) or barely do (a
+/// dynamic one that outweighs the level's bodies: a planet left dynamic),
+/// where that sum, less the acceleration of what the body rests on, is
 /// strongest on a dynamic body resting with another: in a group placed
-/// touching that meets static geometry (a shape, a chain or a plane) as
-/// placed or along its members' paths, or alone, coming to rest beside
-/// another. A stack on
-/// such a planet bears the field as it would bear gravity; a body in orbit
-/// bears none of it, however strong the pull. A dynamic attractor's pull
-/// moves with it and is left to the impacts it causes.
+/// touching that meets static geometry (a shape, a chain or a plane) or
+/// such a heavy attractor, as placed or along its members' paths, or
+/// alone, coming to rest beside another. A stack on such a planet bears
+/// the field as it would bear gravity; a body in orbit bears none of it,
+/// however strong the pull. A light dynamic attractor's pull moves with it
+/// and is left to the impacts it causes.
 template <class IsStatic, class Dynamic, class MassOf, class HasShape>
 Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStatic& isStatic,
                 const Dynamic& dynamic, const MassOf& massOf, const HasShape& hasShape) {
@@ -703,8 +705,27 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
         double gm, eps2;
     };
     std::vector<Source> sources;
+    // A dynamic attractor with a shape at least kHeavyAttractor times the
+    // median dynamic body's mass is ground to what rests on it: a planet
+    // left dynamic barely moves under a stack. What rests on it bears the
+    // field less the planet's own acceleration (under gravity both fall).
+    constexpr double kHeavyAttractor = 100.0;
+    double medianMass = std::numeric_limits<double>::infinity();  // none is heavy
+    const auto& entities = reg.entities();
+    if (std::any_of(entities.begin(), entities.end(),
+                    [&](Entity e) { return reg.has<Attractor>(e) && hasShape(e) && dynamic(e); })) {
+        std::vector<double> masses;
+        for (const Entity e : entities)
+            if (hasShape(e) && dynamic(e)) masses.push_back(massOf(e));
+        std::nth_element(masses.begin(), masses.begin() + std::ptrdiff_t(masses.size() / 2), masses.end());
+        medianMass = masses[masses.size() / 2];
+    }
+    const auto heavyAttractor = [&](Entity e) {
+        return reg.has<Attractor>(e) && hasShape(e) && dynamic(e) && massOf(e) >= kHeavyAttractor * medianMass;
+    };
     for (const Entity e : reg.entities())
-        if (const Attractor* a = reg.tryGet<Attractor>(e); a && reg.alive(e) && isStatic(e) && reg.has<Position>(e))
+        if (const Attractor* a = reg.tryGet<Attractor>(e);
+            a && reg.alive(e) && (isStatic(e) || heavyAttractor(e)) && reg.has<Position>(e))
             sources.push_back({reg.tryGet<Position>(e)->value, scene.world.G * massOf(e), a->softening * a->softening});
     if (sources.empty()) return gravity;
 
@@ -750,7 +771,7 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
         const bool circle = reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) && !reg.has<Capsule>(e) &&
                             !reg.has<Shapes>(e);
         placed.push_back({centre - half, centre + half, 2.0 * std::max(half.x, half.y), false,
-                          isStatic(e) ? Entity{} : e, isStatic(e) && circle ? half.x : 0.0});
+                          isStatic(e) ? Entity{} : e, (isStatic(e) || heavyAttractor(e)) && circle ? half.x : 0.0});
     }
 
     const auto fieldAt = [&](Vec2 p) {
@@ -762,6 +783,17 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
         }
         return field;
     };
+    // Whether a box (lo, hi) comes within `gap` of the shape `o` (a circle
+    // exactly, any other shape by its bounding box).
+    const auto meetsShape = [](const Placed& o, Vec2 lo, Vec2 hi, double gap) {
+        if (!(o.lo.x - hi.x <= gap && lo.x - o.hi.x <= gap && o.lo.y - hi.y <= gap && lo.y - o.hi.y <= gap))
+            return false;
+        if (o.radius == 0.0) return true;
+        // A circle: the box's nearest point to its centre.
+        const Vec2 c = 0.5 * (o.lo + o.hi);
+        const Vec2 nearest{std::clamp(c.x, lo.x, hi.x), std::clamp(c.y, lo.y, hi.y)};
+        return length(nearest - c) - o.radius <= gap;
+    };
     std::vector<const Placed*> statics;
     std::size_t dynamicCount = 0;
     for (const Placed& b : placed) {
@@ -772,50 +804,89 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
     // of static geometry.
     const auto meetsStatic = [&](Vec2 lo, Vec2 hi, double size) {
         const double gap = 0.25 * size;
-        for (const Placed* o : statics) {
-            if (!(o->lo.x - hi.x <= gap && lo.x - o->hi.x <= gap && o->lo.y - hi.y <= gap && lo.y - o->hi.y <= gap))
-                continue;
-            if (o->radius == 0.0) return true;
-            // A circle: the box's nearest point to its centre.
-            const Vec2 c = 0.5 * (o->lo + o->hi);
-            const Vec2 nearest{std::clamp(c.x, lo.x, hi.x), std::clamp(c.y, lo.y, hi.y)};
-            if (length(nearest - c) - o->radius <= gap) return true;
-        }
+        for (const Placed* o : statics)
+            if (meetsShape(*o, lo, hi, gap)) return true;
         const Vec2 centre = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
         return std::any_of(planes.begin(), planes.end(), [&](const Halfspace& h) {
             const double reach = std::abs(h.normal.x) * half.x + std::abs(h.normal.y) * half.y;
             return dot(h.normal, centre) - h.offset - reach <= gap;
         });
     };
+    // The heavy dynamic attractors, each with its acceleration as placed
+    // (none where it rests on static geometry itself) and its velocity.
+    struct Support {
+        const Placed* shape;
+        Vec2 at, velocity, acceleration;
+    };
+    std::vector<Support> supports;
+    for (const Placed& b : placed) {
+        if (b.body.isNull() || !heavyAttractor(b.body)) continue;
+        const Vec2 at = reg.tryGet<Position>(b.body)->value;
+        const Velocity* given = reg.tryGet<Velocity>(b.body);
+        supports.push_back({&b, at, given ? given->value : Vec2{},
+                            meetsStatic(b.lo, b.hi, b.size) ? Vec2{} : fieldAt(at)});
+    }
+    // Where a body rests, and the acceleration of what it rests on.
+    struct Rest {
+        Vec2 at, under;
+    };
+    // The first support (static geometry, then the heavy attractors) that
+    // the box (lo, hi) of `self` meets as placed.
+    const auto restsAsPlaced = [&](const Placed& self, Vec2 lo, Vec2 hi) -> std::optional<Vec2> {
+        if (meetsStatic(lo, hi, self.size)) return Vec2{};
+        for (const Support& s : supports)
+            if (s.shape->body != self.body && meetsShape(*s.shape, lo, hi, 0.25 * self.size)) return s.acceleration;
+        return std::nullopt;
+    };
     // A body placed apart lands when its path under the steady fields (a
     // point's, from its velocity as placed) meets static geometry within
-    // kHorizon: boxes dropped onto a planet bear its pull where they land.
-    // One in orbit never meets any. Each step of the path is swept, so a
-    // fast body does not skip a thin support. Past kMostPathWork box tests
-    // (bodies x steps x static shapes) the paths are not followed, and only
-    // the groups placed on static geometry count.
+    // kHorizon, or a heavy attractor (the path then taken relative to it):
+    // boxes dropped onto a planet bear its pull where they land. One in
+    // orbit never meets any. Each step of the path is swept, so a fast body
+    // does not skip a thin support. Past kMostPathWork box and field tests
+    // the paths are not followed, and only the groups placed on a support
+    // count.
     constexpr double kHorizon = 2.0;  // s
     constexpr int kPathSteps = 256;
     constexpr double kMostPathWork = 5e7;
-    const bool followPaths =
-        double(dynamicCount) * kPathSteps * double(statics.size() + planes.size() + 1) <= kMostPathWork;
-    // Where a body meets static geometry, as placed or along its path, if
-    // it does.
-    const auto landing = [&](const Placed& b) -> std::optional<Vec2> {
+    const double perStep = double(statics.size() + planes.size() + 1) +
+                           double(supports.size()) * double(sources.size() + 1);
+    const bool followPaths = double(dynamicCount) * kPathSteps * perStep <= kMostPathWork;
+    // The path of `b` relative to a frame at `origin`, moving at `frameVelocity`
+    // and accelerating at `frameAcceleration`; `meets` tests a swept box in
+    // that frame. Where it first meets, in the frame.
+    const auto followPath = [&](const Placed& b, Vec2 origin, Vec2 frameVelocity, Vec2 frameAcceleration,
+                                const auto& meets) -> std::optional<Vec2> {
         const Vec2 at = reg.tryGet<Position>(b.body)->value;
-        if (meetsStatic(b.lo, b.hi, b.size)) return at;
-        if (!followPaths) return std::nullopt;
         const Velocity* given = reg.tryGet<Velocity>(b.body);
-        Vec2 x = at, v = given ? given->value : Vec2{};
+        Vec2 x = at - origin, v = (given ? given->value : Vec2{}) - frameVelocity;
         const Vec2 half = 0.5 * (b.hi - b.lo), offset = 0.5 * (b.lo + b.hi) - at;
         const double h = kHorizon / kPathSteps;
         for (int i = 0; i < kPathSteps; ++i) {
-            v += h * fieldAt(x);
+            v += h * (fieldAt(origin + x) - frameAcceleration);
             const Vec2 next = x + h * v;
             if (!std::isfinite(next.x) || !std::isfinite(next.y)) return std::nullopt;
             const Vec2 lo{std::min(x.x, next.x), std::min(x.y, next.y)}, hi{std::max(x.x, next.x), std::max(x.y, next.y)};
-            if (meetsStatic(lo + offset - half, hi + offset + half, b.size)) return next;
+            if (meets(lo + offset - half, hi + offset + half)) return next;
             x = next;
+        }
+        return std::nullopt;
+    };
+    // Where a body comes to rest, as placed or along its path, if it does.
+    const auto landing = [&](const Placed& b) -> std::optional<Rest> {
+        const Vec2 at = reg.tryGet<Position>(b.body)->value;
+        if (const std::optional<Vec2> under = restsAsPlaced(b, b.lo, b.hi)) return Rest{at, *under};
+        if (!followPaths) return std::nullopt;
+        const auto onStatic = [&](Vec2 lo, Vec2 hi) { return meetsStatic(lo, hi, b.size); };
+        if (const std::optional<Vec2> x = followPath(b, Vec2{}, Vec2{}, Vec2{}, onStatic)) return Rest{*x, Vec2{}};
+        for (const Support& s : supports) {
+            if (s.shape->body == b.body) continue;
+            // In the support's frame, where its shape stays as placed.
+            const auto onSupport = [&](Vec2 lo, Vec2 hi) {
+                return meetsShape(*s.shape, lo + s.at, hi + s.at, 0.25 * b.size);
+            };
+            if (const std::optional<Vec2> x = followPath(b, s.at, s.velocity, s.acceleration, onSupport))
+                return Rest{s.at + *x, s.acceleration};
         }
         return std::nullopt;
     };
@@ -823,13 +894,14 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
     // rules need: a lone body on static ground holds at any load (its
     // contacts turn rigid before the slop), so a planet that lands alone
     // on its sun does not make the level heavy. Moving bodies placed
-    // touching make groups (union-find). A group in the air (falling
-    // together, or in orbit) bears nothing from within itself: it rests
-    // where it meets static geometry, as placed or along its members'
-    // paths. A body placed alone counts where it rests beside another.
+    // touching make groups (union-find); a heavy attractor is ground, not
+    // a member. A group in the air (falling together, or in orbit) bears
+    // nothing from within itself: it rests where it meets a support, as
+    // placed or along its members' paths. A body placed alone counts where
+    // it rests beside another.
     std::vector<Placed> moving;
     for (const Placed& b : placed)
-        if (!b.body.isNull()) moving.push_back(b);
+        if (!b.body.isNull() && !heavyAttractor(b.body)) moving.push_back(b);
     std::vector<std::uint32_t> group(moving.size());
     for (std::uint32_t i = 0; i < group.size(); ++i) group[i] = i;
     forEachTouchingPair(moving, [&](std::uint32_t i, std::uint32_t j) {
@@ -837,26 +909,29 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
         const std::uint32_t ri = findRoot(group, i), rj = findRoot(group, j);
         if (ri != rj) group[std::max(ri, rj)] = std::min(ri, rj);
     });
-    std::vector<std::uint8_t> groupOnGround(moving.size(), 0);
-    for (std::uint32_t i = 0; i < moving.size(); ++i)
-        if (moving[i].touching && meetsStatic(moving[i].lo, moving[i].hi, moving[i].size))
-            groupOnGround[findRoot(group, i)] = 1;
+    // The acceleration of what each group (by its root) rests on as placed.
+    std::vector<std::optional<Vec2>> groupUnder(moving.size());
+    for (std::uint32_t i = 0; i < moving.size(); ++i) {
+        const std::uint32_t root = findRoot(group, i);
+        if (moving[i].touching && !groupUnder[root]) groupUnder[root] = restsAsPlaced(moving[i], moving[i].lo, moving[i].hi);
+    }
     std::vector<Placed> resting;  // touching: rests with another
-    std::vector<Vec2> restsAt;    // where each of `resting` rests
+    std::vector<Rest> rests;      // where each of `resting` rests, and on what
     for (std::uint32_t i = 0; i < moving.size(); ++i) {
         const Placed& b = moving[i];
         const Vec2 placedAt = reg.tryGet<Position>(b.body)->value;
-        const std::optional<Vec2> at = groupOnGround[findRoot(group, i)] ? std::optional<Vec2>(placedAt) : landing(b);
-        if (!at) continue;
-        const Vec2 move = *at - placedAt;
+        const std::optional<Vec2>& under = groupUnder[findRoot(group, i)];
+        const std::optional<Rest> rest = under ? std::optional<Rest>(Rest{placedAt, *under}) : landing(b);
+        if (!rest) continue;
+        const Vec2 move = rest->at - placedAt;
         resting.push_back({b.lo + move, b.hi + move, b.size, b.touching, b.body});
-        restsAt.push_back(*at);
+        rests.push_back(*rest);
     }
     markTouching(resting);
     Vec2 strongest = gravity;
     for (std::size_t i = 0; i < resting.size(); ++i) {
         if (!resting[i].touching) continue;
-        const Vec2 field = fieldAt(restsAt[i]);
+        const Vec2 field = fieldAt(rests[i].at) - rests[i].under;
         if (std::isfinite(field.x) && std::isfinite(field.y) && lengthSquared(field) > lengthSquared(strongest))
             strongest = field;
     }
