@@ -477,6 +477,52 @@ TEST(HardSettings, AHeavyDynamicAttractorIsGroundToWhatRestsOnIt) {
     EXPECT_FALSE(clusterChoice.attractorLoad) << clusterChoice.reason();
 }
 
+// A spring is a steady force too. A row of n 1 kg boxes resting on a
+// 2 cm static box (or against a 2 cm wall), no gravity, its far box
+// pulled toward the support by a spring anchored 100 m beyond it with a
+// force F as placed: the group bears F over its mass, read as a load of
+// F / n along the spring, and named. Swept over F (10, 1000 and 10^5 N),
+// n (3 and 10) and the direction (down onto a floor, sideways into a
+// wall): after 3 s the pulled box has moved less than 1 cm and the near
+// box is no more than the slop into the support. Read as no load (the
+// rules saw no gravity), ten boxes got 1 substep: the far box moved
+// 368 mm at 1000 N, and at 10^5 N the row went through the support.
+TEST(HardSettings, ASpringPressingARowOntoItsSupportIsALoad) {
+    for (const bool sideways : {false, true}) {
+        for (const int n : {3, 10}) {
+            for (const double force : {10.0, 1000.0, 1e5}) {
+                // Along the row, away from the support.
+                const Vec2 out = sideways ? Vec2{1.0, 0.0} : Vec2{0.0, 1.0};
+                const auto at = [&](double along) { return out * along; };
+                const auto vec = [](Vec2 v) { return R"({"x": )" + num(v.x) + R"(, "y": )" + num(v.y) + "}"; };
+                std::ostringstream level;
+                level << R"({"world": {"gravity": {"x": 0, "y": 0}}, "entities": [)"
+                      << R"({"name": "support", "position": )" << vec(at(-0.01)) << R"(, "static": true, "box": )"
+                      << (sideways ? R"({"width": 0.02, "height": 20})" : R"({"width": 20, "height": 0.02})")
+                      << R"(, "friction": 0.6})";
+                for (int k = 0; k < n; ++k)
+                    level << R"(, {"name": "b)" << k << R"(", "position": )" << vec(at(0.5 + k))
+                          << R"(, "mass": 1, "box": {"width": 1, "height": 1}, "friction": 0.6})";
+                const double far = n - 0.5, anchorAt = -100.0;
+                level << R"(, {"name": "pull", "spring": {"a": "b)" << n - 1 << R"(", "anchor": )" << vec(at(anchorAt))
+                      << R"(, "k": )" << num(force / (far - anchorAt)) << R"(, "rest_length": 0}}]})";
+                const Scene scene = parse(level.str());
+                const ContactSettingsChoice choice = chooseContactSettings(scene);
+                const std::string label = std::string(sideways ? "sideways" : "down") + ", " + std::to_string(n) +
+                                          " boxes, " + num(force) + " N (" + choice.reason() + ")";
+                EXPECT_NEAR(choice.gravity, force / n, 1e-9 * force) << label;
+                EXPECT_TRUE(choice.springLoad) << label;
+                EXPECT_FALSE(choice.attractorLoad) << label;
+                EXPECT_NE(label.find("springs load resting bodies at up to"), std::string::npos) << label;
+                World w = build(scene);
+                for (int i = 0; i < 180; ++i) ASSERT_TRUE(w.step().ok()) << label;
+                EXPECT_LT(far - dot(w.bodyPosition(std::size_t(n - 1)), out), 0.01) << label;
+                EXPECT_LT(0.5 - dot(w.bodyPosition(0), out), 0.005) << label;
+            }
+        }
+    }
+}
+
 // The warning names the substeps that would carry the stiffness a load
 // needs, for a level's own substeps and for the engine's past its cap.
 TEST(HardSettings, ContactStiffnessHintNamesTheSubstepsThatCarryIt) {

@@ -246,10 +246,12 @@ struct ContactSettingsChoice {
     int iterations = 8;        ///< 8 at 1 substep, else 2
     int stackDepth = 0;        ///< bodies in the deepest column the scene can pile up
     double diameter = 0.0;     ///< metres, the median dynamic shape's size
-    /// m/s^2, the steady load: |world.gravity|, plus static attractors'
-    /// pull where the sum is strongest on a body resting with another
+    /// m/s^2, the steady load: |world.gravity|, plus the pull of static
+    /// and heavy attractors and the springs' force per unit mass, where
+    /// the sum is strongest on a body resting with another
     double gravity = 0.0;
     bool attractorLoad = false;  ///< the load includes attractors' pull
+    bool springLoad = false;     ///< the load includes springs' force
     double massRatio = 1.0;    ///< heaviest / lightest dynamic shape that can pile
     double support = 0.0;      ///< m, thinnest static support along gravity (0: none)
     int columnHeight = 0;      ///< flat-faced bodies in the fullest column as placed

@@ -694,12 +694,47 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
 /// the field as it would bear gravity; a body in orbit bears none of it,
 /// however strong the pull. A light dynamic attractor's pull moves with it
 /// and is left to the impacts it causes.
+///
+/// Springs press too: a group placed resting on a support bears the sum
+/// of the springs' forces on its members as placed (those between two
+/// members cancel), spread over its mass. Its deepest contact then bears
+/// what it bears under that force, as under gravity of that much: a stack
+/// pulled onto its floor by a spring on its top box is read as heavy.
+struct SteadyLoad {
+    Vec2 load;               ///< m/s^2
+    bool attractors = false; ///< the strongest includes attractors' pull
+    bool springs = false;    ///< the strongest includes springs' force
+};
 template <class IsStatic, class Dynamic, class MassOf, class HasShape>
-Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStatic& isStatic,
-                const Dynamic& dynamic, const MassOf& massOf, const HasShape& hasShape) {
+SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStatic& isStatic,
+                      const Dynamic& dynamic, const MassOf& massOf, const HasShape& hasShape) {
     const Registry& reg = scene.registry;
     const Vec2 gravity = switches.gravity ? scene.world.gravity : Vec2{};
-    if (!switches.attractors || !switches.collisions) return gravity;
+    if (!switches.collisions) return {gravity};
+    // The springs that push or pull a dynamic body with a shape as placed.
+    struct Pull {
+        Entity body;
+        Vec2 force;  // N
+    };
+    std::vector<Pull> pulls;
+    if (switches.springs) {
+        for (const Entity e : reg.entities()) {
+            const Spring* spring = reg.alive(e) ? reg.tryGet<Spring>(e) : nullptr;
+            if (!spring || !reg.alive(spring->a) || !reg.has<Position>(spring->a)) continue;
+            const Vec2 pa = reg.tryGet<Position>(spring->a)->value;
+            std::optional<Vec2> pb = spring->anchor;
+            if (!pb && reg.alive(spring->b) && reg.has<Position>(spring->b)) pb = reg.tryGet<Position>(spring->b)->value;
+            if (!pb) continue;
+            const Vec2 d = *pb - pa;
+            const double len = length(d);
+            const double stretch = len - spring->restLength.value_or(len);
+            if (!(len > 0.0) || stretch == 0.0) continue;
+            const Vec2 onA = (spring->k * stretch / len) * d;  // toward b when stretched
+            if (hasShape(spring->a) && dynamic(spring->a)) pulls.push_back({spring->a, onA});
+            if (!spring->anchor && hasShape(spring->b) && dynamic(spring->b)) pulls.push_back({spring->b, -1.0 * onA});
+        }
+    }
+    if (!switches.attractors && pulls.empty()) return {gravity};
     struct Source {
         Vec2 at;
         double gm, eps2;
@@ -723,11 +758,13 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
     const auto heavyAttractor = [&](Entity e) {
         return reg.has<Attractor>(e) && hasShape(e) && dynamic(e) && massOf(e) >= kHeavyAttractor * medianMass;
     };
-    for (const Entity e : reg.entities())
-        if (const Attractor* a = reg.tryGet<Attractor>(e);
-            a && reg.alive(e) && (isStatic(e) || heavyAttractor(e)) && reg.has<Position>(e))
-            sources.push_back({reg.tryGet<Position>(e)->value, scene.world.G * massOf(e), a->softening * a->softening});
-    if (sources.empty()) return gravity;
+    if (switches.attractors)
+        for (const Entity e : reg.entities())
+            if (const Attractor* a = reg.tryGet<Attractor>(e);
+                a && reg.alive(e) && (isStatic(e) || heavyAttractor(e)) && reg.has<Position>(e))
+                sources.push_back(
+                    {reg.tryGet<Position>(e)->value, scene.world.G * massOf(e), a->softening * a->softening});
+    if (sources.empty() && pulls.empty()) return {gravity};
 
     // Every shape as placed, static ones and chain segments included; only
     // a dynamic one's field is read.
@@ -851,7 +888,7 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
     constexpr double kMostPathWork = 5e7;
     const double perStep = double(statics.size() + planes.size() + 1) +
                            double(supports.size()) * double(sources.size() + 1);
-    const bool followPaths = double(dynamicCount) * kPathSteps * perStep <= kMostPathWork;
+    const bool followPaths = !sources.empty() && double(dynamicCount) * kPathSteps * perStep <= kMostPathWork;
     // The path of `b` relative to a frame at `origin`, moving at `frameVelocity`
     // and accelerating at `frameAcceleration`; `meets` tests a swept box in
     // that frame. Where it first meets, in the frame.
@@ -915,25 +952,47 @@ Vec2 steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStat
         const std::uint32_t root = findRoot(group, i);
         if (moving[i].touching && !groupUnder[root]) groupUnder[root] = restsAsPlaced(moving[i], moving[i].lo, moving[i].hi);
     }
-    std::vector<Placed> resting;  // touching: rests with another
-    std::vector<Rest> rests;      // where each of `resting` rests, and on what
+    // The springs' force on each group resting as placed, and its mass.
+    std::unordered_map<std::uint32_t, std::uint32_t> movingOf;  // entity index -> index in `moving`
+    for (std::uint32_t i = 0; i < moving.size(); ++i) movingOf.emplace(moving[i].body.index, i);
+    std::vector<Vec2> groupForce(moving.size());
+    std::vector<std::uint8_t> pressed(moving.size(), 0);
+    for (const Pull& pull : pulls) {
+        const auto it = movingOf.find(pull.body.index);
+        if (it == movingOf.end()) continue;
+        const std::uint32_t root = findRoot(group, it->second);
+        if (!groupUnder[root]) continue;
+        groupForce[root] += pull.force;
+        pressed[root] = 1;
+    }
+    std::vector<double> groupMass(moving.size(), 0.0);
+    for (std::uint32_t i = 0; i < moving.size(); ++i)
+        if (const std::uint32_t root = findRoot(group, i); pressed[root]) groupMass[root] += massOf(moving[i].body);
+    std::vector<Placed> resting;         // touching: rests with another
+    std::vector<Rest> rests;             // where each of `resting` rests, and on what
+    std::vector<std::uint32_t> restingGroup;  // the root of a group resting as placed, or ~0u
     for (std::uint32_t i = 0; i < moving.size(); ++i) {
         const Placed& b = moving[i];
         const Vec2 placedAt = reg.tryGet<Position>(b.body)->value;
-        const std::optional<Vec2>& under = groupUnder[findRoot(group, i)];
+        const std::uint32_t root = findRoot(group, i);
+        const std::optional<Vec2>& under = groupUnder[root];
         const std::optional<Rest> rest = under ? std::optional<Rest>(Rest{placedAt, *under}) : landing(b);
         if (!rest) continue;
         const Vec2 move = rest->at - placedAt;
         resting.push_back({b.lo + move, b.hi + move, b.size, b.touching, b.body});
         rests.push_back(*rest);
+        restingGroup.push_back(under ? root : ~0u);
     }
     markTouching(resting);
-    Vec2 strongest = gravity;
+    SteadyLoad strongest{gravity};
     for (std::size_t i = 0; i < resting.size(); ++i) {
         if (!resting[i].touching) continue;
-        const Vec2 field = fieldAt(rests[i].at) - rests[i].under;
-        if (std::isfinite(field.x) && std::isfinite(field.y) && lengthSquared(field) > lengthSquared(strongest))
-            strongest = field;
+        const Vec2 pulled = fieldAt(rests[i].at) - rests[i].under;
+        const std::uint32_t root = restingGroup[i];
+        const bool springs = root != ~0u && pressed[root] && groupMass[root] > 0.0;
+        const Vec2 field = springs ? pulled + groupForce[root] / groupMass[root] : pulled;
+        if (std::isfinite(field.x) && std::isfinite(field.y) && lengthSquared(field) > lengthSquared(strongest.load))
+            strongest = {field, pulled != gravity, springs};
     }
     return strongest;
 }
@@ -973,7 +1032,10 @@ std::string ContactSettingsChoice::reason() const {
         add("pile " + std::to_string(stackDepth) + " deep" +
             (massRatio > 1.0 ? ", mass ratio " + number(massRatio) + ":1" : std::string()));
     if (columnHeight > stackDepth) add("stack " + std::to_string(columnHeight) + " high");
-    if (attractorLoad) add("attractors load resting bodies at up to " + number(gravity) + " m/s^2");
+    if (attractorLoad && springLoad)
+        add("attractors and springs load resting bodies at up to " + number(gravity) + " m/s^2");
+    else if (attractorLoad) add("attractors load resting bodies at up to " + number(gravity) + " m/s^2");
+    else if (springLoad) add("springs load resting bodies at up to " + number(gravity) + " m/s^2");
     if (loadSubsteps > 1 && loadSubsteps == substeps)
         add("load " + number(gravity) + " m/s^2 on " + number(diameter) + " m bodies" +
             (support > 0.0 ? ", supports " + number(support) + " m thick" : std::string()));
@@ -1019,9 +1081,11 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
         const Shapes* shapes = reg.tryGet<Shapes>(e);
         return shapes ? compoundMassProperties(*shapes, std::nullopt).mass : 1.0;
     };
-    const Vec2 gravity = steadyLoad(scene, switches, isStatic, dynamic, massOf, hasShape);
+    const SteadyLoad steady = steadyLoad(scene, switches, isStatic, dynamic, massOf, hasShape);
+    const Vec2 gravity = steady.load;
     choice.gravity = length(gravity);
-    choice.attractorLoad = gravity != (switches.gravity ? scene.world.gravity : Vec2{});
+    choice.attractorLoad = steady.attractors;
+    choice.springLoad = steady.springs;
     const Vec2 down = choice.gravity > 0.0 ? gravity / choice.gravity : Vec2{0.0, -1.0};
     const Vec2 across{-down.y, down.x};
     const auto sizeOf = [&](Entity e) {
