@@ -294,14 +294,17 @@ TEST(HardSettings, AStaticAttractorLoadsAStackAsGravityDoes) {
 /// Ten 1 m boxes in a column on (or, with `gap` > 0, dropped from 1 m
 /// above, `gap` metres apart) a planet of radius 100 m pulling `field`
 /// m/s^2 at its surface, static unless `dynamicPlanet`, under `gravity`
-/// m/s^2 (down).
+/// m/s^2 (down). The planet's mass is field r^2 at G = 1, or
+/// `planetMass` with G to match.
 std::string onPlanetLevel(double field, double gap = 0.0, int boxes = 10, bool dynamicPlanet = false,
-                          double gravity = 0.0) {
+                          double gravity = 0.0, double planetMass = 0.0) {
     const double r = 100.0;
+    const double mass = planetMass > 0.0 ? planetMass : field * r * r;
     std::ostringstream level;
-    level << R"({"world": {"gravity": {"x": 0, "y": )" << num(-gravity) << R"(}, "G": 1}, "entities": [)"
+    level << R"({"world": {"gravity": {"x": 0, "y": )" << num(-gravity) << R"(}, "G": )"
+          << num(field * r * r / mass) << R"(}, "entities": [)"
           << R"({"name": "planet", "position": {"x": 0, "y": )" << num(-r) << "}"
-          << (dynamicPlanet ? "" : R"(, "static": true)") << R"(, "mass": )" << num(field * r * r)
+          << (dynamicPlanet ? "" : R"(, "static": true)") << R"(, "mass": )" << num(mass)
           << R"(, "radius": )" << num(r) << R"(, "friction": 0.6, "attractor": {"softening": 0}})";
     const double bottom = gap > 0.0 ? 1.5 : 0.5;
     for (int k = 0; k < boxes; ++k)
@@ -405,23 +408,28 @@ TEST(HardSettings, OnlyBodiesThatRestOnSomethingBearASteadyLoad) {
     EXPECT_LT(0.5 - w.bodyPosition(0).y, 0.005);
 }
 
-// A planet left dynamic is ground to what rests on it when it outweighs
-// the level's bodies: it barely moves under them, and they bear its pull
-// less its own acceleration (under gravity both fall, and the stack bears
-// the pull alone). Swept over the pull (10, 1000 and 10^4 m/s^2) and
-// gravity (0, and 10 with the planet falling): ten boxes standing on it
-// bear the field at the bottom box, and after 2 s the top is within 1.5
-// cm of 9.5 m above the planet's surface and 1 cm of upright; dropped
-// half a metre apart (up to 1000 m/s^2; at 10^4 they strike at 100 m/s
-// and more, which the impact rule reads), they get the standing stack's
+// A planet left dynamic is ground to what rests on it: the stack bears
+// its pull less its own acceleration (under gravity both fall, and the
+// stack bears the pull alone), scaled by 1 + m / M for a planet of mass M
+// under boxes of mass m, which pushes it away. Swept over the pull (10,
+// 1000 and 10^4 m/s^2) and gravity (0, and 10 with the planet falling),
+// with the planet 10^4 to 10^7 times a box: ten boxes standing on it bear
+// the field at the bottom box, and after 2 s the top is within 1.5 cm of
+// 9.5 m above the planet's surface and 1 cm of upright; dropped half a
+// metre apart (up to 1000 m/s^2; at 10^4 they strike at 100 m/s and
+// more, which the impact rule reads), they get the standing stack's
 // substeps and stand. Read as no load (static attractors only), the stack
 // got 1 substep and fell through the planet at 1000 m/s^2; under gravity
 // it got 4, and its top sank 16 cm at 1000 and fell through at 10^4.
+// - Swept over the planet's mass at 1000 m/s^2, from 1 to 1000 times the
+//   stack's: the load is the bottom box's field times 1 + m / M, and the
+//   stack stands. Read only for planets 100 times the median body, the
+//   stack on a 99 kg planet of radius 5 m sank 333 mm.
 // - The same planet resting on a static floor under gravity does not
 //   fall: the stack bears the pull and gravity together.
-// - A cluster of equal attracting discs (none outweighs the rest) is read
-//   as before: no attractor load.
-TEST(HardSettings, AHeavyDynamicAttractorIsGroundToWhatRestsOnIt) {
+// - A cluster of attracting discs, each ground to the others, with
+//   nothing else resting on them, bears nothing.
+TEST(HardSettings, ADynamicAttractorIsGroundToWhatRestsOnIt) {
     const double r = 100.0;
     const auto topAbovePlanet = [&](World& w, int steps, const std::string& label) {
         for (int i = 0; i < steps; ++i) EXPECT_TRUE(w.step().ok()) << label;
@@ -433,7 +441,8 @@ TEST(HardSettings, AHeavyDynamicAttractorIsGroundToWhatRestsOnIt) {
             const ContactSettingsChoice choice = chooseContactSettings(standing);
             const std::string label =
                 "field " + num(field) + ", gravity " + num(gravity) + " (" + choice.reason() + ")";
-            const double bottomField = field * r * r / ((r + 0.5) * (r + 0.5));
+            // The planet (field r^2 kg) under ten 1 kg boxes.
+            const double bottomField = field * r * r / ((r + 0.5) * (r + 0.5)) * (1.0 + 10.0 / (field * r * r));
             // Under gravity the baseline is gravity itself, which the
             // weakest pull does not exceed.
             EXPECT_NEAR(choice.gravity, std::max(bottomField, gravity), 1e-9 * field) << label;
@@ -454,6 +463,18 @@ TEST(HardSettings, AHeavyDynamicAttractorIsGroundToWhatRestsOnIt) {
             const Vec2 fellTop = topAbovePlanet(fell, 300, droppedLabel);
             EXPECT_LT(std::abs(9.5 - fellTop.y), 0.015) << droppedLabel << ": top " << fellTop.y;
         }
+    }
+
+    for (const double planetMass : {10.0, 99.0, 100.0, 1000.0, 1e4}) {
+        const Scene light = parse(onPlanetLevel(1000.0, 0.0, 10, true, 0.0, planetMass));
+        const ContactSettingsChoice choice = chooseContactSettings(light);
+        const std::string label = "planet " + num(planetMass) + " kg (" + choice.reason() + ")";
+        const double bottomField = 1000.0 * r * r / ((r + 0.5) * (r + 0.5));
+        EXPECT_NEAR(choice.gravity, bottomField * (1.0 + 10.0 / planetMass), 1e-9 * bottomField) << label;
+        World w = build(light);
+        const Vec2 top = topAbovePlanet(w, 120, label);
+        EXPECT_LT(std::abs(9.5 - top.y), 0.015) << label << ": top " << top.y;
+        EXPECT_LT(std::abs(top.x), 0.01) << label;
     }
 
     std::string held = onPlanetLevel(1000.0, 0.0, 10, true, 10.0);

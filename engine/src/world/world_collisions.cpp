@@ -683,17 +683,18 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
 }
 
 /// The steady load the contact rules read as gravity (m/s^2): the world's
-/// gravity, plus the field of the attractors that do not move under it
-/// (static or kinematic ones, a planet under a level) or barely do (a
-/// dynamic one that outweighs the level's bodies: a planet left dynamic),
-/// where that sum, less the acceleration of what the body rests on, is
-/// strongest on a dynamic body resting with another: in a group placed
-/// touching that meets static geometry (a shape, a chain or a plane) or
-/// such a heavy attractor, as placed or along its members' paths, or
-/// alone, coming to rest beside another. A stack on such a planet bears
-/// the field as it would bear gravity; a body in orbit bears none of it,
-/// however strong the pull. A light dynamic attractor's pull moves with it
-/// and is left to the impacts it causes.
+/// gravity, plus the field of the static or kinematic attractors (a
+/// planet under a level) and the dynamic ones with a shape (a planet left
+/// dynamic), less the acceleration of what the body rests on (scaled up
+/// by 1 + m / M where that is an attractor of mass M under what rests on
+/// it, m, which pushes it away), where that is strongest on a dynamic
+/// body resting with another: in a group placed touching that meets
+/// static geometry (a shape, a chain or a plane) or an attractor with a
+/// shape, as placed or along its members' paths, or alone, coming to rest
+/// beside another. A stack on a planet bears the field as it would bear
+/// gravity; a body in orbit bears none of it, however strong the pull. A
+/// shapeless dynamic attractor's pull moves with it and is left to the
+/// impacts it causes.
 ///
 /// Springs press too: a group placed resting on a support bears the sum
 /// of the springs' forces on its members as placed (those between two
@@ -740,28 +741,15 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         double gm, eps2;
     };
     std::vector<Source> sources;
-    // A dynamic attractor with a shape at least kHeavyAttractor times the
-    // median dynamic body's mass is ground to what rests on it: a planet
-    // left dynamic barely moves under a stack. What rests on it bears the
-    // field less the planet's own acceleration (under gravity both fall).
-    constexpr double kHeavyAttractor = 100.0;
-    double medianMass = std::numeric_limits<double>::infinity();  // none is heavy
-    const auto& entities = reg.entities();
-    if (std::any_of(entities.begin(), entities.end(),
-                    [&](Entity e) { return reg.has<Attractor>(e) && hasShape(e) && dynamic(e); })) {
-        std::vector<double> masses;
-        for (const Entity e : entities)
-            if (hasShape(e) && dynamic(e)) masses.push_back(massOf(e));
-        std::nth_element(masses.begin(), masses.begin() + std::ptrdiff_t(masses.size() / 2), masses.end());
-        medianMass = masses[masses.size() / 2];
-    }
-    const auto heavyAttractor = [&](Entity e) {
-        return reg.has<Attractor>(e) && hasShape(e) && dynamic(e) && massOf(e) >= kHeavyAttractor * medianMass;
-    };
-    if (switches.attractors)
-        for (const Entity e : reg.entities())
+    // A dynamic attractor with a shape is ground to what rests on it: what
+    // rests there bears the field less the attractor's own acceleration
+    // (under gravity both fall), and more as the attractor is lighter, for
+    // the push of what rests on it drives it away (a planet left dynamic
+    // barely moves; a light one does).
+    const auto attractorSupport = [&](Entity e) { return reg.has<Attractor>(e) && hasShape(e) && dynamic(e); };
+    for (const Entity e : reg.entities())
             if (const Attractor* a = reg.tryGet<Attractor>(e);
-                a && reg.alive(e) && (isStatic(e) || heavyAttractor(e)) && reg.has<Position>(e))
+                a && reg.alive(e) && (isStatic(e) || attractorSupport(e)) && reg.has<Position>(e))
                 sources.push_back(
                     {reg.tryGet<Position>(e)->value, scene.world.G * massOf(e), a->softening * a->softening});
     if (sources.empty() && pulls.empty()) return {gravity};
@@ -808,7 +796,7 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         const bool circle = reg.has<Radius>(e) && !reg.has<Box>(e) && !reg.has<Polygon>(e) && !reg.has<Capsule>(e) &&
                             !reg.has<Shapes>(e);
         placed.push_back({centre - half, centre + half, 2.0 * std::max(half.x, half.y), false,
-                          isStatic(e) ? Entity{} : e, (isStatic(e) || heavyAttractor(e)) && circle ? half.x : 0.0});
+                          isStatic(e) ? Entity{} : e, (isStatic(e) || attractorSupport(e)) && circle ? half.x : 0.0});
     }
 
     const auto fieldAt = [&](Vec2 p) {
@@ -849,35 +837,60 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
             return dot(h.normal, centre) - h.offset - reach <= gap;
         });
     };
-    // The heavy dynamic attractors, each with its acceleration as placed
-    // (none where it rests on static geometry itself) and its velocity.
+    // What a body rests on: its acceleration as placed, and its mass
+    // (infinite for static geometry and for an attractor held on it).
+    struct Under {
+        Vec2 acceleration;
+        double mass = std::numeric_limits<double>::infinity();
+    };
+    // The dynamic attractors with a shape, each with its velocity.
     struct Support {
         const Placed* shape;
-        Vec2 at, velocity, acceleration;
+        Vec2 at, velocity;
+        Under under;
     };
     std::vector<Support> supports;
     for (const Placed& b : placed) {
-        if (b.body.isNull() || !heavyAttractor(b.body)) continue;
+        if (b.body.isNull() || !attractorSupport(b.body)) continue;
         const Vec2 at = reg.tryGet<Position>(b.body)->value;
         const Velocity* given = reg.tryGet<Velocity>(b.body);
         supports.push_back({&b, at, given ? given->value : Vec2{},
-                            meetsStatic(b.lo, b.hi, b.size) ? Vec2{} : fieldAt(at)});
+                            meetsStatic(b.lo, b.hi, b.size) ? Under{} : Under{fieldAt(at), massOf(b.body)}});
     }
-    // Where a body rests, and the acceleration of what it rests on.
+    // The attractors by their left edge, to visit only those within reach
+    // of a box (a field of stars among dust has thousands).
+    std::vector<std::uint32_t> byLeft(supports.size());
+    double widest = 0.0;
+    for (std::uint32_t k = 0; k < byLeft.size(); ++k) {
+        byLeft[k] = k;
+        widest = std::max(widest, supports[k].shape->hi.x - supports[k].shape->lo.x);
+    }
+    std::sort(byLeft.begin(), byLeft.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return supports[a].shape->lo.x != supports[b].shape->lo.x ? supports[a].shape->lo.x < supports[b].shape->lo.x
+                                                                  : a < b;
+    });
+    // Where a body rests, and on what.
     struct Rest {
-        Vec2 at, under;
+        Vec2 at;
+        Under under;
     };
-    // The first support (static geometry, then the heavy attractors) that
-    // the box (lo, hi) of `self` meets as placed.
-    const auto restsAsPlaced = [&](const Placed& self, Vec2 lo, Vec2 hi) -> std::optional<Vec2> {
-        if (meetsStatic(lo, hi, self.size)) return Vec2{};
-        for (const Support& s : supports)
-            if (s.shape->body != self.body && meetsShape(*s.shape, lo, hi, 0.25 * self.size)) return s.acceleration;
+    // The first support (static geometry, then the attractors in the
+    // level's order) that the box (lo, hi) of `self` meets as placed.
+    const auto restsAsPlaced = [&](const Placed& self, Vec2 lo, Vec2 hi) -> std::optional<Under> {
+        if (meetsStatic(lo, hi, self.size)) return Under{};
+        const double gap = 0.25 * self.size;
+        auto it = std::lower_bound(byLeft.begin(), byLeft.end(), lo.x - gap - widest,
+                                   [&](std::uint32_t k, double x) { return supports[k].shape->lo.x < x; });
+        std::uint32_t first = ~0u;
+        for (; it != byLeft.end() && supports[*it].shape->lo.x - hi.x <= gap; ++it)
+            if (*it < first && supports[*it].shape->body != self.body && meetsShape(*supports[*it].shape, lo, hi, gap))
+                first = *it;
+        if (first != ~0u) return supports[first].under;
         return std::nullopt;
     };
     // A body placed apart lands when its path under the steady fields (a
     // point's, from its velocity as placed) meets static geometry within
-    // kHorizon, or a heavy attractor (the path then taken relative to it):
+    // kHorizon, or an attractor (the path then taken relative to it):
     // boxes dropped onto a planet bear its pull where they land. One in
     // orbit never meets any. Each step of the path is swept, so a fast body
     // does not skip a thin support. Past kMostPathWork box and field tests
@@ -912,18 +925,18 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     // Where a body comes to rest, as placed or along its path, if it does.
     const auto landing = [&](const Placed& b) -> std::optional<Rest> {
         const Vec2 at = reg.tryGet<Position>(b.body)->value;
-        if (const std::optional<Vec2> under = restsAsPlaced(b, b.lo, b.hi)) return Rest{at, *under};
+        if (const std::optional<Under> under = restsAsPlaced(b, b.lo, b.hi)) return Rest{at, *under};
         if (!followPaths) return std::nullopt;
         const auto onStatic = [&](Vec2 lo, Vec2 hi) { return meetsStatic(lo, hi, b.size); };
-        if (const std::optional<Vec2> x = followPath(b, Vec2{}, Vec2{}, Vec2{}, onStatic)) return Rest{*x, Vec2{}};
+        if (const std::optional<Vec2> x = followPath(b, Vec2{}, Vec2{}, Vec2{}, onStatic)) return Rest{*x, Under{}};
         for (const Support& s : supports) {
             if (s.shape->body == b.body) continue;
             // In the support's frame, where its shape stays as placed.
             const auto onSupport = [&](Vec2 lo, Vec2 hi) {
                 return meetsShape(*s.shape, lo + s.at, hi + s.at, 0.25 * b.size);
             };
-            if (const std::optional<Vec2> x = followPath(b, s.at, s.velocity, s.acceleration, onSupport))
-                return Rest{s.at + *x, s.acceleration};
+            if (const std::optional<Vec2> x = followPath(b, s.at, s.velocity, s.under.acceleration, onSupport))
+                return Rest{s.at + *x, s.under};
         }
         return std::nullopt;
     };
@@ -931,14 +944,14 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     // rules need: a lone body on static ground holds at any load (its
     // contacts turn rigid before the slop), so a planet that lands alone
     // on its sun does not make the level heavy. Moving bodies placed
-    // touching make groups (union-find); a heavy attractor is ground, not
-    // a member. A group in the air (falling together, or in orbit) bears
+    // touching make groups (union-find); an attractor with a shape is
+    // ground, not a member. A group in the air (falling together, or in orbit) bears
     // nothing from within itself: it rests where it meets a support, as
     // placed or along its members' paths. A body placed alone counts where
     // it rests beside another.
     std::vector<Placed> moving;
     for (const Placed& b : placed)
-        if (!b.body.isNull() && !heavyAttractor(b.body)) moving.push_back(b);
+        if (!b.body.isNull() && !attractorSupport(b.body)) moving.push_back(b);
     std::vector<std::uint32_t> group(moving.size());
     for (std::uint32_t i = 0; i < group.size(); ++i) group[i] = i;
     forEachTouchingPair(moving, [&](std::uint32_t i, std::uint32_t j) {
@@ -946,8 +959,8 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         const std::uint32_t ri = findRoot(group, i), rj = findRoot(group, j);
         if (ri != rj) group[std::max(ri, rj)] = std::min(ri, rj);
     });
-    // The acceleration of what each group (by its root) rests on as placed.
-    std::vector<std::optional<Vec2>> groupUnder(moving.size());
+    // What each group (by its root) rests on as placed.
+    std::vector<std::optional<Under>> groupUnder(moving.size());
     for (std::uint32_t i = 0; i < moving.size(); ++i) {
         const std::uint32_t root = findRoot(group, i);
         if (moving[i].touching && !groupUnder[root]) groupUnder[root] = restsAsPlaced(moving[i], moving[i].lo, moving[i].hi);
@@ -965,9 +978,15 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         groupForce[root] += pull.force;
         pressed[root] = 1;
     }
+    // Each group's mass, and all of theirs: what can rest on one attractor
+    // (for a body placed apart, which lands with others unknown).
     std::vector<double> groupMass(moving.size(), 0.0);
-    for (std::uint32_t i = 0; i < moving.size(); ++i)
-        if (const std::uint32_t root = findRoot(group, i); pressed[root]) groupMass[root] += massOf(moving[i].body);
+    double movingMass = 0.0;
+    for (std::uint32_t i = 0; i < moving.size(); ++i) {
+        const double m = massOf(moving[i].body);
+        groupMass[findRoot(group, i)] += m;
+        movingMass += m;
+    }
     std::vector<Placed> resting;         // touching: rests with another
     std::vector<Rest> rests;             // where each of `resting` rests, and on what
     std::vector<std::uint32_t> restingGroup;  // the root of a group resting as placed, or ~0u
@@ -975,7 +994,7 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         const Placed& b = moving[i];
         const Vec2 placedAt = reg.tryGet<Position>(b.body)->value;
         const std::uint32_t root = findRoot(group, i);
-        const std::optional<Vec2>& under = groupUnder[root];
+        const std::optional<Under>& under = groupUnder[root];
         const std::optional<Rest> rest = under ? std::optional<Rest>(Rest{placedAt, *under}) : landing(b);
         if (!rest) continue;
         const Vec2 move = rest->at - placedAt;
@@ -987,8 +1006,11 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     SteadyLoad strongest{gravity};
     for (std::size_t i = 0; i < resting.size(); ++i) {
         if (!resting[i].touching) continue;
-        const Vec2 pulled = fieldAt(rests[i].at) - rests[i].under;
+        const Under& under = rests[i].under;
         const std::uint32_t root = restingGroup[i];
+        Vec2 pulled = fieldAt(rests[i].at) - under.acceleration;
+        // A dynamic support is pushed away by what rests on it.
+        if (std::isfinite(under.mass)) pulled = (1.0 + (root != ~0u ? groupMass[root] : movingMass) / under.mass) * pulled;
         const bool springs = root != ~0u && pressed[root] && groupMass[root] > 0.0;
         const Vec2 field = springs ? pulled + groupForce[root] / groupMass[root] : pulled;
         if (std::isfinite(field.x) && std::isfinite(field.y) && lengthSquared(field) > lengthSquared(strongest.load))
