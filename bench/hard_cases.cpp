@@ -621,21 +621,48 @@ Case stackOf10(double g) {
     return c;
 }
 
-/// The same stack standing on a planet: a static attractor of radius
-/// 100 m, no gravity, pulling `pull` m/s^2 at its surface. Box2D has no
-/// attractors.
-Case stackOnAPlanet(double pull) {
+/// The same stack standing on a planet: an attractor of radius 100 m, no
+/// gravity, pulling `pull` m/s^2 at its surface, static or (`dynamic`)
+/// left free to move, when the sinkage is read from the planet. Box2D has
+/// no attractors.
+Case stackOnAPlanet(double pull, bool dynamic = false) {
     Case c = stackOf10(10.0);
-    c.name = "stack of 10 boxes on a planet, pull " + fmt("%g", pull);
+    c.name = std::string("stack of 10 boxes on a ") + (dynamic ? "dynamic " : "") + "planet, pull " + fmt("%g", pull);
     Scene& s = c.scene = baseWorld(0.0);
     const double radius = 100.0;
     const Entity planet = add(s, {0.0, -radius});
-    s.registry.emplace<Static>(planet, Static{true});
+    if (!dynamic) s.registry.emplace<Static>(planet, Static{true});
     s.registry.emplace<Radius>(planet, Radius{radius});
     s.registry.emplace<Mass>(planet, Mass{pull * radius * radius});  // G = 1
     s.registry.emplace<Attractor>(planet, Attractor{0.0});
     s.registry.emplace<Friction>(planet, Friction{0.6});
     addTenBoxes(s);
+    if (dynamic)
+        c.measure = [](const Bodies& b, const Run& r) {
+            // The planet is the first body.
+            const Vec2 top = r.final.back().p - r.final.front().p, start = b.start.back() - b.start.front();
+            return Figures{std::max(0.0, start.y - top.y), fmt("sank %.3g mm, sideways %.3g mm", 1e3 * (start.y - top.y),
+                                                               1e3 * std::abs(top.x - start.x))};
+        };
+    c.box2d = false;
+    return c;
+}
+
+/// Ten 1 m boxes in a column on a 2 cm static box, no gravity, the top one
+/// pulled down by a spring anchored 100 m below with `force` N as placed.
+/// Box2D 2.4.1 is not run: the harness gives it no springs.
+Case stackPressedBySpring(double force) {
+    Case c = stackOf10(10.0);
+    c.name = "stack of 10 boxes pressed by a spring, " + fmt("%g", force) + " N";
+    Scene& s = c.scene = baseWorld(0.0);
+    addStatic(s, {0.0, -0.01}, 20.0, 0.02, 0.6);
+    addTenBoxes(s);
+    Entity top;
+    for (const Entity e : s.registry.entities())
+        if (s.registry.has<Box>(e) && !s.registry.has<Static>(e)) top = e;
+    const Entity spring = s.registry.create();
+    const double anchorAt = -100.0, stretch = 9.5 - anchorAt;
+    s.registry.emplace<Spring>(spring, Spring{top, Entity{}, Vec2{0.0, anchorAt}, force / stretch, 0.0, 0.0});
     c.box2d = false;
     return c;
 }
@@ -951,6 +978,8 @@ int main(int argc, char** argv) {
     for (double mass : {4.0, 100.0}) cases.push_back(crateOnBridge(mass));
     for (double g : {10.0, 1e4}) cases.push_back(stackOf10(g));
     cases.push_back(stackOnAPlanet(1000.0));
+    cases.push_back(stackOnAPlanet(1000.0, true));
+    cases.push_back(stackPressedBySpring(1000.0));
     for (int n : {64, 1000, 10000})
         if (!(quick && n > 1000)) cases.push_back(crowd(n));
     cases.push_back(pile300());
