@@ -487,6 +487,18 @@ TEST(HardSettings, ADynamicAttractorIsGroundToWhatRestsOnIt) {
     for (int i = 0; i < 120; ++i) ASSERT_TRUE(w.step().ok());
     EXPECT_LT(std::abs(9.5 - (w.bodyPosition(10).y - w.bodyPosition(0).y - r)), 0.015);
 
+    // With attractors switched off the planet is a body like the boxes,
+    // and the row on it floats with it, spring and all: no load.
+    std::string switchedOff = onPlanetLevel(1000.0, 0.0, 10, true);
+    switchedOff.insert(switchedOff.rfind("]}"), R"(, {"name": "pull", "spring": {"a": "box9", "anchor": {"x": 0, "y": -300},)"
+                                                R"( "k": 1, "rest_length": 0}})");
+    SystemSwitches noAttractors;
+    noAttractors.attractors = false;
+    const ContactSettingsChoice off = chooseContactSettings(parse(switchedOff), noAttractors);
+    EXPECT_EQ(off.gravity, 0.0) << off.reason();
+    EXPECT_FALSE(off.attractorLoad) << off.reason();
+    EXPECT_GT(chooseContactSettings(parse(switchedOff)).gravity, 990.0);
+
     std::ostringstream cluster;
     cluster << R"({"world": {"gravity": {"x": 0, "y": 0}, "G": 1}, "entities": [)";
     for (int k = 0; k < 20; ++k)

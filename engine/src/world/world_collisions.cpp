@@ -746,8 +746,11 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     // (under gravity both fall), and more as the attractor is lighter, for
     // the push of what rests on it drives it away (a planet left dynamic
     // barely moves; a light one does).
-    const auto attractorSupport = [&](Entity e) { return reg.has<Attractor>(e) && hasShape(e) && dynamic(e); };
-    for (const Entity e : reg.entities())
+    const auto attractorSupport = [&](Entity e) {
+        return switches.attractors && reg.has<Attractor>(e) && hasShape(e) && dynamic(e);
+    };
+    if (switches.attractors)
+        for (const Entity e : reg.entities())
             if (const Attractor* a = reg.tryGet<Attractor>(e);
                 a && reg.alive(e) && (isStatic(e) || attractorSupport(e)) && reg.has<Position>(e))
                 sources.push_back(
@@ -945,10 +948,10 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     // contacts turn rigid before the slop), so a planet that lands alone
     // on its sun does not make the level heavy. Moving bodies placed
     // touching make groups (union-find); an attractor with a shape is
-    // ground, not a member. A group in the air (falling together, or in orbit) bears
-    // nothing from within itself: it rests where it meets a support, as
-    // placed or along its members' paths. A body placed alone counts where
-    // it rests beside another.
+    // ground, not a member. A group in the air (falling together, or in
+    // orbit) bears nothing from within itself: it rests where it meets a
+    // support, as placed or along its members' paths. A body placed alone
+    // counts where it rests beside another.
     std::vector<Placed> moving;
     for (const Placed& b : placed)
         if (!b.body.isNull() && !attractorSupport(b.body)) moving.push_back(b);
