@@ -556,6 +556,56 @@ TEST(HardSettings, ASpringPressingARowOntoItsSupportIsALoad) {
     }
 }
 
+// A slider motor held still pushes with its largest force: a ram on a
+// slider to the world, driven down onto ten 1 kg boxes standing on a 2 cm
+// static box (no gravity), presses the group of eleven with max_motor_force
+// F, read as a load of F / 11 kg and named. Swept over F (1000 and 10^5 N)
+// and the slider's axis (up with the motor driving at +1 m/s, down at -1
+// m/s: the same push): after 3 s the ram has stalled within 3 cm of where
+// it met the stack, the bottom box is within the slop of the floor and the
+// top box within 1 cm of upright. Read as no load, the boxes got 1 substep
+// and the ram drove through the stack (the top box 3.9 m down, the boxes
+// spilled). Driven away from the stack, the motor runs free and is no
+// load: the ram leaves.
+TEST(HardSettings, ASliderMotorPressingAStackIsALoad) {
+    const auto level = [](double force, double axisY, double speed) {
+        std::ostringstream out;
+        out << R"({"world": {"gravity": {"x": 0, "y": 0}}, "entities": [)"
+            << R"({"name": "floor", "position": {"x": 0, "y": -0.01}, "static": true,)"
+            << R"( "box": {"width": 20, "height": 0.02}, "friction": 0.6})";
+        for (int k = 0; k < 10; ++k)
+            out << R"(, {"name": "b)" << k << R"(", "position": {"x": 0, "y": )" << num(0.5 + k)
+                << R"(}, "mass": 1, "box": {"width": 1, "height": 1}, "friction": 0.6})";
+        out << R"(, {"name": "ram", "position": {"x": 0, "y": 10.5}, "mass": 1, "box": {"width": 1, "height": 1},)"
+            << R"( "friction": 0.6}, {"name": "press", "joint": {"type": "slider", "a": "ram", "axis": {"x": 0, "y": )"
+            << num(axisY) << R"(}, "anchor": {"x": 0, "y": 10.5}, "motor_speed": )" << num(speed)
+            << R"(, "max_motor_force": )" << num(force) << "}}]}";
+        return out.str();
+    };
+    for (const double force : {1000.0, 1e5}) {
+        for (const double axisY : {1.0, -1.0}) {
+            const Scene scene = parse(level(force, axisY, axisY));
+            const ContactSettingsChoice choice = chooseContactSettings(scene);
+            const std::string label = num(force) + " N, axis " + num(axisY) + " (" + choice.reason() + ")";
+            EXPECT_NEAR(choice.gravity, force / 11.0, 1e-9 * force) << label;
+            EXPECT_TRUE(choice.motorLoad) << label;
+            EXPECT_NE(label.find("motors load resting bodies at up to"), std::string::npos) << label;
+            World w = build(scene);
+            for (int i = 0; i < 180; ++i) ASSERT_TRUE(w.step().ok()) << label;
+            EXPECT_LT(10.5 - w.bodyPosition(10).y, 0.03) << label;
+            EXPECT_LT(0.5 - w.bodyPosition(0).y, 0.005) << label;
+            EXPECT_LT(std::abs(w.bodyPosition(9).x), 0.01) << label;
+        }
+    }
+    const Scene away = parse(level(1000.0, 1.0, -1.0));
+    const ContactSettingsChoice free = chooseContactSettings(away);
+    EXPECT_EQ(free.gravity, 0.0) << free.reason();
+    EXPECT_FALSE(free.motorLoad) << free.reason();
+    World w = build(away);
+    for (int i = 0; i < 180; ++i) ASSERT_TRUE(w.step().ok());
+    EXPECT_GT(w.bodyPosition(10).y, 12.0);
+}
+
 // The warning names the substeps that would carry the stiffness a load
 // needs, for a level's own substeps and for the engine's past its cap.
 TEST(HardSettings, ContactStiffnessHintNamesTheSubstepsThatCarryIt) {

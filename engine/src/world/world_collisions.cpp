@@ -696,15 +696,18 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
 /// shapeless dynamic attractor's pull moves with it and is left to the
 /// impacts it causes.
 ///
-/// Springs press too: a group placed resting on a support bears the sum
-/// of the springs' forces on its members as placed (those between two
-/// members cancel), spread over its mass. Its deepest contact then bears
-/// what it bears under that force, as under gravity of that much: a stack
-/// pulled onto its floor by a spring on its top box is read as heavy.
+/// Springs and slider motors press too: a group placed resting on a
+/// support bears the sum of their forces on its members as placed (a
+/// motor's is its largest force, which it gives when the group stalls it;
+/// those between two members cancel), spread over its mass. Its deepest
+/// contact then bears what it bears under that force, as under gravity of
+/// that much: a stack pulled onto its floor by a spring on its top box, or
+/// pressed by a ram, is read as heavy.
 struct SteadyLoad {
     Vec2 load;               ///< m/s^2
     bool attractors = false; ///< the strongest includes attractors' pull
     bool springs = false;    ///< the strongest includes springs' force
+    bool motors = false;     ///< the strongest includes slider motors' force
 };
 template <class IsStatic, class Dynamic, class MassOf, class HasShape>
 SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStatic& isStatic,
@@ -712,10 +715,12 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     const Registry& reg = scene.registry;
     const Vec2 gravity = switches.gravity ? scene.world.gravity : Vec2{};
     if (!switches.collisions) return {gravity};
-    // The springs that push or pull a dynamic body with a shape as placed.
+    // The springs and motors that push or pull a dynamic body with a shape
+    // as placed.
     struct Pull {
         Entity body;
         Vec2 force;  // N
+        bool motor;
     };
     std::vector<Pull> pulls;
     if (switches.springs) {
@@ -731,9 +736,26 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
             const double stretch = len - spring->restLength.value_or(len);
             if (!(len > 0.0) || stretch == 0.0) continue;
             const Vec2 onA = (spring->k * stretch / len) * d;  // toward b when stretched
-            if (hasShape(spring->a) && dynamic(spring->a)) pulls.push_back({spring->a, onA});
-            if (!spring->anchor && hasShape(spring->b) && dynamic(spring->b)) pulls.push_back({spring->b, -1.0 * onA});
+            if (hasShape(spring->a) && dynamic(spring->a)) pulls.push_back({spring->a, onA, false});
+            if (!spring->anchor && hasShape(spring->b) && dynamic(spring->b))
+                pulls.push_back({spring->b, -1.0 * onA, false});
         }
+    }
+    // A slider motor drives b along the axis (in a's frame) against a at
+    // its speed; held still, it pushes with its largest force, +axis on b
+    // and -axis on a for a positive speed (joints/joint_solver.cpp).
+    for (const Entity e : reg.entities()) {
+        const Joint* joint = reg.alive(e) ? reg.tryGet<Joint>(e) : nullptr;
+        if (!joint || joint->type != "slider" || !joint->maxMotorForce || !(*joint->maxMotorForce > 0.0) ||
+            joint->motorSpeed.value_or(0.0) == 0.0 || !reg.alive(joint->a))
+            continue;
+        const double angle = reg.has<Angle>(joint->a) ? reg.tryGet<Angle>(joint->a)->value : 0.0;
+        const Vec2 axis = collision::rotate(collision::Rot::fromAngle(angle), joint->axis.value_or(Vec2{1.0, 0.0}));
+        const double len = length(axis);
+        if (!(len > 0.0)) continue;
+        const Vec2 onB = (std::copysign(*joint->maxMotorForce, *joint->motorSpeed) / len) * axis;
+        if (hasShape(joint->a) && dynamic(joint->a)) pulls.push_back({joint->a, -1.0 * onB, true});
+        if (reg.alive(joint->b) && hasShape(joint->b) && dynamic(joint->b)) pulls.push_back({joint->b, onB, true});
     }
     if (!switches.attractors && pulls.empty()) return {gravity};
     struct Source {
@@ -971,24 +993,34 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     // The springs' force on each group resting as placed, and its mass.
     std::unordered_map<std::uint32_t, std::uint32_t> movingOf;  // entity index -> index in `moving`
     for (std::uint32_t i = 0; i < moving.size(); ++i) movingOf.emplace(moving[i].body.index, i);
+    // Each group's mass and centre, and all of theirs: what can rest on
+    // one attractor (for a body placed apart, which lands with others
+    // unknown).
+    std::vector<double> groupMass(moving.size(), 0.0);
+    std::vector<Vec2> groupMoment(moving.size());
+    double movingMass = 0.0;
+    for (std::uint32_t i = 0; i < moving.size(); ++i) {
+        const double m = massOf(moving[i].body);
+        const std::uint32_t root = findRoot(group, i);
+        groupMass[root] += m;
+        groupMoment[root] += m * reg.tryGet<Position>(moving[i].body)->value;
+        movingMass += m;
+    }
     std::vector<Vec2> groupForce(moving.size());
-    std::vector<std::uint8_t> pressed(moving.size(), 0);
+    std::vector<std::uint8_t> pressed(moving.size(), 0);  // bit 1: by a spring, bit 2: by a motor
     for (const Pull& pull : pulls) {
         const auto it = movingOf.find(pull.body.index);
         if (it == movingOf.end()) continue;
         const std::uint32_t root = findRoot(group, it->second);
         if (!groupUnder[root]) continue;
+        // A motor gives its largest force only held still: when it drives
+        // its body into the rest of the group. Driving it away, it runs free.
+        if (pull.motor && !(groupMass[root] > 0.0 &&
+                            dot(pull.force, groupMoment[root] / groupMass[root] -
+                                                reg.tryGet<Position>(pull.body)->value) > 0.0))
+            continue;
         groupForce[root] += pull.force;
-        pressed[root] = 1;
-    }
-    // Each group's mass, and all of theirs: what can rest on one attractor
-    // (for a body placed apart, which lands with others unknown).
-    std::vector<double> groupMass(moving.size(), 0.0);
-    double movingMass = 0.0;
-    for (std::uint32_t i = 0; i < moving.size(); ++i) {
-        const double m = massOf(moving[i].body);
-        groupMass[findRoot(group, i)] += m;
-        movingMass += m;
+        pressed[root] |= pull.motor ? 2 : 1;
     }
     std::vector<Placed> resting;         // touching: rests with another
     std::vector<Rest> rests;             // where each of `resting` rests, and on what
@@ -1014,10 +1046,10 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         Vec2 pulled = fieldAt(rests[i].at) - under.acceleration;
         // A dynamic support is pushed away by what rests on it.
         if (std::isfinite(under.mass)) pulled = (1.0 + (root != ~0u ? groupMass[root] : movingMass) / under.mass) * pulled;
-        const bool springs = root != ~0u && pressed[root] && groupMass[root] > 0.0;
-        const Vec2 field = springs ? pulled + groupForce[root] / groupMass[root] : pulled;
+        const std::uint8_t by = root != ~0u && groupMass[root] > 0.0 ? pressed[root] : 0;
+        const Vec2 field = by ? pulled + groupForce[root] / groupMass[root] : pulled;
         if (std::isfinite(field.x) && std::isfinite(field.y) && lengthSquared(field) > lengthSquared(strongest.load))
-            strongest = {field, pulled != gravity, springs};
+            strongest = {field, pulled != gravity, (by & 1) != 0, (by & 2) != 0};
     }
     return strongest;
 }
@@ -1057,10 +1089,17 @@ std::string ContactSettingsChoice::reason() const {
         add("pile " + std::to_string(stackDepth) + " deep" +
             (massRatio > 1.0 ? ", mass ratio " + number(massRatio) + ":1" : std::string()));
     if (columnHeight > stackDepth) add("stack " + std::to_string(columnHeight) + " high");
-    if (attractorLoad && springLoad)
-        add("attractors and springs load resting bodies at up to " + number(gravity) + " m/s^2");
-    else if (attractorLoad) add("attractors load resting bodies at up to " + number(gravity) + " m/s^2");
-    else if (springLoad) add("springs load resting bodies at up to " + number(gravity) + " m/s^2");
+    {
+        // What loads resting bodies past gravity: "attractors", "springs and motors", ...
+        std::vector<std::string> by;
+        if (attractorLoad) by.push_back("attractors");
+        if (springLoad) by.push_back("springs");
+        if (motorLoad) by.push_back("motors");
+        std::string named;
+        for (std::size_t k = 0; k < by.size(); ++k)
+            named += (k == 0 ? "" : k + 1 == by.size() ? " and " : ", ") + by[k];
+        if (!by.empty()) add(named + " load resting bodies at up to " + number(gravity) + " m/s^2");
+    }
     if (loadSubsteps > 1 && loadSubsteps == substeps)
         add("load " + number(gravity) + " m/s^2 on " + number(diameter) + " m bodies" +
             (support > 0.0 ? ", supports " + number(support) + " m thick" : std::string()));
@@ -1111,6 +1150,7 @@ ContactSettingsChoice chooseContactSettings(const Scene& scene, const SystemSwit
     choice.gravity = length(gravity);
     choice.attractorLoad = steady.attractors;
     choice.springLoad = steady.springs;
+    choice.motorLoad = steady.motors;
     const Vec2 down = choice.gravity > 0.0 ? gravity / choice.gravity : Vec2{0.0, -1.0};
     const Vec2 across{-down.y, down.x};
     const auto sizeOf = [&](Entity e) {
