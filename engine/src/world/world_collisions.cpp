@@ -729,7 +729,8 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
             if (!spring || !reg.alive(spring->a) || !reg.has<Position>(spring->a)) continue;
             const Vec2 pa = reg.tryGet<Position>(spring->a)->value;
             std::optional<Vec2> pb = spring->anchor;
-            if (!pb && reg.alive(spring->b) && reg.has<Position>(spring->b)) pb = reg.tryGet<Position>(spring->b)->value;
+            if (!pb && reg.alive(spring->b) && reg.has<Position>(spring->b))
+                pb = reg.tryGet<Position>(spring->b)->value;
             if (!pb) continue;
             const Vec2 d = *pb - pa;
             const double len = length(d);
@@ -988,9 +989,9 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     std::vector<std::optional<Under>> groupUnder(moving.size());
     for (std::uint32_t i = 0; i < moving.size(); ++i) {
         const std::uint32_t root = findRoot(group, i);
-        if (moving[i].touching && !groupUnder[root]) groupUnder[root] = restsAsPlaced(moving[i], moving[i].lo, moving[i].hi);
+        if (moving[i].touching && !groupUnder[root])
+            groupUnder[root] = restsAsPlaced(moving[i], moving[i].lo, moving[i].hi);
     }
-    // The springs' force on each group resting as placed, and its mass.
     std::unordered_map<std::uint32_t, std::uint32_t> movingOf;  // entity index -> index in `moving`
     for (std::uint32_t i = 0; i < moving.size(); ++i) movingOf.emplace(moving[i].body.index, i);
     // Each group's mass and centre, and all of theirs: what can rest on
@@ -1006,6 +1007,7 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         groupMoment[root] += m * reg.tryGet<Position>(moving[i].body)->value;
         movingMass += m;
     }
+    // The force of springs and motors on each group resting as placed.
     std::vector<Vec2> groupForce(moving.size());
     std::vector<std::uint8_t> pressed(moving.size(), 0);  // bit 1: by a spring, bit 2: by a motor
     for (const Pull& pull : pulls) {
@@ -1045,7 +1047,8 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         const std::uint32_t root = restingGroup[i];
         Vec2 pulled = fieldAt(rests[i].at) - under.acceleration;
         // A dynamic support is pushed away by what rests on it.
-        if (std::isfinite(under.mass)) pulled = (1.0 + (root != ~0u ? groupMass[root] : movingMass) / under.mass) * pulled;
+        if (std::isfinite(under.mass))
+            pulled = (1.0 + (root != ~0u ? groupMass[root] : movingMass) / under.mass) * pulled;
         const std::uint8_t by = root != ~0u && groupMass[root] > 0.0 ? pressed[root] : 0;
         const Vec2 field = by ? pulled + groupForce[root] / groupMass[root] : pulled;
         if (std::isfinite(field.x) && std::isfinite(field.y) && lengthSquared(field) > lengthSquared(strongest.load))
