@@ -248,12 +248,12 @@ struct ContactSettingsChoice {
     double diameter = 0.0;     ///< metres, the median dynamic shape's size
     /// m/s^2, the steady load: |world.gravity|, plus the pull of static
     /// attractors and dynamic ones with a shape and the force of springs
-    /// and slider motors per unit mass, where the sum is strongest on a
-    /// body resting with another
+    /// and slider and hinge motors per unit mass, where the sum is
+    /// strongest on a body resting with another
     double gravity = 0.0;
     bool attractorLoad = false;  ///< the load includes attractors' pull
     bool springLoad = false;     ///< the load includes springs' force
-    bool motorLoad = false;      ///< the load includes slider motors' force
+    bool motorLoad = false;      ///< the load includes slider or hinge motors' force
     double massRatio = 1.0;    ///< heaviest / lightest dynamic shape that can pile
     double support = 0.0;      ///< m, thinnest static support along gravity (0: none)
     int columnHeight = 0;      ///< flat-faced bodies in the fullest column as placed

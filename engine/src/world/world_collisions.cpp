@@ -11,6 +11,8 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <tuple>
+#include <utility>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -409,8 +411,8 @@ double halfExtentAlong(const Registry& reg, Entity e, Vec2 dir) {
     if (const Shapes* shapes = reg.tryGet<Shapes>(e)) {
         // The whole body's extent: over every shape's outline.
         double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (const CompoundShape& s : shapes->items) {
-            const ShapeOutline outline = compoundShapeOutline(s);
+        for (const CompoundShape& shape : shapes->items) {
+            const ShapeOutline outline = compoundShapeOutline(shape);
             for (const Vec2 v : outline.points) {
                 lo = std::min(lo, dot(v, local) - outline.radius);
                 hi = std::max(hi, dot(v, local) + outline.radius);
@@ -696,18 +698,21 @@ void impactRule(const Scene& scene, const SystemSwitches& switches, double dt, C
 /// shapeless dynamic attractor's pull moves with it and is left to the
 /// impacts it causes.
 ///
-/// Springs and slider motors press too: a group placed resting on a
-/// support bears the sum of their forces on its members as placed (a
-/// motor's is its largest force, which it gives when the group stalls it;
-/// those between two members cancel), spread over its mass. Its deepest
-/// contact then bears what it bears under that force, as under gravity of
-/// that much: a stack pulled onto its floor by a spring on its top box, or
-/// pressed by a ram, is read as heavy.
+/// Springs and motors press too: a group placed resting on a support
+/// bears the sum of their forces on its members as placed (a motor's is
+/// its largest force, which it gives when the group stalls it; those
+/// between two members cancel), spread over its mass. Its deepest contact
+/// then bears what it bears under that force, as under gravity of that
+/// much: a stack pulled onto its floor by a spring on its top box, or
+/// pressed by a ram, is read as heavy. A motor's body placed apart presses
+/// the first resting group it meets along its drive, and a hinge motor's
+/// body, turned about its pivot, the first it meets turning, with the
+/// torque over the lever.
 struct SteadyLoad {
     Vec2 load;               ///< m/s^2
     bool attractors = false; ///< the strongest includes attractors' pull
     bool springs = false;    ///< the strongest includes springs' force
-    bool motors = false;     ///< the strongest includes slider motors' force
+    bool motors = false;     ///< the strongest includes motors' force
 };
 template <class IsStatic, class Dynamic, class MassOf, class HasShape>
 SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const IsStatic& isStatic,
@@ -721,6 +726,12 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         Entity body;
         Vec2 force;  // N
         bool motor;
+        /// A hinge motor's: the hinge's world point, its torque on `body`
+        /// (N*m, counter-clockwise positive) and the body it turns against,
+        /// which it does not press; `force` is unused.
+        std::optional<Vec2> pivot = std::nullopt;
+        double torque = 0.0;
+        Entity partner{};
     };
     std::vector<Pull> pulls;
     if (switches.springs) {
@@ -757,6 +768,22 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         const Vec2 onB = (std::copysign(*joint->maxMotorForce, *joint->motorSpeed) / len) * axis;
         if (hasShape(joint->a) && dynamic(joint->a)) pulls.push_back({joint->a, -1.0 * onB, true});
         if (reg.alive(joint->b) && hasShape(joint->b) && dynamic(joint->b)) pulls.push_back({joint->b, onB, true});
+    }
+    // A hinge motor turns b against a at its speed; held still, it gives
+    // its largest torque, +torque on b and -torque on a for a positive
+    // speed (joints/joint_solver.cpp).
+    for (const Entity e : reg.entities()) {
+        const Joint* joint = reg.alive(e) ? reg.tryGet<Joint>(e) : nullptr;
+        if (!joint || joint->type != "hinge" || !joint->maxMotorTorque || !(*joint->maxMotorTorque > 0.0) ||
+            joint->motorSpeed.value_or(0.0) == 0.0 || !reg.alive(joint->a) || !reg.has<Position>(joint->a))
+            continue;
+        const double angle = reg.has<Angle>(joint->a) ? reg.tryGet<Angle>(joint->a)->value : 0.0;
+        const Vec2 pivot =
+            reg.tryGet<Position>(joint->a)->value + collision::rotate(collision::Rot::fromAngle(angle), joint->localA);
+        const double onB = std::copysign(*joint->maxMotorTorque, *joint->motorSpeed);
+        if (hasShape(joint->a) && dynamic(joint->a)) pulls.push_back({joint->a, Vec2{}, true, pivot, -onB, joint->b});
+        if (reg.alive(joint->b) && hasShape(joint->b) && dynamic(joint->b))
+            pulls.push_back({joint->b, Vec2{}, true, pivot, onB, joint->a});
     }
     if (!switches.attractors && pulls.empty()) return {gravity};
     struct Source {
@@ -1010,11 +1037,96 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     // The force of springs and motors on each group resting as placed.
     std::vector<Vec2> groupForce(moving.size());
     std::vector<std::uint8_t> pressed(moving.size(), 0);  // bit 1: by a spring, bit 2: by a motor
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    // The first body of a group resting as placed that moving[i]'s box
+    // meets, swept along `force` (unbounded: a slider's limits are not
+    // read).
+    const auto drivenInto = [&](const std::vector<Placed>& bodies, std::uint32_t i,
+                                Vec2 force) -> std::optional<std::uint32_t> {
+        const double len = length(force);
+        if (!(len > 0.0)) return std::nullopt;
+        const Vec2 d = force / len;
+        const Vec2 centre = 0.5 * (bodies[i].lo + bodies[i].hi), half = 0.5 * (bodies[i].hi - bodies[i].lo);
+        std::optional<std::uint32_t> first;
+        double firstAt = kInf;
+        for (std::uint32_t j = 0; j < bodies.size(); ++j) {
+            if (j == i || !groupUnder[findRoot(group, j)]) continue;
+            // The ray from the centre against the other box grown by this
+            // box's half extents.
+            double enter = 0.0, leave = kInf;
+            for (const auto& [from, dir, lo, hi] :
+                 {std::tuple{centre.x, d.x, bodies[j].lo.x - half.x, bodies[j].hi.x + half.x},
+                  std::tuple{centre.y, d.y, bodies[j].lo.y - half.y, bodies[j].hi.y + half.y}}) {
+                if (dir == 0.0) {
+                    if (from < lo || from > hi) leave = -1.0;
+                    continue;
+                }
+                const double t0 = (lo - from) / dir, t1 = (hi - from) / dir;
+                enter = std::max(enter, std::min(t0, t1));
+                leave = std::min(leave, std::max(t0, t1));
+            }
+            if (enter <= leave && enter < firstAt) {
+                firstAt = enter;
+                first = j;
+            }
+        }
+        return first;
+    };
+    // The first body of a group resting as placed that moving[i] meets
+    // turning about `pivot` the way `torque` turns it, within its reach, and
+    // the force the torque presses it with: at its nearest point to the
+    // pivot (at least half its size away), across the line to it. A body
+    // turning about its own centre (a wheel, a rotor) presses nothing.
+    const auto turnedInto = [&](const std::vector<Placed>& bodies, std::uint32_t i, Vec2 pivot, double torque,
+                                Entity partner) -> std::optional<std::pair<std::uint32_t, Vec2>> {
+        const Placed& arm = bodies[i];
+        const Vec2 along = 0.5 * (arm.lo + arm.hi) - pivot;
+        if (!(length(along) >= 0.25 * arm.size) || torque == 0.0) return std::nullopt;
+        double reach = 0.0;
+        for (const Vec2 corner : {arm.lo, arm.hi, Vec2{arm.lo.x, arm.hi.y}, Vec2{arm.hi.x, arm.lo.y}})
+            reach = std::max(reach, length(corner - pivot));
+        const double sense = torque > 0.0 ? 1.0 : -1.0;
+        std::optional<std::pair<std::uint32_t, Vec2>> first;
+        double firstTurn = kInf;
+        for (std::uint32_t j = 0; j < bodies.size(); ++j) {
+            if (j == i || bodies[j].body == partner || !groupUnder[findRoot(group, j)]) continue;
+            const Vec2 nearest{std::clamp(pivot.x, bodies[j].lo.x, bodies[j].hi.x),
+                               std::clamp(pivot.y, bodies[j].lo.y, bodies[j].hi.y)};
+            const double lever = length(nearest - pivot);
+            if (lever > reach) continue;
+            const Vec2 to = 0.5 * (bodies[j].lo + bodies[j].hi) - pivot;
+            double turn = sense * std::atan2(cross(along, to), dot(along, to));
+            if (turn <= 0.0) turn += 2.0 * kPi;
+            if (!(turn < firstTurn) || !(length(to) > 0.0)) continue;
+            firstTurn = turn;
+            const Vec2 across = (sense / length(to)) * Vec2{-to.y, to.x};
+            first = {j, (std::abs(torque) / std::max(lever, 0.5 * bodies[j].size)) * across};
+        }
+        return first;
+    };
+    const auto press = [&](std::uint32_t root, Vec2 force) {
+        groupForce[root] += force;
+        pressed[root] |= 2;
+    };
     for (const Pull& pull : pulls) {
         const auto it = movingOf.find(pull.body.index);
         if (it == movingOf.end()) continue;
         const std::uint32_t root = findRoot(group, it->second);
-        if (!groupUnder[root]) continue;
+        if (pull.pivot) {
+            if (const std::optional<std::pair<std::uint32_t, Vec2>> hit =
+                    turnedInto(moving, it->second, *pull.pivot, pull.torque, pull.partner))
+                press(findRoot(group, hit->first), hit->second);
+            continue;
+        }
+        if (!groupUnder[root]) {
+            // A motor keeps its largest force until it stalls, wherever it
+            // meets a resting group; a spring's force as placed is not what
+            // it presses with once its body has moved.
+            if (pull.motor)
+                if (const std::optional<std::uint32_t> hit = drivenInto(moving, it->second, pull.force))
+                    press(findRoot(group, *hit), pull.force);
+            continue;
+        }
         // A motor gives its largest force only held still: when it drives
         // its body into the rest of the group. Driving it away, it runs free.
         if (pull.motor && !(groupMass[root] > 0.0 &&
