@@ -600,12 +600,15 @@ void addTenBoxes(Scene& s) {
     }
 }
 
-/// How far the top box (the last body) sank, and how far it moved sideways.
-Figures topBoxSinkage(const Bodies& b, const Run& r) {
-    const Vec2 top = r.final.back().p, start = b.start.back();
-    return Figures{std::max(0.0, start.y - top.y), fmt("sank %.3g mm, sideways %.3g mm", 1e3 * (start.y - top.y),
-                                                       1e3 * std::abs(top.x - start.x))};
+/// How far a body placed at `start` and ending at `at` sank, and how far
+/// it moved sideways.
+Figures sinkage(Vec2 start, Vec2 at) {
+    return Figures{std::max(0.0, start.y - at.y),
+                   fmt("sank %.3g mm, sideways %.3g mm", 1e3 * (start.y - at.y), 1e3 * std::abs(at.x - start.x))};
 }
+
+/// How far the top box (the last body) sank, and how far it moved sideways.
+Figures topBoxSinkage(const Bodies& b, const Run& r) { return sinkage(b.start.back(), r.final.back().p); }
 
 /// Ten 1 m boxes stacked edge to edge on the ground, under gravity g.
 Case stackOf10(double g) {
@@ -640,30 +643,60 @@ Case stackOnAPlanet(double pull, bool dynamic = false) {
     if (dynamic)
         c.measure = [](const Bodies& b, const Run& r) {
             // The planet is the first body.
-            const Vec2 top = r.final.back().p - r.final.front().p, start = b.start.back() - b.start.front();
-            return Figures{std::max(0.0, start.y - top.y), fmt("sank %.3g mm, sideways %.3g mm", 1e3 * (start.y - top.y),
-                                                               1e3 * std::abs(top.x - start.x))};
+            return sinkage(b.start.back() - b.start.front(), r.final.back().p - r.final.front().p);
         };
+    c.box2d = false;
+    return c;
+}
+
+/// Ten 1 m boxes in a column on a 2 cm static box under gravity `g`, for a
+/// case to add what presses them. Box2D 2.4.1 is not run: the harness gives
+/// it neither springs nor motors.
+Case stackOnThinFloor(std::string name, double g) {
+    Case c = stackOf10(10.0);
+    c.name = std::move(name);
+    Scene& s = c.scene = baseWorld(g);
+    addStatic(s, {0.0, -0.01}, 20.0, 0.02, 0.6);
+    addTenBoxes(s);
     c.box2d = false;
     return c;
 }
 
 /// Ten 1 m boxes in a column on a 2 cm static box, no gravity, the top one
 /// pulled down by a spring anchored 100 m below with `force` N as placed.
-/// Box2D 2.4.1 is not run: the harness gives it no springs.
 Case stackPressedBySpring(double force) {
-    Case c = stackOf10(10.0);
-    c.name = "stack of 10 boxes pressed by a spring, " + fmt("%g", force) + " N";
-    Scene& s = c.scene = baseWorld(0.0);
-    addStatic(s, {0.0, -0.01}, 20.0, 0.02, 0.6);
-    addTenBoxes(s);
+    Case c = stackOnThinFloor("stack of 10 boxes pressed by a spring, " + fmt("%g", force) + " N", 0.0);
+    Scene& s = c.scene;
     Entity top;
     for (const Entity e : s.registry.entities())
         if (s.registry.has<Box>(e) && !s.registry.has<Static>(e)) top = e;
     const Entity spring = s.registry.create();
     const double anchorAt = -100.0, stretch = 9.5 - anchorAt;
     s.registry.emplace<Spring>(spring, Spring{top, Entity{}, Vec2{0.0, anchorAt}, force / stretch, 0.0, 0.0});
-    c.box2d = false;
+    return c;
+}
+
+/// Ten 1 m boxes in a column on a 2 cm static box under gravity 10, a 10 m
+/// bar lying on them hinged to the world at its left end and turned down
+/// onto the top box by a motor of `torque` N*m (about torque / 4.5 m on
+/// the stack).
+Case stackPressedByHingedBar(double torque) {
+    Case c = stackOnThinFloor("stack of 10 boxes pressed by a hinged bar, " + fmt("%g", torque) + " N m", 10.0);
+    Scene& s = c.scene;
+    const Entity bar = add(s, {0.0, 10.1});
+    s.registry.emplace<Box>(bar, Box{10.0, 0.2});
+    s.registry.emplace<Friction>(bar, Friction{0.6});
+    addHinge(s, bar, Entity{}, {-5.0, 0.0}, {-5.0, 10.1});
+    for (const Entity e : s.registry.entities())
+        if (Joint* j = s.registry.tryGet<Joint>(e)) {
+            j->motorSpeed = 1.0;
+            j->maxMotorTorque = torque;
+        }
+    // The top box is the last but one body, before the bar.
+    c.measure = [](const Bodies& b, const Run& r) {
+        const std::size_t top = r.final.size() - 2;
+        return sinkage(b.start[top], r.final[top].p);
+    };
     return c;
 }
 
@@ -980,6 +1013,7 @@ int main(int argc, char** argv) {
     cases.push_back(stackOnAPlanet(1000.0));
     cases.push_back(stackOnAPlanet(1000.0, true));
     cases.push_back(stackPressedBySpring(1000.0));
+    cases.push_back(stackPressedByHingedBar(1e4));
     for (int n : {64, 1000, 10000})
         if (!(quick && n > 1000)) cases.push_back(crowd(n));
     cases.push_back(pile300());
