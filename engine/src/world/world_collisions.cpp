@@ -753,37 +753,33 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
                 pulls.push_back({spring->b, -1.0 * onA, false});
         }
     }
-    // A slider motor drives b along the axis (in a's frame) against a at
-    // its speed; held still, it pushes with its largest force, +axis on b
-    // and -axis on a for a positive speed (joints/joint_solver.cpp).
+    // A motor drives b against a at its speed; held still, it gives its
+    // largest force or torque (joints/joint_solver.cpp): a slider's pushes
+    // b along +axis (in a's frame) and a along -axis, a hinge's turns b by
+    // +torque and a by -torque, for a positive speed.
     for (const Entity e : reg.entities()) {
         const Joint* joint = reg.alive(e) ? reg.tryGet<Joint>(e) : nullptr;
-        if (!joint || joint->type != "slider" || !joint->maxMotorForce || !(*joint->maxMotorForce > 0.0) ||
-            joint->motorSpeed.value_or(0.0) == 0.0 || !reg.alive(joint->a))
-            continue;
+        if (!joint || joint->motorSpeed.value_or(0.0) == 0.0 || !reg.alive(joint->a)) continue;
+        const bool slider = joint->type == "slider", hinge = joint->type == "hinge";
+        const std::optional<double>& most = slider ? joint->maxMotorForce : joint->maxMotorTorque;
+        if (!(slider || hinge) || !most || !(*most > 0.0) || (hinge && !reg.has<Position>(joint->a))) continue;
         const double angle = reg.has<Angle>(joint->a) ? reg.tryGet<Angle>(joint->a)->value : 0.0;
-        const Vec2 axis = collision::rotate(collision::Rot::fromAngle(angle), joint->axis.value_or(Vec2{1.0, 0.0}));
-        const double len = length(axis);
-        if (!(len > 0.0)) continue;
-        const Vec2 onB = (std::copysign(*joint->maxMotorForce, *joint->motorSpeed) / len) * axis;
-        if (hasShape(joint->a) && dynamic(joint->a)) pulls.push_back({joint->a, -1.0 * onB, true});
-        if (reg.alive(joint->b) && hasShape(joint->b) && dynamic(joint->b)) pulls.push_back({joint->b, onB, true});
-    }
-    // A hinge motor turns b against a at its speed; held still, it gives
-    // its largest torque, +torque on b and -torque on a for a positive
-    // speed (joints/joint_solver.cpp).
-    for (const Entity e : reg.entities()) {
-        const Joint* joint = reg.alive(e) ? reg.tryGet<Joint>(e) : nullptr;
-        if (!joint || joint->type != "hinge" || !joint->maxMotorTorque || !(*joint->maxMotorTorque > 0.0) ||
-            joint->motorSpeed.value_or(0.0) == 0.0 || !reg.alive(joint->a) || !reg.has<Position>(joint->a))
-            continue;
-        const double angle = reg.has<Angle>(joint->a) ? reg.tryGet<Angle>(joint->a)->value : 0.0;
-        const Vec2 pivot =
-            reg.tryGet<Position>(joint->a)->value + collision::rotate(collision::Rot::fromAngle(angle), joint->localA);
-        const double onB = std::copysign(*joint->maxMotorTorque, *joint->motorSpeed);
-        if (hasShape(joint->a) && dynamic(joint->a)) pulls.push_back({joint->a, Vec2{}, true, pivot, -onB, joint->b});
-        if (reg.alive(joint->b) && hasShape(joint->b) && dynamic(joint->b))
-            pulls.push_back({joint->b, Vec2{}, true, pivot, onB, joint->a});
+        const collision::Rot turn = collision::Rot::fromAngle(angle);
+        const double signedMost = std::copysign(*most, *joint->motorSpeed);
+        const bool onA = hasShape(joint->a) && dynamic(joint->a);
+        const bool onB = reg.alive(joint->b) && hasShape(joint->b) && dynamic(joint->b);
+        if (slider) {
+            const Vec2 axis = collision::rotate(turn, joint->axis.value_or(Vec2{1.0, 0.0}));
+            const double len = length(axis);
+            if (!(len > 0.0)) continue;
+            const Vec2 force = (signedMost / len) * axis;
+            if (onA) pulls.push_back({joint->a, -1.0 * force, true});
+            if (onB) pulls.push_back({joint->b, force, true});
+        } else {
+            const Vec2 pivot = reg.tryGet<Position>(joint->a)->value + collision::rotate(turn, joint->localA);
+            if (onA) pulls.push_back({joint->a, Vec2{}, true, pivot, -signedMost, joint->b});
+            if (onB) pulls.push_back({joint->b, Vec2{}, true, pivot, signedMost, joint->a});
+        }
     }
     if (!switches.attractors && pulls.empty()) return {gravity};
     struct Source {
@@ -1041,22 +1037,21 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     // The first body of a group resting as placed that moving[i]'s box
     // meets, swept along `force` (unbounded: a slider's limits are not
     // read).
-    const auto drivenInto = [&](const std::vector<Placed>& bodies, std::uint32_t i,
-                                Vec2 force) -> std::optional<std::uint32_t> {
+    const auto drivenInto = [&](std::uint32_t i, Vec2 force) -> std::optional<std::uint32_t> {
         const double len = length(force);
         if (!(len > 0.0)) return std::nullopt;
         const Vec2 d = force / len;
-        const Vec2 centre = 0.5 * (bodies[i].lo + bodies[i].hi), half = 0.5 * (bodies[i].hi - bodies[i].lo);
+        const Vec2 centre = 0.5 * (moving[i].lo + moving[i].hi), half = 0.5 * (moving[i].hi - moving[i].lo);
         std::optional<std::uint32_t> first;
         double firstAt = kInf;
-        for (std::uint32_t j = 0; j < bodies.size(); ++j) {
+        for (std::uint32_t j = 0; j < moving.size(); ++j) {
             if (j == i || !groupUnder[findRoot(group, j)]) continue;
             // The ray from the centre against the other box grown by this
             // box's half extents.
             double enter = 0.0, leave = kInf;
             for (const auto& [from, dir, lo, hi] :
-                 {std::tuple{centre.x, d.x, bodies[j].lo.x - half.x, bodies[j].hi.x + half.x},
-                  std::tuple{centre.y, d.y, bodies[j].lo.y - half.y, bodies[j].hi.y + half.y}}) {
+                 {std::tuple{centre.x, d.x, moving[j].lo.x - half.x, moving[j].hi.x + half.x},
+                  std::tuple{centre.y, d.y, moving[j].lo.y - half.y, moving[j].hi.y + half.y}}) {
                 if (dir == 0.0) {
                     if (from < lo || from > hi) leave = -1.0;
                     continue;
@@ -1077,9 +1072,9 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
     // the force the torque presses it with: at its nearest point to the
     // pivot (at least half its size away), across the line to it. A body
     // turning about its own centre (a wheel, a rotor) presses nothing.
-    const auto turnedInto = [&](const std::vector<Placed>& bodies, std::uint32_t i, Vec2 pivot, double torque,
+    const auto turnedInto = [&](std::uint32_t i, Vec2 pivot, double torque,
                                 Entity partner) -> std::optional<std::pair<std::uint32_t, Vec2>> {
-        const Placed& arm = bodies[i];
+        const Placed& arm = moving[i];
         const Vec2 along = 0.5 * (arm.lo + arm.hi) - pivot;
         if (!(length(along) >= 0.25 * arm.size) || torque == 0.0) return std::nullopt;
         double reach = 0.0;
@@ -1088,25 +1083,25 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         const double sense = torque > 0.0 ? 1.0 : -1.0;
         std::optional<std::pair<std::uint32_t, Vec2>> first;
         double firstTurn = kInf;
-        for (std::uint32_t j = 0; j < bodies.size(); ++j) {
-            if (j == i || bodies[j].body == partner || !groupUnder[findRoot(group, j)]) continue;
-            const Vec2 nearest{std::clamp(pivot.x, bodies[j].lo.x, bodies[j].hi.x),
-                               std::clamp(pivot.y, bodies[j].lo.y, bodies[j].hi.y)};
+        for (std::uint32_t j = 0; j < moving.size(); ++j) {
+            if (j == i || moving[j].body == partner || !groupUnder[findRoot(group, j)]) continue;
+            const Vec2 nearest{std::clamp(pivot.x, moving[j].lo.x, moving[j].hi.x),
+                               std::clamp(pivot.y, moving[j].lo.y, moving[j].hi.y)};
             const double lever = length(nearest - pivot);
             if (lever > reach) continue;
-            const Vec2 to = 0.5 * (bodies[j].lo + bodies[j].hi) - pivot;
+            const Vec2 to = 0.5 * (moving[j].lo + moving[j].hi) - pivot;
             double turn = sense * std::atan2(cross(along, to), dot(along, to));
             if (turn <= 0.0) turn += 2.0 * kPi;
             if (!(turn < firstTurn) || !(length(to) > 0.0)) continue;
             firstTurn = turn;
             const Vec2 across = (sense / length(to)) * Vec2{-to.y, to.x};
-            first = {j, (std::abs(torque) / std::max(lever, 0.5 * bodies[j].size)) * across};
+            first = {j, (std::abs(torque) / std::max(lever, 0.5 * moving[j].size)) * across};
         }
         return first;
     };
-    const auto press = [&](std::uint32_t root, Vec2 force) {
+    const auto press = [&](std::uint32_t root, Vec2 force, bool motor) {
         groupForce[root] += force;
-        pressed[root] |= 2;
+        pressed[root] |= motor ? 2 : 1;
     };
     for (const Pull& pull : pulls) {
         const auto it = movingOf.find(pull.body.index);
@@ -1114,8 +1109,8 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
         const std::uint32_t root = findRoot(group, it->second);
         if (pull.pivot) {
             if (const std::optional<std::pair<std::uint32_t, Vec2>> hit =
-                    turnedInto(moving, it->second, *pull.pivot, pull.torque, pull.partner))
-                press(findRoot(group, hit->first), hit->second);
+                    turnedInto(it->second, *pull.pivot, pull.torque, pull.partner))
+                press(findRoot(group, hit->first), hit->second, true);
             continue;
         }
         if (!groupUnder[root]) {
@@ -1123,8 +1118,8 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
             // meets a resting group; a spring's force as placed is not what
             // it presses with once its body has moved.
             if (pull.motor)
-                if (const std::optional<std::uint32_t> hit = drivenInto(moving, it->second, pull.force))
-                    press(findRoot(group, *hit), pull.force);
+                if (const std::optional<std::uint32_t> hit = drivenInto(it->second, pull.force))
+                    press(findRoot(group, *hit), pull.force, true);
             continue;
         }
         // A motor gives its largest force only held still: when it drives
@@ -1133,8 +1128,7 @@ SteadyLoad steadyLoad(const Scene& scene, const SystemSwitches& switches, const 
                             dot(pull.force, groupMoment[root] / groupMass[root] -
                                                 reg.tryGet<Position>(pull.body)->value) > 0.0))
             continue;
-        groupForce[root] += pull.force;
-        pressed[root] |= pull.motor ? 2 : 1;
+        press(root, pull.force, pull.motor);
     }
     std::vector<Placed> resting;         // touching: rests with another
     std::vector<Rest> rests;             // where each of `resting` rests, and on what
