@@ -107,6 +107,21 @@ std::string tenBoxesOnAThinFloor(double gravity) {
     return out.str();
 }
 
+/// Ten boxes on a thin floor under gravity 10 and a 10 m bar, 0.2 m thick,
+/// `gap` m above them, hinged to the world at (pivotX, its height) with a
+/// motor of `torque` N*m at speed `side` rad/s.
+std::string hingedBarLevel(double torque, double gap, double side, double pivotX) {
+    std::ostringstream out;
+    out << tenBoxesOnAThinFloor(10.0);
+    const double y = 10.1 + gap;
+    out << R"(, {"name": "bar", "position": {"x": 0, "y": )" << num(y)
+        << R"(}, "mass": 1, "box": {"width": 10, "height": 0.2}, "friction": 0.6},)"
+        << R"( {"name": "arm", "joint": {"type": "hinge", "a": "bar", "anchor": {"x": )" << num(pivotX)
+        << R"(, "y": )" << num(y) << R"(}, "motor_speed": )" << num(side)
+        << R"(, "max_motor_torque": )" << num(torque) << "}}]}";
+    return out.str();
+}
+
 /// Ten 1 m boxes on a floor, under `gravity` and, when `field` > 0, the pull
 /// of a static attractor 100 m away, `side` m to the side of straight
 /// below, whose pull at the floor is `field` m/s^2 (a planet under the
@@ -200,6 +215,9 @@ TEST(HardSettings, GeneratedLevelsWithoutSettingsResumeBitForBit) {
     // The load of a static attractor is read where the bodies stand, which
     // a run changes: the recorded choice keeps it.
     expectResumeExact(parse(planetStackLevel({}, 1000.0, 3.0)), 25, 50, "stack on a planet");
+    // So is a hinge motor's, read from where its bar stands against the
+    // stack.
+    expectResumeExact(parse(hingedBarLevel(1e4, 0.5, 1.0, -5.0)), 25, 50, "stack under a hinged bar");
     // Stiffened contacts (contactHertz above the default) are recorded too.
     for (const double g : {100.0, 1000.0}) {
         const Scene stack = parse(stackLevel(10, g));
@@ -633,21 +651,10 @@ TEST(HardSettings, ASliderMotorPressingAStackIsALoad) {
 // a box ending 35 m below the floor. A bar turning about its own centre
 // (a rotor, Box2D's spinner) presses nothing: no load.
 TEST(HardSettings, AHingeMotorPressingAStackIsALoad) {
-    const auto level = [](double torque, double gap, double side, double pivotX) {
-        std::ostringstream out;
-        out << tenBoxesOnAThinFloor(10.0);
-        const double y = 10.1 + gap;
-        out << R"(, {"name": "bar", "position": {"x": 0, "y": )" << num(y)
-            << R"(}, "mass": 1, "box": {"width": 10, "height": 0.2}, "friction": 0.6},)"
-            << R"( {"name": "arm", "joint": {"type": "hinge", "a": "bar", "anchor": {"x": )" << num(pivotX)
-            << R"(, "y": )" << num(y) << R"(}, "motor_speed": )" << num(side)
-            << R"(, "max_motor_torque": )" << num(torque) << "}}]}";
-        return out.str();
-    };
     for (const double torque : {1e3, 1e4, 1e5}) {
         for (const double gap : {0.0, 0.5}) {
             for (const double side : {1.0, -1.0}) {
-                const Scene scene = parse(level(torque, gap, side, -5.0 * side));
+                const Scene scene = parse(hingedBarLevel(torque, gap, side, -5.0 * side));
                 const ContactSettingsChoice choice = chooseContactSettings(scene);
                 const std::string label = num(torque) + " N*m, gap " + num(gap) + ", pivot " +
                                           (side > 0.0 ? "left" : "right") + " (" + choice.reason() + ")";
@@ -665,7 +672,7 @@ TEST(HardSettings, AHingeMotorPressingAStackIsALoad) {
         }
     }
     // The same bar hinged at its centre, on the stack and within reach of it.
-    const ContactSettingsChoice rotor = chooseContactSettings(parse(level(1e5, 0.0, 1.0, 0.0)));
+    const ContactSettingsChoice rotor = chooseContactSettings(parse(hingedBarLevel(1e5, 0.0, 1.0, 0.0)));
     EXPECT_FALSE(rotor.motorLoad) << rotor.reason();
     EXPECT_EQ(rotor.gravity, 10.0) << rotor.reason();
 }
